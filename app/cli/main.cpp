@@ -1,0 +1,28 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The `underfoot` command line: subcommands register themselves (CommandRegistry.h).
+#include "app/cli/CommandRegistry.h"
+
+#include <fmt/core.h>
+
+#include <cstdio>
+#include <exception>
+
+int main(int argc, char** argv) {
+    CLI::App app{"Underfoot: physically based footsteps and perception experiments"};
+    app.set_version_flag("--version", std::string("underfoot ") + UNDERFOOT_VERSION);
+    app.require_subcommand(1);
+    int exitCode = 0;
+    for (auto& entry : underfoot::cli::commandRegistry()) entry.install(app, exitCode);
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        return app.exit(e);
+    } catch (const underfoot::cli::UserError& e) {
+        fmt::print(stderr, "underfoot: {}\n", e.what());
+        return 2;
+    } catch (const std::exception& e) {
+        fmt::print(stderr, "underfoot: error: {}\n", e.what());
+        return 1;
+    }
+    return exitCode;
+}

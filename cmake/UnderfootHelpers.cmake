@@ -1,0 +1,36 @@
+# Helpers shared by every target of the project.
+
+# Warnings and (optionally) sanitizers for one of our own targets.
+function(underfoot_target_defaults target)
+  target_compile_options(${target} PRIVATE -Wall -Wextra -Wshadow -Wconversion -Wno-sign-conversion)
+  if(UNDERFOOT_SANITIZE)
+    target_compile_options(${target} PRIVATE -fsanitize=address,undefined -fno-omit-frame-pointer
+                                             -fno-sanitize-recover=undefined)
+    target_link_options(${target} PRIVATE -fsanitize=address,undefined)
+  endif()
+endfunction()
+
+# A library made of every .cpp below one folder (each part of the project is one library).
+function(underfoot_add_library target folder)
+  file(GLOB_RECURSE sources CONFIGURE_DEPENDS ${folder}/*.cpp)
+  file(GLOB_RECURSE headers CONFIGURE_DEPENDS ${folder}/*.h)
+  add_library(${target} STATIC ${sources} ${headers})
+  target_include_directories(${target} PUBLIC ${PROJECT_SOURCE_DIR})
+  underfoot_target_defaults(${target})
+endfunction()
+
+# One GoogleTest executable per test folder, every test labelled with its part so that
+# `ctest -L part` runs that part alone.
+function(underfoot_add_gtest target label)
+  cmake_parse_arguments(ARG "" "TIMEOUT" "SOURCES;LIBS" ${ARGN})
+  if(NOT ARG_TIMEOUT)
+    set(ARG_TIMEOUT 600)
+  endif()
+  add_executable(${target} ${ARG_SOURCES})
+  target_link_libraries(${target} PRIVATE ${ARG_LIBS} GTest::gtest GTest::gtest_main GTest::gmock)
+  target_compile_definitions(${target} PRIVATE UNDERFOOT_TEST_DATA_DIR="${PROJECT_SOURCE_DIR}/tests/data"
+                                               UNDERFOOT_BINARY_DIR="${PROJECT_BINARY_DIR}")
+  underfoot_target_defaults(${target})
+  gtest_discover_tests(${target} PROPERTIES LABELS ${label} TIMEOUT ${ARG_TIMEOUT}
+                       DISCOVERY_TIMEOUT 60)
+endfunction()

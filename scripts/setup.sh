@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# Underfoot setup: installs every Debian 12 package the project uses, then configures and builds.
+#   bash scripts/setup.sh            # packages + release build in build/
+#   UNDERFOOT_SKIP_APT=1 bash scripts/setup.sh   # build only (packages already there)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+PACKAGES=(
+  build-essential cmake ninja-build pkg-config git clang-format
+  # engine / io
+  libsndfile1-dev libsamplerate0-dev libfftw3-dev libzita-convolver-dev
+  librtaudio-dev libserialport-dev liblo-dev jackd2 socat
+  # files, CLI, formatting
+  libtomlplusplus-dev libcli11-dev libfmt-dev
+  # statistics and real-time containers
+  libboost-dev
+  # storage
+  libsqlite3-dev libsqlitecpp-dev sqlite3
+  # GUI
+  qt6-base-dev qt6-charts-dev libqt6opengl6-dev libqt6sql6-sqlite libgl-dev xvfb xauth
+  # tests and benchmarks
+  googletest libgtest-dev libgmock-dev libbenchmark-dev valgrind
+)
+
+if [ "${UNDERFOOT_SKIP_APT:-0}" != "1" ]; then
+  SUDO=""
+  if [ "$(id -u)" != "0" ]; then SUDO="sudo"; fi
+  export DEBIAN_FRONTEND=noninteractive
+  missing=()
+  for p in "${PACKAGES[@]}"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+  done
+  if [ ${#missing[@]} -gt 0 ]; then
+    echo "setup: installing ${#missing[@]} Debian packages: ${missing[*]}"
+    $SUDO apt-get update -qq
+    $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+  else
+    echo "setup: all ${#PACKAGES[@]} Debian packages already installed"
+  fi
+fi
+
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo
+cmake --build build --parallel "$(nproc)"
+echo "setup: built into build/ (programs: build/app/cli/underfoot, build/app/gui/underfoot-gui)"

@@ -1,0 +1,28 @@
+#!/usr/bin/env bash
+# Underfoot tests: the release build's suites, then the same suites built with
+# AddressSanitizer + UndefinedBehaviorSanitizer.
+#   bash scripts/test.sh                  # everything but long soaks
+#   bash scripts/test.sh -L engine        # extra ctest arguments (here: one part) apply to both runs
+#   UNDERFOOT_SKIP_SANITIZE=1 bash scripts/test.sh   # the release run only
+# Long soaks carry the ctest label `soak` and run with: ctest --test-dir build -L soak
+set -euo pipefail
+cd "$(dirname "$0")/.."
+jobs="$(nproc)"
+
+if [ ! -f build/CMakeCache.txt ]; then
+  cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo
+fi
+cmake --build build --parallel "$jobs"
+echo "== tests (release build)"
+ctest --test-dir build --output-on-failure -j "$jobs" -LE soak "$@"
+
+if [ "${UNDERFOOT_SKIP_SANITIZE:-0}" != "1" ]; then
+  if [ ! -f build-asan/CMakeCache.txt ]; then
+    cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g" \
+      -DUNDERFOOT_SANITIZE=ON -DUNDERFOOT_BUILD_BENCHMARKS=OFF -DUNDERFOOT_BUILD_GUI=OFF
+  fi
+  cmake --build build-asan --parallel "$jobs"
+  echo "== tests (address + undefined sanitizers)"
+  ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+    ctest --test-dir build-asan --output-on-failure -j "$jobs" -LE "soak|nosan" "$@"
+fi
