@@ -65,7 +65,9 @@ double BiquadCoefficients::magnitudeAt(double fs, double f) const {
 void Butterworth::appendSections(FilterType type, int order, double fs, double fc) {
     const bool low = type == FilterType::Lowpass;
     for (int k = 0; k < order / 2; ++k) {
-        const double q = 1.0 / (2.0 * std::cos(kPi * (2.0 * k + 1.0) / (2.0 * order)));
+        // Pole k of the analogue prototype lies at angle pi (N - 2k - 1) / (2N) from the negative
+        // real axis; its section's Q is 1 / (2 cos(angle)).
+        const double q = 1.0 / (2.0 * std::cos(kPi * (order - 2.0 * k - 1.0) / (2.0 * order)));
         sections_.emplace_back(low ? BiquadCoefficients::lowpass(fs, fc, q)
                                    : BiquadCoefficients::highpass(fs, fc, q));
     }
