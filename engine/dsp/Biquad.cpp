@@ -9,7 +9,9 @@ namespace {
 BiquadCoefficients normalise(double b0, double b1, double b2, double a0, double a1, double a2) {
     return {b0 / a0, b1 / a0, b2 / a0, a1 / a0, a2 / a0};
 }
-double omega(double fs, double f) { return kTwoPi * f / fs; }
+double omega(double fs, double f) {
+    return kTwoPi * f / fs;
+}
 } // namespace
 
 BiquadCoefficients BiquadCoefficients::lowpass(double fs, double fc, double q) {

@@ -18,8 +18,10 @@ struct BiquadCoefficients {
 
     static BiquadCoefficients lowpass(double sampleRateHz, double cutoffHz, double q);
     static BiquadCoefficients highpass(double sampleRateHz, double cutoffHz, double q);
-    static BiquadCoefficients bandpass(double sampleRateHz, double centreHz, double q); ///< 0 dB peak
-    static BiquadCoefficients peaking(double sampleRateHz, double centreHz, double q, double gainDb);
+    static BiquadCoefficients bandpass(double sampleRateHz, double centreHz,
+                                       double q); ///< 0 dB peak
+    static BiquadCoefficients peaking(double sampleRateHz, double centreHz, double q,
+                                      double gainDb);
     static BiquadCoefficients lowShelf(double sampleRateHz, double cornerHz, double gainDb);
     static BiquadCoefficients highShelf(double sampleRateHz, double cornerHz, double gainDb);
     /// First-order sections (b2 = a2 = 0), bilinear with pre-warping.
@@ -31,7 +33,7 @@ struct BiquadCoefficients {
 };
 
 class Biquad {
-public:
+  public:
     Biquad() = default;
     explicit Biquad(const BiquadCoefficients& c) : c_(c) {}
     void setCoefficients(const BiquadCoefficients& c) noexcept { c_ = c; }
@@ -50,7 +52,7 @@ public:
         z2_ = snapToZero(z2_);
     }
 
-private:
+  private:
     BiquadCoefficients c_;
     double z1_ = 0, z2_ = 0;
 };
@@ -59,7 +61,7 @@ enum class FilterType { Lowpass, Highpass, Bandpass };
 
 /// Butterworth low/high-pass of any order 1..16, or band-pass as a high-pass + low-pass pair.
 class Butterworth {
-public:
+  public:
     Butterworth() = default;
     /// Designs the filter (allocates: call from prepare()). For Bandpass, `cutoffHz` is the low
     /// edge and `upperHz` the high edge; `order` applies to each edge.
@@ -76,7 +78,7 @@ public:
     double magnitudeAt(double sampleRateHz, double frequencyHz) const;
     int sectionCount() const noexcept { return static_cast<int>(sections_.size()); }
 
-private:
+  private:
     void appendSections(FilterType type, int order, double sampleRateHz, double cutoffHz);
     std::vector<Biquad> sections_;
 };

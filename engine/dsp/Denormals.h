@@ -10,7 +10,7 @@
 namespace underfoot::engine {
 
 class ScopedFlushDenormals {
-public:
+  public:
     ScopedFlushDenormals() noexcept {
 #ifdef UNDERFOOT_HAS_MXCSR
         saved_ = _mm_getcsr();
@@ -32,7 +32,7 @@ public:
         return r == 0.0f;
     }
 
-private:
+  private:
     unsigned saved_ = 0;
 };
 

@@ -25,7 +25,7 @@ inline double onePoleCoefficientTau(double tauSeconds, double sampleRateHz) noex
 }
 
 class OnePole {
-public:
+  public:
     void setCoefficient(double g) noexcept { g_ = g; }
     void setTimeConstant(double tauSeconds, double sampleRateHz) noexcept {
         g_ = onePoleCoefficientTau(tauSeconds, sampleRateHz);
@@ -37,12 +37,12 @@ public:
     }
     double value() const noexcept { return y_; }
 
-private:
+  private:
     double g_ = 0.0, y_ = 0.0;
 };
 
 class EnvelopeFollower {
-public:
+  public:
     /// Sets the coefficients directly (Cook's b_up, b_down in [0, 1)).
     void setCoefficients(double attackG, double releaseG) noexcept {
         attack_ = attackG;
@@ -63,7 +63,7 @@ public:
     double attackCoefficient() const noexcept { return attack_; }
     double releaseCoefficient() const noexcept { return release_; }
 
-private:
+  private:
     double attack_ = 0.0, release_ = 0.0, e_ = 0.0;
 };
 

@@ -14,11 +14,15 @@ struct ProcessSpec {
 };
 
 /// True when v is a finite number (not NaN, not +-Inf).
-inline bool isFinite(double v) noexcept { return std::isfinite(v); }
+inline bool isFinite(double v) noexcept {
+    return std::isfinite(v);
+}
 
 /// Returns 0 for values so small that they would become denormal in feedback state
 /// (the "zap gremlins" idea of SuperCollider; JUCE calls it snapToZero).
-inline double snapToZero(double v) noexcept { return (std::fabs(v) < 1e-30) ? 0.0 : v; }
+inline double snapToZero(double v) noexcept {
+    return (std::fabs(v) < 1e-30) ? 0.0 : v;
+}
 
 inline constexpr double kPi = 3.14159265358979323846;
 inline constexpr double kTwoPi = 2.0 * kPi;

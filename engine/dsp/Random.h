@@ -12,7 +12,7 @@
 namespace underfoot::engine {
 
 class Random {
-public:
+  public:
     explicit Random(std::uint64_t seed = 0x5eed) noexcept { setSeed(seed); }
 
     void setSeed(std::uint64_t seed) noexcept {
@@ -67,8 +67,10 @@ public:
         return static_cast<std::uint32_t>((static_cast<unsigned __int128>(next() >> 32) * n) >> 32);
     }
 
-private:
-    static std::uint64_t rotl(std::uint64_t x, int k) noexcept { return (x << k) | (x >> (64 - k)); }
+  private:
+    static std::uint64_t rotl(std::uint64_t x, int k) noexcept {
+        return (x << k) | (x >> (64 - k));
+    }
     static std::uint64_t splitMix64(std::uint64_t& x) noexcept {
         std::uint64_t z = (x += 0x9E3779B97F4A7C15ull);
         z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;

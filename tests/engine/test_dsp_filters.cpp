@@ -17,7 +17,8 @@ TEST(Butterworth, LowpassIsMinus3dBAtCutoffForEveryOrder) {
         f.design(FilterType::Lowpass, order, 48000.0, 1000.0);
         EXPECT_NEAR(20 * std::log10(f.magnitudeAt(48000.0, 1000.0)), -3.0103, 1e-3) << order;
         EXPECT_NEAR(f.magnitudeAt(48000.0, 1.0), 1.0, 1e-6) << order;
-        // Roll-off of 6 dB per octave per order, well above cutoff (bilinear adds more near Nyquist).
+        // Roll-off of 6 dB per octave per order, well above cutoff (bilinear adds more near
+        // Nyquist).
         const double atFourOctaves = 20 * std::log10(f.magnitudeAt(48000.0, 16000.0));
         EXPECT_LT(atFourOctaves, -24.0 * order + 3.0) << order;
     }

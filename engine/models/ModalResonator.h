@@ -1,0 +1,109 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+/// Modal resonator: a bank of damped oscillators seen through "pickup" points.
+///
+/// Physics (MODELS.md; Adrien 1991; Avanzini & Rocchesso, DAFx 2001): mode i has modal
+/// coordinate q_i obeying  m_i (q_i'' + 2 s_i q_i' + w0_i^2 q_i) = sum_p g[p][i] F_p,  where
+/// s_i = ln(1000) / T60_i and w0_i^2 = (2 pi f_i)^2 + s_i^2, so that the free response is
+/// exp(-s_i t) sin(2 pi f_i t): it rings at exactly f_i and decays by 60 dB in exactly T60_i.
+/// The displacement at pickup p is x_p = sum_i g[p][i] q_i.
+///
+/// Discretisation: the exact state transition of each oscillator (matrix exponential, i.e.
+/// impulse invariance of the free response) with the force taken as linear between samples
+/// (first-order hold). Then  s[n+1] = A s[n] + B0 u[n] + B1 u[n+1],  which is exact for
+/// piecewise-linear forces, unconditionally stable, and keeps an *instantaneous* term B1 that
+/// lets an interactor (impact, friction) solve its force implicitly at n+1 (the K-method of
+/// Borin, De Poli & Rocchesso 2000).
+///
+/// Modes at or above Nyquist cannot ring at their frequency without aliasing. Instead of
+/// dropping them (as the Sound Design Toolkit does above acos(-0.9995)), they are kept as their
+/// quasi-static compliance q = u / w0^2: for excitation far below their frequency this is their
+/// exact response, so the contact still "sees" their stiffness. They do not radiate. Their count
+/// is reported by quasiStaticModeCount(); oversampling brings them back as ringing modes.
+#include "engine/dsp/ProcessSpec.h"
+
+#include <cstddef>
+#include <span>
+#include <vector>
+
+namespace underfoot::engine {
+
+/// One mode of a resonator, in physical units.
+struct Mode {
+    double frequencyHz = 440.0; ///< damped frequency at which it rings
+    double t60Seconds = 0.5;    ///< time to decay by 60 dB
+    double massKg = 1.0;        ///< modal mass (larger = less displacement for a force)
+};
+
+/// Per-mode coefficients of the exact FOH discretisation (see file comment).
+struct ModeCoefficients {
+    double a00, a01, a10, a11; ///< homogeneous transition of [q, v]
+    double b0x, b0v;           ///< response to u[n]
+    double b1x, b1v;           ///< instantaneous response to u[n+1]
+    bool quasiStatic;          ///< mode at/above Nyquist, kept as a compliance
+};
+
+/// Computes the exact discretisation of one mode at a sample rate (per unit of u = F g / m).
+ModeCoefficients computeModeCoefficients(const Mode& mode, double sampleRateHz);
+
+template <typename Real>
+class ModalResonatorT {
+  public:
+    /// Sets modes and pickup gains `gains[p][i]` (allocates). Throws std::invalid_argument for
+    /// non-finite or non-positive frequencies, decays or masses.
+    void configure(std::vector<Mode> modes, std::vector<std::vector<double>> gains);
+    /// Computes coefficients for a sample rate (allocates).
+    void prepare(double sampleRateHz);
+    void reset() noexcept;
+
+    int modeCount() const noexcept { return static_cast<int>(modes_.size()); }
+    int pickupCount() const noexcept { return static_cast<int>(gains_.size()); }
+    int quasiStaticModeCount() const noexcept { return quasiStaticCount_; }
+    const std::vector<Mode>& modes() const noexcept { return modes_; }
+    double sampleRateHz() const noexcept { return sampleRateHz_; }
+
+    // ---- one sample, in two halves, for interactors that solve their force implicitly ----
+    /// Advances every mode by one sample assuming no *new* force at n+1 (the last committed
+    /// force still acts through B0). Afterwards predictedPosition/Velocity(p) are valid.
+    void predict() noexcept;
+    double predictedPosition(int p) const noexcept;
+    double predictedVelocity(int p) const noexcept;
+    /// Instantaneous displacement / velocity at pickup p per newton applied at pickup p at n+1.
+    double compliance(int p) const noexcept { return kx_[static_cast<std::size_t>(p)]; }
+    double mobility(int p) const noexcept { return kv_[static_cast<std::size_t>(p)]; }
+    /// Completes the sample with force `forceN` acting at pickup p (at n+1).
+    void commit(int p, double forceN) noexcept;
+
+    // ---- after commit ----
+    double position(int p) const noexcept;
+    double velocity(int p) const noexcept;
+    /// Mechanical energy stored in the modes (kinetic + potential), joules.
+    double energy() const noexcept;
+
+    /// Convenience: one full sample with an external force at pickup `p`; returns velocity at
+    /// pickup `listen`.
+    double processSample(int p, double forceN, int listen) noexcept {
+        predict();
+        commit(p, forceN);
+        return velocity(listen);
+    }
+
+    /// Zeroes denormal-sized state (call once per block).
+    void flushTinyState() noexcept;
+    /// Largest |velocity| over modes: used to decide when the resonator has decayed to silence.
+    double peakModalVelocity() const noexcept;
+
+  private:
+    std::vector<Mode> modes_;
+    std::vector<std::vector<double>> gains_; // [pickup][mode]
+    std::vector<ModeCoefficients> coefficients_;
+    std::vector<Real> gainOverMass_;        // [pickup * modes + mode] = g[p][i] / m_i
+    std::vector<Real> q_, v_, qh_, vh_, u_; // state, prediction, last generalized force
+    std::vector<double> kx_, kv_;           // per pickup
+    double sampleRateHz_ = 0.0;
+    int quasiStaticCount_ = 0;
+};
+
+using ModalResonator = ModalResonatorT<double>;
+
+} // namespace underfoot::engine
