@@ -11,7 +11,7 @@ PACKAGES=(
   libsndfile1-dev libsamplerate0-dev libfftw3-dev libzita-convolver-dev
   librtaudio-dev libserialport-dev liblo-dev jackd2 socat
   # files, CLI, formatting
-  libtomlplusplus-dev libcli11-dev libfmt-dev
+  libtomlplusplus-dev libcli11-dev libfmt-dev nlohmann-json3-dev
   # statistics and real-time containers
   libboost-dev
   # storage
