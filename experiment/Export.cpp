@@ -1,0 +1,198 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "experiment/Export.h"
+
+#include <fmt/format.h>
+
+namespace underfoot::experiment {
+
+std::string csvField(std::string_view value) {
+    if (value.find_first_of(",\"\r\n") == std::string_view::npos) return std::string(value);
+    std::string out = "\"";
+    for (const char c : value) {
+        if (c == '"') out += '"';
+        out += c;
+    }
+    return out + '"';
+}
+
+namespace {
+std::string ratingCell(const TrialRecord& t, const char* scale) {
+    const auto it = t.answer.ratings.find(scale);
+    return it == t.answer.ratings.end() ? std::string() : std::to_string(it->second);
+}
+
+void writeRow(std::ostream& out, const std::vector<std::string>& cells) {
+    for (std::size_t i = 0; i < cells.size(); ++i) {
+        if (i) out << ',';
+        out << csvField(cells[i]);
+    }
+    out << "\r\n";
+}
+} // namespace
+
+int writeTrialsCsv(const StudyStore& store, std::ostream& out, ExportScope scope) {
+    const StudyInfo info = store.info();
+    const Protocol& protocol = store.protocol();
+    const Questions& q = protocol.questions;
+    std::vector<std::string> header(kTrialColumns.begin(), kTrialColumns.end());
+    writeRow(out, header);
+    int rows = 0;
+    for (const auto& p : store.participants()) {
+        const std::string group = protocol.design == DesignKind::Between ? p.groupId : "";
+        for (const auto& t : store.trials(p.code)) {
+            if (scope == ExportScope::Answered && !t.answered) continue;
+            const AnswerOption* option =
+                t.answer.answer.empty() ? nullptr : q.surfaceOption(t.answer.answer);
+            std::string correct;
+            if (t.answered && q.asksSurface())
+                correct = answerIsCorrect(t.answer.answer, t.stimulus.surface) ? "1" : "0";
+            std::string soundscapeCorrect;
+            if (!t.answer.soundscapeAnswer.empty())
+                soundscapeCorrect =
+                    t.answer.soundscapeAnswer == t.stimulus.soundscape.value_or("") ? "1" : "0";
+            writeRow(out, {info.code,
+                           info.site,
+                           info.protocolId,
+                           info.protocolHash,
+                           p.code,
+                           group,
+                           t.sessionNumber ? std::to_string(*t.sessionNumber) : "",
+                           std::to_string(t.index),
+                           std::to_string(t.block),
+                           t.practice ? "1" : "0",
+                           t.stimulus.id,
+                           t.stimulus.surface,
+                           t.stimulus.soundscape.value_or(""),
+                           toString(t.stimulus.modalities),
+                           t.stimulus.reverb.value_or(""),
+                           std::to_string(t.repetition),
+                           t.renderSeed ? std::to_string(*t.renderSeed) : "",
+                           t.answer.answer,
+                           option ? option->label : "",
+                           correct,
+                           ratingCell(t, "realism"),
+                           ratingCell(t, "quality"),
+                           t.answer.soundscapeAnswer,
+                           soundscapeCorrect,
+                           t.responseTimeS ? fmt::format("{:.3f}", *t.responseTimeS) : "",
+                           t.excluded ? "1" : "0",
+                           t.exclusionReason,
+                           t.answer.comment,
+                           t.startedAt,
+                           t.answeredAt});
+            ++rows;
+        }
+    }
+    return rows;
+}
+
+int writeRatingsCsv(const StudyStore& store, std::ostream& out, ExportScope scope) {
+    const StudyInfo info = store.info();
+    const Protocol& protocol = store.protocol();
+    writeRow(out, {"study", "participant", "group", "trial_index", "stimulus_id", "practice",
+                   "excluded", "scale", "value"});
+    int rows = 0;
+    for (const auto& p : store.participants()) {
+        const std::string group = protocol.design == DesignKind::Between ? p.groupId : "";
+        for (const auto& t : store.trials(p.code)) {
+            if (scope == ExportScope::Answered && !t.answered) continue;
+            for (const auto& [scale, value] : t.answer.ratings) {
+                writeRow(out, {info.code, p.code, group, std::to_string(t.index), t.stimulus.id,
+                               t.practice ? "1" : "0", t.excluded ? "1" : "0", scale,
+                               std::to_string(value)});
+                ++rows;
+            }
+        }
+    }
+    return rows;
+}
+
+void writeCodebook(const StudyStore& store, std::ostream& out) {
+    const StudyInfo info = store.info();
+    const Protocol& p = store.protocol();
+    out << fmt::format("# Codebook: study {} ({})\n\n", info.code, info.site);
+    out << fmt::format("Protocol `{}` version {} — {}  \nSHA-256 of the protocol text: `{}`  \n"
+                       "Study seed: {}; created {}; schema version {}.\n\n",
+                       p.id, p.version, p.title, info.protocolHash, info.seed, info.createdAt,
+                       info.schemaVersion);
+    out << "## trials.csv — one row per trial\n\n"
+           "CSV (RFC 4180, CRLF line ends, UTF-8). An empty cell is a missing value; booleans "
+           "are 0/1; times are ISO 8601 UTC with milliseconds.\n\n"
+           "| column | type | meaning |\n|---|---|---|\n";
+    const char* const rows[][3] = {
+        {"study", "text", "study code"},
+        {"site", "text", "site (lab) code"},
+        {"protocol_id", "text", "protocol id"},
+        {"protocol_hash", "text", "SHA-256 of the exact protocol text the study ran"},
+        {"participant", "text", "pseudonymous participant code"},
+        {"group", "text", "between-subject group id (empty in within-subject designs)"},
+        {"session", "integer", "session number of the participant (1, 2, ... after resumes)"},
+        {"trial_index", "integer", "0-based position in the participant's plan (practice first)"},
+        {"block", "integer", "0 = practice; 1..repetitions for blocked orders; otherwise 1"},
+        {"practice", "0/1", "1 for practice trials (normally left out of analyses)"},
+        {"stimulus_id", "text", "stimulus id of the protocol"},
+        {"surface", "text", "surface walked on (a *_reverb id is the base surface with reverb)"},
+        {"soundscape", "text", "soundscape played with the footsteps (empty: none)"},
+        {"modalities", "audio/haptic/both", "senses the stimulus was rendered to"},
+        {"reverb", "text", "impulse-response name when convolution reverb was applied"},
+        {"repetition", "integer", "1-based repetition of this stimulus for this participant"},
+        {"render_seed", "unsigned 64-bit", "seed the renderer used (replay re-renders with it)"},
+        {"answer", "text", "answer option id (surface id or dont_know)"},
+        {"answer_label", "text", "the option's label as shown"},
+        {"correct", "0/1",
+         "1 when the answer names the surface walked on (its base surface "
+         "for a reverb variant), not the soundscape; dont_know is 0"},
+        {"realism", "integer", "rating on the scale `realism` (see scales below)"},
+        {"quality", "integer", "rating on the scale `quality`"},
+        {"soundscape_answer", "text", "answer to the environment question (soundscape id)"},
+        {"soundscape_correct", "0/1", "1 when soundscape_answer is the soundscape played"},
+        {"response_time_s", "seconds", "from stimulus start to the committed answer"},
+        {"excluded", "0/1", "1 when the experimenter excluded the trial"},
+        {"exclusion_reason", "text", "why it was excluded"},
+        {"comment", "text", "free comment"},
+        {"started_at", "ISO 8601 UTC", "when the stimulus started"},
+        {"answered_at", "ISO 8601 UTC", "when the answer was committed"}};
+    for (const auto& r : rows) out << fmt::format("| `{}` | {} | {} |\n", r[0], r[1], r[2]);
+    out << "\n## ratings.csv — one row per rating\n\n"
+           "Columns: study, participant, group, trial_index, stimulus_id, practice, excluded, "
+           "scale, value. Every scale of the protocol, including those without a column in "
+           "trials.csv.\n";
+    if (!p.questions.scales.empty()) {
+        out << "\n## Scales\n\n| id | range | anchors | prompt |\n|---|---|---|---|\n";
+        for (const auto& s : p.questions.scales)
+            out << fmt::format("| `{}` | {}–{} | {} … {} | {} |\n", s.id, s.min, s.max, s.minLabel,
+                               s.maxLabel, s.prompt);
+    }
+    if (p.questions.asksSurface()) {
+        out << fmt::format("\n## Answer options — {}\n\n| key | id | label |\n|---|---|---|\n",
+                           p.questions.surfacePrompt);
+        for (const auto& o : p.questions.surfaceOptions)
+            out << fmt::format("| {} | `{}` | {} |\n", o.letter, o.id, o.label);
+    }
+    if (!p.questions.soundscapeOptions.empty()) {
+        out << fmt::format("\n## Soundscape options — {}\n\n| key | id | label |\n|---|---|---|\n",
+                           p.questions.soundscapePrompt);
+        for (const auto& o : p.questions.soundscapeOptions)
+            out << fmt::format("| {} | `{}` | {} |\n", o.letter, o.id, o.label);
+    }
+    out << "\n## Stimuli\n\n| id | surface | soundscape | modalities | reverb | factors |\n"
+           "|---|---|---|---|---|---|\n";
+    for (const auto& s : p.stimuli) {
+        std::string factors;
+        for (const auto& [k, v] : s.factors) factors += (factors.empty() ? "" : ", ") + k + "=" + v;
+        out << fmt::format("| `{}` | {} | {} | {} | {} | {} |\n", s.id, s.surface,
+                           s.soundscape.value_or(""), toString(s.modalities), s.reverb.value_or(""),
+                           factors);
+    }
+    if (p.design == DesignKind::Between) {
+        out << "\n## Groups\n\n| id | label | stimuli | modalities override |\n|---|---|---|---|\n";
+        for (const auto& g : p.groups) {
+            std::string ids;
+            for (const auto& s : g.stimuli) ids += (ids.empty() ? "" : ", ") + s;
+            out << fmt::format("| `{}` | {} | {} | {} |\n", g.id, g.label, ids,
+                               g.modalities ? toString(*g.modalities) : "");
+        }
+    }
+}
+
+} // namespace underfoot::experiment

@@ -1,0 +1,64 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+/// Long-format export (one row per trial) and its codebook.
+///
+/// Column order is a contract with analysis/ (which reads exactly these columns):
+/// see kTrialColumns. RFC 4180 quoting, empty cell = missing, booleans 0/1, ISO 8601 UTC times.
+#include "experiment/Store.h"
+
+#include <array>
+#include <ostream>
+#include <string_view>
+
+namespace underfoot::experiment {
+
+/// The columns of the long-format trials CSV, in order.
+inline constexpr std::array<std::string_view, 30> kTrialColumns = {"study",
+                                                                   "site",
+                                                                   "protocol_id",
+                                                                   "protocol_hash",
+                                                                   "participant",
+                                                                   "group",
+                                                                   "session",
+                                                                   "trial_index",
+                                                                   "block",
+                                                                   "practice",
+                                                                   "stimulus_id",
+                                                                   "surface",
+                                                                   "soundscape",
+                                                                   "modalities",
+                                                                   "reverb",
+                                                                   "repetition",
+                                                                   "render_seed",
+                                                                   "answer",
+                                                                   "answer_label",
+                                                                   "correct",
+                                                                   "realism",
+                                                                   "quality",
+                                                                   "soundscape_answer",
+                                                                   "soundscape_correct",
+                                                                   "response_time_s",
+                                                                   "excluded",
+                                                                   "exclusion_reason",
+                                                                   "comment",
+                                                                   "started_at",
+                                                                   "answered_at"};
+
+/// Which trials are written.
+enum class ExportScope { Answered, All };
+
+/// RFC 4180 field quoting (quotes when the field has a comma, quote, CR or LF).
+std::string csvField(std::string_view value);
+
+/// Writes the trials CSV; returns the number of rows.
+int writeTrialsCsv(const StudyStore& store, std::ostream& out,
+                   ExportScope scope = ExportScope::Answered);
+/// Writes every rating of every scale in long format
+/// (study,participant,group,trial_index,stimulus_id,scale,value); returns the number of rows.
+int writeRatingsCsv(const StudyStore& store, std::ostream& out,
+                    ExportScope scope = ExportScope::Answered);
+/// Writes the codebook (Markdown): every column, its type and meaning, and the value labels
+/// (answer options, groups, stimuli, scales) of this study's protocol.
+void writeCodebook(const StudyStore& store, std::ostream& out);
+
+} // namespace underfoot::experiment

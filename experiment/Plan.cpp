@@ -1,0 +1,209 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "experiment/Plan.h"
+
+#include "experiment/Random.h"
+
+#include <fmt/format.h>
+
+#include <stdexcept>
+
+namespace underfoot::experiment {
+
+namespace {
+constexpr std::uint64_t kOrderStream = 1;
+constexpr std::uint64_t kRenderStream = 2;
+
+/// Whether `counts` (total `remaining`) can still be laid out with no two equal neighbours
+/// when the previous element was `last` (-1: none). Each x needs count <= ceil(R/2), and the
+/// previous element, which cannot come first, count <= floor(R/2).
+bool feasible(const std::vector<int>& counts, int remaining, int last) {
+    for (std::size_t x = 0; x < counts.size(); ++x) {
+        const int limit = static_cast<int>(x) == last ? remaining / 2 : (remaining + 1) / 2;
+        if (counts[x] > limit) return false;
+    }
+    return true;
+}
+} // namespace
+
+std::uint64_t participantSeed(std::uint64_t studySeed, int participantIndex) {
+    return deriveSeed(studySeed, {static_cast<std::uint64_t>(participantIndex)});
+}
+
+std::vector<Stimulus> groupStimuli(const Protocol& protocol, const Group& group) {
+    std::vector<Stimulus> out;
+    for (const auto& sid : group.stimuli) {
+        const Stimulus* s = protocol.stimulus(sid);
+        if (!s)
+            throw std::invalid_argument(
+                fmt::format("group '{}' names unknown stimulus '{}'", group.id, sid));
+        Stimulus copy = *s;
+        if (group.modalities) copy.modalities = *group.modalities;
+        out.push_back(std::move(copy));
+    }
+    return out;
+}
+
+std::vector<PlannedTrial> generatePlan(const Protocol& protocol, const std::string& groupId,
+                                       std::uint64_t studySeed, int participantIndex) {
+    const Group* group = protocol.group(groupId);
+    if (!group)
+        throw std::invalid_argument(
+            fmt::format("protocol '{}' has no group '{}'", protocol.id, groupId));
+    if (participantIndex < 0) throw std::invalid_argument("participant index must be >= 0");
+    const std::vector<Stimulus> stimuli = groupStimuli(protocol, *group);
+    const auto& o = protocol.ordering;
+    const int k = static_cast<int>(stimuli.size());
+    const int reps = o.repetitions;
+    if (k == 0) throw std::invalid_argument(fmt::format("group '{}' is empty", groupId));
+    Rng rng(deriveSeed(studySeed, {static_cast<std::uint64_t>(participantIndex), kOrderStream}));
+
+    // Main sequence: (stimulus index, block).
+    std::vector<std::pair<int, int>> sequence;
+    sequence.reserve(static_cast<std::size_t>(k * reps));
+    if (o.order == OrderKind::Fixed) {
+        for (int r = 1; r <= reps; ++r)
+            for (int i = 0; i < k; ++i)
+                sequence.emplace_back(i, o.blocks == BlockKind::Repetition ? r : 1);
+    } else if (o.blocks == BlockKind::Repetition) {
+        std::vector<int> perm(static_cast<std::size_t>(k));
+        for (int r = 1; r <= reps; ++r) {
+            for (int i = 0; i < k; ++i) perm[static_cast<std::size_t>(i)] = i;
+            rng.shuffle(perm);
+            if (o.noImmediateRepeat && !sequence.empty()) {
+                if (k < 2)
+                    throw std::invalid_argument("impossible ordering constraint: "
+                                                "no_immediate_repeat with a single stimulus");
+                // Rejection keeps every valid block equally likely (succeeds with p >= 1/2).
+                while (perm.front() == sequence.back().first) rng.shuffle(perm);
+            }
+            for (int i : perm) sequence.emplace_back(i, r);
+        }
+    } else if (!o.noImmediateRepeat) {
+        std::vector<int> all;
+        for (int r = 0; r < reps; ++r)
+            for (int i = 0; i < k; ++i) all.push_back(i);
+        rng.shuffle(all);
+        for (int i : all) sequence.emplace_back(i, 1);
+    } else {
+        // Sequential draw weighted by remaining counts, restricted to choices that keep the
+        // rest feasible: never relaxes the constraint, fails loudly if it cannot hold.
+        std::vector<int> counts(static_cast<std::size_t>(k), reps);
+        int remaining = k * reps;
+        int last = -1;
+        if (!feasible(counts, remaining, last))
+            throw std::invalid_argument("impossible ordering constraint: no_immediate_repeat");
+        while (remaining > 0) {
+            std::vector<int> weights(static_cast<std::size_t>(k), 0);
+            int total = 0;
+            for (int x = 0; x < k; ++x) {
+                auto& c = counts[static_cast<std::size_t>(x)];
+                if (c == 0 || x == last) continue;
+                --c;
+                if (feasible(counts, remaining - 1, x)) {
+                    weights[static_cast<std::size_t>(x)] = c + 1;
+                    total += c + 1;
+                }
+                ++c;
+            }
+            if (total == 0)
+                throw std::invalid_argument("impossible ordering constraint: no_immediate_repeat");
+            auto pick = static_cast<int>(rng.below(static_cast<std::uint64_t>(total)));
+            int chosen = 0;
+            for (; chosen < k; ++chosen) {
+                pick -= weights[static_cast<std::size_t>(chosen)];
+                if (pick < 0) break;
+            }
+            --counts[static_cast<std::size_t>(chosen)];
+            --remaining;
+            last = chosen;
+            sequence.emplace_back(chosen, 1);
+        }
+    }
+
+    std::vector<PlannedTrial> plan;
+    int index = 0;
+    auto seedFor = [&](int trialIndex) {
+        return deriveSeed(studySeed, {static_cast<std::uint64_t>(participantIndex), kRenderStream,
+                                      static_cast<std::uint64_t>(trialIndex)});
+    };
+    for (const auto& sid : o.practice) {
+        const Stimulus* s = protocol.stimulus(sid);
+        if (!s) throw std::invalid_argument(fmt::format("unknown practice stimulus '{}'", sid));
+        PlannedTrial t;
+        t.index = index;
+        t.block = 0;
+        t.practice = true;
+        t.stimulus = *s;
+        if (group->modalities) t.stimulus.modalities = *group->modalities;
+        t.repetition = 1;
+        t.plannedSeed = seedFor(index);
+        plan.push_back(std::move(t));
+        ++index;
+    }
+    std::vector<int> seen(static_cast<std::size_t>(k), 0);
+    const int mainTotal = static_cast<int>(sequence.size());
+    for (int m = 0; m < mainTotal; ++m) {
+        const auto [si, block] = sequence[static_cast<std::size_t>(m)];
+        PlannedTrial t;
+        t.index = index;
+        t.block = block;
+        t.stimulus = stimuli[static_cast<std::size_t>(si)];
+        t.repetition = ++seen[static_cast<std::size_t>(si)];
+        t.plannedSeed = seedFor(index);
+        t.breakAfter = o.breakEvery > 0 && (m + 1) % o.breakEvery == 0 && m + 1 < mainTotal;
+        plan.push_back(std::move(t));
+        ++index;
+    }
+    return plan;
+}
+
+PlanSummary summarizePlans(const Protocol& protocol, std::uint64_t studySeed,
+                           int participantsPerGroup) {
+    PlanSummary summary;
+    int participantIndex = 0;
+    for (const auto& g : protocol.groups) {
+        PlanSummary::GroupSummary gs;
+        gs.groupId = g.id;
+        BalanceTable table;
+        table.groupId = g.id;
+        table.stimulusIds = g.stimuli;
+        const std::size_t k = g.stimuli.size();
+        const std::size_t positions = k * static_cast<std::size_t>(protocol.ordering.repetitions);
+        table.counts.assign(k, std::vector<int>(positions, 0));
+        for (int p = 0; p < participantsPerGroup; ++p, ++participantIndex) {
+            const auto plan = generatePlan(protocol, g.id, studySeed, participantIndex);
+            std::size_t position = 0;
+            int practice = 0;
+            int breaks = 0;
+            for (const auto& t : plan) {
+                if (t.practice) {
+                    ++practice;
+                    continue;
+                }
+                if (t.breakAfter) ++breaks;
+                for (std::size_t s = 0; s < k; ++s)
+                    if (g.stimuli[s] == t.stimulus.id) ++table.counts[s][position];
+                ++position;
+            }
+            gs.practiceTrials = practice;
+            gs.mainTrials = static_cast<int>(position);
+            gs.breaks = breaks;
+        }
+        if (participantsPerGroup == 0) {
+            gs.practiceTrials = static_cast<int>(protocol.ordering.practice.size());
+            gs.mainTrials = static_cast<int>(positions);
+            gs.breaks = protocol.ordering.breakEvery > 0
+                            ? (gs.mainTrials - 1) / protocol.ordering.breakEvery
+                            : 0;
+        }
+        table.participants = participantsPerGroup;
+        gs.estimatedDurationS = protocol.timing.briefingS +
+                                (gs.practiceTrials + gs.mainTrials) * protocol.timing.trialS +
+                                gs.breaks * protocol.timing.breakS;
+        summary.groups.push_back(gs);
+        summary.balance.push_back(std::move(table));
+    }
+    return summary;
+}
+
+} // namespace underfoot::experiment

@@ -1,0 +1,145 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "experiment/Session.h"
+
+#include <fmt/format.h>
+
+#include <chrono>
+
+namespace underfoot::experiment {
+
+const char* toString(SessionPhase phase) {
+    switch (phase) {
+    case SessionPhase::Briefing:
+        return "briefing";
+    case SessionPhase::Practice:
+        return "practice";
+    case SessionPhase::Trial:
+        return "trial";
+    case SessionPhase::Break:
+        return "break";
+    case SessionPhase::Finished:
+        return "finished";
+    }
+    return "finished";
+}
+
+Session::Session(StudyStore& store, std::string participantCode, StimulusPlayer& player,
+                 SessionSettings settings, SecondsClock clock)
+    : store_(store), player_(player), clock_(std::move(clock)) {
+    if (!clock_) {
+        clock_ = [] {
+            return std::chrono::duration<double>(
+                       std::chrono::steady_clock::now().time_since_epoch())
+                .count();
+        };
+    }
+    participant_ = store_.participant(participantCode);
+    trials_ = store_.trials(participantCode);
+    const auto first = store_.firstUnanswered(participantCode);
+    if (!first)
+        throw StoreError(fmt::format("participant '{}' has answered every trial", participantCode));
+    sessionNumber_ = store_.startSession(participantCode, settings);
+    participant_ = store_.participant(participantCode);
+    position_ = static_cast<std::size_t>(*first);
+    resumed_ = *first > 0;
+    if (resumed_) {
+        store_.journal("session_resumed", participantCode, *first,
+                       jsonObject({{"session", std::to_string(sessionNumber_)}}));
+        phase_ = trials_[position_].practice ? SessionPhase::Practice : SessionPhase::Trial;
+    }
+}
+
+Session::~Session() {
+    if (playing_) player_.stop();
+}
+
+const TrialRecord& Session::current() const {
+    if (phase_ != SessionPhase::Practice && phase_ != SessionPhase::Trial)
+        throw std::logic_error(fmt::format("no current trial in phase {}", toString(phase_)));
+    return trials_[position_];
+}
+
+int Session::answeredCount() const {
+    int n = 0;
+    for (const auto& t : trials_) n += t.answered ? 1 : 0;
+    return n;
+}
+
+void Session::finishBriefing() {
+    if (phase_ != SessionPhase::Briefing)
+        throw std::logic_error(fmt::format("finishBriefing() in phase {}", toString(phase_)));
+    store_.journal("briefing_done", participant_.code, std::nullopt,
+                   jsonObject({{"session", std::to_string(sessionNumber_)}}));
+    phase_ = trials_[position_].practice ? SessionPhase::Practice : SessionPhase::Trial;
+}
+
+void Session::play() {
+    const TrialRecord& t = current();
+    if (playing_) throw std::logic_error("play() while the stimulus is already playing");
+    if (closed_) throw std::logic_error("play() on a closed session");
+    const StimulusStart started = player_.start(t.stimulus, t.plannedSeed);
+    playing_ = true;
+    try {
+        store_.markTrialStarted(participant_.code, t.index, sessionNumber_, started.renderSeed,
+                                started.grfRecording);
+    } catch (...) {
+        player_.stop();
+        playing_ = false;
+        throw;
+    }
+    trials_[position_].renderSeed = started.renderSeed;
+    trials_[position_].grfRecording = started.grfRecording;
+    trials_[position_].sessionNumber = sessionNumber_;
+    startedAtS_ = clock_();
+}
+
+void Session::answer(const TrialAnswer& answer) {
+    const TrialRecord& t = current();
+    if (!playing_)
+        throw std::logic_error(
+            fmt::format("answer() for trial {} before its stimulus played", t.index));
+    const double rt = clock_() - startedAtS_;
+    store_.commitAnswer(participant_.code, t.index, answer, rt >= 0.0 ? rt : 0.0);
+    player_.stop();
+    playing_ = false;
+    trials_[position_].answered = true;
+    trials_[position_].answer = answer;
+    trials_[position_].responseTimeS = rt;
+    advance();
+}
+
+void Session::advance() {
+    const bool breakNow = trials_[position_].breakAfter;
+    ++position_;
+    while (position_ < trials_.size() && trials_[position_].answered) ++position_;
+    if (position_ >= trials_.size()) {
+        phase_ = SessionPhase::Finished;
+        store_.endSession(participant_.code, sessionNumber_, true);
+        closed_ = true;
+        return;
+    }
+    if (breakNow) {
+        phase_ = SessionPhase::Break;
+        store_.journal("break_started", participant_.code, trials_[position_ - 1].index, "{}");
+        return;
+    }
+    phase_ = trials_[position_].practice ? SessionPhase::Practice : SessionPhase::Trial;
+}
+
+void Session::finishBreak() {
+    if (phase_ != SessionPhase::Break)
+        throw std::logic_error(fmt::format("finishBreak() in phase {}", toString(phase_)));
+    store_.journal("break_ended", participant_.code, std::nullopt, "{}");
+    phase_ = trials_[position_].practice ? SessionPhase::Practice : SessionPhase::Trial;
+}
+
+void Session::interrupt() {
+    if (closed_) return;
+    if (playing_) player_.stop();
+    playing_ = false;
+    store_.endSession(participant_.code, sessionNumber_, false);
+    closed_ = true;
+    phase_ = SessionPhase::Finished;
+}
+
+} // namespace underfoot::experiment

@@ -1,0 +1,243 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "experiment/Simulation.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+namespace underfoot::experiment {
+
+namespace {
+std::vector<std::string> splitCsvLine(const std::string& line) {
+    std::vector<std::string> cells;
+    std::string cell;
+    bool quoted = false;
+    for (std::size_t i = 0; i < line.size(); ++i) {
+        const char c = line[i];
+        if (quoted) {
+            if (c == '"' && i + 1 < line.size() && line[i + 1] == '"') {
+                cell += '"';
+                ++i;
+            } else if (c == '"') {
+                quoted = false;
+            } else {
+                cell += c;
+            }
+        } else if (c == '"') {
+            quoted = true;
+        } else if (c == ',') {
+            cells.push_back(cell);
+            cell.clear();
+        } else if (c != '\r') {
+            cell += c;
+        }
+    }
+    cells.push_back(cell);
+    return cells;
+}
+
+std::string normalize(std::string s) {
+    for (auto& c : s)
+        c = c == ' ' ? '_' : static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return s;
+}
+
+std::string surfaceFor(const std::string& cell, const Catalogue& catalogue) {
+    if (const auto* e = catalogue.surfaceByCode(cell)) return e->id;
+    if (catalogue.surface(cell)) return cell;
+    return {};
+}
+
+std::string soundscapeFor(const std::string& cell, const Catalogue& catalogue) {
+    const std::string n = normalize(cell);
+    if (n.empty()) return {};
+    if (catalogue.soundscape(n)) return n;
+    for (const auto& e : catalogue.soundscapes)
+        if (e.id.rfind(n + "_", 0) == 0 || normalize(e.label) == n) return e.id;
+    return {};
+}
+} // namespace
+
+const ConfusionMatrix::Row* ConfusionMatrix::find(const Stimulus& stimulus) const {
+    for (const auto& row : rows) {
+        if (row.surface != stimulus.surface) continue;
+        if (hasSoundscape && row.soundscape != stimulus.soundscape.value_or("")) continue;
+        return &row;
+    }
+    return nullptr;
+}
+
+ConfusionMatrix parseConfusionMatrix(const std::string& text, const std::string& source,
+                                     const Catalogue& catalogue) {
+    ConfusionMatrix m;
+    m.source = source;
+    std::istringstream in(text);
+    std::string line;
+    int lineNo = 0;
+    std::size_t firstAnswer = 1;
+    while (std::getline(in, line)) {
+        ++lineNo;
+        if (line.empty() || line == "\r") continue;
+        const auto cells = splitCsvLine(line);
+        if (m.answers.empty()) {
+            if (cells.size() < 3 || normalize(cells[0]) != "stimulus")
+                throw std::runtime_error(fmt::format(
+                    "{}:{}: expected a header 'stimulus[,soundscape],CODE,...'", source, lineNo));
+            m.hasSoundscape = normalize(cells[1]) == "soundscape";
+            firstAnswer = m.hasSoundscape ? 2 : 1;
+            for (std::size_t i = firstAnswer; i < cells.size(); ++i) {
+                if (cells[i] == "DK" || cells[i] == kDontKnow) {
+                    m.answers.emplace_back(kDontKnow);
+                    continue;
+                }
+                const std::string id = surfaceFor(cells[i], catalogue);
+                if (id.empty())
+                    throw std::runtime_error(fmt::format(
+                        "{}:{}: column {} header '{}' is not a surface code or id (expected one "
+                        "of the codes of data/published/README.md, or DK)",
+                        source, lineNo, i + 1, cells[i]));
+                m.answers.push_back(id);
+            }
+            continue;
+        }
+        if (cells.size() != firstAnswer + m.answers.size())
+            throw std::runtime_error(fmt::format("{}:{}: {} cells; expected {} as in the header",
+                                                 source, lineNo, cells.size(),
+                                                 firstAnswer + m.answers.size()));
+        ConfusionMatrix::Row row;
+        row.line = lineNo;
+        row.surface = surfaceFor(cells[0], catalogue);
+        if (row.surface.empty())
+            throw std::runtime_error(fmt::format("{}:{}: stimulus '{}' is not a surface code or id",
+                                                 source, lineNo, cells[0]));
+        if (m.hasSoundscape) {
+            row.soundscape = soundscapeFor(cells[1], catalogue);
+            if (row.soundscape.empty() && !cells[1].empty())
+                throw std::runtime_error(fmt::format("{}:{}: soundscape '{}' is not a known "
+                                                     "soundscape",
+                                                     source, lineNo, cells[1]));
+        }
+        double total = 0.0;
+        for (std::size_t i = firstAnswer; i < cells.size(); ++i) {
+            double v = 0.0;
+            try {
+                std::size_t used = 0;
+                v = cells[i].empty() ? 0.0 : std::stod(cells[i], &used);
+                if (!cells[i].empty() && used != cells[i].size()) throw std::invalid_argument("");
+            } catch (const std::exception&) {
+                throw std::runtime_error(fmt::format("{}:{}: column {} is '{}'; expected a count",
+                                                     source, lineNo, i + 1, cells[i]));
+            }
+            if (!std::isfinite(v) || v < 0)
+                throw std::runtime_error(fmt::format("{}:{}: column {} is '{}'; expected a "
+                                                     "finite count >= 0",
+                                                     source, lineNo, i + 1, cells[i]));
+            row.counts.push_back(v);
+            total += v;
+        }
+        if (total <= 0)
+            throw std::runtime_error(fmt::format("{}:{}: the row has no answers", source, lineNo));
+        m.rows.push_back(std::move(row));
+    }
+    if (m.rows.empty())
+        throw std::runtime_error(fmt::format("{}: no rows; expected a confusion matrix", source));
+    return m;
+}
+
+ConfusionMatrix loadConfusionMatrix(const std::string& path, const Catalogue& catalogue) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw std::runtime_error(fmt::format("{}: cannot open the confusion matrix", path));
+    std::ostringstream text;
+    text << in.rdbuf();
+    return parseConfusionMatrix(text.str(), path, catalogue);
+}
+
+std::vector<std::string> checkMatrixAgainst(const ConfusionMatrix& m, const Protocol& protocol) {
+    std::vector<std::string> problems;
+    for (const auto& g : protocol.groups)
+        for (const auto& s : groupStimuli(protocol, g))
+            if (!m.find(s))
+                problems.push_back(fmt::format(
+                    "{}: no row for stimulus '{}' (surface {}{}{})", m.source, s.id, s.surface,
+                    s.soundscape ? ", soundscape " : "", s.soundscape.value_or("")));
+    for (const auto& practiceId : protocol.ordering.practice)
+        if (const Stimulus* s = protocol.stimulus(practiceId); s && !m.find(*s))
+            problems.push_back(
+                fmt::format("{}: no row for practice stimulus '{}'", m.source, practiceId));
+    if (protocol.questions.asksSurface())
+        for (std::size_t c = 0; c < m.answers.size(); ++c) {
+            if (protocol.questions.surfaceOption(m.answers[c])) continue;
+            double used = 0;
+            for (const auto& row : m.rows) used += row.counts[c];
+            if (used > 0)
+                problems.push_back(fmt::format("{}: answer '{}' has counts but is not an option "
+                                               "of protocol {}'s answer list",
+                                               m.source, m.answers[c], protocol.id));
+        }
+    return problems;
+}
+
+SimulatedParticipant::SimulatedParticipant(const ConfusionMatrix& matrix, const Protocol& protocol,
+                                           std::string groupId, std::uint64_t seed,
+                                           SimulationSettings settings)
+    : matrix_(matrix), protocol_(protocol), groupId_(std::move(groupId)), rng_(seed),
+      settings_(settings) {}
+
+TrialAnswer SimulatedParticipant::answer(const TrialRecord& trial) {
+    TrialAnswer a;
+    const Questions& q = protocol_.questions;
+    bool correct = false;
+    if (q.asksSurface()) {
+        const auto* row = matrix_.find(trial.stimulus);
+        if (!row)
+            throw std::runtime_error(
+                fmt::format("{}: no row for stimulus '{}'", matrix_.source, trial.stimulus.id));
+        double total = 0;
+        for (std::size_t c = 0; c < row->counts.size(); ++c)
+            if (q.surfaceOption(matrix_.answers[c])) total += row->counts[c];
+        if (total <= 0)
+            throw std::runtime_error(fmt::format("{}:{}: no count for an option of the answer "
+                                                 "list",
+                                                 matrix_.source, row->line));
+        double pick = rng_.uniform() * total;
+        std::size_t chosen = 0;
+        for (std::size_t c = 0; c < row->counts.size(); ++c) {
+            if (!q.surfaceOption(matrix_.answers[c]) || row->counts[c] <= 0) continue;
+            chosen = c;
+            pick -= row->counts[c];
+            if (pick < 0) break;
+        }
+        a.answer = matrix_.answers[chosen];
+        correct = answerIsCorrect(a.answer, trial.stimulus.surface);
+    }
+    for (const auto& scale : q.scales) {
+        const double mid = 0.5 * (scale.min + scale.max);
+        const double spread = 0.2 * (scale.max - scale.min);
+        const double value = mid + (correct ? 0.5 : 0.0) + spread * rng_.gaussian();
+        a.ratings[scale.id] =
+            std::clamp(static_cast<int>(std::lround(value)), scale.min, scale.max);
+    }
+    if (q.asksSoundscape(groupId_)) {
+        const auto& options = q.soundscapeOptions;
+        const std::string truth = trial.stimulus.soundscape.value_or("");
+        if (!truth.empty() && q.soundscapeOption(truth) &&
+            rng_.uniform() < settings_.soundscapeAccuracy) {
+            a.soundscapeAnswer = truth;
+        } else {
+            std::vector<std::string> others;
+            for (const auto& o : options)
+                if (o.id != truth) others.push_back(o.id);
+            a.soundscapeAnswer = others[static_cast<std::size_t>(rng_.below(others.size()))];
+        }
+    }
+    return a;
+}
+
+double SimulatedParticipant::responseTimeS() {
+    return settings_.medianResponseS * std::exp(0.4 * rng_.gaussian());
+}
+
+} // namespace underfoot::experiment

@@ -1,0 +1,73 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+/// Synthetic participants answering from a confusion matrix, so that a whole study can be
+/// produced end to end (CI, demos, analysis tests).
+#include "experiment/Protocol.h"
+#include "experiment/Random.h"
+#include "experiment/Store.h"
+
+#include <map>
+#include <string>
+#include <vector>
+
+namespace underfoot::experiment {
+
+/// A confusion matrix: rows are presented stimuli (surface, optional soundscape), columns are
+/// answer option ids, cells are counts.
+struct ConfusionMatrix {
+    struct Row {
+        std::string surface;
+        std::string soundscape; ///< empty when the matrix has no soundscape column
+        std::vector<double> counts;
+        int line = 0;
+    };
+    std::string source;
+    std::vector<std::string> answers; ///< answer option ids (surface ids or dont_know)
+    std::vector<Row> rows;
+    bool hasSoundscape = false;
+
+    /// The row for a stimulus, or nullptr.
+    const Row* find(const Stimulus& stimulus) const;
+};
+
+/// Reads the published CSV format (`stimulus[,soundscape],CODE,...,DK`; codes as in
+/// data/published/README.md; surface ids are accepted too). Throws std::runtime_error naming
+/// file:line and what was expected.
+ConfusionMatrix loadConfusionMatrix(const std::string& path,
+                                    const Catalogue& catalogue = defaultCatalogue());
+ConfusionMatrix parseConfusionMatrix(const std::string& text, const std::string& source,
+                                     const Catalogue& catalogue = defaultCatalogue());
+
+/// Checks that the matrix can drive `protocol`: a row for every stimulus and every answer
+/// column with a count is an option of the answer list. Returns the problems.
+std::vector<std::string> checkMatrixAgainst(const ConfusionMatrix& matrix,
+                                            const Protocol& protocol);
+
+/// Settings of synthetic participants.
+struct SimulationSettings {
+    /// Probability of naming the soundscape correctly when asked.
+    double soundscapeAccuracy = 0.85;
+    /// Median response time (log-normal, sigma 0.4).
+    double medianResponseS = 8.0;
+};
+
+/// One synthetic participant: draws answers from the matrix row of each stimulus.
+class SimulatedParticipant {
+  public:
+    SimulatedParticipant(const ConfusionMatrix& matrix, const Protocol& protocol,
+                         std::string groupId, std::uint64_t seed, SimulationSettings settings = {});
+    /// An answer to a trial (surface answer from the matrix; ratings around the scale middle,
+    /// half a point higher when correct; soundscape answer with the configured accuracy).
+    TrialAnswer answer(const TrialRecord& trial);
+    /// Response time for the last answer (seconds).
+    double responseTimeS();
+
+  private:
+    const ConfusionMatrix& matrix_;
+    const Protocol& protocol_;
+    std::string groupId_;
+    Rng rng_;
+    SimulationSettings settings_;
+};
+
+} // namespace underfoot::experiment

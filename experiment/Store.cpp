@@ -1,0 +1,889 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "experiment/Store.h"
+
+#include "experiment/Random.h"
+
+#include <SQLiteCpp/SQLiteCpp.h>
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <ctime>
+#include <filesystem>
+
+namespace underfoot::experiment {
+
+namespace {
+
+/// Schema migrations: entry i brings user_version from i to i + 1. Never edit a shipped entry;
+/// append a new one (and bump kSchemaVersion).
+const char* const kMigrations[] = {
+    // 0 -> 1: initial schema.
+    R"sql(
+CREATE TABLE study (
+  id INTEGER PRIMARY KEY CHECK (id = 1),
+  code TEXT NOT NULL,
+  site TEXT NOT NULL,
+  seed INTEGER NOT NULL,
+  created_at TEXT NOT NULL,
+  app_version TEXT NOT NULL
+);
+CREATE TABLE protocol (
+  id INTEGER PRIMARY KEY CHECK (id = 1),
+  protocol_id TEXT NOT NULL,
+  version INTEGER NOT NULL,
+  source_name TEXT NOT NULL,
+  text TEXT NOT NULL,
+  hash TEXT NOT NULL,
+  stored_at TEXT NOT NULL
+);
+CREATE TABLE participants (
+  id INTEGER PRIMARY KEY,
+  code TEXT NOT NULL UNIQUE,
+  idx INTEGER NOT NULL UNIQUE,
+  age INTEGER,
+  gender TEXT NOT NULL DEFAULT '',
+  shoes TEXT NOT NULL DEFAULT '',
+  hearing TEXT NOT NULL DEFAULT '',
+  group_id TEXT NOT NULL,
+  assignment TEXT NOT NULL CHECK (assignment IN ('balanced', 'override')),
+  override_reason TEXT NOT NULL DEFAULT '',
+  status TEXT NOT NULL CHECK (status IN ('registered', 'active', 'completed', 'dropped')),
+  seed INTEGER NOT NULL,
+  registered_at TEXT NOT NULL
+);
+CREATE TABLE sessions (
+  id INTEGER PRIMARY KEY,
+  participant_id INTEGER NOT NULL REFERENCES participants(id),
+  number INTEGER NOT NULL,
+  group_id TEXT NOT NULL,
+  seed INTEGER NOT NULL,
+  app_version TEXT NOT NULL,
+  audio_config TEXT NOT NULL,
+  sensor_config TEXT NOT NULL,
+  experimenter TEXT NOT NULL,
+  started_at TEXT NOT NULL,
+  ended_at TEXT,
+  outcome TEXT,
+  UNIQUE (participant_id, number)
+);
+CREATE TABLE trials (
+  id INTEGER PRIMARY KEY,
+  participant_id INTEGER NOT NULL REFERENCES participants(id),
+  trial_index INTEGER NOT NULL,
+  block INTEGER NOT NULL,
+  practice INTEGER NOT NULL CHECK (practice IN (0, 1)),
+  stimulus_id TEXT NOT NULL,
+  stimulus TEXT NOT NULL,
+  repetition INTEGER NOT NULL,
+  break_after INTEGER NOT NULL CHECK (break_after IN (0, 1)),
+  planned_seed INTEGER NOT NULL,
+  session_number INTEGER,
+  render_seed INTEGER,
+  grf_recording TEXT,
+  started_at TEXT,
+  answered_at TEXT,
+  response_time_s REAL,
+  answer TEXT,
+  soundscape_answer TEXT,
+  comment TEXT,
+  excluded INTEGER NOT NULL DEFAULT 0 CHECK (excluded IN (0, 1)),
+  exclusion_reason TEXT NOT NULL DEFAULT '',
+  UNIQUE (participant_id, trial_index)
+);
+CREATE TABLE ratings (
+  trial_id INTEGER NOT NULL REFERENCES trials(id),
+  scale TEXT NOT NULL,
+  value INTEGER NOT NULL,
+  PRIMARY KEY (trial_id, scale)
+);
+CREATE TABLE events (
+  id INTEGER PRIMARY KEY AUTOINCREMENT,
+  at TEXT NOT NULL,
+  kind TEXT NOT NULL,
+  participant_id INTEGER,
+  trial_index INTEGER,
+  detail TEXT NOT NULL
+);
+CREATE TRIGGER events_no_update BEFORE UPDATE ON events
+  BEGIN SELECT RAISE(ABORT, 'the event journal is append-only'); END;
+CREATE TRIGGER events_no_delete BEFORE DELETE ON events
+  BEGIN SELECT RAISE(ABORT, 'the event journal is append-only'); END;
+)sql",
+};
+constexpr int kMigrationCount = static_cast<int>(sizeof(kMigrations) / sizeof(kMigrations[0]));
+static_assert(kMigrationCount == kSchemaVersion);
+
+std::int64_t toDb(std::uint64_t v) {
+    return static_cast<std::int64_t>(v);
+}
+std::uint64_t fromDb(std::int64_t v) {
+    return static_cast<std::uint64_t>(v);
+}
+
+std::string columnText(const SQLite::Column& c) {
+    return c.isNull() ? std::string() : c.getString();
+}
+
+ParticipantStatus statusFromText(const std::string& s) {
+    if (s == "active") return ParticipantStatus::Active;
+    if (s == "completed") return ParticipantStatus::Completed;
+    if (s == "dropped") return ParticipantStatus::Dropped;
+    return ParticipantStatus::Registered;
+}
+
+constexpr const char* kParticipantColumns =
+    "id, code, idx, age, gender, shoes, hearing, group_id, assignment, override_reason, status, "
+    "registered_at";
+
+ParticipantInfo readParticipant(SQLite::Statement& q) {
+    ParticipantInfo p;
+    p.id = q.getColumn(0).getInt64();
+    p.code = q.getColumn(1).getString();
+    p.index = q.getColumn(2).getInt();
+    if (!q.getColumn(3).isNull()) p.age = q.getColumn(3).getInt();
+    p.gender = q.getColumn(4).getString();
+    p.shoes = q.getColumn(5).getString();
+    p.hearing = q.getColumn(6).getString();
+    p.groupId = q.getColumn(7).getString();
+    p.assignment =
+        q.getColumn(8).getString() == "override" ? Assignment::Override : Assignment::Balanced;
+    p.overrideReason = q.getColumn(9).getString();
+    p.status = statusFromText(q.getColumn(10).getString());
+    p.registeredAt = q.getColumn(11).getString();
+    return p;
+}
+
+} // namespace
+
+const char* toString(ParticipantStatus status) {
+    switch (status) {
+    case ParticipantStatus::Registered:
+        return "registered";
+    case ParticipantStatus::Active:
+        return "active";
+    case ParticipantStatus::Completed:
+        return "completed";
+    case ParticipantStatus::Dropped:
+        return "dropped";
+    }
+    return "registered";
+}
+
+std::string isoUtc(std::chrono::system_clock::time_point t) {
+    const auto ms =
+        std::chrono::duration_cast<std::chrono::milliseconds>(t.time_since_epoch()).count();
+    const std::time_t seconds = static_cast<std::time_t>(ms / 1000 - (ms % 1000 < 0 ? 1 : 0));
+    const long millis = static_cast<long>(((ms % 1000) + 1000) % 1000);
+    std::tm tm{};
+    gmtime_r(&seconds, &tm);
+    return fmt::format("{:04}-{:02}-{:02}T{:02}:{:02}:{:02}.{:03}Z", tm.tm_year + 1900,
+                       tm.tm_mon + 1, tm.tm_mday, tm.tm_hour, tm.tm_min, tm.tm_sec, millis);
+}
+
+std::string jsonObject(std::initializer_list<std::pair<std::string_view, std::string>> fields) {
+    std::string out = "{";
+    auto escape = [](std::string_view s) {
+        std::string e;
+        for (const char c : s) {
+            switch (c) {
+            case '"':
+                e += "\\\"";
+                break;
+            case '\\':
+                e += "\\\\";
+                break;
+            case '\n':
+                e += "\\n";
+                break;
+            case '\r':
+                e += "\\r";
+                break;
+            case '\t':
+                e += "\\t";
+                break;
+            default:
+                if (static_cast<unsigned char>(c) < 0x20)
+                    e += fmt::format("\\u{:04x}", static_cast<unsigned>(c));
+                else
+                    e += c;
+            }
+        }
+        return e;
+    };
+    bool first = true;
+    for (const auto& [key, value] : fields) {
+        if (!first) out += ',';
+        first = false;
+        out += '"' + escape(key) + "\":\"" + escape(value) + '"';
+    }
+    return out + "}";
+}
+
+// ----------------------------------------------------------------------------------------------
+
+StudyStore::StudyStore(std::string path, std::unique_ptr<SQLite::Database> db, Clock clock)
+    : path_(std::move(path)), db_(std::move(db)), clock_(std::move(clock)) {}
+StudyStore::StudyStore(StudyStore&&) noexcept = default;
+StudyStore& StudyStore::operator=(StudyStore&&) noexcept = default;
+StudyStore::~StudyStore() = default;
+
+std::string StudyStore::now() const {
+    return isoUtc(clock_.now());
+}
+
+void StudyStore::configure() {
+    db_->exec("PRAGMA journal_mode=WAL");
+    db_->exec("PRAGMA synchronous=FULL");
+    db_->exec("PRAGMA foreign_keys=ON");
+    db_->setBusyTimeout(5000);
+    // Migrations, each in its own transaction together with the version bump.
+    const int version = db_->execAndGet("PRAGMA user_version").getInt();
+    if (version > kSchemaVersion)
+        throw StoreError(fmt::format("{}: schema version {} was written by a newer Underfoot; "
+                                     "this version reads up to {}",
+                                     path_, version, kSchemaVersion));
+    for (int v = version; v < kSchemaVersion; ++v) {
+        SQLite::Transaction tx(*db_, SQLite::TransactionBehavior::IMMEDIATE);
+        db_->exec(kMigrations[v]);
+        db_->exec(fmt::format("PRAGMA user_version = {}", v + 1));
+        if (v > 0) // a real migration of an existing study is journaled
+            appendEvent("schema_migrated", std::nullopt, std::nullopt,
+                        jsonObject({{"from", std::to_string(v)}, {"to", std::to_string(v + 1)}}));
+        tx.commit();
+    }
+}
+
+StudyStore StudyStore::create(const std::string& path, const Protocol& protocol,
+                              const StudySettings& settings, Clock clock,
+                              const Catalogue& catalogue) {
+    if (std::filesystem::exists(path))
+        throw StoreError(fmt::format("{}: the file already exists; expected a new study file "
+                                     "(open the existing study instead)",
+                                     path));
+    if (settings.code.empty()) throw StoreError(fmt::format("{}: the study needs a code", path));
+    auto db =
+        std::make_unique<SQLite::Database>(path, SQLite::OPEN_READWRITE | SQLite::OPEN_CREATE);
+    StudyStore store(path, std::move(db), std::move(clock));
+    store.configure();
+    SQLite::Transaction tx(*store.db_, SQLite::TransactionBehavior::IMMEDIATE);
+    const std::string at = store.now();
+    SQLite::Statement study(*store.db_, "INSERT INTO study (id, code, site, seed, created_at, "
+                                        "app_version) VALUES (1, ?, ?, ?, ?, ?)");
+    study.bind(1, settings.code);
+    study.bind(2, settings.site);
+    study.bind(3, toDb(settings.seed));
+    study.bind(4, at);
+    study.bind(5, settings.appVersion);
+    study.exec();
+    SQLite::Statement proto(*store.db_, "INSERT INTO protocol (id, protocol_id, version, "
+                                        "source_name, text, hash, stored_at) VALUES "
+                                        "(1, ?, ?, ?, ?, ?, ?)");
+    proto.bind(1, protocol.id);
+    proto.bind(2, protocol.version);
+    proto.bind(3, protocol.sourceName);
+    proto.bind(4, protocol.sourceText);
+    proto.bind(5, protocol.hash);
+    proto.bind(6, at);
+    proto.exec();
+    store.appendEvent("study_created", std::nullopt, std::nullopt,
+                      jsonObject({{"code", settings.code},
+                                  {"site", settings.site},
+                                  {"seed", std::to_string(settings.seed)},
+                                  {"protocol", protocol.id},
+                                  {"hash", protocol.hash}}));
+    tx.commit();
+    store.loadProtocol(catalogue);
+    return store;
+}
+
+StudyStore StudyStore::open(const std::string& path, Clock clock, const Catalogue& catalogue) {
+    if (!std::filesystem::exists(path))
+        throw StoreError(fmt::format("{}: no such study file; expected a file made by "
+                                     "`underfoot study create`",
+                                     path));
+    std::unique_ptr<SQLite::Database> db;
+    try {
+        db = std::make_unique<SQLite::Database>(path, SQLite::OPEN_READWRITE);
+        db->execAndGet("SELECT count(*) FROM sqlite_master");
+    } catch (const SQLite::Exception& e) {
+        throw StoreError(fmt::format("{}: not a readable study file ({})", path, e.what()));
+    }
+    StudyStore store(path, std::move(db), std::move(clock));
+    const int version = store.db_->execAndGet("PRAGMA user_version").getInt();
+    if (version == 0)
+        throw StoreError(fmt::format("{}: not an Underfoot study (schema version 0)", path));
+    store.configure();
+    store.loadProtocol(catalogue);
+    return store;
+}
+
+void StudyStore::loadProtocol(const Catalogue& catalogue) {
+    SQLite::Statement q(*db_, "SELECT text, source_name, hash FROM protocol WHERE id = 1");
+    if (!q.executeStep()) throw StoreError(fmt::format("{}: the study has no protocol", path_));
+    const std::string text = q.getColumn(0).getString();
+    const std::string hash = q.getColumn(2).getString();
+    if (sha256Hex(text) != hash)
+        throw StoreError(fmt::format("{}: the stored protocol text does not match its stored "
+                                     "hash (file damaged or edited by hand)",
+                                     path_));
+    try {
+        protocol_ =
+            std::make_unique<Protocol>(parseProtocol(text, q.getColumn(1).getString(), catalogue));
+    } catch (const ProtocolError& e) {
+        throw StoreError(
+            fmt::format("{}: the stored protocol no longer validates:\n{}", path_, e.what()));
+    }
+}
+
+StudyInfo StudyStore::info() const {
+    SQLite::Statement q(*db_, "SELECT s.code, s.site, s.seed, s.created_at, s.app_version, "
+                              "p.protocol_id, p.version, p.hash FROM study s, protocol p");
+    if (!q.executeStep()) throw StoreError(fmt::format("{}: the study row is missing", path_));
+    StudyInfo i;
+    i.code = q.getColumn(0).getString();
+    i.site = q.getColumn(1).getString();
+    i.seed = fromDb(q.getColumn(2).getInt64());
+    i.createdAt = q.getColumn(3).getString();
+    i.appVersion = q.getColumn(4).getString();
+    i.protocolId = q.getColumn(5).getString();
+    i.protocolVersion = q.getColumn(6).getInt();
+    i.protocolHash = q.getColumn(7).getString();
+    i.schemaVersion = db_->execAndGet("PRAGMA user_version").getInt();
+    return i;
+}
+
+void StudyStore::verifyProtocol(const Protocol& fileProtocol) const {
+    if (fileProtocol.hash != protocol_->hash)
+        throw StoreError(fmt::format(
+            "{}: protocol file {} (sha256 {}) differs from the protocol this study was started "
+            "with ({} version {}, sha256 {}); a changed protocol is refused for an existing "
+            "study — create a new study for the new protocol",
+            path_, fileProtocol.sourceName, fileProtocol.hash.substr(0, 12), protocol_->id,
+            protocol_->version, protocol_->hash.substr(0, 12)));
+}
+
+void StudyStore::appendEvent(const std::string& kind, std::optional<std::int64_t> participantId,
+                             std::optional<int> trialIndex, const std::string& detail) {
+    SQLite::Statement q(*db_, "INSERT INTO events (at, kind, participant_id, trial_index, detail) "
+                              "VALUES (?, ?, ?, ?, ?)");
+    q.bind(1, now());
+    q.bind(2, kind);
+    if (participantId) q.bind(3, *participantId);
+    if (trialIndex) q.bind(4, *trialIndex);
+    q.bind(5, detail);
+    q.exec();
+}
+
+void StudyStore::journal(const std::string& kind, const std::string& code,
+                         std::optional<int> trialIndex, const std::string& detail) {
+    SQLite::Transaction tx(*db_, SQLite::TransactionBehavior::IMMEDIATE);
+    appendEvent(kind, code.empty() ? std::nullopt : std::optional(participantId(code)), trialIndex,
+                detail);
+    tx.commit();
+}
+
+std::vector<Event> StudyStore::events() const {
+    std::vector<Event> out;
+    SQLite::Statement q(*db_, "SELECT e.id, e.at, e.kind, p.code, e.trial_index, e.detail FROM "
+                              "events e LEFT JOIN participants p ON p.id = e.participant_id "
+                              "ORDER BY e.id");
+    while (q.executeStep()) {
+        Event e;
+        e.id = q.getColumn(0).getInt64();
+        e.at = q.getColumn(1).getString();
+        e.kind = q.getColumn(2).getString();
+        e.participant = columnText(q.getColumn(3));
+        if (!q.getColumn(4).isNull()) e.trialIndex = q.getColumn(4).getInt();
+        e.detail = q.getColumn(5).getString();
+        out.push_back(std::move(e));
+    }
+    return out;
+}
+
+std::int64_t StudyStore::participantId(const std::string& code) const {
+    SQLite::Statement q(*db_, "SELECT id FROM participants WHERE code = ?");
+    q.bind(1, code);
+    if (!q.executeStep())
+        throw StoreError(
+            fmt::format("{}: no participant '{}'; expected a registered code", path_, code));
+    return q.getColumn(0).getInt64();
+}
+
+ParticipantInfo StudyStore::participant(const std::string& code) const {
+    SQLite::Statement q(
+        *db_, fmt::format("SELECT {} FROM participants WHERE code = ?", kParticipantColumns));
+    q.bind(1, code);
+    if (!q.executeStep())
+        throw StoreError(
+            fmt::format("{}: no participant '{}'; expected a registered code", path_, code));
+    return readParticipant(q);
+}
+
+std::vector<ParticipantInfo> StudyStore::participants() const {
+    std::vector<ParticipantInfo> out;
+    SQLite::Statement q(
+        *db_, fmt::format("SELECT {} FROM participants ORDER BY idx", kParticipantColumns));
+    while (q.executeStep()) out.push_back(readParticipant(q));
+    return out;
+}
+
+std::vector<GroupCount> StudyStore::groupCounts() const {
+    std::vector<GroupCount> out;
+    for (const auto& g : protocol_->groups) out.push_back({g.id, 0, 0, 0, g.target});
+    SQLite::Statement q(*db_, "SELECT group_id, status, count(*) FROM participants GROUP BY "
+                              "group_id, status");
+    while (q.executeStep()) {
+        const std::string gid = q.getColumn(0).getString();
+        const auto status = statusFromText(q.getColumn(1).getString());
+        const int n = q.getColumn(2).getInt();
+        auto it = std::find_if(out.begin(), out.end(),
+                               [&](const GroupCount& c) { return c.groupId == gid; });
+        if (it == out.end()) continue;
+        if (status == ParticipantStatus::Dropped)
+            it->dropped += n;
+        else if (status == ParticipantStatus::Completed)
+            it->completed += n;
+        else
+            it->active += n;
+    }
+    return out;
+}
+
+std::string StudyStore::nextGroup(int participantIndex) const {
+    const auto counts = groupCounts();
+    // Least-complete group: smallest share of its target (or smallest count without targets);
+    // dropouts do not count, so their slot is filled again. Ties are broken at random from the
+    // study seed and the participant index, so the order of groups is not predictable.
+    std::vector<std::size_t> best;
+    double bestShare = 0.0;
+    for (std::size_t i = 0; i < counts.size(); ++i) {
+        const int filled = counts[i].active + counts[i].completed;
+        const double share = counts[i].target > 0 ? static_cast<double>(filled) / counts[i].target
+                                                  : static_cast<double>(filled);
+        if (best.empty() || share < bestShare - 1e-12) {
+            best = {i};
+            bestShare = share;
+        } else if (std::fabs(share - bestShare) <= 1e-12) {
+            best.push_back(i);
+        }
+    }
+    Rng rng(deriveSeed(info().seed, {static_cast<std::uint64_t>(participantIndex), 3}));
+    return counts[best[static_cast<std::size_t>(rng.below(best.size()))]].groupId;
+}
+
+std::vector<std::string> StudyStore::checkAnswer(const std::string& groupId,
+                                                 const TrialAnswer& answer) const {
+    std::vector<std::string> problems;
+    const Questions& q = protocol_->questions;
+    if (q.asksSurface()) {
+        if (answer.answer.empty())
+            problems.push_back("the surface answer is missing");
+        else if (!q.surfaceOption(answer.answer))
+            problems.push_back(
+                fmt::format("'{}' is not an option of the answer list", answer.answer));
+    } else if (!answer.answer.empty()) {
+        problems.push_back("this protocol asks no surface question");
+    }
+    for (const auto& scale : q.scales) {
+        const auto it = answer.ratings.find(scale.id);
+        if (it == answer.ratings.end())
+            problems.push_back(fmt::format("the rating '{}' is missing", scale.id));
+        else if (it->second < scale.min || it->second > scale.max)
+            problems.push_back(fmt::format("rating '{}' is {}; expected {} to {}", scale.id,
+                                           it->second, scale.min, scale.max));
+    }
+    for (const auto& [scaleId, value] : answer.ratings)
+        if (!q.scale(scaleId))
+            problems.push_back(fmt::format("unknown scale '{}' (value {})", scaleId, value));
+    if (q.asksSoundscape(groupId)) {
+        if (answer.soundscapeAnswer.empty())
+            problems.push_back("the soundscape answer is missing");
+        else if (!q.soundscapeOption(answer.soundscapeAnswer))
+            problems.push_back(fmt::format("'{}' is not an option of the soundscape list",
+                                           answer.soundscapeAnswer));
+    } else if (!answer.soundscapeAnswer.empty()) {
+        problems.push_back("the soundscape question is not asked to this group");
+    }
+    if (!answer.comment.empty() && !q.comment) problems.push_back("this protocol takes no comment");
+    return problems;
+}
+
+ParticipantInfo StudyStore::registerParticipant(const NewParticipant& np) {
+    if (np.code.empty() || np.code.size() > 32 ||
+        !std::all_of(np.code.begin(), np.code.end(), [](char c) {
+            return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-';
+        }))
+        throw StoreError(fmt::format("participant code '{}': expected 1 to 32 letters, digits, "
+                                     "'_' or '-' (a pseudonym, never a name)",
+                                     np.code));
+    if (np.age && (*np.age < 0 || *np.age > 130))
+        throw StoreError(
+            fmt::format("participant {}: age {} is out of range 0-130", np.code, *np.age));
+    SQLite::Transaction tx(*db_, SQLite::TransactionBehavior::IMMEDIATE);
+    {
+        SQLite::Statement exists(*db_, "SELECT 1 FROM participants WHERE code = ?");
+        exists.bind(1, np.code);
+        if (exists.executeStep())
+            throw StoreError(
+                fmt::format("{}: participant '{}' is already registered", path_, np.code));
+    }
+    const int index = db_->execAndGet("SELECT count(*) FROM participants").getInt();
+    std::string groupId;
+    Assignment assignment = Assignment::Balanced;
+    if (np.groupOverride) {
+        if (!protocol_->group(*np.groupOverride))
+            throw StoreError(fmt::format("group override '{}' is not a group of protocol '{}'",
+                                         *np.groupOverride, protocol_->id));
+        if (np.overrideReason.empty())
+            throw StoreError("a group override needs a reason (it is journaled)");
+        groupId = *np.groupOverride;
+        assignment = Assignment::Override;
+    } else {
+        groupId = nextGroup(index);
+    }
+    const std::uint64_t seed = info().seed;
+    const std::vector<PlannedTrial> plan = generatePlan(*protocol_, groupId, seed, index);
+    const std::string at = now();
+    SQLite::Statement ins(*db_, "INSERT INTO participants (code, idx, age, gender, shoes, hearing, "
+                                "group_id, assignment, override_reason, status, seed, "
+                                "registered_at) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, 'registered', "
+                                "?, ?)");
+    ins.bind(1, np.code);
+    ins.bind(2, index);
+    if (np.age) ins.bind(3, *np.age);
+    ins.bind(4, np.gender);
+    ins.bind(5, np.shoes);
+    ins.bind(6, np.hearing);
+    ins.bind(7, groupId);
+    ins.bind(8, assignment == Assignment::Override ? "override" : "balanced");
+    ins.bind(9, np.overrideReason);
+    ins.bind(10, toDb(participantSeed(seed, index)));
+    ins.bind(11, at);
+    ins.exec();
+    const std::int64_t pid = db_->getLastInsertRowid();
+    SQLite::Statement trial(*db_, "INSERT INTO trials (participant_id, trial_index, block, "
+                                  "practice, stimulus_id, stimulus, repetition, break_after, "
+                                  "planned_seed) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?)");
+    for (const auto& t : plan) {
+        trial.reset();
+        trial.bind(1, pid);
+        trial.bind(2, t.index);
+        trial.bind(3, t.block);
+        trial.bind(4, t.practice ? 1 : 0);
+        trial.bind(5, t.stimulus.id);
+        trial.bind(6, stimulusToToml(t.stimulus));
+        trial.bind(7, t.repetition);
+        trial.bind(8, t.breakAfter ? 1 : 0);
+        trial.bind(9, toDb(t.plannedSeed));
+        trial.exec();
+    }
+    appendEvent(
+        "participant_registered", pid, std::nullopt,
+        jsonObject({{"code", np.code},
+                    {"index", std::to_string(index)},
+                    {"group", groupId},
+                    {"assignment", assignment == Assignment::Override ? "override" : "balanced"},
+                    {"reason", np.overrideReason},
+                    {"trials", std::to_string(plan.size())}}));
+    tx.commit();
+    return participant(np.code);
+}
+
+void StudyStore::dropParticipant(const std::string& code, const std::string& reason) {
+    if (reason.empty()) throw StoreError("dropping a participant needs a reason (journaled)");
+    SQLite::Transaction tx(*db_, SQLite::TransactionBehavior::IMMEDIATE);
+    const std::int64_t pid = participantId(code);
+    SQLite::Statement q(*db_, "UPDATE participants SET status = 'dropped' WHERE id = ?");
+    q.bind(1, pid);
+    q.exec();
+    appendEvent("participant_dropped", pid, std::nullopt, jsonObject({{"reason", reason}}));
+    tx.commit();
+}
+
+int StudyStore::startSession(const std::string& code, const SessionSettings& settings) {
+    SQLite::Transaction tx(*db_, SQLite::TransactionBehavior::IMMEDIATE);
+    const ParticipantInfo p = participant(code);
+    if (p.status == ParticipantStatus::Dropped)
+        throw StoreError(fmt::format("participant '{}' dropped out; a session cannot start", code));
+    if (p.status == ParticipantStatus::Completed)
+        throw StoreError(fmt::format("participant '{}' has completed every trial", code));
+    SQLite::Statement n(*db_, "SELECT coalesce(max(number), 0) + 1 FROM sessions WHERE "
+                              "participant_id = ?");
+    n.bind(1, p.id);
+    n.executeStep();
+    const int number = n.getColumn(0).getInt();
+    SQLite::Statement ins(*db_, "INSERT INTO sessions (participant_id, number, group_id, seed, "
+                                "app_version, audio_config, sensor_config, experimenter, "
+                                "started_at) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?)");
+    ins.bind(1, p.id);
+    ins.bind(2, number);
+    ins.bind(3, p.groupId);
+    ins.bind(4, toDb(participantSeed(info().seed, p.index)));
+    ins.bind(5, settings.appVersion);
+    ins.bind(6, settings.audioConfig);
+    ins.bind(7, settings.sensorConfig);
+    ins.bind(8, settings.experimenter);
+    ins.bind(9, now());
+    ins.exec();
+    SQLite::Statement st(*db_, "UPDATE participants SET status = 'active' WHERE id = ?");
+    st.bind(1, p.id);
+    st.exec();
+    appendEvent("session_started", p.id, std::nullopt,
+                jsonObject({{"session", std::to_string(number)},
+                            {"experimenter", settings.experimenter},
+                            {"audio", settings.audioConfig},
+                            {"sensor", settings.sensorConfig},
+                            {"app_version", settings.appVersion}}));
+    tx.commit();
+    return number;
+}
+
+void StudyStore::endSession(const std::string& code, int sessionNumber, bool completed) {
+    SQLite::Transaction tx(*db_, SQLite::TransactionBehavior::IMMEDIATE);
+    const std::int64_t pid = participantId(code);
+    SQLite::Statement q(*db_, "UPDATE sessions SET ended_at = ?, outcome = ? WHERE "
+                              "participant_id = ? AND number = ?");
+    q.bind(1, now());
+    q.bind(2, completed ? "completed" : "interrupted");
+    q.bind(3, pid);
+    q.bind(4, sessionNumber);
+    q.exec();
+    if (completed) {
+        SQLite::Statement st(*db_, "UPDATE participants SET status = 'completed' WHERE id = ?");
+        st.bind(1, pid);
+        st.exec();
+    }
+    appendEvent("session_ended", pid, std::nullopt,
+                jsonObject({{"session", std::to_string(sessionNumber)},
+                            {"outcome", completed ? "completed" : "interrupted"}}));
+    tx.commit();
+}
+
+namespace {
+constexpr const char* kTrialColumns =
+    "t.id, p.code, t.trial_index, t.block, t.practice, t.stimulus, t.repetition, t.planned_seed, "
+    "t.render_seed, t.grf_recording, t.session_number, t.started_at, t.answered_at, "
+    "t.response_time_s, t.answer, t.soundscape_answer, t.comment, t.excluded, "
+    "t.exclusion_reason, t.break_after";
+
+TrialRecord readTrial(SQLite::Database& db, SQLite::Statement& q) {
+    TrialRecord r;
+    const std::int64_t trialId = q.getColumn(0).getInt64();
+    r.participant = q.getColumn(1).getString();
+    r.index = q.getColumn(2).getInt();
+    r.block = q.getColumn(3).getInt();
+    r.practice = q.getColumn(4).getInt() != 0;
+    r.stimulus = stimulusFromToml(q.getColumn(5).getString());
+    r.repetition = q.getColumn(6).getInt();
+    r.plannedSeed = fromDb(q.getColumn(7).getInt64());
+    if (!q.getColumn(8).isNull()) r.renderSeed = fromDb(q.getColumn(8).getInt64());
+    if (!q.getColumn(9).isNull()) r.grfRecording = q.getColumn(9).getString();
+    if (!q.getColumn(10).isNull()) r.sessionNumber = q.getColumn(10).getInt();
+    r.startedAt = columnText(q.getColumn(11));
+    r.answeredAt = columnText(q.getColumn(12));
+    r.answered = !r.answeredAt.empty();
+    if (!q.getColumn(13).isNull()) r.responseTimeS = q.getColumn(13).getDouble();
+    r.answer.answer = columnText(q.getColumn(14));
+    r.answer.soundscapeAnswer = columnText(q.getColumn(15));
+    r.answer.comment = columnText(q.getColumn(16));
+    r.excluded = q.getColumn(17).getInt() != 0;
+    r.exclusionReason = q.getColumn(18).getString();
+    r.breakAfter = q.getColumn(19).getInt() != 0;
+    if (r.answered) {
+        SQLite::Statement rq(db, "SELECT scale, value FROM ratings WHERE trial_id = ?");
+        rq.bind(1, trialId);
+        while (rq.executeStep())
+            r.answer.ratings[rq.getColumn(0).getString()] = rq.getColumn(1).getInt();
+    }
+    return r;
+}
+} // namespace
+
+std::vector<TrialRecord> StudyStore::trials(const std::string& code) const {
+    const std::int64_t pid = participantId(code);
+    std::vector<TrialRecord> out;
+    SQLite::Statement q(*db_, fmt::format("SELECT {} FROM trials t JOIN participants p ON p.id = "
+                                          "t.participant_id WHERE t.participant_id = ? ORDER BY "
+                                          "t.trial_index",
+                                          kTrialColumns));
+    q.bind(1, pid);
+    while (q.executeStep()) out.push_back(readTrial(*db_, q));
+    return out;
+}
+
+TrialRecord StudyStore::trial(const std::string& code, int trialIndex) const {
+    const std::int64_t pid = participantId(code);
+    SQLite::Statement q(*db_, fmt::format("SELECT {} FROM trials t JOIN participants p ON p.id = "
+                                          "t.participant_id WHERE t.participant_id = ? AND "
+                                          "t.trial_index = ?",
+                                          kTrialColumns));
+    q.bind(1, pid);
+    q.bind(2, trialIndex);
+    if (!q.executeStep())
+        throw StoreError(
+            fmt::format("{}: participant '{}' has no trial {}", path_, code, trialIndex));
+    return readTrial(*db_, q);
+}
+
+std::optional<int> StudyStore::firstUnanswered(const std::string& code) const {
+    const std::int64_t pid = participantId(code);
+    SQLite::Statement q(*db_, "SELECT min(trial_index) FROM trials WHERE participant_id = ? AND "
+                              "answered_at IS NULL");
+    q.bind(1, pid);
+    q.executeStep();
+    if (q.getColumn(0).isNull()) return std::nullopt;
+    return q.getColumn(0).getInt();
+}
+
+void StudyStore::markTrialStarted(const std::string& code, int trialIndex, int sessionNumber,
+                                  std::uint64_t renderSeed,
+                                  const std::optional<std::string>& grfRecording) {
+    SQLite::Transaction tx(*db_, SQLite::TransactionBehavior::IMMEDIATE);
+    const std::int64_t pid = participantId(code);
+    SQLite::Statement check(*db_, "SELECT answered_at, started_at FROM trials WHERE "
+                                  "participant_id = ? AND trial_index = ?");
+    check.bind(1, pid);
+    check.bind(2, trialIndex);
+    if (!check.executeStep())
+        throw StoreError(
+            fmt::format("{}: participant '{}' has no trial {}", path_, code, trialIndex));
+    if (!check.getColumn(0).isNull())
+        throw StoreError(
+            fmt::format("participant '{}' trial {} is already answered", code, trialIndex));
+    const bool restarted = !check.getColumn(1).isNull();
+    SQLite::Statement q(*db_, "UPDATE trials SET started_at = ?, render_seed = ?, grf_recording = "
+                              "?, session_number = ? WHERE participant_id = ? AND trial_index = ?");
+    q.bind(1, now());
+    q.bind(2, toDb(renderSeed));
+    if (grfRecording) q.bind(3, *grfRecording);
+    q.bind(4, sessionNumber);
+    q.bind(5, pid);
+    q.bind(6, trialIndex);
+    q.exec();
+    appendEvent(restarted ? "trial_restarted" : "trial_started", pid, trialIndex,
+                jsonObject({{"session", std::to_string(sessionNumber)},
+                            {"render_seed", std::to_string(renderSeed)},
+                            {"grf", grfRecording.value_or("")}}));
+    tx.commit();
+}
+
+void StudyStore::commitAnswer(const std::string& code, int trialIndex, const TrialAnswer& answer,
+                              std::optional<double> responseTimeS) {
+    if (responseTimeS && (!std::isfinite(*responseTimeS) || *responseTimeS < 0))
+        throw StoreError(fmt::format("participant '{}' trial {}: response time must be a finite "
+                                     "number >= 0",
+                                     code, trialIndex));
+    SQLite::Transaction tx(*db_, SQLite::TransactionBehavior::IMMEDIATE);
+    const ParticipantInfo p = participant(code);
+    if (const auto problems = checkAnswer(p.groupId, answer); !problems.empty()) {
+        std::string all;
+        for (const auto& s : problems) all += (all.empty() ? "" : "; ") + s;
+        throw StoreError(fmt::format("participant '{}' trial {}: {}", code, trialIndex, all));
+    }
+    SQLite::Statement cur(*db_, "SELECT id, started_at, answered_at FROM trials WHERE "
+                                "participant_id = ? AND trial_index = ?");
+    cur.bind(1, p.id);
+    cur.bind(2, trialIndex);
+    if (!cur.executeStep())
+        throw StoreError(
+            fmt::format("{}: participant '{}' has no trial {}", path_, code, trialIndex));
+    const std::int64_t trialId = cur.getColumn(0).getInt64();
+    if (cur.getColumn(1).isNull())
+        throw StoreError(fmt::format("participant '{}' trial {} has not started; expected its "
+                                     "stimulus to be played first",
+                                     code, trialIndex));
+    const bool changing = !cur.getColumn(2).isNull();
+    if (changing) {
+        if (protocol_->lock == LockRule::OnAnswer)
+            throw StoreError(fmt::format("participant '{}' trial {}: answers are locked once "
+                                         "given (protocol rule lock = \"answer\")",
+                                         code, trialIndex));
+        SQLite::Statement later(*db_, "SELECT 1 FROM trials WHERE participant_id = ? AND "
+                                      "trial_index > ? AND started_at IS NOT NULL");
+        later.bind(1, p.id);
+        later.bind(2, trialIndex);
+        if (later.executeStep())
+            throw StoreError(fmt::format("participant '{}' trial {}: the answer is locked because "
+                                         "the next trial has started",
+                                         code, trialIndex));
+    }
+    SQLite::Statement q(*db_, "UPDATE trials SET answered_at = ?, response_time_s = ?, answer = ?, "
+                              "soundscape_answer = ?, comment = ? WHERE id = ?");
+    q.bind(1, now());
+    if (responseTimeS) q.bind(2, *responseTimeS);
+    if (!answer.answer.empty()) q.bind(3, answer.answer);
+    if (!answer.soundscapeAnswer.empty()) q.bind(4, answer.soundscapeAnswer);
+    if (!answer.comment.empty()) q.bind(5, answer.comment);
+    q.bind(6, trialId);
+    q.exec();
+    SQLite::Statement del(*db_, "DELETE FROM ratings WHERE trial_id = ?");
+    del.bind(1, trialId);
+    del.exec();
+    SQLite::Statement rate(*db_, "INSERT INTO ratings (trial_id, scale, value) VALUES (?, ?, ?)");
+    std::string ratingsText;
+    for (const auto& [scale, value] : answer.ratings) {
+        rate.reset();
+        rate.bind(1, trialId);
+        rate.bind(2, scale);
+        rate.bind(3, value);
+        rate.exec();
+        ratingsText += fmt::format("{}{}={}", ratingsText.empty() ? "" : " ", scale, value);
+    }
+    appendEvent(changing ? "answer_changed" : "answered", p.id, trialIndex,
+                jsonObject({{"answer", answer.answer},
+                            {"ratings", ratingsText},
+                            {"soundscape", answer.soundscapeAnswer},
+                            {"comment", answer.comment},
+                            {"response_time_s",
+                             responseTimeS ? fmt::format("{:.3f}", *responseTimeS) : ""}}));
+    tx.commit();
+}
+
+void StudyStore::setExcluded(const std::string& code, int trialIndex, bool excluded,
+                             const std::string& reason) {
+    if (excluded && reason.empty())
+        throw StoreError("excluding a trial needs a reason (journaled and exported)");
+    SQLite::Transaction tx(*db_, SQLite::TransactionBehavior::IMMEDIATE);
+    const std::int64_t pid = participantId(code);
+    SQLite::Statement q(*db_, "UPDATE trials SET excluded = ?, exclusion_reason = ? WHERE "
+                              "participant_id = ? AND trial_index = ?");
+    q.bind(1, excluded ? 1 : 0);
+    q.bind(2, excluded ? reason : std::string());
+    q.bind(3, pid);
+    q.bind(4, trialIndex);
+    if (q.exec() != 1)
+        throw StoreError(
+            fmt::format("{}: participant '{}' has no trial {}", path_, code, trialIndex));
+    appendEvent(excluded ? "trial_excluded" : "trial_included", pid, trialIndex,
+                jsonObject({{"reason", reason}}));
+    tx.commit();
+}
+
+ReplayInfo StudyStore::trialForReplay(const std::string& code, int trialIndex) const {
+    const TrialRecord t = trial(code, trialIndex);
+    if (!t.renderSeed || !t.sessionNumber)
+        throw StoreError(fmt::format("participant '{}' trial {} was never presented; nothing to "
+                                     "replay",
+                                     code, trialIndex));
+    ReplayInfo r;
+    const StudyInfo i = info();
+    r.study = i.code;
+    r.protocolHash = i.protocolHash;
+    r.participant = code;
+    r.trialIndex = trialIndex;
+    r.stimulus = t.stimulus;
+    r.renderSeed = *t.renderSeed;
+    r.grfRecording = t.grfRecording;
+    SQLite::Statement q(*db_, "SELECT audio_config, sensor_config FROM sessions WHERE "
+                              "participant_id = ? AND number = ?");
+    q.bind(1, participantId(code));
+    q.bind(2, *t.sessionNumber);
+    if (q.executeStep()) {
+        r.audioConfig = q.getColumn(0).getString();
+        r.sensorConfig = q.getColumn(1).getString();
+    }
+    return r;
+}
+
+} // namespace underfoot::experiment

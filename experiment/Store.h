@@ -1,0 +1,255 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+/// The study store: one SQLite file per study (schema with a version and explicit migrations).
+///
+/// Durability: WAL journal, synchronous=FULL, and every answer committed in its own transaction
+/// before the call returns, so an acknowledged answer survives a crash or a power loss. The event
+/// journal is append-only (triggers refuse UPDATE and DELETE). The protocol's full text and
+/// SHA-256 are stored; a different protocol text is refused for an existing study.
+#include "experiment/Plan.h"
+#include "experiment/Protocol.h"
+
+#include <chrono>
+#include <functional>
+#include <map>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace SQLite {
+class Database;
+}
+
+namespace underfoot::experiment {
+
+/// An error about a study file (wrong schema, protocol hash mismatch, unknown participant,
+/// locked answer...). The message names the file and what was expected.
+struct StoreError : std::runtime_error {
+    using std::runtime_error::runtime_error;
+};
+
+/// Current schema version written by this code.
+inline constexpr int kSchemaVersion = 1;
+
+/// Time source (injectable for tests).
+struct Clock {
+    std::function<std::chrono::system_clock::time_point()> now = [] {
+        return std::chrono::system_clock::now();
+    };
+};
+
+/// ISO 8601 UTC with milliseconds, e.g. "2026-11-21T20:45:34.123Z".
+std::string isoUtc(std::chrono::system_clock::time_point t);
+
+/// Study-level settings given at creation.
+struct StudySettings {
+    std::string code;
+    std::string site;
+    std::uint64_t seed = 1;
+    std::string appVersion;
+};
+
+/// Study-level information read back.
+struct StudyInfo {
+    std::string code;
+    std::string site;
+    std::uint64_t seed = 0;
+    std::string createdAt;
+    std::string appVersion;
+    std::string protocolId;
+    int protocolVersion = 0;
+    std::string protocolHash;
+    int schemaVersion = 0;
+};
+
+/// How a participant got its group.
+enum class Assignment { Balanced, Override };
+/// Where a participant is in the study.
+enum class ParticipantStatus { Registered, Active, Completed, Dropped };
+const char* toString(ParticipantStatus status);
+
+/// Pseudonymous participant data (no names).
+struct NewParticipant {
+    std::string code;
+    std::optional<int> age;
+    std::string gender;
+    std::string shoes;
+    std::string hearing;
+    /// Experimenter override of the balanced assignment (needs a reason).
+    std::optional<std::string> groupOverride;
+    std::string overrideReason;
+};
+
+struct ParticipantInfo {
+    std::int64_t id = 0;
+    std::string code;
+    int index = 0;
+    std::optional<int> age;
+    std::string gender;
+    std::string shoes;
+    std::string hearing;
+    std::string groupId;
+    Assignment assignment = Assignment::Balanced;
+    std::string overrideReason;
+    ParticipantStatus status = ParticipantStatus::Registered;
+    std::string registeredAt;
+};
+
+/// Participants per group (dropouts excluded) against the target.
+struct GroupCount {
+    std::string groupId;
+    int active = 0;
+    int completed = 0;
+    int dropped = 0;
+    int target = 0;
+};
+
+/// Configuration recorded with a session.
+struct SessionSettings {
+    std::string experimenter;
+    std::string audioConfig;
+    std::string sensorConfig;
+    std::string appVersion;
+};
+
+/// An answer to one trial.
+struct TrialAnswer {
+    /// Answer option id (surface id or "dont_know"); empty when not asked.
+    std::string answer;
+    /// Scale id -> value.
+    std::map<std::string, int> ratings;
+    /// Soundscape option id; empty when not asked.
+    std::string soundscapeAnswer;
+    std::string comment;
+};
+
+/// A stored trial.
+struct TrialRecord {
+    std::string participant;
+    int index = 0;
+    int block = 1;
+    bool practice = false;
+    Stimulus stimulus;
+    int repetition = 1;
+    std::uint64_t plannedSeed = 0;
+    std::optional<std::uint64_t> renderSeed;
+    std::optional<std::string> grfRecording;
+    std::optional<int> sessionNumber;
+    std::string startedAt;
+    std::string answeredAt;
+    std::optional<double> responseTimeS;
+    bool answered = false;
+    TrialAnswer answer;
+    bool excluded = false;
+    std::string exclusionReason;
+    bool breakAfter = false;
+};
+
+/// Everything needed to re-render a trial exactly.
+struct ReplayInfo {
+    std::string study;
+    std::string protocolHash;
+    std::string participant;
+    int trialIndex = 0;
+    Stimulus stimulus;
+    std::uint64_t renderSeed = 0;
+    std::optional<std::string> grfRecording;
+    std::string audioConfig;
+    std::string sensorConfig;
+};
+
+/// One journal entry.
+struct Event {
+    std::int64_t id = 0;
+    std::string at;
+    std::string kind;
+    std::string participant;
+    std::optional<int> trialIndex;
+    std::string detail;
+};
+
+class StudyStore {
+  public:
+    /// Creates a new study file (refuses an existing file).
+    static StudyStore create(const std::string& path, const Protocol& protocol,
+                             const StudySettings& settings, Clock clock = {},
+                             const Catalogue& catalogue = defaultCatalogue());
+    /// Opens an existing study (migrating an older schema; refusing a newer one).
+    static StudyStore open(const std::string& path, Clock clock = {},
+                           const Catalogue& catalogue = defaultCatalogue());
+
+    StudyStore(StudyStore&&) noexcept;
+    StudyStore& operator=(StudyStore&&) noexcept;
+    ~StudyStore();
+
+    const std::string& path() const { return path_; }
+    StudyInfo info() const;
+    /// The protocol stored in the study (parsed from its stored text).
+    const Protocol& protocol() const { return *protocol_; }
+    /// Throws StoreError when `fileProtocol` is not the exact text the study was started with.
+    void verifyProtocol(const Protocol& fileProtocol) const;
+
+    /// Registers a participant: assigns a group (balanced, or the override with its reason),
+    /// generates and stores the plan, journals it; all in one transaction.
+    ParticipantInfo registerParticipant(const NewParticipant& participant);
+    /// Marks a participant as dropped out (frees its group slot); journaled.
+    void dropParticipant(const std::string& code, const std::string& reason);
+    ParticipantInfo participant(const std::string& code) const;
+    std::vector<ParticipantInfo> participants() const;
+    std::vector<GroupCount> groupCounts() const;
+    /// The group a new participant would get now (balanced assignment).
+    std::string nextGroup(int participantIndex) const;
+
+    /// Opens a session for a participant; returns its number (1, 2, ... per participant).
+    int startSession(const std::string& code, const SessionSettings& settings);
+    /// Closes a session; `completed` also marks the participant completed.
+    void endSession(const std::string& code, int sessionNumber, bool completed);
+
+    std::vector<TrialRecord> trials(const std::string& code) const;
+    TrialRecord trial(const std::string& code, int trialIndex) const;
+    /// Index of the first unanswered trial, or nullopt when all are answered.
+    std::optional<int> firstUnanswered(const std::string& code) const;
+
+    /// Records that a trial's stimulus started (render seed, GRF recording reference); locks the
+    /// previous trial's answer under the "next_trial" rule.
+    void markTrialStarted(const std::string& code, int trialIndex, int sessionNumber,
+                          std::uint64_t renderSeed, const std::optional<std::string>& grfRecording);
+    /// Validates and commits an answer in its own durable transaction.
+    void commitAnswer(const std::string& code, int trialIndex, const TrialAnswer& answer,
+                      std::optional<double> responseTimeS);
+    /// Excludes (or re-includes with an empty reason) a trial from analysis; journaled.
+    void setExcluded(const std::string& code, int trialIndex, bool excluded,
+                     const std::string& reason);
+    /// Appends a free event to the journal.
+    void journal(const std::string& kind, const std::string& code, std::optional<int> trialIndex,
+                 const std::string& detail);
+    std::vector<Event> events() const;
+
+    /// What replay needs for one trial (throws StoreError if the trial never started).
+    ReplayInfo trialForReplay(const std::string& code, int trialIndex) const;
+
+    /// Validation of an answer against the protocol; returns the problems (empty: valid).
+    std::vector<std::string> checkAnswer(const std::string& groupId,
+                                         const TrialAnswer& answer) const;
+
+  private:
+    StudyStore(std::string path, std::unique_ptr<SQLite::Database> db, Clock clock);
+    void configure();
+    void loadProtocol(const Catalogue& catalogue);
+    std::int64_t participantId(const std::string& code) const;
+    void appendEvent(const std::string& kind, std::optional<std::int64_t> participantId,
+                     std::optional<int> trialIndex, const std::string& detail);
+    std::string now() const;
+
+    std::string path_;
+    std::unique_ptr<SQLite::Database> db_;
+    Clock clock_;
+    std::unique_ptr<Protocol> protocol_;
+};
+
+/// Minimal JSON object writer for journal details: {"k":"v",...} with escaping.
+std::string jsonObject(std::initializer_list<std::pair<std::string_view, std::string>> fields);
+
+} // namespace underfoot::experiment
