@@ -9,13 +9,15 @@
 /// clamped at F >= 0 (the contact never pulls, Marhefka & Orin 1999). mu = lambda / k is the
 /// dissipation in s/m: restitution for a rigid floor is e ~ 1 - (2/3)... falls with mu v_in.
 ///
-/// Discretisation: the exciter is integrated exactly for a force linear between samples (the
-/// same first-order hold as ModalResonator), so both bodies respond instantaneously to the
-/// contact force at n+1 through known compliances; the contact force is then the root of a
+/// Discretisation: the floor is integrated exactly for a force linear between samples (see
+/// ModalResonator), the exciter with the average-acceleration (trapezoidal) rule, unconditionally
+/// stable however stiff the contact; both bodies respond instantaneously to the contact force
+/// at n+1 through known compliances; the contact force is then the root of a
 /// scalar monotone equation g(F) = F - HC(c_h - K_c F, c'_h - K_d F), solved by Newton's method
 /// safeguarded by bisection on the bracket [0, HC(c_h, c'_h)] (the "K-method" of Borin, De Poli
-/// & Rocchesso 2000). The explicit variant computes the force from the state at n, as the
-/// Sound Design Toolkit does. Work per sample is bounded by the iteration cap.
+/// & Rocchesso 2000), followed by an energy check that bisects the force history when the
+/// discrete contact would create energy. The explicit variant computes the force from the state at
+/// n, as the Sound Design Toolkit does. Work per sample is bounded by the iteration cap.
 #include "engine/dsp/Biquad.h"
 #include "engine/models/ModalResonator.h"
 
@@ -47,6 +49,7 @@ struct ContactStats {
     long long solverIterations = 0; ///< Newton iterations since reset
     long long solvedSamples = 0;    ///< samples in contact since reset
     int maxIterationsInOneSample = 0;
+    long long passivityCorrections = 0; ///< samples where the energy guard removed a gain
 };
 
 template <typename Real>
@@ -76,9 +79,12 @@ class HuntCrossleyImpactT {
     /// True when nothing moves and nothing pushes: process() then costs almost nothing.
     bool isSleeping() const noexcept { return !awake_; }
     const ContactStats& stats() const noexcept { return stats_; }
-    /// Kinetic energy of the exciter + modal energy of the floor + elastic contact energy, J.
+    /// Kinetic energy of the exciter + modal energy of the floor + energy stored in the contact
+    /// (the work it absorbed and has not yet returned), J.
     double totalEnergy() const noexcept;
     double exciterVelocity() const noexcept { return exciterV_; }
+    /// Contact force of the last sample, N (never negative).
+    double lastContactForce() const noexcept { return lastForce_; }
     double compression() const noexcept { return exciterX_ - resonator_.position(0); }
     const ModalResonatorT<Real>& resonator() const noexcept { return resonator_; }
     const ImpactParams& params() const noexcept { return params_; }
@@ -86,12 +92,14 @@ class HuntCrossleyImpactT {
   private:
     double contactForce(double c, double cdot) const noexcept;
     double step(double fextNow, double fextNext) noexcept; // one internal sample, returns output
+    double solveForce(double ch, double dh) noexcept;      // contact force at n+1
 
     ImpactParams params_;
     ModalResonatorT<Real> resonator_;
     int listen_ = 0;
     double fs_ = 48000.0, internalFs_ = 48000.0, T_ = 1.0 / 48000.0;
     double exciterX_ = 0, exciterV_ = 0, lastForce_ = 0, lastExternal_ = 0;
+    double contactEnergy_ = 0; // work absorbed by the open contact and not yet returned, J
     bool inContact_ = false, awake_ = false;
     int quietSamples_ = 0;
     double kc_ = 0, kd_ = 0; // instantaneous compliance and mobility of the compression

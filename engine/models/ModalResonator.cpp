@@ -97,7 +97,11 @@ void ModalResonatorT<Real>::prepare(double sampleRateHz) {
     const std::size_t n = modes_.size(), np = gains_.size();
     coefficients_.resize(n);
     quasiStaticCount_ = 0;
+    w0sq_.resize(n);
     for (std::size_t i = 0; i < n; ++i) {
+        const double s = std::log(1000.0) / modes_[i].t60Seconds;
+        const double wd = kTwoPi * modes_[i].frequencyHz;
+        w0sq_[i] = wd * wd + s * s;
         coefficients_[i] = computeModeCoefficients(modes_[i], sampleRateHz);
         quasiStaticCount_ += coefficients_[i].quasiStatic ? 1 : 0;
     }
@@ -129,11 +133,12 @@ void ModalResonatorT<Real>::reset() noexcept {
 }
 
 template <typename Real>
-void ModalResonatorT<Real>::predict() noexcept {
+void ModalResonatorT<Real>::predict(double heldScale) noexcept {
     const std::size_t n = q_.size();
+    const Real h = static_cast<Real>(heldScale);
     for (std::size_t i = 0; i < n; ++i) {
         const auto& c = coefficients_[i];
-        const Real q = q_[i], v = v_[i], u = u_[i];
+        const Real q = q_[i], v = v_[i], u = h * u_[i];
         qh_[i] = static_cast<Real>(c.a00) * q + static_cast<Real>(c.a01) * v +
                  static_cast<Real>(c.b0x) * u;
         vh_[i] = static_cast<Real>(c.a10) * q + static_cast<Real>(c.a11) * v +
@@ -172,6 +177,20 @@ void ModalResonatorT<Real>::commit(int p, double forceN) noexcept {
 }
 
 template <typename Real>
+double ModalResonatorT<Real>::energyIfCommitted(int p, double forceN) const noexcept {
+    const std::size_t n = q_.size(), off = static_cast<std::size_t>(p) * n;
+    double e = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        const auto& c = coefficients_[i];
+        const double u = double(gainOverMass_[off + i]) * forceN;
+        const double q = double(qh_[i]) + c.b1x * u;
+        const double v = c.quasiStatic ? 0.0 : double(vh_[i]) + c.b1v * u;
+        e += 0.5 * modes_[i].massKg * (v * v + w0sq_[i] * q * q);
+    }
+    return e;
+}
+
+template <typename Real>
 double ModalResonatorT<Real>::position(int p) const noexcept {
     double x = 0;
     for (std::size_t i = 0; i < q_.size(); ++i) x += gains_[static_cast<std::size_t>(p)][i] * q_[i];
@@ -191,11 +210,8 @@ template <typename Real>
 double ModalResonatorT<Real>::energy() const noexcept {
     double e = 0;
     for (std::size_t i = 0; i < q_.size(); ++i) {
-        const double s = std::log(1000.0) / modes_[i].t60Seconds;
-        const double wd = kTwoPi * modes_[i].frequencyHz;
-        const double w0sq = wd * wd + s * s;
         const double q = q_[i], v = coefficients_[i].quasiStatic ? 0.0 : double(v_[i]);
-        e += 0.5 * modes_[i].massKg * (v * v + w0sq * q * q);
+        e += 0.5 * modes_[i].massKg * (v * v + w0sq_[i] * q * q);
     }
     return e;
 }

@@ -65,12 +65,16 @@ class ModalResonatorT {
     // ---- one sample, in two halves, for interactors that solve their force implicitly ----
     /// Advances every mode by one sample assuming no *new* force at n+1 (the last committed
     /// force still acts through B0). Afterwards predictedPosition/Velocity(p) are valid.
-    void predict() noexcept;
+    /// `heldScale` scales the force held from the previous sample (1 = as committed); the
+    /// impact's passivity guard uses smaller values.
+    void predict(double heldScale = 1.0) noexcept;
     double predictedPosition(int p) const noexcept;
     double predictedVelocity(int p) const noexcept;
     /// Instantaneous displacement / velocity at pickup p per newton applied at pickup p at n+1.
     double compliance(int p) const noexcept { return kx_[static_cast<std::size_t>(p)]; }
     double mobility(int p) const noexcept { return kv_[static_cast<std::size_t>(p)]; }
+    /// Energy the modes would hold after commit(p, forceN), without committing.
+    double energyIfCommitted(int p, double forceN) const noexcept;
     /// Completes the sample with force `forceN` acting at pickup p (at n+1).
     void commit(int p, double forceN) noexcept;
 
@@ -100,6 +104,7 @@ class ModalResonatorT {
     std::vector<Real> gainOverMass_;        // [pickup * modes + mode] = g[p][i] / m_i
     std::vector<Real> q_, v_, qh_, vh_, u_; // state, prediction, last generalized force
     std::vector<double> kx_, kv_;           // per pickup
+    std::vector<double> w0sq_;              // undamped angular frequency squared, per mode
     double sampleRateHz_ = 0.0;
     int quasiStaticCount_ = 0;
 };
