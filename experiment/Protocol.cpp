@@ -10,6 +10,7 @@
 #include <fstream>
 #include <set>
 #include <sstream>
+#include <tuple>
 
 namespace underfoot::experiment {
 
@@ -608,10 +609,11 @@ Protocol parseProtocol(const std::string& text, const std::string& sourceName,
                     fmt::format("[[stimuli]] #{}", stimulusPlace.size() + 1);
                 r.checkKeys(t,
                             {"id", "label", "surface", "soundscape", "modalities", "reverb",
-                             "input", "wading"},
+                             "input", "wading", "practice_only"},
                             context);
                 Stimulus s;
                 s.id = r.id(t, "id", context, true).value_or("");
+                s.practiceOnly = r.boolean(t, "practice_only", context).value_or(false);
                 readStimulusFields(r, t, context, catalogue, defaultInput, s);
                 addStimulus(std::move(s), t.source());
             }
@@ -719,7 +721,10 @@ Protocol parseProtocol(const std::string& text, const std::string& sourceName,
         Group all;
         all.id = "all";
         all.label = "all participants";
-        for (const auto& s : p.stimuli) all.stimuli.push_back(s.id);
+        for (const auto& s : p.stimuli)
+            if (!s.practiceOnly) all.stimuli.push_back(s.id);
+        if (all.stimuli.empty() && !p.stimuli.empty())
+            r.problem(root, "every stimulus is practice_only; expected at least one main stimulus");
         p.groups.push_back(std::move(all));
     } else if (!groupsNode) {
         r.problem(root, "design type = \"between\" needs [[groups]]");
@@ -741,12 +746,17 @@ Protocol parseProtocol(const std::string& text, const std::string& sourceName,
             if (!g.id.empty() && !groupIds.insert(g.id).second)
                 r.problem(t, fmt::format("group id '{}' is used twice", g.id));
             if (!t.get("stimuli")) {
-                for (const auto& s : p.stimuli) g.stimuli.push_back(s.id);
+                for (const auto& s : p.stimuli)
+                    if (!s.practiceOnly) g.stimuli.push_back(s.id);
             } else {
                 for (const auto& [sid, where] : r.strings(t, "stimuli", context)) {
                     if (!p.stimulus(sid))
                         r.problem(where, fmt::format("group '{}' names unknown stimulus '{}'; "
                                                      "expected one of the [[stimuli]] ids",
+                                                     g.id, sid));
+                    else if (p.stimulus(sid)->practiceOnly)
+                        r.problem(where, fmt::format("group '{}' names stimulus '{}', which is "
+                                                     "practice_only",
                                                      g.id, sid));
                     else if (std::find(g.stimuli.begin(), g.stimuli.end(), sid) != g.stimuli.end())
                         r.problem(where, fmt::format("group '{}' lists stimulus '{}' twice "
@@ -807,7 +817,7 @@ Protocol parseProtocol(const std::string& text, const std::string& sourceName,
             p.questions.surfaceOptions = readOptions(r, *s, "[questions.surface]", true, catalogue);
             // Every stimulus must be answerable correctly.
             for (const auto& st : p.stimuli) {
-                if (st.surface.empty()) continue;
+                if (st.surface.empty() || !catalogue.surface(st.surface)) continue;
                 bool answerable = false;
                 for (const auto& o : p.questions.surfaceOptions)
                     answerable = answerable || answerIsCorrect(o.id, st.surface);
@@ -883,7 +893,14 @@ Protocol parseProtocol(const std::string& text, const std::string& sourceName,
             p.lock = *l;
     }
 
-    if (!r.problems().empty()) throw ProtocolError(r.problems());
+    if (!r.problems().empty()) {
+        auto problems = r.problems();
+        std::stable_sort(problems.begin(), problems.end(),
+                         [](const ProtocolProblem& a, const ProtocolProblem& b) {
+                             return std::tie(a.line, a.column) < std::tie(b.line, b.column);
+                         });
+        throw ProtocolError(std::move(problems));
+    }
     return p;
 }
 
@@ -948,6 +965,7 @@ std::string stimulusToToml(const Stimulus& s) {
         input.insert("walker", parametersToToml(s.input.walker));
     t.insert("input", std::move(input));
     if (!s.wading.empty()) t.insert("wading", parametersToToml(s.wading));
+    if (s.practiceOnly) t.insert("practice_only", true);
     if (!s.factors.empty()) {
         toml::table f;
         for (const auto& [k, v] : s.factors) f.insert(k, v);
@@ -984,6 +1002,7 @@ Stimulus stimulusFromToml(const std::string& text) {
                                              : SensorKind::None;
     s.input.walker = parametersFromToml(t["input"]["walker"].as_table());
     s.wading = parametersFromToml(t["wading"].as_table());
+    s.practiceOnly = t["practice_only"].value_or(false);
     if (const toml::table* f = t["factors"].as_table())
         for (auto&& [k, v] : *f) s.factors[std::string(k.str())] = v.value_or(std::string{});
     if (s.id.empty() || s.surface.empty())

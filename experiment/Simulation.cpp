@@ -241,3 +241,88 @@ double SimulatedParticipant::responseTimeS() {
 }
 
 } // namespace underfoot::experiment
+
+#include "experiment/Session.h"
+
+namespace underfoot::experiment {
+
+int runSimulatedSession(StudyStore& store, const std::string& code, const ConfusionMatrix& matrix,
+                        std::uint64_t seed, const SimulationSettings& settings,
+                        const CommitCallback& onCommitted) {
+    const ParticipantInfo info = store.participant(code);
+    const auto first = store.firstUnanswered(code);
+    if (!first) return 0;
+    // The answerer's stream depends on where the session resumes, so a resumed participant
+    // still gets reproducible answers.
+    SimulatedParticipant answerer(matrix, store.protocol(), info.groupId,
+                                  deriveSeed(seed, {static_cast<std::uint64_t>(info.index),
+                                                    static_cast<std::uint64_t>(*first)}),
+                                  settings);
+    double simulatedTimeS = 0.0;
+    SilentPlayer player;
+    Session session(store, code, player,
+                    SessionSettings{"simulation", "none (simulated)", "none (simulated)",
+                                    UNDERFOOT_VERSION},
+                    [&] { return simulatedTimeS; });
+    int committed = 0;
+    while (session.phase() != SessionPhase::Finished) {
+        switch (session.phase()) {
+        case SessionPhase::Briefing: session.finishBriefing(); break;
+        case SessionPhase::Break: session.finishBreak(); break;
+        case SessionPhase::Practice:
+        case SessionPhase::Trial: {
+            const TrialRecord trial = session.current();
+            session.play();
+            const TrialAnswer a = answerer.answer(trial);
+            simulatedTimeS += answerer.responseTimeS();
+            session.answer(a);
+            ++committed;
+            if (onCommitted) onCommitted(code, trial.index);
+            break;
+        }
+        case SessionPhase::Finished: break;
+        }
+    }
+    return committed;
+}
+
+int simulateStudy(StudyStore& store, const MatrixByGroup& matrices, int participants,
+                  const SimulationSettings& settings, const std::string& codePrefix,
+                  const CommitCallback& onCommitted) {
+    auto matrixFor = [&](const std::string& groupId) -> const ConfusionMatrix& {
+        if (auto it = matrices.find(groupId); it != matrices.end()) return it->second;
+        if (auto it = matrices.find(""); it != matrices.end()) return it->second;
+        throw std::runtime_error(fmt::format("no confusion matrix for group '{}'", groupId));
+    };
+    const std::uint64_t seed = deriveSeed(store.info().seed, {0x5157}); // "simulation" stream
+    int committed = 0;
+    int completed = 0;
+    for (const auto& p : store.participants()) {
+        if (p.status == ParticipantStatus::Dropped) continue;
+        if (p.status != ParticipantStatus::Completed && store.firstUnanswered(p.code))
+            committed += runSimulatedSession(store, p.code, matrixFor(p.groupId), seed, settings,
+                                             onCommitted);
+        ++completed;
+    }
+    int next = static_cast<int>(store.participants().size()) + 1;
+    while (completed < participants) {
+        std::string code;
+        do {
+            code = fmt::format("{}{:03}", codePrefix, next++);
+        } while ([&] {
+            try {
+                store.participant(code);
+                return true;
+            } catch (const StoreError&) {
+                return false;
+            }
+        }());
+        const ParticipantInfo p = store.registerParticipant({code, std::nullopt, "", "", "", {}, ""});
+        committed +=
+            runSimulatedSession(store, p.code, matrixFor(p.groupId), seed, settings, onCommitted);
+        ++completed;
+    }
+    return committed;
+}
+
+} // namespace underfoot::experiment

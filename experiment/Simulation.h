@@ -6,6 +6,7 @@
 #include "experiment/Random.h"
 #include "experiment/Store.h"
 
+#include <functional>
 #include <map>
 #include <string>
 #include <vector>
@@ -69,5 +70,28 @@ class SimulatedParticipant {
     Rng rng_;
     SimulationSettings settings_;
 };
+
+} // namespace underfoot::experiment
+
+namespace underfoot::experiment {
+
+/// Confusion matrices by group id; the entry "" is used for groups without their own.
+using MatrixByGroup = std::map<std::string, ConfusionMatrix>;
+
+/// Called after each answer is durably committed (participant code, trial index).
+using CommitCallback = std::function<void(const std::string&, int)>;
+
+/// Runs (or resumes) one participant's session with a synthetic answerer, from the first
+/// unanswered trial to the end. Returns the number of answers committed.
+int runSimulatedSession(StudyStore& store, const std::string& code, const ConfusionMatrix& matrix,
+                        std::uint64_t seed, const SimulationSettings& settings,
+                        const CommitCallback& onCommitted = {});
+
+/// Produces a whole study: first finishes every registered, unfinished participant, then
+/// registers new ones (codes `<prefix>001`, ...) with balanced assignment until `participants`
+/// have completed. Deterministic for a given study seed. Returns the number of answers.
+int simulateStudy(StudyStore& store, const MatrixByGroup& matrices, int participants,
+                  const SimulationSettings& settings, const std::string& codePrefix = "S",
+                  const CommitCallback& onCommitted = {});
 
 } // namespace underfoot::experiment

@@ -1,0 +1,105 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// `underfoot protocol check FILE`: validates a protocol and prints its plan summary.
+#include "app/cli/CommandRegistry.h"
+#include "experiment/Plan.h"
+#include "experiment/Protocol.h"
+
+#include <fmt/core.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace {
+
+using namespace underfoot::experiment;
+
+std::string minutes(double seconds) {
+    return fmt::format("{:.0f} min {:02.0f} s", std::floor(seconds / 60.0),
+                       std::fmod(seconds, 60.0));
+}
+
+void printSummary(const Protocol& p, std::uint64_t seed, int participants) {
+    fmt::print("{} — {} (version {})\n", p.id, p.title, p.version);
+    if (!p.reference.empty()) fmt::print("reference: {}\n", p.reference);
+    fmt::print("sha256: {}\n", p.hash);
+    fmt::print("design: {}-subject, {} stimuli, {} repetition(s), order {}{}{}\n",
+               toString(p.design), p.stimuli.size(), p.ordering.repetitions,
+               p.ordering.order == OrderKind::Random ? "random per participant" : "fixed",
+               p.ordering.blocks == BlockKind::Repetition ? ", one block per repetition" : "",
+               p.ordering.noImmediateRepeat ? ", no immediate repeat" : "");
+    fmt::print("questions: {}{}{}{}\n",
+               p.questions.asksSurface()
+                   ? fmt::format("surface ({} options)", p.questions.surfaceOptions.size())
+                   : "no surface question",
+               p.questions.scales.empty() ? "" : fmt::format(", {} scale(s)",
+                                                             p.questions.scales.size()),
+               p.questions.soundscapeOptions.empty() ? "" : ", soundscape",
+               p.questions.comment ? ", comment" : "");
+    const PlanSummary summary = summarizePlans(p, seed, participants);
+    fmt::print("\nPer participant\n");
+    fmt::print("  {:<14} {:>8} {:>6} {:>6} {:>7}  {}\n", "group", "practice", "trials", "breaks",
+               "target", "estimated duration");
+    for (std::size_t i = 0; i < summary.groups.size(); ++i) {
+        const auto& g = summary.groups[i];
+        fmt::print("  {:<14} {:>8} {:>6} {:>6} {:>7}  {}\n", g.groupId, g.practiceTrials,
+                   g.mainTrials, g.breaks,
+                   p.groups[i].target > 0 ? std::to_string(p.groups[i].target) : "-",
+                   minutes(g.estimatedDurationS));
+    }
+    fmt::print("\nBalance over {} simulated participant(s) per group (seed {}): presentations "
+               "per stimulus, times first, mean position (ideal in brackets)\n",
+               participants, seed);
+    for (const auto& table : summary.balance) {
+        fmt::print("  group {}\n", table.groupId);
+        const std::size_t positions = table.counts.empty() ? 0 : table.counts[0].size();
+        const double ideal = positions > 0 ? (static_cast<double>(positions) - 1.0) / 2.0 : 0.0;
+        for (std::size_t s = 0; s < table.stimulusIds.size(); ++s) {
+            int total = 0;
+            double weighted = 0;
+            for (std::size_t pos = 0; pos < positions; ++pos) {
+                total += table.counts[s][pos];
+                weighted += static_cast<double>(table.counts[s][pos] * static_cast<int>(pos));
+            }
+            fmt::print("    {:<20} {:>5} {:>5} {:>7.2f} [{:.1f}]\n", table.stimulusIds[s], total,
+                       positions ? table.counts[s][0] : 0, total ? weighted / total : 0.0, ideal);
+        }
+    }
+}
+
+const underfoot::cli::CommandRegistrar registrar{
+    "protocol", [](CLI::App& app, int& exitCode) {
+        auto* cmd = app.add_subcommand("protocol", "Protocol files: validate and summarise");
+        cmd->require_subcommand(1);
+        auto* check = cmd->add_subcommand(
+            "check", "Validate a protocol (every problem with file:line:column) and print the "
+                     "plan summary: trials per participant, balance table, estimated duration");
+        static std::string file;
+        static std::uint64_t seed = 1;
+        static int participants = 0;
+        check->add_option("FILE", file, "protocol TOML file")->required();
+        check->add_option("--seed", seed, "study seed for the balance table")->default_val(1);
+        check->add_option("--participants", participants,
+                          "participants per group for the balance table (default: the group "
+                          "target, else 20)")
+            ->check(CLI::Range(0, 100000));
+        check->callback([&exitCode] {
+            Protocol p;
+            try {
+                p = loadProtocol(file);
+            } catch (const ProtocolError& e) {
+                fmt::print(stderr, "{}\n", e.what());
+                fmt::print(stderr, "underfoot: {} problem(s) in {}\n", e.problems().size(), file);
+                exitCode = 2;
+                return;
+            }
+            int n = participants;
+            if (n == 0) {
+                for (const auto& g : p.groups) n = std::max(n, g.target);
+                if (n == 0) n = 20;
+            }
+            printSummary(p, seed, n);
+            exitCode = 0;
+        });
+    }};
+
+} // namespace
