@@ -1,0 +1,151 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "engine/models/Friction.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace underfoot::engine {
+
+template <typename Real>
+void ElastoPlasticFrictionT<Real>::configure(const FrictionParams& p, std::vector<Mode> modes,
+                                             std::vector<std::vector<double>> gains) {
+    auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
+    auto nonNegative = [](double v) { return std::isfinite(v) && v >= 0.0; };
+    if (!positive(p.sigma0) || !nonNegative(p.sigma1) || !nonNegative(p.sigma2) ||
+        !nonNegative(p.sigma3))
+        throw std::invalid_argument("friction: sigma0 must be > 0 and sigma1..3 >= 0");
+    if (!nonNegative(p.dynamicCoefficient) || !(p.staticCoefficient >= p.dynamicCoefficient))
+        throw std::invalid_argument("friction: need 0 <= mu_d <= mu_s");
+    if (!positive(p.stribeckVelocity) || !positive(p.exciterMassKg))
+        throw std::invalid_argument("friction: Stribeck velocity and mass must be > 0");
+    if (!(p.breakAway > 0.0 && p.breakAway < 1.0))
+        throw std::invalid_argument("friction: break-away fraction must lie in (0, 1)");
+    params_ = p;
+    resonator_.configure(std::move(modes), std::move(gains));
+}
+
+template <typename Real>
+void ElastoPlasticFrictionT<Real>::prepare(double fs) {
+    T_ = 1.0 / fs;
+    resonator_.prepare(fs);
+    kd_ = T_ / (2.0 * params_.exciterMassKg) + resonator_.mobility(0);
+    reset(0);
+}
+
+template <typename Real>
+void ElastoPlasticFrictionT<Real>::reset(std::uint64_t seed) noexcept {
+    resonator_.reset();
+    rng_.setSeed(seed);
+    z_ = v_ = force_ = exciterX_ = exciterV_ = lastDrive_ = 0;
+}
+
+template <typename Real>
+double ElastoPlasticFrictionT<Real>::alphaOf(double z, double v, double zss,
+                                             double zba) const noexcept {
+    if (v == 0.0 || (z > 0) != (v > 0)) return 0.0; // opposite signs: elastic only
+    const double az = std::fabs(z), ass = std::fabs(zss);
+    if (az <= zba) return 0.0;
+    if (az >= ass) return 1.0;
+    return 0.5 * std::sin(kPi * (az - 0.5 * (ass + zba)) / (ass - zba)) + 0.5;
+}
+
+template <typename Real>
+double ElastoPlasticFrictionT<Real>::processSample(double normal, double drive) noexcept {
+    const double T = T_, M = params_.exciterMassKg;
+    const double N = std::max(0.0, normal);
+    const double fc = params_.dynamicCoefficient * N, fs = params_.staticCoefficient * N;
+    const double noise = params_.sigma3 * rng_.bipolar();
+
+    // Predictions without a new friction force (old force held, drive ramped).
+    const double aNow = (lastDrive_ - force_) / M;
+    const double aNextExt = drive / M;
+    const double vePred = exciterV_ + 0.5 * T * (aNow + aNextExt);
+    const double xePred = exciterX_ + T * exciterV_ + T * T * (aNow / 3.0 + aNextExt / 6.0);
+    resonator_.predict();
+    const double vRelPred = vePred - resonator_.predictedVelocity(0);
+
+    // Friction force as a function of the relative velocity at n+1.
+    const double z0 = z_;
+    auto bristleAt = [&](double v1) {
+        if (N <= 0.0) return 0.0; // no load: the bristles relax completely
+        const double s = (v1 >= 0.0) ? 1.0 : -1.0;
+        const double zss = s *
+                           (fc + (fs - fc) * std::exp(-(v1 * v1) / (params_.stribeckVelocity *
+                                                                    params_.stribeckVelocity))) /
+                           params_.sigma0;
+        const double zba = params_.breakAway * fc / params_.sigma0;
+        const double a = alphaOf(z0, v1, zss, zba);
+        // Backward Euler: z1 = z0 + T v1 (1 - a z1 / zss), linear in z1 (v1 / zss >= 0).
+        const double denom = 1.0 + (zss != 0.0 ? T * v1 * a / zss : 0.0);
+        return (z0 + T * v1) / denom;
+    };
+    auto forceAt = [&](double v1, double z1) {
+        return params_.sigma0 * z1 + params_.sigma1 * (z1 - z0) / T + params_.sigma2 * v1 + noise;
+    };
+    // h(v) = v - (vRelPred - kd F(v)) is increasing in v; find its root.
+    auto h = [&](double v1) { return v1 - vRelPred + kd_ * forceAt(v1, bristleAt(v1)); };
+    double lo = vRelPred, hi = vRelPred;
+    double hlo = h(lo), hhi = hlo;
+    double step = std::max(1e-6, std::fabs(vRelPred));
+    for (int k = 0; k < 60 && hlo > 0.0; ++k) {
+        hi = lo;
+        hhi = hlo;
+        lo -= step;
+        step *= 2;
+        hlo = h(lo);
+    }
+    step = std::max(1e-6, std::fabs(vRelPred));
+    for (int k = 0; k < 60 && hhi < 0.0; ++k) {
+        lo = hi;
+        hlo = hhi;
+        hi += step;
+        step *= 2;
+        hhi = h(hi);
+    }
+    double v1 = (hlo == 0.0) ? lo : hi;
+    if (hlo < 0.0 && hhi > 0.0) {
+        for (int it = 0; it < params_.maxIterations; ++it) {
+            double x = lo - hlo * (hi - lo) / (hhi - hlo); // secant (regula falsi)
+            if (!(x > lo && x < hi)) x = 0.5 * (lo + hi);
+            const double hx = h(x);
+            v1 = x;
+            if (hx == 0.0 || (hi - lo) < 1e-12 * (1.0 + std::fabs(x))) break;
+            if (hx < 0.0) {
+                lo = x;
+                hlo = hx;
+            } else {
+                hi = x;
+                hhi = hx;
+            }
+            if (it % 2 == 1) { // Illinois-style safeguard: alternate with bisection
+                const double m = 0.5 * (lo + hi), hm = h(m);
+                if (hm < 0.0) {
+                    lo = m;
+                    hlo = hm;
+                } else {
+                    hi = m;
+                    hhi = hm;
+                }
+                v1 = m;
+            }
+        }
+    }
+    const double z1 = bristleAt(v1);
+    const double f = forceAt(v1, z1);
+
+    // Commit: friction acts against the exciter's relative motion, with it on the resonator.
+    exciterX_ = xePred - T * T / (6.0 * M) * f;
+    exciterV_ = vePred - 0.5 * T / M * f;
+    resonator_.commit(0, f);
+    z_ = snapToZero(z1);
+    v_ = exciterV_ - resonator_.velocity(0);
+    force_ = f;
+    lastDrive_ = drive;
+    return resonator_.velocity(0);
+}
+
+template class ElastoPlasticFrictionT<double>;
+template class ElastoPlasticFrictionT<float>;
+
+} // namespace underfoot::engine

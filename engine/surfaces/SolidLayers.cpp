@@ -1,0 +1,290 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Solid-floor layers. The GRF (N) drives them through two physical gestures:
+//  - a foot contact begins when the GRF rises through `onset_n` after the foot was off the floor
+//    (below `release_n` for at least 30 ms): the sole strikes the floor with a velocity that
+//    grows with the loading rate (a harder, faster landing is a faster sole);
+//  - further sharp rises of the load (the forefoot slapping down, or the micro-impacts that a
+//    microphone envelope carries) re-strike the floor while the foot is down;
+//  - a fraction of the GRF itself presses the sole onto the floor (the low "thud" of the
+//    floor's bending under the load, and the contact damping while standing).
+#include "engine/surfaces/SolidLayers.h"
+
+#include "engine/dsp/Envelope.h"
+#include "engine/models/Friction.h"
+#include "engine/models/Impact.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace underfoot::engine {
+namespace {
+
+/// Reads `modes = [{ freq_hz, t60_s, mass_kg, gain }, ...]` (the floor's resonances).
+void readModes(PresetReader& reader, const AccuracyOptions& options, std::vector<Mode>& modes,
+               std::vector<double>& gains) {
+    auto tables = reader.tables("modes");
+    if (tables.empty())
+        reader.fail(
+            "",
+            "expected `modes = [{ freq_hz = ..., t60_s = ..., mass_kg = ..., gain = ... }, ...]`");
+    for (auto& m : tables) {
+        Mode mode;
+        mode.frequencyHz =
+            m.requiredNumber("freq_hz", 10.0, 40000.0, "Hz", "frequency of the mode", true);
+        mode.t60Seconds =
+            m.requiredNumber("t60_s", 0.001, 30.0, "s", "time to decay by 60 dB", true);
+        mode.massKg = m.number("mass_kg", 1.0, 1e-4, 1e4, "kg",
+                               "modal mass (heavier = quieter, stiffer floor)", true);
+        gains.push_back(m.number("gain", 1.0, -10.0, 10.0, "", "mode shape at the contact point"));
+        m.finish();
+        modes.push_back(mode);
+    }
+    // Keep the lowest `maxModes` modes (an accuracy knob).
+    if (static_cast<int>(modes.size()) > options.maxModes) {
+        std::vector<std::size_t> order(modes.size());
+        for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+        std::sort(order.begin(), order.end(),
+                  [&](auto a, auto b) { return modes[a].frequencyHz < modes[b].frequencyHz; });
+        order.resize(static_cast<std::size_t>(options.maxModes));
+        std::vector<Mode> m2;
+        std::vector<double> g2;
+        for (auto i : order) {
+            m2.push_back(modes[i]);
+            g2.push_back(gains[i]);
+        }
+        modes = m2;
+        gains = g2;
+    }
+}
+
+/// Detects foot contacts and sharp load rises in a GRF, sample by sample (no allocation).
+class StepGestures {
+  public:
+    double onsetN = 30.0, releaseN = 10.0, retriggerRate = 15000.0, retriggerGapS = 0.05;
+    double referenceRate = 20000.0; ///< N/s giving the nominal strike velocity
+
+    void prepare(double fs) {
+        fs_ = fs;
+        smooth_ = onePoleCoefficientTau(0.0005, fs); // 0.5 ms derivative smoothing
+        reset();
+    }
+    void reset() {
+        last_ = rate_ = 0.0;
+        offSeconds_ = sinceStrike_ = 1e9;
+        down_ = false;
+        rearmed_ = true;
+    }
+    /// Returns a strike strength factor (> 0) when a strike happens at this sample, else 0.
+    double next(double grf) noexcept {
+        const double d = (grf - last_) * fs_;
+        last_ = grf;
+        rate_ = d + smooth_ * (rate_ - d);
+        sinceStrike_ += 1.0;
+        double strike = 0.0;
+        if (!down_) {
+            if (grf < releaseN) offSeconds_ += 1.0 / fs_;
+            if (grf >= onsetN) {
+                down_ = true;
+                rearmed_ = false;
+                if (offSeconds_ >= 0.03) strike = strength(std::max(rate_, 0.0));
+            }
+        } else if (grf < releaseN) {
+            down_ = false;
+            offSeconds_ = 1.0 / fs_;
+        } else if (retriggerRate > 0.0) {
+            if (rate_ < 0.5 * retriggerRate) rearmed_ = true;
+            if (rearmed_ && rate_ > retriggerRate && sinceStrike_ > retriggerGapS * fs_) {
+                rearmed_ = false;
+                strike = 0.5 * strength(rate_);
+            }
+        }
+        if (strike > 0.0) sinceStrike_ = 0.0;
+        return strike;
+    }
+    double rate() const noexcept { return rate_; }
+
+  private:
+    double strength(double rate) const noexcept {
+        return std::clamp(std::sqrt(rate / referenceRate), 0.25, 3.0);
+    }
+    double fs_ = 48000, smooth_ = 0, last_ = 0, rate_ = 0;
+    double offSeconds_ = 1e9, sinceStrike_ = 1e9; // time off the floor, samples since a strike
+    bool down_ = false, rearmed_ = true;
+};
+
+void readGestures(PresetReader& r, StepGestures& g) {
+    g.onsetN = r.number("onset_n", 30.0, 1.0, 500.0, "N", "GRF at which a foot contact begins");
+    g.releaseN =
+        r.number("release_n", 10.0, 0.0, 400.0, "N", "GRF below which the foot is off the floor");
+    if (g.releaseN >= g.onsetN) r.fail("release_n", "expected release_n below onset_n");
+    g.referenceRate = r.number("reference_rate_n_per_s", 20000.0, 100.0, 1e6, "N/s",
+                               "loading rate that gives the nominal strike velocity", true);
+    g.retriggerRate = r.number("retrigger_rate_n_per_s", 15000.0, 0.0, 1e6, "N/s",
+                               "load rise rate that re-strikes while the foot is down (0 = never)");
+    g.retriggerGapS =
+        r.number("retrigger_gap_s", 0.05, 0.005, 1.0, "s", "shortest time between strikes");
+}
+
+class ImpactLayer final : public SurfaceLayer {
+  public:
+    ImpactLayer(PresetReader& r, const AccuracyOptions& options) {
+        std::vector<Mode> modes;
+        std::vector<double> gains;
+        readModes(r, options, modes, gains);
+        ImpactParams p;
+        p.stiffness = r.number("stiffness", 1e7, 1e4, 1e11, "N/m^alpha",
+                               "sole-floor contact stiffness", true);
+        p.alpha = r.number("alpha", 1.5, 1.0, 3.0, "", "contact hardening exponent");
+        p.dissipation =
+            r.number("dissipation", 0.5, 0.0, 5.0, "s/m", "contact damping (Hunt-Crossley mu)");
+        p.exciterMassKg = r.number("sole_mass_kg", 0.3, 0.001, 5.0, "kg",
+                                   "effective mass of the striking sole", true);
+        p.oversampling = options.oversampling;
+        p.newtonIterations = options.newtonIterations;
+        p.solver = options.explicitImpact ? ImpactSolver::Explicit : ImpactSolver::Newton;
+        strikeVelocity_ =
+            r.number("strike_velocity", 0.5, 0.01, 3.0, "m/s", "sole speed at a nominal landing");
+        pressFraction_ = r.number("press_fraction", 0.05, 0.0, 1.0, "",
+                                  "share of the GRF pressing the sole on the floor");
+        gain_ = dbToGain(r.number("gain_db", 20.0, -40.0, 80.0, "dB",
+                                  "output gain (0 dB: 1 m/s floor velocity = full scale)"));
+        readGestures(r, gestures_);
+        impact_.configure(p, std::move(modes), {gains});
+    }
+    void prepare(const ProcessSpec& spec) override {
+        impact_.prepare(spec);
+        gestures_.prepare(spec.sampleRateHz);
+        press_.assign(static_cast<std::size_t>(spec.maxBlockSize), 0.0f);
+        buffer_.assign(static_cast<std::size_t>(spec.maxBlockSize), 0.0f);
+    }
+    void reset(std::uint64_t) noexcept override {
+        impact_.reset();
+        gestures_.reset();
+    }
+    void process(const float* grf, float* out, int n) noexcept override {
+        int start = 0;
+        bool anyLoad = false;
+        for (int i = 0; i < n; ++i) {
+            const double g = std::max(0.0f, grf[i]);
+            anyLoad |= g > 0.0;
+            press_[static_cast<std::size_t>(i)] = static_cast<float>(pressFraction_ * g);
+            const double strike = gestures_.next(g);
+            if (strike > 0.0) {
+                run(start, i, out);
+                impact_.strike(strikeVelocity_ * strike);
+                start = i;
+            }
+        }
+        if (!anyLoad && impact_.isSleeping()) return; // nothing to do
+        run(start, n, out);
+    }
+    bool isSleeping() const noexcept override { return impact_.isSleeping(); }
+    const char* kind() const noexcept override { return "impact"; }
+
+  private:
+    void run(int from, int to, float* out) noexcept {
+        if (to <= from) return;
+        impact_.process(press_.data() + from, buffer_.data() + from, to - from);
+        const float g = static_cast<float>(gain_);
+        for (int i = from; i < to; ++i) out[i] += g * buffer_[static_cast<std::size_t>(i)];
+    }
+    HuntCrossleyImpact impact_;
+    StepGestures gestures_;
+    double strikeVelocity_, pressFraction_, gain_;
+    std::vector<float> press_, buffer_;
+};
+
+/// Creaking boards: while the load changes, the boards shear against each other (and their nails):
+/// an anchor moves with a speed proportional to the GRF's rate of change and drags a rubbing mass
+/// through a stiff spring; stick-slip against the boards' modes makes the creak.
+class FrictionLayer final : public SurfaceLayer {
+  public:
+    FrictionLayer(PresetReader& r, const AccuracyOptions& options) {
+        std::vector<Mode> modes;
+        std::vector<double> gains;
+        readModes(r, options, modes, gains);
+        FrictionParams p;
+        p.sigma0 = r.number("sigma0", 1e5, 1e2, 1e8, "N/m", "bristle stiffness", true);
+        p.sigma1 = r.number("sigma1", 300.0, 0.0, 1e5, "N s/m", "bristle damping");
+        p.sigma2 = r.number("sigma2", 0.5, 0.0, 100.0, "N s/m", "viscous friction");
+        p.sigma3 = r.number("sigma3", 0.0, 0.0, 100.0, "N", "roughness noise");
+        p.staticCoefficient =
+            r.number("static_coefficient", 0.6, 0.0, 2.0, "", "static friction per newton of load");
+        p.dynamicCoefficient = r.number("dynamic_coefficient", 0.3, 0.0, 2.0, "",
+                                        "Coulomb friction per newton of load");
+        if (p.dynamicCoefficient > p.staticCoefficient)
+            r.fail("dynamic_coefficient", "expected dynamic_coefficient <= static_coefficient");
+        p.stribeckVelocity =
+            r.number("stribeck_velocity", 0.05, 1e-4, 1.0, "m/s", "Stribeck velocity", true);
+        p.breakAway = r.number("break_away", 0.7, 0.05, 0.95, "",
+                               "break-away deflection / static deflection");
+        p.exciterMassKg = r.number("rubbing_mass_kg", 0.05, 1e-3, 5.0, "kg",
+                                   "mass of the rubbing board edge", true);
+        normalFraction_ = r.number("normal_fraction", 0.2, 0.0, 1.0, "",
+                                   "share of the GRF pressing the rubbing surfaces");
+        driveStiffness_ = r.number("drive_stiffness", 1e6, 1e2, 1e7, "N/m",
+                                   "stiffness dragging the rubbing mass", true);
+        driveDamping_ = r.number("drive_damping", 5.0, 0.0, 1e3, "N s/m", "damping of the drag");
+        slipPerRate_ = r.number("slip_m_per_s_per_kn_per_s", 0.002, 0.0, 0.1, "(m/s)/(kN/s)",
+                                "shear speed of the boards per kN/s of load change");
+        threshold_ = r.number("slip_threshold_n_per_s", 500.0, 0.0, 1e5, "N/s",
+                              "load change below which the boards do not shear");
+        gain_ = dbToGain(
+            r.number("gain_db", 20.0, -40.0, 80.0, "dB", "output gain (0 dB: 1 m/s = full scale)"));
+        friction_.configure(p, std::move(modes), {gains});
+    }
+    void prepare(const ProcessSpec& spec) override {
+        fs_ = spec.sampleRateHz;
+        friction_.prepare(fs_);
+        smooth_ = onePoleCoefficientTau(0.005, fs_);
+    }
+    void reset(std::uint64_t seed) noexcept override {
+        friction_.reset(seed);
+        last_ = rate_ = anchor_ = 0;
+        quiet_ = 1 << 30;
+    }
+    void process(const float* grf, float* out, int n) noexcept override {
+        const float g = static_cast<float>(gain_);
+        for (int i = 0; i < n; ++i) {
+            const double load = std::max(0.0f, grf[i]);
+            const double d = (load - last_) * fs_;
+            last_ = load;
+            rate_ = d + smooth_ * (rate_ - d);
+            if (load <= 0.0 && quiet_ > static_cast<long>(fs_)) {
+                continue; // asleep: no load and the boards have rung out
+            }
+            const double shear = std::max(0.0, std::fabs(rate_) - threshold_) * 1e-3 * slipPerRate_;
+            anchor_ += shear / fs_;
+            const double xe = friction_.exciterPosition(), ve = friction_.exciterVelocity();
+            if (load <= 0.0) anchor_ = xe; // unloaded: the drag relaxes
+            const double drive = driveStiffness_ * (anchor_ - xe) + driveDamping_ * (shear - ve);
+            const double y = friction_.processSample(normalFraction_ * load, drive);
+            out[i] += g * static_cast<float>(y);
+            quiet_ = (std::fabs(y) < 1e-9 && load <= 0.0) ? quiet_ + 1 : 0;
+        }
+        friction_.resonator().flushTinyState();
+    }
+    bool isSleeping() const noexcept override {
+        return quiet_ > static_cast<long>(fs_) && last_ <= 0.0;
+    }
+    const char* kind() const noexcept override { return "friction"; }
+
+  private:
+    ElastoPlasticFriction friction_;
+    double normalFraction_, driveStiffness_, driveDamping_, slipPerRate_, threshold_, gain_;
+    double fs_ = 48000, smooth_ = 0, last_ = 0, rate_ = 0, anchor_ = 0;
+    long quiet_ = 1 << 30;
+};
+
+} // namespace
+
+std::unique_ptr<SurfaceLayer> makeImpactLayer(PresetReader& reader,
+                                              const AccuracyOptions& options) {
+    return std::make_unique<ImpactLayer>(reader, options);
+}
+std::unique_ptr<SurfaceLayer> makeFrictionLayer(PresetReader& reader,
+                                                const AccuracyOptions& options) {
+    return std::make_unique<FrictionLayer>(reader, options);
+}
+
+} // namespace underfoot::engine
