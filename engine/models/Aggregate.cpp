@@ -1,0 +1,256 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "engine/models/Aggregate.h"
+
+#include "engine/dsp/ProcessSpec.h"
+
+#include <fmt/core.h>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace underfoot::engine {
+
+namespace {
+constexpr int kLanes = 8;                 // resonator slots summed in parallel lanes
+constexpr int kMaxEventsPerSample = 8;    // bound on the work of one sample
+constexpr int kMaxBurstEvents = 256;      // bound on one burst
+constexpr double kMaxVoiceSeconds = 30.0; // no voice rings longer than this
+constexpr double kSilenceBelowMaxDb = -80.0;
+
+void require(bool ok, const char* name, const std::string& expected, double value) {
+    if (!ok)
+        throw std::invalid_argument(
+            fmt::format("aggregate parameter {}: expected {}, got {:g}", name, expected, value));
+}
+
+int roundUpLanes(int slots) {
+    return (slots + kLanes - 1) / kLanes * kLanes;
+}
+} // namespace
+
+void AggregateParameters::validate() const {
+    auto finite = [](double v) { return std::isfinite(v); };
+    require(finite(gamma) && gamma >= -10 && gamma <= 10, "gamma", "a number in [-10, 10]", gamma);
+    require(finite(energyMin) && energyMin > 0, "energyMin", "a positive number", energyMin);
+    require(finite(energyMax) && energyMax >= energyMin, "energyMax", "a number >= energyMin",
+            energyMax);
+    require(resonances >= 1 && resonances <= 4, "resonances", "1..4", resonances);
+    require(finite(freqMinHz) && freqMinHz > 0, "freqMinHz", "a positive frequency", freqMinHz);
+    require(finite(freqMaxHz) && freqMaxHz >= freqMinHz, "freqMaxHz", "a frequency >= freqMinHz",
+            freqMaxHz);
+    require(finite(qMin) && qMin >= 0.1, "qMin", "a quality factor >= 0.1", qMin);
+    require(finite(qMax) && qMax >= qMin, "qMax", "a quality factor >= qMin", qMax);
+    require(voices >= 1 && voices <= 4096, "voices", "1..4096", voices);
+    require(finite(burstEvents) && burstEvents >= 0 && burstEvents <= 64, "burstEvents",
+            "a mean count in [0, 64]", burstEvents);
+    require(finite(burstMs) && burstMs > 0, "burstMs", "a positive time", burstMs);
+    require(finite(maxRateHz) && maxRateHz > 0, "maxRateHz", "a positive rate", maxRateHz);
+}
+
+void AggregateModel::configure(const AggregateParameters& parameters) {
+    parameters.validate();
+    params_ = parameters;
+}
+
+void AggregateModel::prepare(double sampleRateHz, int maxEventsPerSecond) {
+    if (!(sampleRateHz > 0) || !std::isfinite(sampleRateHz))
+        throw std::invalid_argument(fmt::format("aggregate: bad sample rate {:g}", sampleRateHz));
+    sampleRateHz_ = sampleRateHz;
+    const double cap =
+        std::min(params_.maxRateHz, static_cast<double>(std::max(1, maxEventsPerSecond)));
+    // The cap bounds the total rate, burst micro-events included.
+    rateCapHz_ = cap;
+    silenceAmplitude_ = std::sqrt(params_.energyMax) * std::pow(10.0, kSilenceBelowMaxDb / 20.0);
+    stride_ = params_.resonances;
+    const std::size_t slots = static_cast<std::size_t>(roundUpLanes(params_.voices * stride_));
+    c1_.assign(slots, 0.0f);
+    c2_.assign(slots, 0.0f);
+    y1_.assign(slots, 0.0f);
+    y2_.assign(slots, 0.0f);
+    const auto v = static_cast<std::size_t>(params_.voices);
+    deathSample_.assign(v, 0);
+    startAmplitude_.assign(v, 0.0);
+    logDecay_.assign(v, 0.0);
+    startSample_.assign(v, 0);
+    reset(0);
+}
+
+void AggregateModel::reset(std::uint64_t seed) noexcept {
+    random_.setSeed(seed);
+    clock_.reset(random_);
+    burstClock_.reset(random_);
+    burstRemaining_ = 0;
+    burstScale_ = 0.0;
+    pendingTrigger_ = 0.0;
+    std::fill(c1_.begin(), c1_.end(), 0.0f);
+    std::fill(c2_.begin(), c2_.end(), 0.0f);
+    std::fill(y1_.begin(), y1_.end(), 0.0f);
+    std::fill(y2_.begin(), y2_.end(), 0.0f);
+    activeVoices_ = 0;
+    nextDeath_ = INT64_MAX;
+    sample_ = 0;
+    eventCount_ = 0;
+    stolen_ = 0;
+}
+
+void AggregateModel::trigger(double energy) noexcept {
+    if (std::isfinite(energy) && energy > 0) pendingTrigger_ += energy;
+}
+
+void AggregateModel::spawn(double energy, bool burst) noexcept {
+    ++eventCount_;
+    if (observer_) observer_(observerUser_, {sample_, energy, burst});
+    const double amplitude = std::sqrt(energy);
+    if (!(amplitude > silenceAmplitude_) || c1_.empty()) return; // inaudible: no voice
+    int v;
+    if (activeVoices_ < params_.voices) {
+        v = activeVoices_++;
+    } else { // pool full: replace the quietest voice
+        v = 0;
+        double quietest = HUGE_VAL;
+        for (int i = 0; i < activeVoices_; ++i) {
+            const auto u = static_cast<std::size_t>(i);
+            const double a =
+                startAmplitude_[u] *
+                std::exp(logDecay_[u] * static_cast<double>(sample_ - startSample_[u]));
+            if (a < quietest) {
+                quietest = a;
+                v = i;
+            }
+        }
+        ++stolen_;
+    }
+    const double nyquistGuard = 0.45 * sampleRateHz_; // resonances stay below Nyquist
+    const double fLo = std::min(params_.freqMinHz, nyquistGuard);
+    const double fHi = std::min(params_.freqMaxHz, nyquistGuard);
+    double weights[4];
+    double sumSquares = 0.0;
+    for (int k = 0; k < stride_; ++k) {
+        weights[k] = random_.uniform(0.3, 1.0);
+        sumSquares += weights[k] * weights[k];
+    }
+    const double norm = amplitude / std::sqrt(sumSquares);
+    double slowest = 0.0; // largest log(r), i.e. the slowest decay
+    bool first = true;
+    for (int k = 0; k < stride_; ++k) {
+        const double f = fLo * std::pow(fHi / fLo, random_.uniform());
+        const double q = params_.qMin * std::pow(params_.qMax / params_.qMin, random_.uniform());
+        const double theta = kTwoPi * f / sampleRateHz_;
+        const double logR = -kPi * f / (q * sampleRateHz_);
+        const double r = std::exp(logR);
+        const auto s = static_cast<std::size_t>(v * stride_ + k);
+        c1_[s] = static_cast<float>(2.0 * r * std::cos(theta));
+        c2_[s] = static_cast<float>(r * r);
+        y1_[s] = 0.0f;
+        // y[n] = a r^n sin((n+1) theta) needs y[-1] = 0, y[-2] = -a sin(theta) / r^2.
+        y2_[s] = static_cast<float>(-norm * weights[k] * std::sin(theta) / (r * r));
+        if (first || logR > slowest) slowest = logR;
+        first = false;
+    }
+    const auto u = static_cast<std::size_t>(v);
+    const double life = std::min(std::log(silenceAmplitude_ / amplitude) / slowest,
+                                 kMaxVoiceSeconds * sampleRateHz_);
+    deathSample_[u] = sample_ + static_cast<std::int64_t>(std::ceil(life)) + 1;
+    startAmplitude_[u] = amplitude;
+    logDecay_[u] = slowest;
+    startSample_[u] = sample_;
+    nextDeath_ = std::min(nextDeath_, deathSample_[u]);
+}
+
+void AggregateModel::freeVoice(int v) noexcept {
+    const int last = activeVoices_ - 1;
+    if (v != last) {
+        for (int k = 0; k < stride_; ++k) {
+            const auto d = static_cast<std::size_t>(v * stride_ + k);
+            const auto s = static_cast<std::size_t>(last * stride_ + k);
+            c1_[d] = c1_[s];
+            c2_[d] = c2_[s];
+            y1_[d] = y1_[s];
+            y2_[d] = y2_[s];
+        }
+        const auto d = static_cast<std::size_t>(v), s = static_cast<std::size_t>(last);
+        deathSample_[d] = deathSample_[s];
+        startAmplitude_[d] = startAmplitude_[s];
+        logDecay_[d] = logDecay_[s];
+        startSample_[d] = startSample_[s];
+    }
+    for (int k = 0; k < stride_; ++k) {
+        const auto s = static_cast<std::size_t>(last * stride_ + k);
+        c1_[s] = c2_[s] = y1_[s] = y2_[s] = 0.0f;
+    }
+    --activeVoices_;
+}
+
+void AggregateModel::retireDeadVoices() noexcept {
+    for (int v = activeVoices_ - 1; v >= 0; --v)
+        if (deathSample_[static_cast<std::size_t>(v)] <= sample_) freeVoice(v);
+    nextDeath_ = INT64_MAX;
+    for (int v = 0; v < activeVoices_; ++v)
+        nextDeath_ = std::min(nextDeath_, deathSample_[static_cast<std::size_t>(v)]);
+}
+
+void AggregateModel::process(const float* rateHz, const float* energyScale, float* out,
+                             int n) noexcept {
+    if (c1_.empty()) return;
+    const double dt = 1.0 / sampleRateHz_;
+    const double meanBurst = params_.burstEvents;
+    // Total rate = primary x (1 + mean burst): cap the primary so the total stays under the cap.
+    const double primaryCap = rateCapHz_ / (1.0 + meanBurst);
+    const double burstExpected = dt * 1000.0 / params_.burstMs;
+    const double burstP = meanBurst / (1.0 + meanBurst); // geometric: P(N = k) = (1-p) p^k
+    const double logBurstP = burstP > 0 ? std::log(burstP) : 0.0;
+    float* c1 = c1_.data();
+    float* c2 = c2_.data();
+    float* y1 = y1_.data();
+    float* y2 = y2_.data();
+    for (int i = 0; i < n; ++i) {
+        double rate = static_cast<double>(rateHz[i]);
+        if (!(rate > 0)) rate = 0; // also NaN
+        rate = std::min(rate, primaryCap);
+        double scale = static_cast<double>(energyScale[i]);
+        if (!(scale > 0) || !std::isfinite(scale)) scale = 0;
+        if (pendingTrigger_ > 0) {
+            spawn(pendingTrigger_, false);
+            pendingTrigger_ = 0;
+        }
+        const int count = clock_.advance(rate * dt, random_, kMaxEventsPerSample);
+        for (int e = 0; e < count; ++e) {
+            spawn(scale * random_.powerLaw(params_.gamma, params_.energyMin, params_.energyMax),
+                  false);
+            if (burstP > 0) {
+                const double extra = std::floor(std::log(random_.uniformOpen0()) / logBurstP);
+                burstRemaining_ = std::min(
+                    kMaxBurstEvents, burstRemaining_ + static_cast<int>(std::min(extra, 1e4)));
+                burstScale_ = scale;
+            }
+        }
+        if (burstRemaining_ > 0) {
+            const int b = std::min(
+                burstRemaining_, burstClock_.advance(burstExpected, random_, kMaxEventsPerSample));
+            for (int e = 0; e < b; ++e)
+                spawn(burstScale_ *
+                          random_.powerLaw(params_.gamma, params_.energyMin, params_.energyMax),
+                      true);
+            burstRemaining_ -= b;
+        }
+        if (sample_ >= nextDeath_) retireDeadVoices();
+        const int slots = roundUpLanes(activeVoices_ * stride_);
+        float acc[kLanes] = {};
+        for (int j = 0; j < slots; j += kLanes) {
+            for (int l = 0; l < kLanes; ++l) {
+                const int s = j + l;
+                const float y = c1[s] * y1[s] - c2[s] * y2[s];
+                y2[s] = y1[s];
+                y1[s] = y;
+                acc[l] += y;
+            }
+        }
+        float sum = 0.0f;
+        for (float a : acc) sum += a;
+        out[i] += sum;
+        ++sample_;
+    }
+}
+
+} // namespace underfoot::engine

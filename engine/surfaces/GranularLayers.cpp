@@ -1,0 +1,197 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "engine/surfaces/GranularLayers.h"
+
+#include "engine/dsp/Envelope.h"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+namespace underfoot::engine {
+
+namespace {
+constexpr double kMaxForceN = 1e5;    // GRF beyond this is clamped (no human produces it)
+constexpr double kTailSeconds = 0.25; // filters ring out this long before the layer sleeps
+constexpr double kDerivativeRefKnPerS = 10.0;
+
+/// GRF sample -> newtons, with NaN/Inf/negative read as 0 (no contact).
+inline double sanitizeForce(float v) noexcept {
+    const double f = static_cast<double>(v);
+    if (!(f > 0.0)) return 0.0;
+    return std::min(f, kMaxForceN);
+}
+} // namespace
+
+GrainsLayer::GrainsLayer(const AggregateParameters& model, const GrainsControl& control,
+                         const AccuracyOptions& options)
+    : control_(control), maxEventsPerSecond_(options.maxEventsPerSecond) {
+    model_.configure(model);
+    gain_ = dbToGain(control.gainDb);
+}
+
+void GrainsLayer::prepare(const ProcessSpec& spec) {
+    sampleRateHz_ = spec.sampleRateHz;
+    model_.prepare(spec.sampleRateHz, maxEventsPerSecond_);
+    derivativeG_ = onePoleCoefficientTau(control_.derivativeMs * 1e-3, sampleRateHz_);
+    const double nyquistGuard = 0.45 * sampleRateHz_;
+    useLowpass_ = control_.lowpassHz > 0 && control_.lowpassHz < nyquistGuard;
+    useHighpass_ = control_.highpassHz > 0;
+    if (useLowpass_)
+        lowpass_.setCoefficients(
+            BiquadCoefficients::lowpass(sampleRateHz_, control_.lowpassHz, 0.7071067811865476));
+    if (useHighpass_)
+        highpass_.setCoefficients(BiquadCoefficients::highpass(
+            sampleRateHz_, std::min(control_.highpassHz, nyquistGuard), 0.7071067811865476));
+    const auto block = static_cast<std::size_t>(std::max(1, spec.maxBlockSize));
+    rate_.assign(block, 0.0f);
+    scale_.assign(block, 0.0f);
+    buffer_.assign(block, 0.0f);
+    tailLength_ = static_cast<int>(kTailSeconds * sampleRateHz_);
+    reset(0);
+}
+
+void GrainsLayer::reset(std::uint64_t seed) noexcept {
+    model_.reset(seed);
+    lowpass_.reset();
+    highpass_.reset();
+    previousF_ = 0.0;
+    derivative_ = 0.0;
+    onsetArmed_ = true;
+    sleeping_ = true;
+    tailSamples_ = 0;
+}
+
+void GrainsLayer::process(const float* grf, float* out, int n) noexcept {
+    const int block = static_cast<int>(buffer_.size());
+    if (block == 0) return; // not prepared
+    for (int done = 0; done < n; done += block)
+        processChunk(grf + done, out + done, std::min(block, n - done));
+}
+
+void GrainsLayer::processChunk(const float* grf, float* out, int n) noexcept {
+    const double threshold = control_.contactThresholdN;
+    if (sleeping_) {
+        bool contact = false;
+        for (int i = 0; i < n && !contact; ++i) contact = sanitizeForce(grf[i]) > threshold;
+        if (!contact) {
+            previousF_ = sanitizeForce(grf[n - 1]);
+            return;
+        }
+        sleeping_ = false;
+        tailSamples_ = 0;
+    }
+    const double toKnPerS = sampleRateHz_ * 1e-3;
+    const double g = derivativeG_;
+    bool contactSeen = false;
+    for (int i = 0; i < n; ++i) {
+        const double f = sanitizeForce(grf[i]);
+        const double raw = (f - previousF_) * toKnPerS;
+        previousF_ = f;
+        derivative_ = raw + g * (derivative_ - raw);
+        const auto u = static_cast<std::size_t>(i);
+        if (f > threshold) {
+            contactSeen = true;
+            const double kn = f * 1e-3;
+            const double rise = std::max(derivative_, 0.0);
+            const double fall = std::max(-derivative_, 0.0);
+            rate_[u] = static_cast<float>(control_.eventsPerSecondPerKn * kn +
+                                          control_.eventsPerKnRise * rise +
+                                          control_.eventsPerKnFall * fall);
+            const double load = control_.loadExponent == 1.0 ? kn
+                                : control_.loadExponent == 0.0
+                                    ? 1.0
+                                    : std::pow(kn, control_.loadExponent);
+            scale_[u] = static_cast<float>(
+                load * (1.0 + control_.riseEnergy * rise / kDerivativeRefKnPerS));
+            if (onsetArmed_ && f >= control_.onsetForceN) {
+                onsetArmed_ = false;
+                if (control_.onsetEnergy > 0)
+                    model_.trigger(control_.onsetEnergy *
+                                   std::clamp(rise / kDerivativeRefKnPerS, 0.1, 3.0));
+            }
+        } else {
+            rate_[u] = 0.0f;
+            scale_[u] = 0.0f;
+            onsetArmed_ = true;
+        }
+    }
+    float* buffer = buffer_.data();
+    std::fill(buffer, buffer + n, 0.0f);
+    model_.process(rate_.data(), scale_.data(), buffer, n);
+    if (useHighpass_) highpass_.process(buffer, n);
+    if (useLowpass_) lowpass_.process(buffer, n);
+    const float gain = static_cast<float>(gain_);
+    for (int i = 0; i < n; ++i) out[i] += gain * buffer[i];
+    derivative_ = snapToZero(derivative_);
+    if (!contactSeen && model_.idle()) {
+        tailSamples_ += n;
+        if (tailSamples_ >= tailLength_) { // rung out: sleep with clean state
+            lowpass_.reset();
+            highpass_.reset();
+            derivative_ = 0.0;
+            sleeping_ = true;
+        }
+    } else {
+        tailSamples_ = 0;
+    }
+}
+
+namespace {
+/// Reads a [lo, hi] pair; a reversed pair is accepted and swapped (sweeps draw them separately).
+std::pair<double, double> orderedPair(double a, double b) {
+    return {std::min(a, b), std::max(a, b)};
+}
+} // namespace
+
+std::unique_ptr<SurfaceLayer> makeGrainsLayer(PresetReader& r, const AccuracyOptions& options) {
+    AggregateParameters m;
+    GrainsControl c;
+    c.gainDb = r.number("gain_db", 0.0, -60.0, 40.0, "dB", "level of this layer");
+    c.eventsPerSecondPerKn =
+        r.number("events_per_s_per_kn", 0.0, 0.0, 10000.0, "events/s/kN",
+                 "event rate per kN of standing load (grains settling under the weight)");
+    c.eventsPerKnRise = r.number("events_per_kn_rise", 0.0, 0.0, 5000.0, "events/kN",
+                                 "events per kN of load increase (crunch while loading)");
+    c.eventsPerKnFall = r.number("events_per_kn_fall", 0.0, 0.0, 5000.0, "events/kN",
+                                 "events per kN of load decrease (spring-back on release)");
+    m.maxRateHz = r.number("max_rate_hz", 4000.0, 1.0, 20000.0, "events/s",
+                           "this layer's cap on the event rate (bursts included)", true);
+    m.gamma = r.number("gamma", -1.5, -4.0, 1.0, "", "exponent of the energy law p(E) ~ E^gamma");
+    m.energyMin = r.number("energy_min", 1e-3, 1e-6, 1.0, "relative",
+                           "smallest event energy (the largest is 1)", true);
+    m.energyMax = 1.0;
+    c.loadExponent = r.number("load_exponent", 1.0, 0.0, 3.0, "",
+                              "event energies scale as (GRF / 1 kN)^load_exponent");
+    c.riseEnergy =
+        r.number("rise_energy", 0.0, 0.0, 20.0, "per 10 kN/s",
+                 "extra energy while the load rises: x (1 + rise_energy dF/dt / 10 kN/s)");
+    c.onsetEnergy = r.number("onset_energy", 0.0, 0.0, 10.0, "relative",
+                             "energy of one event when the heel loads (0: none)");
+    c.onsetForceN = r.number("onset_force_n", 200.0, 1.0, 2000.0, "N",
+                             "load at which the onset event fires", true);
+    m.resonances = r.integer("resonances", 2, 1, 4, "damped resonances per event");
+    std::tie(m.freqMinHz, m.freqMaxHz) =
+        orderedPair(r.number("freq_min_hz", 1000.0, 20.0, 20000.0, "Hz",
+                             "lowest resonance frequency of a grain", true),
+                    r.number("freq_max_hz", 4000.0, 20.0, 20000.0, "Hz",
+                             "highest resonance frequency of a grain", true));
+    std::tie(m.qMin, m.qMax) = orderedPair(
+        r.number("q_min", 5.0, 0.5, 200.0, "", "lowest quality factor (decay Q / (pi f))", true),
+        r.number("q_max", 20.0, 0.5, 200.0, "", "highest quality factor", true));
+    m.burstEvents = r.number("burst_events", 0.0, 0.0, 32.0, "events",
+                             "mean number of micro-events following each event (a crunch)");
+    m.burstMs = r.number("burst_ms", 2.0, 0.1, 100.0, "ms", "mean gap inside a burst", true);
+    m.voices = r.integer("voices", 32, 1, 256, "simultaneous events");
+    c.derivativeMs =
+        r.number("derivative_ms", 5.0, 0.5, 50.0, "ms", "smoothing time constant of dF/dt", true);
+    c.contactThresholdN = r.number("contact_threshold_n", 5.0, 0.5, 100.0, "N",
+                                   "load below which the foot is off the ground (silence)", true);
+    c.lowpassHz =
+        r.number("lowpass_hz", 0.0, 0.0, 20000.0, "Hz", "tone: 2nd-order low-pass cutoff (0: off)");
+    c.highpassHz =
+        r.number("highpass_hz", 20.0, 0.0, 5000.0, "Hz", "2nd-order high-pass cutoff (0: off)");
+    if (c.lowpassHz > 0 && c.lowpassHz < 20) c.lowpassHz = 20; // a 0+ cutoff would mute everything
+    return std::make_unique<GrainsLayer>(m, c, options);
+}
+
+} // namespace underfoot::engine

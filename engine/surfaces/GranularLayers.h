@@ -1,0 +1,75 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+/// The "grains" layer: one stochastic aggregate process (engine/models/Aggregate.h) driven by the
+/// ground reaction force. Aggregate surfaces (gravel, sand, snow, leaves, grass, underbrush,
+/// dirt, carpet) are sums of such layers.
+///
+/// GRF -> process (per sample, F in kN, dF/dt in kN/s smoothed by a one-pole of derivative_ms):
+///   rate    = events_per_s_per_kn x F + events_per_kn_rise x max(dF/dt, 0)
+///                                     + events_per_kn_fall x max(-dF/dt, 0)        [events/s]
+///   (grains settle under a standing load; they crunch while the load builds up and shifts, and
+///   some spring back on release: the two derivative terms are "events per kN of load change")
+///   scale   = F^load_exponent x (1 + rise_energy x max(dF/dt, 0) / 10)   (energy multiplier)
+///   onset   = one event of energy onset_energy x clamp(dF/dt / 10, 0.1, 3) when the load first
+///             crosses onset_force_n in a step (the heel lands: a thump or a crunch).
+/// Everything is zero while F <= contact_threshold_n; when the voices have rung out and the load
+/// stays below the threshold the layer sleeps (a block then costs one scan of the GRF).
+/// The sum of the voices goes through an optional 2nd-order Butterworth high-pass and low-pass
+/// (tone) and the layer gain.
+#include "engine/dsp/Biquad.h"
+#include "engine/models/Aggregate.h"
+#include "engine/surfaces/Layer.h"
+
+namespace underfoot::engine {
+
+/// The GRF mapping of a grains layer (see the file comment).
+struct GrainsControl {
+    double eventsPerSecondPerKn = 0.0;
+    double eventsPerKnRise = 0.0;
+    double eventsPerKnFall = 0.0;
+    double loadExponent = 1.0;
+    double riseEnergy = 0.0;
+    double onsetEnergy = 0.0;
+    double onsetForceN = 200.0;
+    double derivativeMs = 5.0;
+    double contactThresholdN = 5.0;
+    double lowpassHz = 0.0;  ///< 0: off
+    double highpassHz = 0.0; ///< 0: off
+    double gainDb = 0.0;
+};
+
+class GrainsLayer final : public SurfaceLayer {
+  public:
+    GrainsLayer(const AggregateParameters& model, const GrainsControl& control,
+                const AccuracyOptions& options);
+    void prepare(const ProcessSpec& spec) override;
+    void reset(std::uint64_t seed) noexcept override;
+    void process(const float* grfNewtons, float* out, int n) noexcept override;
+    bool isSleeping() const noexcept override { return sleeping_; }
+    const char* kind() const noexcept override { return "grains"; }
+
+    const AggregateModel& model() const noexcept { return model_; }
+    AggregateModel& model() noexcept { return model_; }
+    const GrainsControl& control() const noexcept { return control_; }
+
+  private:
+    void processChunk(const float* grf, float* out, int n) noexcept;
+    AggregateModel model_;
+    GrainsControl control_;
+    int maxEventsPerSecond_;
+    double sampleRateHz_ = 48000.0;
+    double derivativeG_ = 0.0;
+    double gain_ = 1.0;
+    Biquad lowpass_, highpass_;
+    bool useLowpass_ = false, useHighpass_ = false;
+    std::vector<float> rate_, scale_, buffer_;
+    double previousF_ = 0.0, derivative_ = 0.0;
+    bool onsetArmed_ = true;
+    bool sleeping_ = true;
+    int tailSamples_ = 0, tailLength_ = 0;
+};
+
+/// Factory for the layer table: reads every parameter of a grains layer (with unit and range).
+std::unique_ptr<SurfaceLayer> makeGrainsLayer(PresetReader& reader, const AccuracyOptions& options);
+
+} // namespace underfoot::engine
