@@ -19,6 +19,7 @@
 /// computed on the calling thread: deterministic, identical for every host block size, and
 /// still no locks or allocation in process(). The thread policy passed is SCHED_OTHER anyway.
 #include "engine/io/AudioFile.h"
+#include "engine/reverb/ImpulseResponses.h" // findImpulseResponse(), for users of the convolver
 
 #include <memory>
 #include <vector>
