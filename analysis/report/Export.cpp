@@ -1,0 +1,555 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "analysis/report/Export.h"
+
+#include "analysis/io/Csv.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace underfoot::analysis {
+
+std::optional<ReportFormat> parseReportFormat(std::string_view name) {
+    if (name == "csv") return ReportFormat::Csv;
+    if (name == "latex" || name == "tex") return ReportFormat::Latex;
+    if (name == "markdown" || name == "md") return ReportFormat::Markdown;
+    if (name == "html") return ReportFormat::Html;
+    return std::nullopt;
+}
+
+namespace {
+
+// ------------------------------------------------------------------ shared helpers
+
+std::string full(double v) {
+    return std::isnan(v) ? std::string() : fmt::format("{}", v);
+}
+
+std::string fixed(double v, int digits) {
+    if (std::isnan(v)) return "NA";
+    if (std::isinf(v)) return v > 0 ? "Inf" : "-Inf";
+    return fmt::format("{:.{}f}", v, digits);
+}
+
+std::string pValue(double p) {
+    if (std::isnan(p)) return "NA";
+    if (p < 0.001) return "< 0.001";
+    return fmt::format("{:.4f}", p);
+}
+
+std::string count(double v) {
+    return fmt::format("{}", static_cast<long long>(std::llround(v)));
+}
+
+std::string stimulusLabel(const StimulusKey& k) {
+    return k.soundscapeId.empty() ? labelFor(k.surfaceId)
+                                  : labelFor(k.surfaceId) + " / " + labelFor(k.soundscapeId);
+}
+
+std::string columnCode(const std::string& id) {
+    if (id == kDontKnowId) return "DK";
+    if (auto s = findSurface(id)) return s->code;
+    return id;
+}
+
+std::string dfText(const TestResult& t) {
+    std::string out;
+    for (std::size_t i = 0; i < t.df.size(); ++i)
+        out += (i ? ", " : "") + fixed(t.df[i], t.df[i] == std::round(t.df[i]) ? 0 : 2);
+    return out.empty() ? "NA" : out;
+}
+
+/// A plain table shared by the LaTeX, Markdown and HTML renderers.
+struct TextTable {
+    std::string caption;
+    std::vector<std::string> header;
+    std::vector<bool> numeric; ///< right-aligned columns
+    std::vector<std::vector<std::string>> rows;
+};
+
+TextTable confusionTable(const ConfusionMatrix& m) {
+    TextTable t;
+    t.caption = fmt::format("Confusion matrix, {} (counts; rows = presented stimulus)", m.group);
+    t.header.push_back("Stimulus");
+    t.numeric.push_back(false);
+    for (const auto& o : m.columns.options) {
+        t.header.push_back(columnCode(o.id));
+        t.numeric.push_back(true);
+    }
+    t.header.push_back("n");
+    t.numeric.push_back(true);
+    for (std::size_t i = 0; i < m.rows.size(); ++i) {
+        std::vector<std::string> row{stimulusLabel(m.rows[i])};
+        for (double v : m.counts[i]) row.push_back(count(v));
+        row.push_back(count(m.rowTotal(i)));
+        t.rows.push_back(std::move(row));
+    }
+    return t;
+}
+
+TextTable categoryTable(const CategoryMatrix& m) {
+    TextTable t;
+    t.caption = fmt::format("Category recognition, {} (row %)", m.group);
+    t.header.push_back("Presented");
+    t.numeric.push_back(false);
+    for (const auto& c : m.columns) {
+        t.header.push_back(c == "dont_know" ? "don't know" : c);
+        t.numeric.push_back(true);
+    }
+    for (std::size_t i = 0; i < m.rows.size(); ++i) {
+        std::vector<std::string> row{categoryName(m.rows[i])};
+        for (std::size_t j = 0; j < m.columns.size(); ++j)
+            row.push_back(fixed(m.rowPercent(i, j), 1) + " (" + count(m.counts[i][j]) + ")");
+        t.rows.push_back(std::move(row));
+    }
+    return t;
+}
+
+TextTable summaryTable(const AnalysisReport& r) {
+    TextTable t;
+    t.caption = "Per-stimulus summary: % with 95% Wilson interval; realism on correct answers "
+                "only, quality on all answers except \"I don't know\" (mean ± SD)";
+    t.header = {"Group", "Stimulus", "n", "% correct", "% wrong", "% don't know"};
+    t.numeric = {false, false, true, true, true, true};
+    if (r.hasRatings) {
+        t.header.insert(t.header.end(), {"Realism", "Quality"});
+        t.numeric.insert(t.numeric.end(), {true, true});
+    }
+    const bool anySoundscape =
+        std::any_of(r.summary.begin(), r.summary.end(),
+                    [](const SummaryRow& s) { return s.soundscapeCorrect.n > 0; });
+    if (anySoundscape) {
+        t.header.push_back("% soundscape");
+        t.numeric.push_back(true);
+    }
+    auto pct = [](const Proportion& p) {
+        if (p.n == 0) return std::string("NA");
+        return fixed(p.percent, 2) + " [" + fixed(p.wilson.lower, 1) + ", " +
+               fixed(p.wilson.upper, 1) + "]";
+    };
+    auto mean = [](const MeanSummary& m) {
+        if (m.n == 0) return std::string("NA");
+        return fixed(m.mean, 2) + " ± " + fixed(m.sd, 2) + " (n=" + count(m.n) + ")";
+    };
+    for (const auto& s : r.summary) {
+        std::vector<std::string> row{s.group,      stimulusLabel(s.stimulus),
+                                     count(s.n),   pct(s.correct),
+                                     pct(s.wrong), pct(s.dontKnow)};
+        if (r.hasRatings) {
+            row.push_back(mean(s.realism));
+            row.push_back(mean(s.quality));
+        }
+        if (anySoundscape) row.push_back(pct(s.soundscapeCorrect));
+        t.rows.push_back(std::move(row));
+    }
+    return t;
+}
+
+TextTable comparisonTable(const AnalysisReport& r) {
+    TextTable t;
+    t.caption = "Between-group comparisons: chi-square with Yates' correction on correct vs "
+                "not correct (Fisher's exact p as a check), Welch t-tests on ratings; Holm "
+                "adjustment across surfaces";
+    t.header = {"Measure", "Surface", "Groups",   "A",        "B",     "Statistic",
+                "df",      "p",       "p (Holm)", "Fisher p", "Effect"};
+    t.numeric = {false, false, false, true, true, true, true, true, true, true, true};
+    for (const auto& c : r.comparisons) {
+        const bool counts = c.measure == Measure::Correct || c.measure == Measure::DontKnow;
+        auto value = [&](double v, double n) {
+            return (counts ? fixed(v, 1) + "%" : fixed(v, 2)) + " (n=" + count(n) + ")";
+        };
+        std::vector<std::string> row{
+            measureName(c.measure), c.surfaceId.empty() ? "all" : labelFor(c.surfaceId),
+            c.groupA + " vs " + c.groupB, value(c.valueA, c.nA), value(c.valueB, c.nB)};
+        if (c.test.ok()) {
+            row.push_back((c.test.statisticName == "t" ? "t = " : "X² = ") +
+                          fixed(c.test.statistic, 4));
+            row.push_back(dfText(c.test));
+            row.push_back(pValue(c.test.p));
+            row.push_back(pValue(c.pHolm));
+        } else {
+            row.push_back(c.test.error);
+            row.push_back("");
+            row.push_back("NA");
+            row.push_back("NA");
+        }
+        row.push_back(counts ? pValue(c.fisherP) : "");
+        row.push_back(std::isnan(c.effect) ? "NA" : c.effectName + " = " + fixed(c.effect, 3));
+        t.rows.push_back(std::move(row));
+    }
+    return t;
+}
+
+std::vector<TextTable> allTables(const AnalysisReport& r) {
+    std::vector<TextTable> tables;
+    for (const auto& m : r.confusions) tables.push_back(confusionTable(m));
+    for (const auto& m : r.categories) tables.push_back(categoryTable(m));
+    tables.push_back(summaryTable(r));
+    if (!r.comparisons.empty()) tables.push_back(comparisonTable(r));
+    return tables;
+}
+
+// ------------------------------------------------------------------ tidy CSV
+
+void tidy(std::string& out, const std::string& table, const std::string& group,
+          const std::string& stimulus, const std::string& soundscape, const std::string& column,
+          const std::string& statistic, double value, const std::string& note = {}) {
+    out +=
+        csv::joinLine({table, group, stimulus, soundscape, column, statistic, full(value), note});
+    out += '\n';
+}
+
+std::string renderCsv(const AnalysisReport& r) {
+    std::string out(kTidyCsvHeader);
+    out += '\n';
+    for (const auto& m : r.confusions)
+        for (std::size_t i = 0; i < m.rows.size(); ++i)
+            for (std::size_t j = 0; j < m.columns.options.size(); ++j) {
+                const auto& row = m.rows[i];
+                const auto& id = m.columns.options[j].id;
+                tidy(out, "confusion", m.group, row.surfaceId, row.soundscapeId, id, "count",
+                     m.counts[i][j]);
+                tidy(out, "confusion", m.group, row.surfaceId, row.soundscapeId, id, "row_percent",
+                     m.rowPercent(i, j));
+            }
+    for (const auto& m : r.categories)
+        for (std::size_t i = 0; i < m.rows.size(); ++i)
+            for (std::size_t j = 0; j < m.columns.size(); ++j) {
+                tidy(out, "category", m.group, categoryName(m.rows[i]), "", m.columns[j], "count",
+                     m.counts[i][j]);
+                tidy(out, "category", m.group, categoryName(m.rows[i]), "", m.columns[j],
+                     "row_percent", m.rowPercent(i, j));
+            }
+    for (const auto& s : r.summary) {
+        const auto& k = s.stimulus;
+        tidy(out, "summary", s.group, k.surfaceId, k.soundscapeId, "trials", "n", s.n);
+        const std::pair<const char*, const Proportion*> props[] = {
+            {"correct", &s.correct},
+            {"wrong", &s.wrong},
+            {"dont_know", &s.dontKnow},
+            {"soundscape_correct", &s.soundscapeCorrect}};
+        for (const auto& [name, p] : props) {
+            tidy(out, "summary", s.group, k.surfaceId, k.soundscapeId, name, "count", p->count);
+            tidy(out, "summary", s.group, k.surfaceId, k.soundscapeId, name, "n", p->n);
+            tidy(out, "summary", s.group, k.surfaceId, k.soundscapeId, name, "percent", p->percent);
+            tidy(out, "summary", s.group, k.surfaceId, k.soundscapeId, name, "wilson_lower",
+                 p->wilson.lower);
+            tidy(out, "summary", s.group, k.surfaceId, k.soundscapeId, name, "wilson_upper",
+                 p->wilson.upper);
+        }
+        if (!r.hasRatings) continue;
+        const std::pair<const char*, const MeanSummary*> means[] = {{"realism", &s.realism},
+                                                                    {"quality", &s.quality}};
+        for (const auto& [name, m] : means) {
+            tidy(out, "summary", s.group, k.surfaceId, k.soundscapeId, name, "n", m->n);
+            tidy(out, "summary", s.group, k.surfaceId, k.soundscapeId, name, "mean", m->mean);
+            tidy(out, "summary", s.group, k.surfaceId, k.soundscapeId, name, "sd", m->sd);
+            tidy(out, "summary", s.group, k.surfaceId, k.soundscapeId, name, "se", m->se);
+            tidy(out, "summary", s.group, k.surfaceId, k.soundscapeId, name, "ci_lower",
+                 m->ci.lower);
+            tidy(out, "summary", s.group, k.surfaceId, k.soundscapeId, name, "ci_upper",
+                 m->ci.upper);
+        }
+    }
+    for (const auto& c : r.comparisons) {
+        const std::string groups = c.groupA + " vs " + c.groupB;
+        const std::string measure = measureName(c.measure);
+        const std::string note = c.test.ok() ? c.test.method : c.test.error;
+        auto row = [&](const char* stat, double v) {
+            tidy(out, "comparison", groups, c.surfaceId, "", measure, stat, v, note);
+        };
+        row("n_a", c.nA);
+        row("n_b", c.nB);
+        row("value_a", c.valueA);
+        row("value_b", c.valueB);
+        row("statistic", c.test.statistic);
+        row("df", c.test.df.empty() ? std::numeric_limits<double>::quiet_NaN() : c.test.df[0]);
+        row("p", c.test.p);
+        row("p_holm", c.pHolm);
+        if (!std::isnan(c.fisherP)) row("fisher_p", c.fisherP);
+        row(c.effectName == "phi" ? "phi" : "cohens_d", c.effect);
+    }
+    return out;
+}
+
+// ------------------------------------------------------------------ LaTeX
+
+std::string latexEscape(std::string_view text) {
+    std::string out;
+    for (char c : text) {
+        switch (c) {
+        case '&':
+            out += "\\&";
+            break;
+        case '%':
+            out += "\\%";
+            break;
+        case '$':
+            out += "\\$";
+            break;
+        case '#':
+            out += "\\#";
+            break;
+        case '_':
+            out += "\\_";
+            break;
+        case '{':
+            out += "\\{";
+            break;
+        case '}':
+            out += "\\}";
+            break;
+        case '~':
+            out += "\\textasciitilde{}";
+            break;
+        case '^':
+            out += "\\textasciicircum{}";
+            break;
+        case '\\':
+            out += "\\textbackslash{}";
+            break;
+        case '<':
+            out += "\\textless{}";
+            break;
+        case '>':
+            out += "\\textgreater{}";
+            break;
+        default:
+            out += c;
+        }
+    }
+    // UTF-8 symbols used by the tables
+    std::string replaced;
+    for (std::size_t i = 0; i < out.size();) {
+        if (out.compare(i, 2, "\xC2\xB1") == 0) {
+            replaced += "$\\pm$";
+            i += 2;
+        } else if (out.compare(i, 2, "\xC2\xB2") == 0) {
+            replaced += "$^2$";
+            i += 2;
+        } else {
+            replaced += out[i++];
+        }
+    }
+    return replaced;
+}
+
+std::string renderLatex(const AnalysisReport& r) {
+    std::string out = "% Generated by `underfoot analyze`. Needs \\usepackage{booktabs}.\n";
+    if (!r.title.empty()) out += "% " + r.title + "\n";
+    for (const auto& note : r.notes) out += "% " + note + "\n";
+    for (const auto& t : allTables(r)) {
+        out += "\\begin{table}[htbp]\n\\centering\n\\small\n";
+        out += "\\caption{" + latexEscape(t.caption) + "}\n";
+        out += "\\begin{tabular}{";
+        for (bool n : t.numeric) out += n ? 'r' : 'l';
+        out += "}\n\\toprule\n";
+        for (std::size_t j = 0; j < t.header.size(); ++j)
+            out += (j ? " & " : "") + latexEscape(t.header[j]);
+        out += " \\\\\n\\midrule\n";
+        for (const auto& row : t.rows) {
+            for (std::size_t j = 0; j < row.size(); ++j)
+                out += (j ? " & " : "") + latexEscape(row[j]);
+            out += " \\\\\n";
+        }
+        out += "\\bottomrule\n\\end{tabular}\n\\end{table}\n\n";
+    }
+    return out;
+}
+
+// ------------------------------------------------------------------ Markdown
+
+std::string markdownCell(std::string_view text) {
+    std::string out;
+    for (char c : text) {
+        if (c == '|')
+            out += "\\|";
+        else if (c == '\n')
+            out += ' ';
+        else
+            out += c;
+    }
+    return out;
+}
+
+std::string renderMarkdown(const AnalysisReport& r) {
+    std::string out = "# " + (r.title.empty() ? std::string("Analysis") : r.title) + "\n\n";
+    for (const auto& note : r.notes) out += "- " + markdownCell(note) + "\n";
+    if (!r.notes.empty()) out += "\n";
+    for (const auto& t : allTables(r)) {
+        out += "**" + markdownCell(t.caption) + "**\n\n|";
+        for (const auto& h : t.header) out += " " + markdownCell(h) + " |";
+        out += "\n|";
+        for (bool n : t.numeric) out += n ? " ---: |" : " :--- |";
+        out += "\n";
+        for (const auto& row : t.rows) {
+            out += "|";
+            for (const auto& cell : row) out += " " + markdownCell(cell) + " |";
+            out += "\n";
+        }
+        out += "\n";
+    }
+    return out;
+}
+
+// ------------------------------------------------------------------ HTML
+
+std::string xmlEscape(std::string_view text) {
+    std::string out;
+    for (char c : text) {
+        switch (c) {
+        case '&':
+            out += "&amp;";
+            break;
+        case '<':
+            out += "&lt;";
+            break;
+        case '>':
+            out += "&gt;";
+            break;
+        case '"':
+            out += "&quot;";
+            break;
+        case '\'':
+            out += "&#39;";
+            break;
+        default:
+            out += c;
+        }
+    }
+    return out;
+}
+
+/// Colour of a row percentage: white (0 %) to deep blue (100 %).
+std::string heatColour(double percent) {
+    const double t = std::isnan(percent) ? 0.0 : std::clamp(percent / 100.0, 0.0, 1.0);
+    auto mix = [&](double from, double to) {
+        return static_cast<int>(std::lround(from + (to - from) * std::sqrt(t)));
+    };
+    return fmt::format("rgb({},{},{})", mix(255, 8), mix(255, 48), mix(255, 107));
+}
+
+std::string htmlTable(const TextTable& t) {
+    std::string out = "<table>\n<caption>" + xmlEscape(t.caption) + "</caption>\n<thead><tr>";
+    for (std::size_t j = 0; j < t.header.size(); ++j)
+        out += std::string(t.numeric[j] ? "<th class=\"num\">" : "<th>") + xmlEscape(t.header[j]) +
+               "</th>";
+    out += "</tr></thead>\n<tbody>\n";
+    for (const auto& row : t.rows) {
+        out += "<tr>";
+        for (std::size_t j = 0; j < row.size(); ++j)
+            out +=
+                std::string(j < t.numeric.size() && t.numeric[j] ? "<td class=\"num\">" : "<td>") +
+                xmlEscape(row[j]) + "</td>";
+        out += "</tr>\n";
+    }
+    return out + "</tbody>\n</table>\n";
+}
+
+std::string renderHtml(const AnalysisReport& r) {
+    const std::string title = r.title.empty() ? std::string("Underfoot analysis") : r.title;
+    std::string out =
+        "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\" />\n"
+        "<title>" +
+        xmlEscape(title) +
+        "</title>\n<style>\n"
+        "body{font-family:system-ui,sans-serif;margin:2em;color:#222;max-width:80em}\n"
+        "table{border-collapse:collapse;margin:1em 0 2em 0;font-size:0.9em}\n"
+        "caption{text-align:left;font-weight:600;padding-bottom:0.4em}\n"
+        "th,td{padding:0.25em 0.6em;border-bottom:1px solid #ddd}\n"
+        "thead th{border-bottom:2px solid #444}\n"
+        ".num{text-align:right;font-variant-numeric:tabular-nums}\n"
+        "figure{margin:1em 0 2em 0}\nfigcaption{font-weight:600}\n"
+        "</style>\n</head>\n<body>\n<h1>" +
+        xmlEscape(title) + "</h1>\n";
+    if (!r.source.empty()) out += "<p>Source: " + xmlEscape(r.source) + "</p>\n";
+    if (!r.notes.empty()) {
+        out += "<ul class=\"notes\">\n";
+        for (const auto& note : r.notes) out += "<li>" + xmlEscape(note) + "</li>\n";
+        out += "</ul>\n";
+    }
+    out += "<h2>Confusion matrices</h2>\n";
+    for (const auto& m : r.confusions) {
+        out += "<figure class=\"confusion\" id=\"confusion-" + xmlEscape(m.group) + "\">\n";
+        out += "<figcaption>Confusion matrix, " + xmlEscape(m.group) +
+               " (colour = row %, numbers = counts)</figcaption>\n";
+        out += confusionHeatMapSvg(m);
+        out += "</figure>\n";
+    }
+    out += "<h2>Categories</h2>\n";
+    for (const auto& m : r.categories) out += htmlTable(categoryTable(m));
+    out += "<h2>Summary</h2>\n" + htmlTable(summaryTable(r));
+    if (!r.comparisons.empty()) out += "<h2>Tests</h2>\n" + htmlTable(comparisonTable(r));
+    out += "</body>\n</html>\n";
+    return out;
+}
+
+} // namespace
+
+std::string confusionHeatMapSvg(const ConfusionMatrix& m) {
+    constexpr int cell = 34, left = 230, top = 70, right = 50;
+    const int columns = static_cast<int>(m.columns.options.size());
+    const int rows = static_cast<int>(m.rows.size());
+    const int width = left + cell * columns + right, height = top + cell * rows + 10;
+    std::string out = fmt::format("<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{}\" "
+                                  "height=\"{}\" viewBox=\"0 0 {} {}\" role=\"img\" "
+                                  "font-family=\"sans-serif\" font-size=\"12\">\n",
+                                  width, height, width, height);
+    out += "<title>" + xmlEscape("Confusion matrix " + m.group) + "</title>\n";
+    for (int j = 0; j < columns; ++j) {
+        const auto& o = m.columns.options[static_cast<std::size_t>(j)];
+        const int x = left + cell * j + cell / 2;
+        out += fmt::format("<text x=\"{}\" y=\"{}\" text-anchor=\"middle\" "
+                           "font-weight=\"bold\">{}<title>{}</title></text>\n",
+                           x, top - 8, xmlEscape(columnCode(o.id)), xmlEscape(o.label));
+    }
+    out += fmt::format("<text x=\"{}\" y=\"{}\" text-anchor=\"middle\" "
+                       "font-weight=\"bold\">n</text>\n",
+                       left + cell * columns + right / 2, top - 8);
+    for (int i = 0; i < rows; ++i) {
+        const auto row = static_cast<std::size_t>(i);
+        const int y = top + cell * i;
+        out += fmt::format("<text x=\"{}\" y=\"{}\" text-anchor=\"end\">{}</text>\n", left - 8,
+                           y + cell / 2 + 4, xmlEscape(stimulusLabel(m.rows[row])));
+        for (int j = 0; j < columns; ++j) {
+            const auto col = static_cast<std::size_t>(j);
+            const double pct = m.rowPercent(row, col);
+            const int x = left + cell * j;
+            const bool correct = answerIsCorrect(m.rows[row].surfaceId, m.columns.options[col].id);
+            out += fmt::format("<rect class=\"cell\" x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\" "
+                               "fill=\"{}\" stroke=\"{}\" stroke-width=\"{}\"><title>{} -&gt; "
+                               "{}: {} ({}%)</title></rect>\n",
+                               x, y, cell, cell, heatColour(pct), correct ? "#d62728" : "#cccccc",
+                               correct ? 2 : 1, xmlEscape(stimulusLabel(m.rows[row])),
+                               xmlEscape(m.columns.options[col].label), count(m.counts[row][col]),
+                               fixed(pct, 1));
+            if (m.counts[row][col] > 0)
+                out += fmt::format("<text x=\"{}\" y=\"{}\" text-anchor=\"middle\" "
+                                   "fill=\"{}\">{}</text>\n",
+                                   x + cell / 2, y + cell / 2 + 4, pct > 45 ? "#ffffff" : "#111111",
+                                   count(m.counts[row][col]));
+        }
+        out += fmt::format("<text x=\"{}\" y=\"{}\" text-anchor=\"middle\">{}</text>\n",
+                           left + cell * columns + right / 2, y + cell / 2 + 4,
+                           count(m.rowTotal(row)));
+    }
+    return out + "</svg>\n";
+}
+
+std::string renderReport(const AnalysisReport& report, ReportFormat format) {
+    switch (format) {
+    case ReportFormat::Csv:
+        return renderCsv(report);
+    case ReportFormat::Latex:
+        return renderLatex(report);
+    case ReportFormat::Markdown:
+        return renderMarkdown(report);
+    case ReportFormat::Html:
+        return renderHtml(report);
+    }
+    return renderCsv(report);
+}
+
+} // namespace underfoot::analysis

@@ -1,0 +1,117 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// `underfoot analyze`: confusion matrices, summaries and between-group tests of a study, from the
+// long-format trial CSV of `underfoot export` or from published count tables.
+#include "analysis/io/CountTables.h"
+#include "analysis/io/TrialCsv.h"
+#include "analysis/report/Export.h"
+#include "analysis/tables/Tables.h"
+#include "app/cli/CommandRegistry.h"
+
+#include <fmt/core.h>
+#include <fmt/format.h>
+
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <memory>
+#include <stdexcept>
+
+namespace {
+
+using namespace underfoot;
+
+struct AnalyzeOptions {
+    std::string trials;
+    std::vector<std::string> counts;
+    std::vector<double> presentations;
+    std::string by;
+    std::string format = "markdown";
+    std::string output;
+    std::string title;
+    bool poolSoundscapes = false;
+    double confLevel = 0.95;
+};
+
+int analyze(const AnalyzeOptions& o) {
+    if (o.trials.empty() == o.counts.empty())
+        throw cli::UserError("give either --trials FILE or one or more --counts FILE");
+    if (!o.by.empty() && o.by != "group")
+        throw cli::UserError(fmt::format("--by {}: expected 'group'", o.by));
+    const auto format = analysis::parseReportFormat(o.format);
+    if (!format)
+        throw cli::UserError(
+            fmt::format("--format {}: expected csv, latex, markdown or html", o.format));
+    if (!(o.confLevel > 0 && o.confLevel < 1))
+        throw cli::UserError(
+            fmt::format("--conf-level {}: expected a number in (0, 1)", o.confLevel));
+    if (!o.presentations.empty() && o.presentations.size() != 1 &&
+        o.presentations.size() != o.counts.size())
+        throw cli::UserError(
+            "--presentations: give one value for all --counts files or one per file");
+    for (double p : o.presentations)
+        if (!(p > 0) || p != std::floor(p))
+            throw cli::UserError(fmt::format("--presentations {}: expected a positive integer", p));
+
+    analysis::AnalysisOptions options;
+    options.byGroup = o.by == "group";
+    options.split = o.poolSoundscapes ? analysis::SoundscapeSplit::Pooled
+                                      : analysis::SoundscapeSplit::BySoundscape;
+    options.confLevel = o.confLevel;
+    analysis::AnalysisReport report;
+    try {
+        if (!o.trials.empty()) {
+            const auto trials = analysis::readTrialCsv(o.trials);
+            report = analysis::analyzeTrials(trials, options);
+            report.source = o.trials;
+        } else {
+            std::vector<analysis::ConfusionMatrix> tables;
+            for (std::size_t i = 0; i < o.counts.size(); ++i) {
+                const double nominal = o.presentations.empty()       ? std::nan("")
+                                       : o.presentations.size() == 1 ? o.presentations[0]
+                                                                     : o.presentations[i];
+                tables.push_back(analysis::readCountTable(o.counts[i], nominal));
+            }
+            report = analysis::analyzeConfusions(std::move(tables), options);
+            report.source = fmt::format("{}", fmt::join(o.counts, ", "));
+        }
+    } catch (const std::runtime_error& e) {
+        throw cli::UserError(e.what());
+    }
+    report.title = o.title.empty() ? "Underfoot analysis" : o.title;
+    const std::string text = analysis::renderReport(report, *format);
+    if (o.output.empty() || o.output == "-") {
+        fmt::print("{}", text);
+        return 0;
+    }
+    std::ofstream out(o.output, std::ios::binary);
+    if (!out) throw cli::UserError(fmt::format("{}: cannot open for writing", o.output));
+    out << text;
+    if (!out.flush()) throw cli::UserError(fmt::format("{}: write failed", o.output));
+    return 0;
+}
+
+const cli::CommandRegistrar registrar("analyze", [](CLI::App& app, int& exitCode) {
+    auto* cmd = app.add_subcommand(
+        "analyze", "Confusion matrices, per-stimulus summaries and between-group tests of a "
+                   "study (trial CSV or published count tables)");
+    auto o = std::make_shared<AnalyzeOptions>();
+    cmd->add_option("--trials", o->trials, "Long-format trial CSV written by `underfoot export`");
+    cmd->add_option("--counts", o->counts,
+                    "Count table(s) in the format of data/published/*_confusion.csv; one group "
+                    "per file");
+    cmd->add_option("--presentations", o->presentations,
+                    "Presentations per stimulus row of the --counts tables (one value, or one "
+                    "per file), to flag rows that do not add up");
+    cmd->add_option("--by", o->by, "Split tables and compare between: group");
+    cmd->add_option("--format", o->format, "csv (tidy), latex (booktabs), markdown or html")
+        ->capture_default_str();
+    cmd->add_option("-o,--output", o->output, "Output file (default: standard output)");
+    cmd->add_option("--title", o->title, "Report title");
+    cmd->add_option("--conf-level", o->confLevel, "Confidence level of the intervals")
+        ->capture_default_str();
+    cmd->add_flag("--pool-soundscapes", o->poolSoundscapes,
+                  "One row per surface instead of one per surface and soundscape");
+    cmd->callback([&exitCode, o] { exitCode = analyze(*o); });
+});
+
+} // namespace
