@@ -42,7 +42,6 @@ struct SoundscapeRenderer::Layer {
         std::size_t clipPos = 0;
         bool active = false;
         float gainL = 0, gainR = 0;
-        int offset = 0; // first frame of the current block at which the voice sounds
     };
     std::vector<std::vector<float>> clips; // mono, at the output rate
     std::vector<Voice> voices;
@@ -221,11 +220,12 @@ double SoundscapeRenderer::calibrate(Layer& layer) {
         for (long t = 0; t < total; t += block) {
             const int m = static_cast<int>(std::min<long>(block, total - t));
             layer.bed->process(scratchL_.data(), scratchR_.data(), m);
-            if (t < warm) continue;
-            for (int i = 0; i < m; ++i)
+            // Sample-exact warm-up boundary: the calibration must not depend on the block size.
+            for (int i = static_cast<int>(std::clamp<long>(warm - t, 0, m)); i < m; ++i) {
                 sum += 0.5 * (static_cast<double>(scratchL_[i]) * scratchL_[i] +
                               static_cast<double>(scratchR_[i]) * scratchR_[i]);
-            measured += m;
+                ++measured;
+            }
         }
         return sum / static_cast<double>(measured);
     }
@@ -304,6 +304,60 @@ void SoundscapeRenderer::process(float* left, float* right, int n) noexcept {
     }
 }
 
+void SoundscapeRenderer::startEvent(Layer& layer) noexcept {
+    Layer::Voice* free = nullptr;
+    for (auto& v : layer.voices)
+        if (!v.active) {
+            free = &v;
+            break;
+        }
+    if (!free) {
+        ++layer.stats.eventsDropped;
+        return;
+    }
+    const double eventGain = layer.drawEventGain();
+    const double pan = layer.rng.uniform(layer.def->panMin, layer.def->panMax);
+    float pl = 0, pr = 0;
+    panGains(pan, pl, pr);
+    free->gainL = static_cast<float>(eventGain) * pl;
+    free->gainR = static_cast<float>(eventGain) * pr;
+    free->active = true;
+    if (free->synth) {
+        free->synth->start(layer.rng);
+    } else {
+        free->clip = &layer.clips[layer.rng.below(static_cast<std::uint32_t>(layer.clips.size()))];
+        free->clipPos = 0;
+    }
+    ++layer.stats.eventsStarted;
+}
+
+void SoundscapeRenderer::renderVoices(Layer& layer, float* left, float* right, int from,
+                                      int to) noexcept {
+    const int want = to - from;
+    if (want <= 0) return;
+    const auto g = static_cast<float>(layer.gain);
+    for (auto& v : layer.voices) {
+        if (!v.active) continue;
+        int got = 0;
+        if (v.synth) {
+            got = v.synth->process(scratchMono_.data(), want);
+        } else {
+            const std::size_t remaining = v.clip->size() - v.clipPos;
+            got =
+                static_cast<int>(std::min<std::size_t>(remaining, static_cast<std::size_t>(want)));
+            std::copy_n(v.clip->data() + v.clipPos, got, scratchMono_.data());
+            v.clipPos += static_cast<std::size_t>(got);
+        }
+        const float gl = g * v.gainL, gr = g * v.gainR;
+        for (int i = 0; i < got; ++i) {
+            left[from + i] += gl * scratchMono_[i];
+            right[from + i] += gr * scratchMono_[i];
+        }
+        layer.stats.framesComputed += static_cast<std::uint64_t>(got);
+        if (got < want) v.active = false;
+    }
+}
+
 void SoundscapeRenderer::processChunk(float* left, float* right, int n) noexcept {
     for (auto& lp : layers_) {
         Layer& layer = *lp;
@@ -328,61 +382,23 @@ void SoundscapeRenderer::processChunk(float* left, float* right, int n) noexcept
             continue;
         }
 
-        // Events: start the onsets that fall in this block.
+        // Events: voices are rendered in segments split at the onsets, so that a voice that
+        // ends before an onset is free for it whatever the block size (output is independent
+        // of how the host slices time).
         const double blockEnd = static_cast<double>(layer.now + n);
-        while (layer.nextOnset < blockEnd) {
-            const int offset = std::clamp(
-                static_cast<int>(layer.nextOnset - static_cast<double>(layer.now)), 0, n - 1);
-            Layer::Voice* free = nullptr;
-            for (auto& v : layer.voices)
-                if (!v.active) {
-                    free = &v;
-                    break;
-                }
-            if (free) {
-                const double eventGain = layer.drawEventGain();
-                const double pan = layer.rng.uniform(layer.def->panMin, layer.def->panMax);
-                float pl = 0, pr = 0;
-                panGains(pan, pl, pr);
-                free->gainL = static_cast<float>(eventGain) * pl;
-                free->gainR = static_cast<float>(eventGain) * pr;
-                free->offset = offset;
-                free->active = true;
-                if (free->synth) {
-                    free->synth->start(layer.rng);
-                } else {
-                    free->clip = &layer.clips[layer.rng.below(
-                        static_cast<std::uint32_t>(layer.clips.size()))];
-                    free->clipPos = 0;
-                }
-                ++layer.stats.eventsStarted;
-            } else {
-                ++layer.stats.eventsDropped;
-            }
+        int pos = 0;
+        for (;;) {
+            const bool onset = layer.nextOnset < blockEnd;
+            const int segEnd =
+                onset
+                    ? std::clamp(static_cast<int>(layer.nextOnset - static_cast<double>(layer.now)),
+                                 pos, n - 1)
+                    : n;
+            renderVoices(layer, left, right, pos, segEnd);
+            pos = segEnd;
+            if (!onset) break;
+            startEvent(layer);
             layer.nextOnset += std::max(1.0, layer.drawInterval());
-        }
-        // Render the sounding voices.
-        for (auto& v : layer.voices) {
-            if (!v.active) continue;
-            const int want = n - v.offset;
-            int got = 0;
-            if (v.synth) {
-                got = v.synth->process(scratchMono_.data(), want);
-            } else {
-                const std::size_t left_ = v.clip->size() - v.clipPos;
-                got =
-                    static_cast<int>(std::min<std::size_t>(left_, static_cast<std::size_t>(want)));
-                std::copy_n(v.clip->data() + v.clipPos, got, scratchMono_.data());
-                v.clipPos += static_cast<std::size_t>(got);
-            }
-            const float gl = g * v.gainL, gr = g * v.gainR;
-            for (int i = 0; i < got; ++i) {
-                left[v.offset + i] += gl * scratchMono_[i];
-                right[v.offset + i] += gr * scratchMono_[i];
-            }
-            layer.stats.framesComputed += static_cast<std::uint64_t>(got);
-            if (got < want) v.active = false;
-            v.offset = 0;
         }
         layer.now += n;
     }

@@ -62,6 +62,8 @@ class SoundscapeRenderer {
   private:
     struct Layer;
     void processChunk(float* left, float* right, int n) noexcept;
+    void startEvent(Layer& layer) noexcept;
+    void renderVoices(Layer& layer, float* left, float* right, int from, int to) noexcept;
     double calibrate(Layer& layer);
 
     SoundscapeDefinition definition_;

@@ -370,6 +370,8 @@ class BabbleBed final : public BedGenerator {
             v.sylPos = 1;
             v.f1Hz = v.f1Target = 500;
             v.f2Hz = v.f2Target = 1500;
+            v.f1.set(fs_, v.f1Hz, 4.0); // a talker may start between two retunings
+            v.f2.set(fs_, v.f2Hz, 6.0);
         }
         for (auto& d : dist_) {
             d.reset();
