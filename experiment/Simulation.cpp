@@ -260,15 +260,19 @@ int runSimulatedSession(StudyStore& store, const std::string& code, const Confus
                                   settings);
     double simulatedTimeS = 0.0;
     SilentPlayer player;
-    Session session(store, code, player,
-                    SessionSettings{"simulation", "none (simulated)", "none (simulated)",
-                                    UNDERFOOT_VERSION},
-                    [&] { return simulatedTimeS; });
+    Session session(
+        store, code, player,
+        SessionSettings{"simulation", "none (simulated)", "none (simulated)", UNDERFOOT_VERSION},
+        [&] { return simulatedTimeS; });
     int committed = 0;
     while (session.phase() != SessionPhase::Finished) {
         switch (session.phase()) {
-        case SessionPhase::Briefing: session.finishBriefing(); break;
-        case SessionPhase::Break: session.finishBreak(); break;
+        case SessionPhase::Briefing:
+            session.finishBriefing();
+            break;
+        case SessionPhase::Break:
+            session.finishBreak();
+            break;
         case SessionPhase::Practice:
         case SessionPhase::Trial: {
             const TrialRecord trial = session.current();
@@ -280,7 +284,8 @@ int runSimulatedSession(StudyStore& store, const std::string& code, const Confus
             if (onCommitted) onCommitted(code, trial.index);
             break;
         }
-        case SessionPhase::Finished: break;
+        case SessionPhase::Finished:
+            break;
         }
     }
     return committed;
@@ -317,7 +322,8 @@ int simulateStudy(StudyStore& store, const MatrixByGroup& matrices, int particip
                 return false;
             }
         }());
-        const ParticipantInfo p = store.registerParticipant({code, std::nullopt, "", "", "", {}, ""});
+        const ParticipantInfo p =
+            store.registerParticipant({code, std::nullopt, "", "", "", {}, ""});
         committed +=
             runSimulatedSession(store, p.code, matrixFor(p.groupId), seed, settings, onCommitted);
         ++completed;

@@ -31,8 +31,8 @@ void printSummary(const Protocol& p, std::uint64_t seed, int participants) {
                p.questions.asksSurface()
                    ? fmt::format("surface ({} options)", p.questions.surfaceOptions.size())
                    : "no surface question",
-               p.questions.scales.empty() ? "" : fmt::format(", {} scale(s)",
-                                                             p.questions.scales.size()),
+               p.questions.scales.empty() ? ""
+                                          : fmt::format(", {} scale(s)", p.questions.scales.size()),
                p.questions.soundscapeOptions.empty() ? "" : ", soundscape",
                p.questions.comment ? ", comment" : "");
     const PlanSummary summary = summarizePlans(p, seed, participants);
@@ -78,9 +78,10 @@ const underfoot::cli::CommandRegistrar registrar{
         static int participants = 0;
         check->add_option("FILE", file, "protocol TOML file")->required();
         check->add_option("--seed", seed, "study seed for the balance table")->default_val(1);
-        check->add_option("--participants", participants,
-                          "participants per group for the balance table (default: the group "
-                          "target, else 20)")
+        check
+            ->add_option("--participants", participants,
+                         "participants per group for the balance table (default: the group "
+                         "target, else 20)")
             ->check(CLI::Range(0, 100000));
         check->callback([&exitCode] {
             Protocol p;

@@ -1,0 +1,192 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// `underfoot study ...`: create a study file, register / drop participants, exclude trials,
+// inspect a study, its journal and what replay needs for a trial.
+#include "app/cli/CommandRegistry.h"
+#include "experiment/Protocol.h"
+#include "experiment/Store.h"
+
+#include <fmt/core.h>
+
+#include <functional>
+
+namespace {
+
+using namespace underfoot::experiment;
+using underfoot::cli::UserError;
+
+/// Runs `body`, turning the experiment library's input errors into UserError.
+void guarded(const std::function<void()>& body) {
+    try {
+        body();
+    } catch (const ProtocolError& e) {
+        throw UserError(e.what());
+    } catch (const StoreError& e) {
+        throw UserError(e.what());
+    }
+}
+
+struct Options {
+    std::string study;
+    std::string protocol;
+    std::string code;
+    std::string site;
+    std::uint64_t seed = 1;
+    std::string participant;
+    int age = -1;
+    std::string gender, shoes, hearing, group, reason;
+    int trial = -1;
+    bool include = false;
+};
+
+Options& opts() {
+    static Options o;
+    return o;
+}
+
+const underfoot::cli::CommandRegistrar registrar{
+    "study", [](CLI::App& app, int& exitCode) {
+        auto* cmd = app.add_subcommand("study", "Study files: create, register participants, "
+                                                "inspect");
+        cmd->require_subcommand(1);
+        Options& o = opts();
+
+        auto* create = cmd->add_subcommand("create", "Create a study file from a protocol");
+        create->add_option("--study", o.study, "new study file (.db)")->required();
+        create->add_option("--protocol", o.protocol, "protocol TOML file")->required();
+        create->add_option("--code", o.code, "study code")->required();
+        create->add_option("--site", o.site, "site (lab) code");
+        create->add_option("--seed", o.seed, "study seed (plans and assignment derive from it)")
+            ->required();
+        create->callback([&exitCode, &o] {
+            guarded([&] {
+                const Protocol p = loadProtocol(o.protocol);
+                StudyStore store =
+                    StudyStore::create(o.study, p, {o.code, o.site, o.seed, UNDERFOOT_VERSION});
+                fmt::print("created {} (study {}, protocol {} sha256 {})\n", o.study, o.code, p.id,
+                           p.hash);
+            });
+            exitCode = 0;
+        });
+
+        auto* info = cmd->add_subcommand("info", "Show a study, its groups and participants");
+        info->add_option("--study", o.study, "study file")->required();
+        info->callback([&exitCode, &o] {
+            guarded([&] {
+                StudyStore store = StudyStore::open(o.study);
+                const StudyInfo i = store.info();
+                fmt::print("study {} (site {}), seed {}, created {}\n", i.code, i.site, i.seed,
+                           i.createdAt);
+                fmt::print("protocol {} version {} sha256 {}; schema {}\n", i.protocolId,
+                           i.protocolVersion, i.protocolHash, i.schemaVersion);
+                fmt::print("\n{:<14} {:>7} {:>9} {:>7} {:>6}\n", "group", "active", "completed",
+                           "dropped", "target");
+                for (const auto& g : store.groupCounts())
+                    fmt::print("{:<14} {:>7} {:>9} {:>7} {:>6}\n", g.groupId, g.active, g.completed,
+                               g.dropped, g.target);
+                fmt::print("\n{:<10} {:>4} {:<12} {:<10} {:>8}  {}\n", "code", "idx", "group",
+                           "status", "answered", "assignment");
+                for (const auto& p : store.participants()) {
+                    const auto trials = store.trials(p.code);
+                    int answered = 0;
+                    for (const auto& t : trials) answered += t.answered ? 1 : 0;
+                    fmt::print("{:<10} {:>4} {:<12} {:<10} {:>4}/{:<3}  {}\n", p.code, p.index,
+                               p.groupId, toString(p.status), answered, trials.size(),
+                               p.assignment == Assignment::Override
+                                   ? "override: " + p.overrideReason
+                                   : "balanced");
+                }
+            });
+            exitCode = 0;
+        });
+
+        auto* reg = cmd->add_subcommand("register", "Register a participant (pseudonymous code; "
+                                                    "no names) and store its plan");
+        reg->add_option("--study", o.study, "study file")->required();
+        reg->add_option("--participant", o.participant, "pseudonymous code, e.g. P07")->required();
+        reg->add_option("--age", o.age, "age in years")->check(CLI::Range(0, 130));
+        reg->add_option("--gender", o.gender, "gender (free text)");
+        reg->add_option("--shoes", o.shoes, "shoe type");
+        reg->add_option("--hearing", o.hearing, "self-reported hearing");
+        reg->add_option("--group", o.group, "override the balanced group assignment");
+        reg->add_option("--reason", o.reason, "reason for the override (journaled)");
+        reg->callback([&exitCode, &o] {
+            guarded([&] {
+                StudyStore store = StudyStore::open(o.study);
+                NewParticipant np{o.participant, std::nullopt, o.gender, o.shoes,
+                                  o.hearing,     std::nullopt, o.reason};
+                if (o.age >= 0) np.age = o.age;
+                if (!o.group.empty()) np.groupOverride = o.group;
+                const ParticipantInfo p = store.registerParticipant(np);
+                fmt::print("registered {} (index {}) in group {} ({}), {} trials planned\n", p.code,
+                           p.index, p.groupId,
+                           p.assignment == Assignment::Override ? "override" : "balanced",
+                           store.trials(p.code).size());
+            });
+            exitCode = 0;
+        });
+
+        auto* drop = cmd->add_subcommand("drop", "Mark a participant as dropped out (frees the "
+                                                 "group slot)");
+        drop->add_option("--study", o.study, "study file")->required();
+        drop->add_option("--participant", o.participant, "participant code")->required();
+        drop->add_option("--reason", o.reason, "why (journaled)")->required();
+        drop->callback([&exitCode, &o] {
+            guarded([&] {
+                StudyStore store = StudyStore::open(o.study);
+                store.dropParticipant(o.participant, o.reason);
+                fmt::print("{} dropped\n", o.participant);
+            });
+            exitCode = 0;
+        });
+
+        auto* exclude = cmd->add_subcommand("exclude", "Exclude a trial from analysis (or "
+                                                       "--include it again)");
+        exclude->add_option("--study", o.study, "study file")->required();
+        exclude->add_option("--participant", o.participant, "participant code")->required();
+        exclude->add_option("--trial", o.trial, "trial index")->required();
+        exclude->add_option("--reason", o.reason, "why (journaled, exported)");
+        exclude->add_flag("--include", o.include, "include the trial again");
+        exclude->callback([&exitCode, &o] {
+            guarded([&] {
+                StudyStore store = StudyStore::open(o.study);
+                store.setExcluded(o.participant, o.trial, !o.include, o.reason);
+                fmt::print("{} trial {} {}\n", o.participant, o.trial,
+                           o.include ? "included" : "excluded");
+            });
+            exitCode = 0;
+        });
+
+        auto* trial = cmd->add_subcommand("trial", "Show what replay needs for one trial "
+                                                   "(stimulus, render seed, GRF recording)");
+        trial->add_option("--study", o.study, "study file")->required();
+        trial->add_option("--participant", o.participant, "participant code")->required();
+        trial->add_option("--trial", o.trial, "trial index")->required();
+        trial->callback([&exitCode, &o] {
+            guarded([&] {
+                StudyStore store = StudyStore::open(o.study);
+                const ReplayInfo r = store.trialForReplay(o.participant, o.trial);
+                fmt::print("study {} protocol sha256 {}\nparticipant {} trial {}\nrender seed {}\n"
+                           "GRF recording {}\naudio config {}\nsensor config {}\n\n{}",
+                           r.study, r.protocolHash, r.participant, r.trialIndex, r.renderSeed,
+                           r.grfRecording.value_or("(none)"), r.audioConfig, r.sensorConfig,
+                           stimulusToToml(r.stimulus));
+                fmt::print("\n");
+            });
+            exitCode = 0;
+        });
+
+        auto* events = cmd->add_subcommand("events", "Print the append-only event journal");
+        events->add_option("--study", o.study, "study file")->required();
+        events->callback([&exitCode, &o] {
+            guarded([&] {
+                StudyStore store = StudyStore::open(o.study);
+                for (const auto& e : store.events())
+                    fmt::print("{} {:>6} {:<24} {:<8} {:>4} {}\n", e.at, e.id, e.kind,
+                               e.participant, e.trialIndex ? std::to_string(*e.trialIndex) : "",
+                               e.detail);
+            });
+            exitCode = 0;
+        });
+    }};
+
+} // namespace
