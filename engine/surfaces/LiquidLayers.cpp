@@ -15,6 +15,7 @@ constexpr double kTailSeconds = 0.1;
 constexpr double kDerivativeRefKnPerS = 10.0;
 constexpr double kQuiet = 1e-6;   // envelopes below this are silent
 constexpr double kOffDb = -120.0; // noise levels at or below this are off
+constexpr double kWakeEnd = 1e-3; // the wake envelope ends 60 dB below its nominal start
 
 inline double sanitizeForce(float v) noexcept {
     const double f = static_cast<double>(v);
@@ -123,6 +124,7 @@ void BubblesLayer::processChunk(const float* grf, float* out, int n) noexcept {
         }
         rate_[static_cast<std::size_t>(i)] = static_cast<float>(rate);
         wakeEnv_ *= wakeG_;
+        if (wakeEnv_ < kWakeEnd) wakeEnv_ = 0.0; // 60 dB down: the wake is over
         splashEnv_ = splashDrive > splashEnv_ ? splashDrive : splashEnv_ * splashDecayG_;
         motionEnv_ = motionDrive + motionG_ * (motionEnv_ - motionDrive);
         const double splashAmp = splashGain_ * splashEnv_;

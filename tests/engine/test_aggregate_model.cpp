@@ -1,0 +1,294 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Stochastic aggregate model: Poisson event rate (constant, ramped, modulated, capped), power-law
+// energy exponent, determinism, silence, no allocation in process().
+#include "engine/models/Aggregate.h"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cmath>
+#include <cstdlib>
+#include <new>
+#include <vector>
+
+using namespace underfoot::engine;
+
+// ---- a binary-wide allocation counter (test_engine has no other global operator new) ----
+namespace underfoot::test {
+std::atomic<long> allocationCount{0};
+std::atomic<bool> countAllocations{false};
+} // namespace underfoot::test
+
+// The replacements pair malloc with free; GCC cannot see that once they are inlined here.
+#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
+namespace {
+void* countedAllocation(std::size_t size) {
+    if (underfoot::test::countAllocations.load(std::memory_order_relaxed))
+        underfoot::test::allocationCount.fetch_add(1, std::memory_order_relaxed);
+    if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
+    throw std::bad_alloc();
+}
+} // namespace
+void* operator new(std::size_t size) {
+    return countedAllocation(size);
+}
+void* operator new[](std::size_t size) {
+    return countedAllocation(size);
+}
+void operator delete(void* p) noexcept {
+    std::free(p);
+}
+void operator delete[](void* p) noexcept {
+    std::free(p);
+}
+void operator delete(void* p, std::size_t) noexcept {
+    std::free(p);
+}
+void operator delete[](void* p, std::size_t) noexcept {
+    std::free(p);
+}
+
+namespace {
+constexpr double kFs = 48000.0;
+
+struct Collector {
+    std::vector<AggregateEvent> events;
+};
+void collect(void* user, const AggregateEvent& e) {
+    static_cast<Collector*>(user)->events.push_back(e);
+}
+
+AggregateModel makeModel(AggregateParameters p = {}, int cap = 100000) {
+    AggregateModel m;
+    m.configure(p);
+    m.prepare(kFs, cap);
+    m.reset(1);
+    return m;
+}
+
+// Runs the model with a per-sample rate function; returns the output.
+template <typename RateFn>
+std::vector<float> run(AggregateModel& m, double seconds, RateFn rate, double scale = 1.0) {
+    const int n = static_cast<int>(seconds * kFs);
+    std::vector<float> out(static_cast<std::size_t>(n), 0.0f);
+    std::vector<float> r(512), s(512, static_cast<float>(scale));
+    for (int done = 0; done < n; done += 512) {
+        const int k = std::min(512, n - done);
+        for (int i = 0; i < k; ++i)
+            r[static_cast<std::size_t>(i)] = static_cast<float>(rate((done + i) / kFs));
+        m.process(r.data(), s.data(), out.data() + done, k);
+    }
+    return out;
+}
+} // namespace
+
+TEST(AggregateModel, ConstantRateMatchesSetRateAndIntervalsAreExponential) {
+    auto m = makeModel();
+    Collector c;
+    m.setEventObserver(&collect, &c);
+    const double rate = 500.0, seconds = 40.0;
+    run(m, seconds, [&](double) { return rate; });
+    // Poisson count: mean = sd^2 = 20000; 4 sd = 566.
+    const double expected = rate * seconds;
+    EXPECT_NEAR(static_cast<double>(m.eventCount()), expected, 4.0 * std::sqrt(expected));
+    // Inter-arrival times: exponential, so mean = 1/rate and coefficient of variation = 1.
+    double sum = 0, sumSq = 0;
+    for (std::size_t i = 1; i < c.events.size(); ++i) {
+        const double dt = static_cast<double>(c.events[i].sample - c.events[i - 1].sample) / kFs;
+        sum += dt;
+        sumSq += dt * dt;
+    }
+    const double k = static_cast<double>(c.events.size() - 1);
+    const double mean = sum / k, sd = std::sqrt(sumSq / k - mean * mean);
+    EXPECT_NEAR(mean, 1.0 / rate, 0.03 / rate);
+    EXPECT_NEAR(sd / mean, 1.0, 0.03);
+}
+
+TEST(AggregateModel, RampedAndModulatedRatesMatchTheIntegratedRate) {
+    // Linear ramp 0 -> 2000 events/s over 10 s: 2500 events in the first half, 7500 in the second.
+    auto m = makeModel();
+    Collector c;
+    m.setEventObserver(&collect, &c);
+    run(m, 10.0, [](double t) { return 200.0 * t; });
+    int first = 0, second = 0;
+    for (const auto& e : c.events) (e.sample < 5 * 48000 ? first : second)++;
+    EXPECT_NEAR(first, 2500.0, 4.0 * std::sqrt(2500.0));
+    EXPECT_NEAR(second, 7500.0, 4.0 * std::sqrt(7500.0));
+    // Fast modulation (a step of the GRF is ~0.7 s): 800 (1 + sin(2 pi 8 t)) for 10 s -> 8000
+    // events, and the events concentrate where the rate is high.
+    auto m2 = makeModel();
+    Collector c2;
+    m2.setEventObserver(&collect, &c2);
+    run(m2, 10.0, [](double t) { return 800.0 * (1.0 + std::sin(6.283185307179586 * 8.0 * t)); });
+    EXPECT_NEAR(static_cast<double>(c2.events.size()), 8000.0, 4.0 * std::sqrt(8000.0));
+    int high = 0;
+    for (const auto& e : c2.events) {
+        const double phase = std::fmod(static_cast<double>(e.sample) / kFs * 8.0, 1.0);
+        if (phase < 0.5) ++high; // sin > 0 half: expected share (1 + 2/pi) / 2 = 0.818
+    }
+    EXPECT_NEAR(high / static_cast<double>(c2.events.size()), 0.5 + 1.0 / 3.141592653589793, 0.02);
+}
+
+TEST(AggregateModel, RateIsCappedIncludingBursts) {
+    AggregateParameters p;
+    p.burstEvents = 3.0;
+    p.burstMs = 0.5;
+    auto m = makeModel(p, 1000);
+    EXPECT_DOUBLE_EQ(m.rateCapHz(), 1000.0);
+    run(m, 10.0, [](double) { return 1e7; });
+    // Total (primary + burst) about the cap: 10000 +- statistical spread of the bursts.
+    EXPECT_NEAR(static_cast<double>(m.eventCount()), 10000.0, 600.0);
+    // Bursts: with a moderate rate, each primary event brings burstEvents follow-ups on average.
+    auto m2 = makeModel(p);
+    Collector c;
+    m2.setEventObserver(&collect, &c);
+    run(m2, 20.0, [](double) { return 100.0; });
+    int primary = 0, burst = 0;
+    for (const auto& e : c.events) (e.burst ? burst : primary)++;
+    EXPECT_NEAR(primary, 2000.0, 4.0 * std::sqrt(2000.0));
+    // Geometric counts with mean 3: variance 12 per primary event -> sd of the total ~155.
+    EXPECT_NEAR(static_cast<double>(burst) / primary, 3.0, 0.3);
+}
+
+namespace {
+// Least-squares slope of log density against log energy on log-spaced bins.
+double fittedExponent(const std::vector<AggregateEvent>& events, double lo, double hi) {
+    const int bins = 20;
+    std::vector<double> counts(bins, 0.0);
+    const double logLo = std::log(lo), span = std::log(hi) - logLo;
+    for (const auto& e : events) {
+        const int b = static_cast<int>((std::log(e.energy) - logLo) / span * bins);
+        if (b >= 0 && b < bins) counts[static_cast<std::size_t>(b)] += 1;
+    }
+    double sx = 0, sy = 0, sxx = 0, sxy = 0;
+    int used = 0;
+    for (int b = 0; b < bins; ++b) {
+        const double c = counts[static_cast<std::size_t>(b)];
+        if (c < 20) continue; // too few to fit
+        const double e0 = std::exp(logLo + span * b / bins),
+                     e1 = std::exp(logLo + span * (b + 1) / bins);
+        const double x = std::log(std::sqrt(e0 * e1)), y = std::log(c / (e1 - e0));
+        sx += x;
+        sy += y;
+        sxx += x * x;
+        sxy += x * y;
+        ++used;
+    }
+    return (used * sxy - sx * sy) / (used * sxx - sx * sx);
+}
+} // namespace
+
+class AggregateEnergyLaw : public ::testing::TestWithParam<double> {};
+
+TEST_P(AggregateEnergyLaw, FittedExponentMatchesGamma) {
+    AggregateParameters p;
+    p.gamma = GetParam();
+    p.energyMin = 1e-4;
+    p.energyMax = 1.0;
+    auto m = makeModel(p);
+    Collector c;
+    m.setEventObserver(&collect, &c);
+    run(m, 20.0, [](double) { return 3000.0; });
+    ASSERT_GT(c.events.size(), 50000u);
+    EXPECT_NEAR(fittedExponent(c.events, p.energyMin, p.energyMax), p.gamma, 0.06);
+}
+
+INSTANTIATE_TEST_SUITE_P(Gammas, AggregateEnergyLaw, ::testing::Values(-2.5, -1.5, -1.0, -0.5));
+
+TEST(AggregateModel, EnergyScaleMultipliesEnergiesAndSetsAmplitude) {
+    AggregateParameters p;
+    p.resonances = 1;
+    p.freqMinHz = p.freqMaxHz = 1000.0;
+    p.qMin = p.qMax = 50.0;
+    auto m = makeModel(p);
+    m.trigger(0.25); // peak amplitude sqrt(0.25) = 0.5
+    auto out = run(m, 0.05, [](double) { return 0.0; });
+    double peak = 0;
+    for (float v : out) peak = std::max(peak, std::fabs(static_cast<double>(v)));
+    // a r^n sin((n+1) theta) peaks near the first quarter period: 0.5 exp(-pi f t / Q), t ~ 0.25 ms
+    EXPECT_NEAR(peak, 0.5 * std::exp(-3.14159 * 1000.0 * 0.00025 / 50.0), 0.002);
+    // Scaled energies in the observer.
+    auto m2 = makeModel();
+    Collector c;
+    m2.setEventObserver(&collect, &c);
+    run(
+        m2, 2.0, [](double) { return 1000.0; }, 4.0);
+    for (const auto& e : c.events) {
+        EXPECT_GE(e.energy, 4.0 * 1e-3 * (1 - 1e-12));
+        EXPECT_LE(e.energy, 4.0 * (1 + 1e-12));
+    }
+}
+
+TEST(AggregateModel, DeterministicForASeedAndSeedsDiffer) {
+    auto a = makeModel(), b = makeModel(), c = makeModel();
+    a.reset(42);
+    b.reset(42);
+    c.reset(43);
+    auto rate = [](double t) { return 1500.0 * (1.0 + std::sin(10.0 * t)); };
+    const auto xa = run(a, 2.0, rate), xb = run(b, 2.0, rate), xc = run(c, 2.0, rate);
+    EXPECT_EQ(xa, xb);
+    EXPECT_NE(xa, xc);
+    // reset() restores the initial state exactly.
+    a.reset(42);
+    EXPECT_EQ(run(a, 2.0, rate), xa);
+}
+
+TEST(AggregateModel, SilentAtZeroRateAndVoicesEnd) {
+    auto m = makeModel();
+    auto out = run(m, 1.0, [](double) { return 0.0; });
+    for (float v : out) ASSERT_EQ(v, 0.0f);
+    EXPECT_TRUE(m.idle());
+    // A burst of events, then zero rate: every voice ends (idle) and the output is exactly zero.
+    run(m, 0.2, [](double) { return 2000.0; });
+    EXPECT_GT(m.activeVoices(), 0);
+    auto tail = run(m, 2.0, [](double) { return 0.0; });
+    EXPECT_TRUE(m.idle());
+    for (std::size_t i = tail.size() - 1000; i < tail.size(); ++i) ASSERT_EQ(tail[i], 0.0f);
+    // NaN and negative rates count as zero.
+    auto out2 = run(m, 0.5, [](double t) { return t < 0.25 ? std::nan("") : -5.0; });
+    for (float v : out2) ASSERT_EQ(v, 0.0f);
+}
+
+TEST(AggregateModel, VoicePoolIsBoundedAndStealsTheQuietest) {
+    AggregateParameters p;
+    p.voices = 4;
+    p.qMin = p.qMax = 200.0; // long-ringing voices fill the pool
+    p.freqMinHz = 200.0;
+    p.freqMaxHz = 400.0;
+    auto m = makeModel(p);
+    auto out = run(m, 1.0, [](double) { return 2000.0; });
+    EXPECT_LE(m.activeVoices(), 4);
+    EXPECT_GT(m.stolenVoices(), 0u);
+    // Bounded: at most 4 voices of peak sqrt(K E) <= sqrt(2) each.
+    for (float v : out) ASSERT_LE(std::fabs(v), 4.0f * std::sqrt(2.0f) + 1e-3f);
+}
+
+TEST(AggregateModel, NoAllocationInProcess) {
+    AggregateParameters p;
+    p.burstEvents = 2;
+    auto m = makeModel(p);
+    std::vector<float> rate(512, 3000.0f), scale(512, 1.0f), out(512, 0.0f);
+    underfoot::test::allocationCount = 0;
+    underfoot::test::countAllocations = true;
+    for (int b = 0; b < 200; ++b) m.process(rate.data(), scale.data(), out.data(), 512);
+    m.trigger(1.0);
+    m.process(rate.data(), scale.data(), out.data(), 512);
+    underfoot::test::countAllocations = false;
+    EXPECT_GT(m.eventCount(), 1000u);
+    EXPECT_EQ(underfoot::test::allocationCount.load(), 0);
+}
+
+TEST(AggregateModel, RejectsInvalidParameters) {
+    AggregateParameters p;
+    p.energyMin = 0;
+    EXPECT_THROW(p.validate(), std::invalid_argument);
+    p = {};
+    p.freqMaxHz = 10.0; // below freqMinHz
+    EXPECT_THROW(p.validate(), std::invalid_argument);
+    p = {};
+    p.resonances = 5;
+    EXPECT_THROW(p.validate(), std::invalid_argument);
+    p = {};
+    p.qMin = std::nan("");
+    EXPECT_THROW(p.validate(), std::invalid_argument);
+}
