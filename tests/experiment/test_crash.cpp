@@ -1,0 +1,150 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Crash test for real: a child process answers trials (printing "ack CODE TRIAL" after each
+// commit) and is killed with SIGKILL at random points, many times. Every acknowledged answer
+// must be in the database, answered trials must form a prefix of each plan, and the next run
+// must resume at the first unanswered trial.
+#include "TestSupport.h"
+#include "experiment/Random.h"
+#include "experiment/Store.h"
+
+#include <gtest/gtest.h>
+
+#include <cerrno>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <fcntl.h>
+#include <map>
+#include <poll.h>
+#include <set>
+#include <sstream>
+#include <sys/wait.h>
+#include <unistd.h>
+
+using namespace underfoot::experiment;
+using namespace underfoot::experiment::test;
+
+namespace {
+
+struct ChildRun {
+    std::vector<std::pair<std::string, int>> acks;
+    bool finished = false; // exited by itself with status 0
+};
+
+/// Runs the child, kills it after `killAfterMs` (negative: let it finish) and returns the
+/// complete ack lines it printed.
+ChildRun runChild(const std::string& study, const std::string& matrix, int participants,
+                  int killAfterMs) {
+    int fds[2];
+    if (::pipe(fds) != 0) throw std::runtime_error("pipe failed");
+    const std::string count = std::to_string(participants);
+    const pid_t pid = ::fork();
+    if (pid < 0) throw std::runtime_error("fork failed");
+    if (pid == 0) {
+        ::dup2(fds[1], STDOUT_FILENO);
+        ::close(fds[0]);
+        ::close(fds[1]);
+        const char* argv[] = {UNDERFOOT_SESSION_CHILD, study.c_str(), matrix.c_str(), count.c_str(),
+                              nullptr};
+        ::execv(UNDERFOOT_SESSION_CHILD, const_cast<char* const*>(argv));
+        ::_exit(127);
+    }
+    ::close(fds[1]);
+    std::string output;
+    const auto start = std::chrono::steady_clock::now();
+    bool killed = false;
+    char buffer[4096];
+    while (true) {
+        int timeoutMs = -1;
+        if (killAfterMs >= 0 && !killed) {
+            const auto elapsed = std::chrono::duration_cast<std::chrono::milliseconds>(
+                                     std::chrono::steady_clock::now() - start)
+                                     .count();
+            timeoutMs = static_cast<int>(std::max<long>(0, killAfterMs - elapsed));
+            if (timeoutMs == 0) {
+                ::kill(pid, SIGKILL);
+                killed = true;
+                timeoutMs = -1;
+            }
+        }
+        pollfd p{fds[0], POLLIN, 0};
+        const int ready = ::poll(&p, 1, timeoutMs);
+        if (ready < 0 && errno == EINTR) continue;
+        if (ready == 0) continue; // deadline reached: kill on the next turn
+        const ssize_t n = ::read(fds[0], buffer, sizeof buffer);
+        if (n <= 0) break; // EOF: the child is gone
+        output.append(buffer, static_cast<std::size_t>(n));
+    }
+    ::close(fds[0]);
+    int status = 0;
+    ::waitpid(pid, &status, 0);
+    ChildRun run;
+    run.finished = WIFEXITED(status) && WEXITSTATUS(status) == 0;
+    std::istringstream lines(output);
+    std::string line;
+    while (std::getline(lines, line)) {
+        if (lines.eof()) break; // a last line without '\n' was cut by the kill
+        std::istringstream words(line);
+        std::string word, code;
+        int index = -1;
+        if (words >> word >> code >> index && word == "ack") run.acks.emplace_back(code, index);
+    }
+    return run;
+}
+
+} // namespace
+
+TEST(ExperimentCrash, SigkillAtRandomPointsLosesNoAcknowledgedAnswer) {
+    TempDir dir;
+    const std::string study = dir.file("crash.db");
+    {
+        StudyStore::create(study, loadProtocol(shipped("tvcg2011_exp1.toml")),
+                           {"CR", "ci", 4, "t"});
+    }
+    const std::string matrix = dataFile("tvcg2011_exp1_confusion.csv");
+    const int participants = 1000; // never reached while killing
+    const int kills = 40;
+    Rng rng(20261121);
+    std::set<std::pair<std::string, int>> acknowledged;
+    std::map<std::string, int> expectedResume; // participant -> first unanswered after a kill
+    int totalAcks = 0;
+    for (int k = 0; k < kills; ++k) {
+        const int killAfterMs = static_cast<int>(rng.below(250));
+        const ChildRun run = runChild(study, matrix, participants, killAfterMs);
+        ASSERT_FALSE(run.finished);
+        // The run resumes each unfinished participant at its first unanswered trial.
+        std::set<std::string> seen;
+        for (const auto& [code, index] : run.acks) {
+            if (seen.insert(code).second && expectedResume.count(code)) {
+                EXPECT_EQ(index, expectedResume[code]) << "kill " << k << " " << code;
+            }
+            acknowledged.insert({code, index});
+        }
+        totalAcks += static_cast<int>(run.acks.size());
+        StudyStore store = StudyStore::open(study);
+        for (const auto& [code, index] : acknowledged)
+            ASSERT_TRUE(store.trial(code, index).answered)
+                << "acknowledged answer lost: " << code << " trial " << index << " (kill " << k
+                << ")";
+        expectedResume.clear();
+        for (const auto& p : store.participants()) {
+            const auto trials = store.trials(p.code);
+            const auto first = store.firstUnanswered(p.code);
+            const int prefix = first ? *first : static_cast<int>(trials.size());
+            for (const auto& t : trials)
+                ASSERT_EQ(t.answered, t.index < prefix) << p.code << " trial " << t.index;
+            if (first) expectedResume[p.code] = *first;
+        }
+    }
+    EXPECT_GT(totalAcks, 50) << "the kills came too early to test anything";
+    RecordProperty("acknowledged_answers", totalAcks);
+    std::printf("crash test: %d kills, %d acknowledged answers, all present\n", kills, totalAcks);
+    // Finally let it run: the interrupted participant finishes, then one more is completed.
+    StudyStore before = StudyStore::open(study);
+    const int registered = static_cast<int>(before.participants().size());
+    const ChildRun last = runChild(study, matrix, registered + 1, -1);
+    EXPECT_TRUE(last.finished);
+    StudyStore after = StudyStore::open(study);
+    for (const auto& p : after.participants()) EXPECT_FALSE(after.firstUnanswered(p.code));
+    for (const auto& [code, index] : acknowledged) EXPECT_TRUE(after.trial(code, index).answered);
+}

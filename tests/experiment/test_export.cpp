@@ -1,0 +1,184 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "TestSupport.h"
+#include "experiment/Export.h"
+#include "experiment/Session.h"
+#include "experiment/Simulation.h"
+
+#include <gtest/gtest.h>
+
+#include <map>
+#include <sstream>
+
+using namespace underfoot::experiment;
+using namespace underfoot::experiment::test;
+
+namespace {
+/// Minimal RFC 4180 reader for the checks (quoted fields, doubled quotes, CRLF).
+std::vector<std::vector<std::string>> readCsv(const std::string& text) {
+    std::vector<std::vector<std::string>> rows(1);
+    std::string cell;
+    bool quoted = false;
+    for (std::size_t i = 0; i < text.size(); ++i) {
+        const char c = text[i];
+        if (quoted) {
+            if (c == '"' && i + 1 < text.size() && text[i + 1] == '"')
+                cell += '"', ++i;
+            else if (c == '"')
+                quoted = false;
+            else
+                cell += c;
+        } else if (c == '"')
+            quoted = true;
+        else if (c == ',')
+            rows.back().push_back(cell), cell.clear();
+        else if (c == '\r' && i + 1 < text.size() && text[i + 1] == '\n') {
+            rows.back().push_back(cell);
+            cell.clear();
+            rows.emplace_back();
+            ++i;
+        } else
+            cell += c;
+    }
+    if (rows.back().empty()) rows.pop_back();
+    return rows;
+}
+} // namespace
+
+TEST(ExperimentExport, HeaderIsTheAnalysisContract) {
+    const std::string expected =
+        "study,site,protocol_id,protocol_hash,participant,group,session,trial_index,block,"
+        "practice,stimulus_id,surface,soundscape,modalities,reverb,repetition,render_seed,answer,"
+        "answer_label,correct,realism,quality,soundscape_answer,soundscape_correct,"
+        "response_time_s,excluded,exclusion_reason,comment,started_at,answered_at";
+    std::string joined;
+    for (auto c : kTrialColumns) joined += (joined.empty() ? "" : ",") + std::string(c);
+    EXPECT_EQ(joined, expected);
+}
+
+TEST(ExperimentExport, CsvFieldQuoting) {
+    EXPECT_EQ(csvField("plain"), "plain");
+    EXPECT_EQ(csvField("a,b"), "\"a,b\"");
+    EXPECT_EQ(csvField("say \"hi\""), "\"say \"\"hi\"\"\"");
+    EXPECT_EQ(csvField("two\nlines"), "\"two\nlines\"");
+}
+
+TEST(ExperimentExport, RowsCarryAnswersCorrectnessAndQuotedComments) {
+    TempDir dir;
+    StudyStore store = StudyStore::create(dir.file("e.db"), parseProtocol(miniProtocol(), "m.toml"),
+                                          {"EXP", "site \"A\"", 5, "t"});
+    store.registerParticipant({"P1", 30, "", "", "", {}, ""});
+    SilentPlayer player;
+    Session session(store, "P1", player, {"E", "a", "s", "t"});
+    session.finishBriefing();
+    int k = 0;
+    while (session.phase() != SessionPhase::Finished) {
+        const TrialRecord t = session.current();
+        session.play();
+        TrialAnswer a;
+        // Answer "wood" to everything: correct for WD and for WR (wood with reverb).
+        a.answer = k == 0 ? "dont_know" : "wood";
+        a.ratings["realism"] = 3;
+        a.comment = k == 1 ? "steps, \"crunchy\"\nthen quiet" : "";
+        session.answer(a);
+        ++k;
+    }
+    store.setExcluded("P1", 2, true, "walked off the board");
+    std::ostringstream out;
+    EXPECT_EQ(writeTrialsCsv(store, out), 6);
+    const auto rows = readCsv(out.str());
+    ASSERT_EQ(rows.size(), 7u);
+    std::map<std::string, std::size_t> col;
+    for (std::size_t i = 0; i < rows[0].size(); ++i) col[rows[0][i]] = i;
+    for (std::size_t r = 1; r < rows.size(); ++r) {
+        const auto& row = rows[r];
+        ASSERT_EQ(row.size(), kTrialColumns.size());
+        EXPECT_EQ(row[col["study"]], "EXP");
+        EXPECT_EQ(row[col["site"]], "site \"A\"");
+        EXPECT_EQ(row[col["group"]], ""); // within-subject design
+        EXPECT_EQ(row[col["protocol_hash"]], store.protocol().hash);
+        EXPECT_EQ(row[col["realism"]], "3");
+        EXPECT_EQ(row[col["quality"]], "");
+        EXPECT_EQ(row[col["soundscape_correct"]], "");
+        const std::string surface = row[col["surface"]];
+        const std::string answer = row[col["answer"]];
+        const std::string expectCorrect =
+            answer == "wood" && (surface == "wood" || surface == "wood_reverb") ? "1" : "0";
+        EXPECT_EQ(row[col["correct"]], expectCorrect) << surface << " " << answer;
+        if (surface == "wood_reverb") {
+            EXPECT_EQ(row[col["reverb"]], "hall");
+        }
+        EXPECT_EQ(row[col["answered_at"]].size(), 24u); // 2026-11-21T20:45:34.123Z
+        EXPECT_EQ(row[col["answered_at"]].back(), 'Z');
+    }
+    EXPECT_EQ(rows[1][col["answer"]], "dont_know");
+    EXPECT_EQ(rows[1][col["answer_label"]], "I don't know");
+    EXPECT_EQ(rows[2][col["comment"]], "steps, \"crunchy\"\nthen quiet");
+    EXPECT_EQ(rows[3][col["excluded"]], "1");
+    EXPECT_EQ(rows[3][col["exclusion_reason"]], "walked off the board");
+    std::ostringstream codebook;
+    writeCodebook(store, codebook);
+    for (auto c : kTrialColumns)
+        EXPECT_NE(codebook.str().find("`" + std::string(c) + "`"), std::string::npos) << c;
+}
+
+TEST(ExperimentExport, SimulatedExp1StudyReproducesThePublishedDiagonal) {
+    TempDir dir;
+    StudyStore store = StudyStore::create(
+        dir.file("sim.db"), loadProtocol(shipped("tvcg2011_exp1.toml")), {"SIM1", "ci", 2011, "t"});
+    MatrixByGroup m;
+    m[""] = loadConfusionMatrix(dataFile("tvcg2011_exp1_confusion.csv"));
+    EXPECT_TRUE(checkMatrixAgainst(m[""], store.protocol()).empty());
+    const int answers = simulateStudy(store, m, 30, {});
+    EXPECT_EQ(answers, 30 * 26);
+    std::ostringstream out;
+    ASSERT_EQ(writeTrialsCsv(store, out), 30 * 26);
+    const auto rows = readCsv(out.str());
+    std::map<std::string, std::size_t> col;
+    for (std::size_t i = 0; i < rows[0].size(); ++i) col[rows[0][i]] = i;
+    std::map<std::string, std::pair<int, int>> bySurface; // correct, total
+    for (std::size_t r = 1; r < rows.size(); ++r) {
+        auto& c = bySurface[rows[r][col["surface"]]];
+        c.first += rows[r][col["correct"]] == "1";
+        ++c.second;
+    }
+    // Creaking wood: 28 of 30 correct in the published matrix (p = 0.933); 60 draws give a
+    // binomial sd of 0.032, so the 0.80 bound is 4 sd away. High grass: 0 of 30 correct.
+    EXPECT_GT(bySurface["creaking_wood"].first, 0.80 * bySurface["creaking_wood"].second);
+    EXPECT_EQ(bySurface["high_grass"].first, 0);
+    EXPECT_EQ(bySurface["high_grass"].second, 60);
+}
+
+TEST(ExperimentSimulation, MatrixMustCoverTheProtocol) {
+    const Protocol exp2 = loadProtocol(shipped("tvcg2011_exp2.toml"));
+    const ConfusionMatrix cond1 =
+        loadConfusionMatrix(dataFile("tvcg2011_exp2_cond1_no_soundscape_confusion.csv"));
+    Protocol onlyNone = exp2;
+    onlyNone.groups = {*exp2.group("none")};
+    EXPECT_TRUE(checkMatrixAgainst(cond1, onlyNone).empty());
+    const ConfusionMatrix cond3 =
+        loadConfusionMatrix(dataFile("tvcg2011_exp2_cond3_incoherent_confusion.csv"));
+    EXPECT_TRUE(cond3.hasSoundscape);
+    Protocol onlyIncoherent = exp2;
+    onlyIncoherent.groups = {*exp2.group("incoherent")};
+    EXPECT_TRUE(checkMatrixAgainst(cond3, onlyIncoherent).empty());
+    // The incoherent matrix has no row for gravel, so it cannot drive the coherent group.
+    Protocol onlyCoherent = exp2;
+    onlyCoherent.groups = {*exp2.group("coherent")};
+    EXPECT_FALSE(checkMatrixAgainst(cond3, onlyCoherent).empty());
+    // Exp 1's matrix names reverb variants, which are not options of exp 2's answer list.
+    const ConfusionMatrix exp1 = loadConfusionMatrix(dataFile("tvcg2011_exp1_confusion.csv"));
+    EXPECT_FALSE(checkMatrixAgainst(exp1, onlyNone).empty());
+}
+
+TEST(ExperimentSimulation, BadMatricesAreReportedWithLine) {
+    EXPECT_THROW(parseConfusionMatrix("stimulus,BS,DK\nBS,1\n", "m.csv"), std::runtime_error);
+    EXPECT_THROW(parseConfusionMatrix("stimulus,BS,XX\nBS,1,2\n", "m.csv"), std::runtime_error);
+    EXPECT_THROW(parseConfusionMatrix("stimulus,BS,DK\nBS,1,nan\n", "m.csv"), std::runtime_error);
+    EXPECT_THROW(parseConfusionMatrix("stimulus,BS,DK\nBS,0,0\n", "m.csv"), std::runtime_error);
+    try {
+        parseConfusionMatrix("stimulus,BS,DK\nBS,1,2\nGL,x,1\n", "m.csv");
+        FAIL();
+    } catch (const std::runtime_error& e) {
+        EXPECT_NE(std::string(e.what()).find("m.csv:3:"), std::string::npos) << e.what();
+    }
+}
