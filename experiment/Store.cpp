@@ -860,6 +860,16 @@ void StudyStore::setExcluded(const std::string& code, int trialIndex, bool exclu
     tx.commit();
 }
 
+std::map<std::string, std::pair<int, int>> StudyStore::progressCounts() const {
+    std::map<std::string, std::pair<int, int>> out;
+    SQLite::Statement q(*db_,
+                        "SELECT p.code, count(t.answered_at), count(t.id) FROM participants p "
+                        "LEFT JOIN trials t ON t.participant_id = p.id GROUP BY p.id");
+    while (q.executeStep())
+        out[q.getColumn(0).getString()] = {q.getColumn(1).getInt(), q.getColumn(2).getInt()};
+    return out;
+}
+
 ReplayInfo StudyStore::trialForReplay(const std::string& code, int trialIndex) const {
     const TrialRecord t = trial(code, trialIndex);
     if (!t.renderSeed || !t.sessionNumber)

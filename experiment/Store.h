@@ -227,6 +227,9 @@ class StudyStore {
                  const std::string& detail);
     std::vector<Event> events() const;
 
+    /// Answered and planned trial counts per participant code (one aggregate query).
+    std::map<std::string, std::pair<int, int>> progressCounts() const;
+
     /// What replay needs for one trial (throws StoreError if the trial never started).
     ReplayInfo trialForReplay(const std::string& code, int trialIndex) const;
 

@@ -85,12 +85,11 @@ const underfoot::cli::CommandRegistrar registrar{
                                g.dropped, g.target);
                 fmt::print("\n{:<10} {:>4} {:<12} {:<10} {:>8}  {}\n", "code", "idx", "group",
                            "status", "answered", "assignment");
+                const auto counts = store.progressCounts();
                 for (const auto& p : store.participants()) {
-                    const auto trials = store.trials(p.code);
-                    int answered = 0;
-                    for (const auto& t : trials) answered += t.answered ? 1 : 0;
+                    const auto [answered, planned] = counts.at(p.code);
                     fmt::print("{:<10} {:>4} {:<12} {:<10} {:>4}/{:<3}  {}\n", p.code, p.index,
-                               p.groupId, toString(p.status), answered, trials.size(),
+                               p.groupId, toString(p.status), answered, planned,
                                p.assignment == Assignment::Override
                                    ? "override: " + p.overrideReason
                                    : "balanced");
