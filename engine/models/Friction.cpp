@@ -55,7 +55,8 @@ double ElastoPlasticFrictionT<Real>::processSample(double normal, double drive) 
     const double T = T_, M = params_.exciterMassKg;
     const double N = std::max(0.0, normal);
     const double fc = params_.dynamicCoefficient * N, fs = params_.staticCoefficient * N;
-    const double noise = params_.sigma3 * rng_.bipolar();
+    // Roughness noise acts only while the surfaces are pressed together.
+    const double noise = N > 0.0 ? params_.sigma3 * rng_.bipolar() : 0.0;
 
     // Predictions without a new friction force (old force held, drive ramped).
     const double aNow = (lastDrive_ - force_) / M;
@@ -85,49 +86,42 @@ double ElastoPlasticFrictionT<Real>::processSample(double normal, double drive) 
     };
     // h(v) = v - (vRelPred - kd F(v)) is increasing in v; find its root.
     auto h = [&](double v1) { return v1 - vRelPred + kd_ * forceAt(v1, bristleAt(v1)); };
-    double lo = vRelPred, hi = vRelPred;
-    double hlo = h(lo), hhi = hlo;
-    double step = std::max(1e-6, std::fabs(vRelPred));
-    for (int k = 0; k < 60 && hlo > 0.0; ++k) {
-        hi = lo;
-        hhi = hlo;
-        lo -= step;
-        step *= 2;
-        hlo = h(lo);
+    // Since dh/dv >= 1 wherever F is increasing, the root lies within |h(v0)| of v0: bracket
+    // it at once (widening only if the bristle model makes h locally non-monotone).
+    const double v0 = vRelPred, h0 = h(v0);
+    double lo = v0, hi = v0, hlo = h0, hhi = h0;
+    double width = std::max(std::fabs(h0), 1e-9);
+    for (int k = 0; k < 40; ++k) {
+        if (hlo > 0.0) {
+            lo = v0 - width;
+            hlo = h(lo);
+        }
+        if (hhi < 0.0) {
+            hi = v0 + width;
+            hhi = h(hi);
+        }
+        if (hlo <= 0.0 && hhi >= 0.0) break;
+        width *= 2.0;
     }
-    step = std::max(1e-6, std::fabs(vRelPred));
-    for (int k = 0; k < 60 && hhi < 0.0; ++k) {
-        lo = hi;
-        hlo = hhi;
-        hi += step;
-        step *= 2;
-        hhi = h(hi);
-    }
-    double v1 = (hlo == 0.0) ? lo : hi;
-    if (hlo < 0.0 && hhi > 0.0) {
+    double v1 = (h0 == 0.0) ? v0 : (hlo == 0.0 ? lo : hi);
+    if (h0 != 0.0 && hlo < 0.0 && hhi > 0.0) {
+        // Illinois variant of regula falsi: superlinear, never leaves the bracket.
+        int side = 0;
         for (int it = 0; it < params_.maxIterations; ++it) {
-            double x = lo - hlo * (hi - lo) / (hhi - hlo); // secant (regula falsi)
-            if (!(x > lo && x < hi)) x = 0.5 * (lo + hi);
+            const double x = lo - hlo * (hi - lo) / (hhi - hlo);
             const double hx = h(x);
             v1 = x;
             if (hx == 0.0 || (hi - lo) < 1e-12 * (1.0 + std::fabs(x))) break;
             if (hx < 0.0) {
                 lo = x;
                 hlo = hx;
+                if (side == -1) hhi *= 0.5;
+                side = -1;
             } else {
                 hi = x;
                 hhi = hx;
-            }
-            if (it % 2 == 1) { // Illinois-style safeguard: alternate with bisection
-                const double m = 0.5 * (lo + hi), hm = h(m);
-                if (hm < 0.0) {
-                    lo = m;
-                    hlo = hm;
-                } else {
-                    hi = m;
-                    hhi = hm;
-                }
-                v1 = m;
+                if (side == 1) hlo *= 0.5;
+                side = 1;
             }
         }
     }
@@ -139,7 +133,7 @@ double ElastoPlasticFrictionT<Real>::processSample(double normal, double drive) 
     exciterV_ = vePred - 0.5 * T / M * f;
     resonator_.commit(0, f);
     z_ = snapToZero(z1);
-    v_ = exciterV_ - resonator_.velocity(0);
+    v_ = exciterV_ - resonator_.contactVelocity();
     force_ = f;
     lastDrive_ = drive;
     return resonator_.velocity(0);

@@ -36,6 +36,7 @@ void HuntCrossleyImpactT<Real>::prepare(const ProcessSpec& spec) {
     internalFs_ = fs_ * params_.oversampling;
     T_ = 1.0 / internalFs_;
     resonator_.prepare(internalFs_);
+    resonator_.setOutputPickup(listen_);
     const double M = params_.exciterMassKg;
     kc_ = T_ * T_ / (6.0 * M) + resonator_.compliance(0); // exact for a linear force ramp
     kd_ = T_ / (2.0 * M) + resonator_.mobility(0);
@@ -63,7 +64,7 @@ void HuntCrossleyImpactT<Real>::strike(double velocity) noexcept {
         exciterV_ += velocity;
     } else {
         exciterX_ = resonator_.position(0); // touching, zero compression
-        exciterV_ = velocity + resonator_.velocity(0);
+        exciterV_ = velocity + resonator_.contactVelocity();
     }
     awake_ = true;
     quietSamples_ = 0;
@@ -83,7 +84,8 @@ double HuntCrossleyImpactT<Real>::contactForce(double c, double cdot) const noex
 template <typename Real>
 double HuntCrossleyImpactT<Real>::solveForce(double ch, double dh) noexcept {
     if (params_.solver == ImpactSolver::Explicit)
-        return contactForce(exciterX_ - resonator_.position(0), exciterV_ - resonator_.velocity(0));
+        return contactForce(exciterX_ - resonator_.position(0),
+                            exciterV_ - resonator_.contactVelocity());
     const double fMax = contactForce(ch, dh);
     if (!(fMax > 0.0)) return 0.0;
     // g(F) = F - HC(ch - kc F, dh - kd F) is increasing in F; its root lies in [0, fMax].
@@ -98,7 +100,7 @@ double HuntCrossleyImpactT<Real>::solveForce(double ch, double dh) noexcept {
             hi = f;
         else
             lo = f;
-        if (std::fabs(g) <= 1e-12 * fMax) break;
+        if (std::fabs(g) <= 1e-10 * fMax) break;
         double dg = 1.0;
         if (hc > 0.0) {
             // dHC/dF = -(k a c^(a-1) (1 + mu cd) kc + k c^a mu kd)
@@ -127,7 +129,7 @@ double HuntCrossleyImpactT<Real>::step(double fextNow, double fextNext) noexcept
     struct Trial {
         double force, x, v, energy, work;
     };
-    auto trial = [&](double held, double scale, bool evaluate) {
+    auto trial = [&](double held, double scale) {
         const double aNow = (fextNow - held * lastForce_) / M;
         const double xPred = exciterX_ + T * exciterV_ + T * T * (aNow / 3.0 + aNextExt / 6.0);
         const double vPred = exciterV_ + 0.5 * T * (aNow + aNextExt);
@@ -138,14 +140,20 @@ double HuntCrossleyImpactT<Real>::step(double fextNow, double fextNext) noexcept
         t.force = scale * solveForce(ch, dh);
         t.x = xPred - T * T / (6.0 * M) * t.force;
         t.v = vPred - 0.5 * T / M * t.force;
-        if (evaluate) {
-            t.energy = 0.5 * M * t.v * t.v + resonator_.energyIfCommitted(0, t.force);
-            t.work = 0.5 * (fextNow + fextNext) * (t.x - exciterX_);
-        }
+        return t;
+    };
+    // Energy of the bodies after a trial (the resonator's prediction must be the trial's).
+    auto evaluate = [&](Trial& t) {
+        t.energy = 0.5 * M * t.v * t.v + resonator_.energyIfCommitted(0, t.force);
+        t.work = 0.5 * (fextNow + fextNext) * (t.x - exciterX_);
+    };
+    auto evaluated = [&](double held, double scale) {
+        Trial t = trial(held, scale);
+        evaluate(t);
         return t;
     };
 
-    Trial t = trial(1.0, 1.0, false);
+    Trial t = trial(1.0, 1.0);
     double held = 1.0;
     double absorbed = 0.0;
     if (t.force > 0.0 || lastForce_ > 0.0) {
@@ -163,15 +171,15 @@ double HuntCrossleyImpactT<Real>::step(double fextNow, double fextNext) noexcept
         const double tolerance = 1e-13 * bodiesBefore;
         auto absorbedBy = [&](const Trial& x) { return bodiesBefore + x.work - x.energy; };
         auto passive = [&](const Trial& x) { return contactEnergy_ + absorbedBy(x) >= -tolerance; };
-        t = trial(1.0, 1.0, true);
+        evaluate(t);
         if (!passive(t)) {
             ++stats_.passivityCorrections;
-            Trial best = trial(0.0, 1.0, true);
+            Trial best = evaluated(0.0, 1.0);
             if (passive(best)) {
                 double lo = 0.0, hi = 1.0; // held-force scale: lo passive, hi not
                 for (int k = 0; k < 16; ++k) {
                     const double mid = 0.5 * (lo + hi);
-                    const Trial m = trial(mid, 1.0, true);
+                    const Trial m = evaluated(mid, 1.0);
                     if (passive(m)) {
                         lo = mid;
                         best = m;
@@ -182,11 +190,11 @@ double HuntCrossleyImpactT<Real>::step(double fextNow, double fextNext) noexcept
                 held = lo;
             } else {
                 held = 0.0;
-                double lo = 0.0, hi = 1.0; // new-force scale
-                best = trial(0.0, 0.0, true);
+                double lo = 0.0, hi = 1.0;  // new-force scale
+                best = evaluated(0.0, 0.0); // no force at all: the floor only loses energy
                 for (int k = 0; k < 16; ++k) {
                     const double mid = 0.5 * (lo + hi);
-                    const Trial m = trial(0.0, mid, true);
+                    const Trial m = evaluated(0.0, mid);
                     if (passive(m)) {
                         lo = mid;
                         best = m;
@@ -203,7 +211,7 @@ double HuntCrossleyImpactT<Real>::step(double fextNow, double fextNext) noexcept
 
     // Commit the sample with the contact force at n+1.
     const double force = t.force;
-    const double dh = (exciterV_ - resonator_.velocity(0));
+    const double approach = exciterV_ - resonator_.contactVelocity(); // at n, for the stats
     exciterX_ = t.x;
     exciterV_ = t.v;
     resonator_.commit(0, force);
@@ -218,12 +226,12 @@ double HuntCrossleyImpactT<Real>::step(double fextNow, double fextNext) noexcept
         if (!inContact_) {
             contactStart_ = time_;
             stats_.peakForceN = 0;
-            stats_.incomingVelocity = dh;
+            stats_.incomingVelocity = approach;
         }
         stats_.peakForceN = std::max(stats_.peakForceN, force);
     } else if (inContact_) {
         stats_.contactTimeSeconds = time_ - contactStart_;
-        stats_.outgoingVelocity = exciterV_ - resonator_.velocity(0);
+        stats_.outgoingVelocity = exciterV_ - resonator_.contactVelocity();
     }
     inContact_ = contactNow;
     return resonator_.velocity(listen_);
@@ -258,7 +266,7 @@ void HuntCrossleyImpactT<Real>::process(const float* fext, float* out, int n) no
     resonator_.flushTinyState();
     // Sleep when there is no contact, no push, the exciter is not approaching the floor and
     // the floor rings below ~-200 dB re 1 m/s (far below any audible output gain).
-    const bool separating = exciterV_ - resonator_.velocity(0) <= 1e-9;
+    const bool separating = exciterV_ - resonator_.contactVelocity() <= 1e-9;
     const bool still = !inContact_ && !pushed && separating &&
                        resonator_.peakModalVelocity() < 1e-10 && peak < 1e-10;
     if (still) {

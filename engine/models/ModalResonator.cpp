@@ -116,6 +116,7 @@ void ModalResonatorT<Real>::prepare(double sampleRateHz) {
             kv_[p] += g * g / modes_[i].massKg * coefficients_[i].b1v;
         }
     }
+    setOutputPickup(std::min(outputPickup_, static_cast<int>(np) - 1));
     q_.assign(n, Real(0));
     v_.assign(n, Real(0));
     qh_.assign(n, Real(0));
@@ -130,12 +131,15 @@ void ModalResonatorT<Real>::reset() noexcept {
     std::fill(qh_.begin(), qh_.end(), Real(0));
     std::fill(vh_.begin(), vh_.end(), Real(0));
     std::fill(u_.begin(), u_.end(), Real(0));
+    x0_ = v0_ = outputVelocity_ = predictedX0_ = predictedV0_ = 0.0;
 }
 
 template <typename Real>
 void ModalResonatorT<Real>::predict(double heldScale) noexcept {
     const std::size_t n = q_.size();
     const Real h = static_cast<Real>(heldScale);
+    const double* g0 = gains_.front().data();
+    double x0 = 0.0, v0 = 0.0;
     for (std::size_t i = 0; i < n; ++i) {
         const auto& c = coefficients_[i];
         const Real q = q_[i], v = v_[i], u = h * u_[i];
@@ -143,11 +147,16 @@ void ModalResonatorT<Real>::predict(double heldScale) noexcept {
                  static_cast<Real>(c.b0x) * u;
         vh_[i] = static_cast<Real>(c.a10) * q + static_cast<Real>(c.a11) * v +
                  static_cast<Real>(c.b0v) * u;
+        x0 += g0[i] * double(qh_[i]);
+        v0 += g0[i] * double(vh_[i]);
     }
+    predictedX0_ = x0;
+    predictedV0_ = v0;
 }
 
 template <typename Real>
 double ModalResonatorT<Real>::predictedPosition(int p) const noexcept {
+    if (p == 0) return predictedX0_;
     const std::size_t n = q_.size(), off = static_cast<std::size_t>(p) * n;
     double x = 0;
     for (std::size_t i = 0; i < n; ++i) x += gains_[static_cast<std::size_t>(p)][i] * qh_[i];
@@ -157,6 +166,7 @@ double ModalResonatorT<Real>::predictedPosition(int p) const noexcept {
 
 template <typename Real>
 double ModalResonatorT<Real>::predictedVelocity(int p) const noexcept {
+    if (p == 0) return predictedV0_;
     const std::size_t n = q_.size();
     double v = 0;
     for (std::size_t i = 0; i < n; ++i) v += gains_[static_cast<std::size_t>(p)][i] * vh_[i];
@@ -167,13 +177,22 @@ template <typename Real>
 void ModalResonatorT<Real>::commit(int p, double forceN) noexcept {
     const std::size_t n = q_.size(), off = static_cast<std::size_t>(p) * n;
     const Real f = static_cast<Real>(forceN);
+    const double* g0 = gains_.front().data();
+    const double* go = outGain_.data();
+    double x0 = 0.0, v0 = 0.0, vo = 0.0;
     for (std::size_t i = 0; i < n; ++i) {
         const auto& c = coefficients_[i];
         const Real u = gainOverMass_[off + i] * f;
         q_[i] = qh_[i] + static_cast<Real>(c.b1x) * u;
         v_[i] = vh_[i] + static_cast<Real>(c.b1v) * u;
         u_[i] = u;
+        x0 += g0[i] * double(q_[i]);
+        v0 += g0[i] * double(v_[i]);
+        vo += go[i] * double(v_[i]);
     }
+    x0_ = x0;
+    v0_ = v0;
+    outputVelocity_ = vo;
 }
 
 template <typename Real>
@@ -191,7 +210,17 @@ double ModalResonatorT<Real>::energyIfCommitted(int p, double forceN) const noex
 }
 
 template <typename Real>
+void ModalResonatorT<Real>::setOutputPickup(int p) {
+    outputPickup_ = p;
+    outGain_.assign(modes_.size(), 0.0);
+    for (std::size_t i = 0; i < modes_.size(); ++i)
+        if (i < coefficients_.size() && !coefficients_[i].quasiStatic)
+            outGain_[i] = gains_.at(static_cast<std::size_t>(p))[i];
+}
+
+template <typename Real>
 double ModalResonatorT<Real>::position(int p) const noexcept {
+    if (p == 0) return x0_;
     double x = 0;
     for (std::size_t i = 0; i < q_.size(); ++i) x += gains_[static_cast<std::size_t>(p)][i] * q_[i];
     return x;
@@ -200,6 +229,7 @@ double ModalResonatorT<Real>::position(int p) const noexcept {
 template <typename Real>
 double ModalResonatorT<Real>::velocity(int p) const noexcept {
     // Quasi-static modes do not radiate (their "velocity" is a finite difference of a compliance).
+    if (p == outputPickup_) return outputVelocity_;
     double v = 0;
     for (std::size_t i = 0; i < v_.size(); ++i)
         if (!coefficients_[i].quasiStatic) v += gains_[static_cast<std::size_t>(p)][i] * v_[i];

@@ -78,8 +78,13 @@ class ModalResonatorT {
     /// Completes the sample with force `forceN` acting at pickup p (at n+1).
     void commit(int p, double forceN) noexcept;
 
+    /// The pickup whose velocity velocity(p) returns fastest (computed during commit()).
+    void setOutputPickup(int p);
+
     // ---- after commit ----
     double position(int p) const noexcept;
+    /// Velocity of the contact point (pickup 0), all modes included (computed by commit()).
+    double contactVelocity() const noexcept { return v0_; }
     double velocity(int p) const noexcept;
     /// Mechanical energy stored in the modes (kinetic + potential), joules.
     double energy() const noexcept;
@@ -106,6 +111,10 @@ class ModalResonatorT {
     std::vector<double> kx_, kv_;           // per pickup
     std::vector<double> w0sq_;              // undamped angular frequency squared, per mode
     double sampleRateHz_ = 0.0;
+    double predictedX0_ = 0.0, predictedV0_ = 0.0;      // pickup 0, computed by predict()
+    double x0_ = 0.0, v0_ = 0.0, outputVelocity_ = 0.0; // computed by commit()
+    int outputPickup_ = 0;
+    std::vector<double> outGain_; // output pickup's gains, 0 for non-radiating modes
     int quasiStaticCount_ = 0;
 };
 

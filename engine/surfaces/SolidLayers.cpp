@@ -10,6 +10,7 @@
 #include "engine/surfaces/SolidLayers.h"
 
 #include "engine/dsp/Envelope.h"
+#include "engine/dsp/Random.h"
 #include "engine/models/Friction.h"
 #include "engine/models/Impact.h"
 
@@ -62,13 +63,17 @@ class StepGestures {
   public:
     double onsetN = 30.0, releaseN = 10.0, retriggerRate = 15000.0, retriggerGapS = 0.05;
     double referenceRate = 20000.0; ///< N/s giving the nominal strike velocity
+    double toeDelayS = 0.07;        ///< forefoot lands this long after the heel (0 = never)
+    double toeStrength = 0.6;       ///< forefoot strike velocity relative to the heel's
 
     void prepare(double fs) {
         fs_ = fs;
         smooth_ = onePoleCoefficientTau(0.0005, fs); // 0.5 ms derivative smoothing
         reset();
     }
-    void reset() {
+    void reset(std::uint64_t seed = 1) {
+        rng_.setSeed(seed);
+        toeCountdown_ = -1.0;
         last_ = rate_ = 0.0;
         offSeconds_ = sinceStrike_ = 1e9;
         down_ = false;
@@ -86,7 +91,15 @@ class StepGestures {
             if (grf >= onsetN) {
                 down_ = true;
                 rearmed_ = false;
-                if (offSeconds_ >= 0.03) strike = strength(std::max(rate_, 0.0));
+                if (offSeconds_ >= 0.03) {
+                    strike = strength(std::max(rate_, 0.0));
+                    // Heel then forefoot ("heel-toe" roll-over, Perry & Burnfield 2010): the
+                    // forefoot lands about 70 ms later; +-15 % jitter so no two steps are alike.
+                    if (toeStrength > 0.0 && toeDelayS > 0.0) {
+                        toeCountdown_ = toeDelayS * fs_ * (1.0 + 0.15 * rng_.bipolar());
+                        toeLevel_ = toeStrength * strike;
+                    }
+                }
             }
         } else if (grf < releaseN) {
             down_ = false;
@@ -97,6 +110,10 @@ class StepGestures {
                 rearmed_ = false;
                 strike = 0.5 * strength(rate_);
             }
+        }
+        if (toeCountdown_ >= 0.0) {
+            toeCountdown_ -= 1.0;
+            if (toeCountdown_ < 0.0 && down_) strike = std::max(strike, toeLevel_);
         }
         if (strike > 0.0) sinceStrike_ = 0.0;
         return strike;
@@ -109,6 +126,8 @@ class StepGestures {
     }
     double fs_ = 48000, smooth_ = 0, last_ = 0, rate_ = 0;
     double offSeconds_ = 1e9, sinceStrike_ = 1e9; // time off the floor, samples since a strike
+    double toeCountdown_ = -1.0, toeLevel_ = 0.0; // pending forefoot strike
+    Random rng_;
     bool down_ = false, rearmed_ = true;
 };
 
@@ -157,9 +176,9 @@ class ImpactLayer final : public SurfaceLayer {
         press_.assign(static_cast<std::size_t>(spec.maxBlockSize), 0.0f);
         buffer_.assign(static_cast<std::size_t>(spec.maxBlockSize), 0.0f);
     }
-    void reset(std::uint64_t) noexcept override {
+    void reset(std::uint64_t seed) noexcept override {
         impact_.reset();
-        gestures_.reset();
+        gestures_.reset(seed);
     }
     void process(const float* grf, float* out, int n) noexcept override {
         int start = 0;
@@ -250,17 +269,22 @@ class FrictionLayer final : public SurfaceLayer {
             const double d = (load - last_) * fs_;
             last_ = load;
             rate_ = d + smooth_ * (rate_ - d);
-            if (load <= 0.0 && quiet_ > static_cast<long>(fs_)) {
-                continue; // asleep: no load and the boards have rung out
-            }
             const double shear = std::max(0.0, std::fabs(rate_) - threshold_) * 1e-3 * slipPerRate_;
+            // Asleep while nothing shears and the boards have rung out (standing still or in the
+            // air): the friction state is held, nothing is computed.
+            if (shear <= 0.0 && quiet_ > static_cast<long>(0.05 * fs_)) {
+                anchor_ = friction_.exciterPosition();
+                continue;
+            }
             anchor_ += shear / fs_;
             const double xe = friction_.exciterPosition(), ve = friction_.exciterVelocity();
             if (load <= 0.0) anchor_ = xe; // unloaded: the drag relaxes
             const double drive = driveStiffness_ * (anchor_ - xe) + driveDamping_ * (shear - ve);
             const double y = friction_.processSample(normalFraction_ * load, drive);
             out[i] += g * static_cast<float>(y);
-            quiet_ = (std::fabs(y) < 1e-9 && load <= 0.0) ? quiet_ + 1 : 0;
+            quiet_ = (std::fabs(y) < 1e-7 && std::fabs(friction_.relativeVelocity()) < 1e-6)
+                         ? quiet_ + 1
+                         : 0;
         }
         friction_.resonator().flushTinyState();
     }
