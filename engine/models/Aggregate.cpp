@@ -140,11 +140,22 @@ void AggregateModel::spawn(double energy, bool burst) noexcept {
         const double logR = -kPi * f / (q * sampleRateHz_);
         const double r = std::exp(logR);
         const auto s = static_cast<std::size_t>(v * stride_ + k);
-        c1_[s] = static_cast<float>(2.0 * r * std::cos(theta));
-        c2_[s] = static_cast<float>(r * r);
-        y1_[s] = 0.0f;
-        // y[n] = a r^n sin((n+1) theta) needs y[-1] = 0, y[-2] = -a sin(theta) / r^2.
-        y2_[s] = static_cast<float>(-norm * weights[k] * std::sin(theta) / (r * r));
+        // Rotation (coupled) form: [x, y] <- r [cos, -sin; sin, cos] [x, y]. Its coefficients
+        // keep sin(theta) apart from cos(theta), so low frequencies stay accurate in float at any
+        // sample rate, and the pole radius is r exactly as long as a^2 + b^2 < 1.
+        float a = static_cast<float>(r * std::cos(theta));
+        float b = static_cast<float>(r * std::sin(theta));
+        const double radius2 = static_cast<double>(a) * a + static_cast<double>(b) * b;
+        if (radius2 >= 1.0) { // rounding reached the unit circle: pull the pole back inside
+            const double shrink = (1.0 - 1e-6) / std::sqrt(radius2);
+            a = static_cast<float>(a * shrink);
+            b = static_cast<float>(b * shrink);
+        }
+        c1_[s] = a;
+        c2_[s] = b;
+        // Starts at [A, 0]: y[n] = A r^n sin(n theta) (from the first processed sample on).
+        y1_[s] = static_cast<float>(norm * weights[k]);
+        y2_[s] = 0.0f;
         if (first || logR > slowest) slowest = logR;
         first = false;
     }
@@ -240,9 +251,10 @@ void AggregateModel::process(const float* rateHz, const float* energyScale, floa
         for (int j = 0; j < slots; j += kLanes) {
             for (int l = 0; l < kLanes; ++l) {
                 const int s = j + l;
-                const float y = c1[s] * y1[s] - c2[s] * y2[s];
-                y2[s] = y1[s];
-                y1[s] = y;
+                const float x = c1[s] * y1[s] - c2[s] * y2[s];
+                const float y = c2[s] * y1[s] + c1[s] * y2[s];
+                y1[s] = x;
+                y2[s] = y;
                 acc[l] += y;
             }
         }

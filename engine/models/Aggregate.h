@@ -23,8 +23,9 @@
 ///  - Response: each event starts one voice of `resonances` damped two-pole resonators whose
 ///    frequencies are drawn log-uniformly in [freqMinHz, freqMaxHz] and quality factors
 ///    log-uniformly in [qMin, qMax] (each grain rings differently). The free response of
-///    resonance k is  a_k r_k^n sin((n+1) theta_k)  with  theta = 2 pi f / fs,
-///    r = exp(-pi f / (Q fs))  (decay time constant Q / (pi f)), and amplitudes with
+///    resonance k is  a_k r_k^n sin(n theta_k)  with  theta = 2 pi f / fs,
+///    r = exp(-pi f / (Q fs))  (decay time constant Q / (pi f)), computed as a rotating phasor
+///    (coupled form, float, accurate at low frequencies), and amplitudes with
 ///    sum a_k^2 = E (peak amplitude sqrt(E): the energy an impact hands to a mode sets its
 ///    initial amplitude; the Q only sets how long it rings).
 ///  - Bursts (crumpling cascades): each event may be followed by a geometric number of
@@ -146,7 +147,8 @@ class AggregateModel {
     double pendingTrigger_ = 0.0;
 
     // Resonator slots, structure of arrays: voice v owns slots [v*stride_, (v+1)*stride_).
-    // Active voices are kept packed at the front.
+    // Active voices are kept packed at the front. c1 = r cos(theta), c2 = r sin(theta); the
+    // phasor is (y1, y2) and the output its imaginary part y2.
     std::vector<float> c1_, c2_, y1_, y2_;
     std::vector<std::int64_t> deathSample_;         // per voice
     std::vector<double> startAmplitude_, logDecay_; // per voice, for stealing the quietest

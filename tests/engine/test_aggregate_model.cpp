@@ -50,6 +50,7 @@ void operator delete[](void* p, std::size_t) noexcept {
 
 namespace {
 constexpr double kFs = 48000.0;
+constexpr double kPiValue = 3.141592653589793;
 
 struct Collector {
     std::vector<AggregateEvent> events;
@@ -205,7 +206,7 @@ TEST(AggregateModel, EnergyScaleMultipliesEnergiesAndSetsAmplitude) {
     auto out = run(m, 0.05, [](double) { return 0.0; });
     double peak = 0;
     for (float v : out) peak = std::max(peak, std::fabs(static_cast<double>(v)));
-    // a r^n sin((n+1) theta) peaks near the first quarter period: 0.5 exp(-pi f t / Q), t ~ 0.25 ms
+    // a r^n sin(n theta) peaks at the first quarter period: 0.5 exp(-pi f t / Q), t = 0.25 ms
     EXPECT_NEAR(peak, 0.5 * std::exp(-3.14159 * 1000.0 * 0.00025 / 50.0), 0.002);
     // Scaled energies in the observer.
     auto m2 = makeModel();
@@ -216,6 +217,57 @@ TEST(AggregateModel, EnergyScaleMultipliesEnergiesAndSetsAmplitude) {
     for (const auto& e : c.events) {
         EXPECT_GE(e.energy, 4.0 * 1e-3 * (1 - 1e-12));
         EXPECT_LE(e.energy, 4.0 * (1 + 1e-12));
+    }
+}
+
+TEST(AggregateModel, EachResonanceRingsAtItsFrequencyAndDecayAtAnyRate) {
+    // One event, one resonance of fixed f and Q: zero crossings give f, the slope of log peak
+    // heights gives the decay rate pi f / Q; low frequencies at high rates are the hard case for
+    // a float two-pole (the rotation form keeps them exact).
+    for (double fs : {22050.0, 48000.0, 192000.0}) {
+        for (double f : {40.0, 1000.0, 8000.0}) {
+            AggregateParameters p;
+            p.resonances = 1;
+            p.freqMinHz = p.freqMaxHz = f;
+            p.qMin = p.qMax = 30.0;
+            AggregateModel m;
+            m.configure(p);
+            m.prepare(fs, 1000);
+            m.reset(1);
+            m.trigger(1.0);
+            const double decay = kPiValue * f / 30.0; // 1/s
+            const int n = static_cast<int>(std::min(3.0 / decay, 2.0) * fs);
+            std::vector<float> out(static_cast<std::size_t>(n), 0.0f),
+                zero(static_cast<std::size_t>(n), 0.0f);
+            m.process(zero.data(), zero.data(), out.data(), n);
+            std::vector<double> crossings;
+            double sx = 0, sy = 0, sxx = 0, sxy = 0;
+            int peaks = 0;
+            for (std::size_t i = 1; i + 1 < out.size(); ++i) {
+                if (out[i - 1] < 0 && out[i] >= 0)
+                    crossings.push_back(static_cast<double>(i - 1) +
+                                        out[i - 1] / (out[i - 1] - out[i]));
+                const double a = std::fabs(out[i]);
+                if (a > std::fabs(out[i - 1]) && a >= std::fabs(out[i + 1]) && a > 1e-6 &&
+                    f < fs / 8) {
+                    const double t = static_cast<double>(i) / fs;
+                    sx += t;
+                    sy += std::log(a);
+                    sxx += t * t;
+                    sxy += t * std::log(a);
+                    ++peaks;
+                }
+            }
+            ASSERT_GT(crossings.size(), 5u);
+            const double measured = fs * static_cast<double>(crossings.size() - 1) /
+                                    (crossings.back() - crossings.front());
+            EXPECT_NEAR(measured, f, f * 2e-3) << "fs " << fs << " f " << f;
+            if (peaks >
+                10) { // sampled peaks are exact maxima only when a period spans many samples
+                const double slope = (peaks * sxy - sx * sy) / (peaks * sxx - sx * sx);
+                EXPECT_NEAR(-slope, decay, decay * 0.03) << "fs " << fs << " f " << f;
+            }
+        }
     }
 }
 
