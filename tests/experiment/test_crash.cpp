@@ -15,6 +15,7 @@
 #include <cstdio>
 #include <fcntl.h>
 #include <map>
+#include <optional>
 #include <poll.h>
 #include <set>
 #include <sstream>
@@ -33,8 +34,10 @@ struct ChildRun {
 
 /// Runs the child, kills it after `killAfterMs` (negative: let it finish) and returns the
 /// complete ack lines it printed.
+/// With `fromFirstAck`, the delay counts from the first ack (kills land among commits even on a
+/// slow machine); otherwise from the start (kills also land in start-up and registration).
 ChildRun runChild(const std::string& study, const std::string& matrix, int participants,
-                  int killAfterMs) {
+                  int killAfterMs, bool fromFirstAck = false) {
     int fds[2];
     if (::pipe(fds) != 0) throw std::runtime_error("pipe failed");
     const std::string count = std::to_string(participants);
@@ -51,21 +54,27 @@ ChildRun runChild(const std::string& study, const std::string& matrix, int parti
     }
     ::close(fds[1]);
     std::string output;
-    const auto start = std::chrono::steady_clock::now();
+    using Clock = std::chrono::steady_clock;
+    const auto spawned = Clock::now();
+    std::optional<Clock::time_point> start;
+    if (!fromFirstAck) start = spawned;
     bool killed = false;
     char buffer[4096];
     while (true) {
-        int timeoutMs = -1;
+        int timeoutMs = 1000;
         if (killAfterMs >= 0 && !killed) {
-            const auto elapsed = std::chrono::duration_cast<std::chrono::milliseconds>(
-                                     std::chrono::steady_clock::now() - start)
-                                     .count();
-            timeoutMs = static_cast<int>(std::max<long>(0, killAfterMs - elapsed));
+            if (!start && output.find('\n') != std::string::npos) start = Clock::now();
+            const auto since = Clock::now() - (start ? *start : spawned);
+            const auto elapsed = std::chrono::duration_cast<std::chrono::milliseconds>(since);
+            // Safety net: a child that never acknowledges anything is killed after 60 s.
+            const long limit = start ? killAfterMs : 60000;
+            timeoutMs = static_cast<int>(std::max<long>(0, limit - elapsed.count()));
             if (timeoutMs == 0) {
                 ::kill(pid, SIGKILL);
                 killed = true;
-                timeoutMs = -1;
+                timeoutMs = 1000;
             }
+            if (!start) timeoutMs = std::min(timeoutMs, 5);
         }
         pollfd p{fds[0], POLLIN, 0};
         const int ready = ::poll(&p, 1, timeoutMs);
@@ -109,8 +118,11 @@ TEST(ExperimentCrash, SigkillAtRandomPointsLosesNoAcknowledgedAnswer) {
     std::map<std::string, int> expectedResume; // participant -> first unanswered after a kill
     int totalAcks = 0;
     for (int k = 0; k < kills; ++k) {
-        const int killAfterMs = static_cast<int>(rng.below(250));
-        const ChildRun run = runChild(study, matrix, participants, killAfterMs);
+        // Alternate: kills timed from the start (start-up, registration, first commits) and
+        // kills timed from the first commit (in the middle of sessions).
+        const bool fromFirstAck = k % 2 == 1;
+        const int killAfterMs = static_cast<int>(rng.below(fromFirstAck ? 120 : 250));
+        const ChildRun run = runChild(study, matrix, participants, killAfterMs, fromFirstAck);
         ASSERT_FALSE(run.finished);
         // The run resumes each unfinished participant at its first unanswered trial.
         std::set<std::string> seen;
