@@ -26,6 +26,7 @@ using namespace underfoot::engine;
 namespace {
 constexpr double kFs = 48000.0;
 constexpr int kBlock = 512;
+constexpr double kWarmupSeconds = 1.25; // one stride at 100 steps/min (+ margin)
 
 const std::vector<std::string> kSurfaces = {
     "beach_sand",        "gravel",     "dirt_pebbles", "deep_snow", "frozen_snow", "high_grass",
@@ -50,21 +51,35 @@ std::uint64_t layerEvents(const Surface& s) {
 }
 
 // Two feet, each its own Surface voice, driven by the virtual walker.
-Render renderWalk(const std::string& id, double seconds, std::uint64_t seed) {
+Render renderWalk(const std::string& id, double seconds, std::uint64_t seed, double fs = kFs) {
     auto left = Surface::loadById(id), right = Surface::loadById(id);
-    left->prepare({kFs, kBlock});
-    right->prepare({kFs, kBlock});
+    left->prepare({fs, kBlock});
+    right->prepare({fs, kBlock});
     left->reset(Random::deriveSeed(seed, 1));
     right->reset(Random::deriveSeed(seed, 2));
     VirtualWalker walker;
-    walker.prepare({kFs, kBlock});
+    walker.prepare({fs, kBlock});
     walker.reset(seed);
     Render r;
-    const int total = static_cast<int>(seconds * kFs);
+    const int total = static_cast<int>(seconds * fs);
     r.audio.assign(static_cast<std::size_t>(total), 0.0f);
     r.leftAudio = r.leftGrf = r.audio;
     std::vector<float> gl(kBlock), gr(kBlock), ol(kBlock), orr(kBlock);
     bool wasL = false, wasR = false;
+    // Warm-up: the walker starts with the right foot already in mid-stance (its load appears at
+    // once at t = 0), which is no footstep; the first stride is rendered and discarded.
+    const int warmup = static_cast<int>(kWarmupSeconds * fs);
+    for (int done = 0; done < warmup; done += kBlock) {
+        const int n = std::min(kBlock, warmup - done);
+        walker.process(gl.data(), gr.data(), n);
+        left->process(gl.data(), ol.data(), n);
+        right->process(gr.data(), orr.data(), n);
+        for (int i = 0; i < n; ++i) {
+            wasL = gl[static_cast<std::size_t>(i)] > 5;
+            wasR = gr[static_cast<std::size_t>(i)] > 5;
+        }
+    }
+    const std::uint64_t eventsBefore = layerEvents(*left) + layerEvents(*right);
     for (int done = 0; done < total; done += kBlock) {
         const int n = std::min(kBlock, total - done);
         walker.process(gl.data(), gr.data(), n);
@@ -84,7 +99,7 @@ Render renderWalk(const std::string& id, double seconds, std::uint64_t seed) {
             r.leftGrf[k] = gl[u];
         }
     }
-    r.events = layerEvents(*left) + layerEvents(*right);
+    r.events = layerEvents(*left) + layerEvents(*right) - eventsBefore;
     return r;
 }
 
@@ -238,6 +253,8 @@ TEST(GranularSurfaces, CalibratedToAboutMinus12DbfsPeak) {
             peaks.push_back(20 * std::log10(p));
         }
         std::sort(peaks.begin(), peaks.end());
+        std::printf("%-18s median peak %6.1f dBFS (seeds 7-11: %.1f .. %.1f)\n", id.c_str(),
+                    peaks[2], peaks[0], peaks[4]);
         EXPECT_NEAR(peaks[2], -12.0, 2.0) << id;
         EXPECT_LT(peaks[4], -3.0) << id;
     }
@@ -246,18 +263,20 @@ TEST(GranularSurfaces, CalibratedToAboutMinus12DbfsPeak) {
 TEST(GranularSurfaces, SurfacesAreDistinctByTheNumbers) {
     const auto& f = allFigures();
     auto at = [&](const char* id) { return f.at(id); };
-    // Gravel: hard small stones, bright; sand: dull hiss (measured 3495 vs 1203 Hz).
+    // Gravel: hard small stones, bright; sand: dull hiss (measured 3413 vs 1083 Hz).
     EXPECT_GT(at("gravel").centroidHz, 2.0 * at("beach_sand").centroidHz);
-    // Deep snow: muffled and lower than both (measured 793 Hz).
+    // Deep snow: muffled and lower than both (measured 748 Hz).
     EXPECT_LT(at("deep_snow").centroidHz, 0.4 * at("gravel").centroidHz);
     EXPECT_LT(at("deep_snow").centroidHz, 0.8 * at("beach_sand").centroidHz);
     // Snow crunches are cascades of fewer, larger breaks; gravel and sand are dense streams of
-    // small impacts (measured 519 vs 1229 and 887 events per step).
+    // small impacts (measured 589 vs 1266 and 966 events per step).
     EXPECT_LT(at("deep_snow").eventsPerStep, 0.6 * at("gravel").eventsPerStep);
     EXPECT_LT(at("deep_snow").eventsPerStep, 0.8 * at("beach_sand").eventsPerStep);
-    // Snow keeps compacting through the stance: more of its energy comes after the heel peak.
+    // Snow keeps compacting through the stance: more of its energy comes after the heel peak
+    // (measured 0.71 vs 0.57 of the step's energy after 0.2 s).
     EXPECT_GT(at("deep_snow").lateShare, at("gravel").lateShare + 0.1);
-    // Frozen snow is brighter and spikier than deep snow.
+    // Frozen snow is brighter and spikier than deep snow (measured 2363 vs 748 Hz, crest 20.5
+    // vs 18.6 dB).
     EXPECT_GT(at("frozen_snow").centroidHz, 2.0 * at("deep_snow").centroidHz);
     EXPECT_GT(at("frozen_snow").crestDb, at("deep_snow").crestDb + 1.0);
     // Dirt plus pebbles: mostly low earth (more power below 500 Hz than gravel and sparser).
@@ -294,5 +313,29 @@ TEST(GranularSurfaces, SameSeedSameSamplesAndSilenceWithoutSteps) {
             for (float v : out) ASSERT_EQ(v, 0.0f) << id;
         }
         EXPECT_TRUE(s->isSleeping()) << id;
+    }
+}
+
+TEST(GranularSurfaces, SameLevelAndFiniteAtOtherSampleRates) {
+    // The models are written in physical units: at 22.05 and 192 kHz every surface stays finite
+    // and its median peak within 3 dB of the 48 kHz one (resonances above 0.45 fs are clamped).
+    for (const auto& id : kSurfaces) {
+        auto medianPeakDb = [&](double fs) {
+            std::vector<double> peaks;
+            for (std::uint64_t seed = 7; seed < 10; ++seed) {
+                const auto r = renderWalk(id, 3.0, seed, fs);
+                double p = 0;
+                for (float v : r.audio) {
+                    if (!std::isfinite(v)) return 1e9;
+                    p = std::max(p, std::fabs(static_cast<double>(v)));
+                }
+                peaks.push_back(20 * std::log10(p));
+            }
+            std::sort(peaks.begin(), peaks.end());
+            return peaks[1];
+        };
+        const double reference = medianPeakDb(kFs);
+        EXPECT_NEAR(medianPeakDb(22050.0), reference, 3.0) << id;
+        EXPECT_NEAR(medianPeakDb(192000.0), reference, 3.0) << id;
     }
 }
