@@ -13,6 +13,7 @@ namespace {
 constexpr double kMaxForceN = 1e5;    // GRF beyond this is clamped (no human produces it)
 constexpr double kTailSeconds = 0.25; // filters ring out this long before the layer sleeps
 constexpr double kDerivativeRefKnPerS = 10.0;
+constexpr double kJumpN = 100.0; // a rise from no contact by more than this in one sample is a cut
 
 /// GRF sample -> newtons, with NaN/Inf/negative read as 0 (no contact).
 inline double sanitizeForce(float v) noexcept {
@@ -85,6 +86,12 @@ void GrainsLayer::processChunk(const float* grf, float* out, int n) noexcept {
     bool contactSeen = false;
     for (int i = 0; i < n; ++i) {
         const double f = sanitizeForce(grf[i]);
+        if (previousF_ <= threshold && f - previousF_ > kJumpN) {
+            // No foot lands this fast: the GRF starts mid-stance (a file or walker starting in
+            // the middle of a step). Take the load as already there: no landing, no rise.
+            previousF_ = f;
+            onsetArmed_ = false;
+        }
         const double raw = (f - previousF_) * toKnPerS;
         previousF_ = f;
         derivative_ = raw + g * (derivative_ - raw);

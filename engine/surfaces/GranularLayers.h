@@ -12,6 +12,8 @@
 ///   scale   = F^load_exponent x (1 + rise_energy x max(dF/dt, 0) / 10)   (energy multiplier)
 ///   onset   = one event of energy onset_energy x clamp(dF/dt / 10, 0.1, 3) when the load first
 ///             crosses onset_force_n in a step (the heel lands: a thump or a crunch).
+/// A load that appears from no contact by more than 100 N within one sample (a GRF file or the
+/// walker starting mid-stance) is taken as already there: no landing event, no rise.
 /// Everything is zero while F <= contact_threshold_n; when the voices have rung out and the load
 /// stays below the threshold the layer sleeps (a block then costs one scan of the GRF).
 /// The sum of the voices goes through an optional 2nd-order Butterworth high-pass and low-pass

@@ -13,6 +13,7 @@ namespace {
 constexpr double kMaxForceN = 1e5;
 constexpr double kTailSeconds = 0.1;
 constexpr double kDerivativeRefKnPerS = 10.0;
+constexpr double kJumpN = 100.0;  // a rise from no contact by more than this in one sample is a cut
 constexpr double kQuiet = 1e-6;   // envelopes below this are silent
 constexpr double kOffDb = -120.0; // noise levels at or below this are off
 constexpr double kWakeEnd = 1e-3; // the wake envelope ends 60 dB below its nominal start
@@ -92,13 +93,15 @@ void BubblesLayer::processChunk(const float* grf, float* out, int n) noexcept {
     float* buffer = buffer_.data();
     for (int i = 0; i < n; ++i) {
         const double f = sanitizeForce(grf[i]);
+        const bool jump = previousF_ <= threshold && f - previousF_ > kJumpN;
+        if (jump) previousF_ = f; // the GRF starts mid-stance: the foot is already in the water
         const double raw = (f - previousF_) * toKnPerS;
         previousF_ = f;
         derivative_ = raw + derivativeG_ * (derivative_ - raw);
         const bool contact = f > threshold;
         if (contact && !inContact_) {
             inContact_ = true;
-            contactSamples_ = 0;
+            contactSamples_ = jump ? splashSamples_ : 0; // no landing, no splash
             releasePeak_ = 0.0;
         } else if (!contact && inContact_) {
             inContact_ = false;

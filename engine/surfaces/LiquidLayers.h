@@ -16,6 +16,8 @@
 ///    puddle; the leg swinging through the water when wading, STUDIES.md §4);
 ///  - slosh: low band-pass noise (slosh_hz) following the motion (|dF/dt| / 10 kN/s, smoothed, plus
 ///    the wake envelope): the mass of water being displaced.
+/// A load appearing from no contact by more than 100 N within one sample (a GRF starting
+/// mid-stance) is no landing: no splash.
 /// With the GRF at zero from reset the layer is silent and sleeps; after a step it sleeps again
 /// once the bubbles, the wake and the noise have decayed.
 #include "engine/dsp/Biquad.h"

@@ -274,3 +274,23 @@ TEST(SurfaceLayers, NoAllocationWhileProcessing) {
         EXPECT_EQ(underfoot::test::allocationCount.load(), 0) << id;
     }
 }
+
+TEST(GrainsLayer, AGrfStartingMidStanceIsNoLanding) {
+    // A GRF file (or the walker) may start in the middle of a step: the load is there at the
+    // first sample. That is no landing: no onset event and no burst of "rise" events.
+    auto s = surfaceWithLayer("events_per_kn_rise = 300.0\nonset_energy = 1.0");
+    std::vector<float> grf(static_cast<std::size_t>(0.5 * kFs), 600.0f);
+    render(*s, grf);
+    EXPECT_EQ(events(*s), 0u);
+    auto b = surfaceWithLayer("splash_bubbles_per_kn = 2000.0\nsplash_noise_db = 0.0", "bubbles");
+    const auto out = render(*b, grf);
+    EXPECT_EQ(dynamic_cast<const BubblesLayer&>(b->layer(0)).stream().bubbleCount(), 0u);
+    for (float v : out) ASSERT_EQ(v, 0.0f);
+    // A real landing (a ramp over 50 ms) does fire.
+    std::vector<float> ramp(static_cast<std::size_t>(0.5 * kFs), 600.0f);
+    for (std::size_t i = 0; i < static_cast<std::size_t>(0.05 * kFs); ++i)
+        ramp[i] = static_cast<float>(600.0 * static_cast<double>(i) / (0.05 * kFs));
+    s->reset(1);
+    render(*s, ramp);
+    EXPECT_GT(events(*s), 100u); // 300 per kN x 0.6 kN = 180 expected, plus the onset
+}
