@@ -48,6 +48,8 @@ class ElastoPlasticFrictionT {
     /// tangentially. Returns the resonator's velocity at pickup 0 (m/s).
     double processSample(double normalForceN, double driveForceN) noexcept;
 
+    /// Unloaded surfaces: the bristles relax and the rubbing mass stops (keeps the ringing).
+    void relax() noexcept { z_ = exciterV_ = force_ = lastDrive_ = v_ = 0.0; }
     double frictionForce() const noexcept { return force_; }
     double bristle() const noexcept { return z_; }
     double relativeVelocity() const noexcept { return v_; }

@@ -265,10 +265,10 @@ void HuntCrossleyImpactT<Real>::process(const float* fext, float* out, int n) no
     }
     resonator_.flushTinyState();
     // Sleep when there is no contact, no push, the exciter is not approaching the floor and
-    // the floor rings below ~-200 dB re 1 m/s (far below any audible output gain).
+    // the floor rings below the sleep velocity (layers set it to -120 dBFS at their output).
     const bool separating = exciterV_ - resonator_.contactVelocity() <= 1e-9;
     const bool still = !inContact_ && !pushed && separating &&
-                       resonator_.peakModalVelocity() < 1e-10 && peak < 1e-10;
+                       resonator_.peakModalVelocity() < sleepVelocity_ && peak < sleepVelocity_;
     if (still) {
         awake_ = false;
         resonator_.reset();

@@ -76,6 +76,8 @@ class HuntCrossleyImpactT {
     /// floor; writes the listen pickup's velocity (m/s) into `out` (overwrites).
     void process(const float* externalForceN, float* out, int n) noexcept;
 
+    /// Output velocity (m/s) below which a free, untouched floor is considered silent.
+    void setSleepVelocity(double v) noexcept { sleepVelocity_ = v; }
     /// True when nothing moves and nothing pushes: process() then costs almost nothing.
     bool isSleeping() const noexcept { return !awake_; }
     const ContactStats& stats() const noexcept { return stats_; }
@@ -102,6 +104,7 @@ class HuntCrossleyImpactT {
     double contactEnergy_ = 0; // work absorbed by the open contact and not yet returned, J
     bool inContact_ = false, awake_ = false;
     int quietSamples_ = 0;
+    double sleepVelocity_ = 1e-10;
     double kc_ = 0, kd_ = 0; // instantaneous compliance and mobility of the compression
     Butterworth decimator_;
     ContactStats stats_;

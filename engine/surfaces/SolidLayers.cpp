@@ -169,6 +169,7 @@ class ImpactLayer final : public SurfaceLayer {
                                   "output gain (0 dB: 1 m/s floor velocity = full scale)"));
         readGestures(r, gestures_);
         impact_.configure(p, std::move(modes), {gains});
+        impact_.setSleepVelocity(1e-6 / gain_); // asleep below -120 dBFS at the output
     }
     void prepare(const ProcessSpec& spec) override {
         impact_.prepare(spec);
@@ -250,6 +251,7 @@ class FrictionLayer final : public SurfaceLayer {
                               "load change below which the boards do not shear");
         gain_ = dbToGain(
             r.number("gain_db", 20.0, -40.0, 80.0, "dB", "output gain (0 dB: 1 m/s = full scale)"));
+        sleepVelocity_ = 1e-6 / gain_; // asleep below -120 dBFS at the output
         friction_.configure(p, std::move(modes), {gains});
     }
     void prepare(const ProcessSpec& spec) override {
@@ -278,25 +280,27 @@ class FrictionLayer final : public SurfaceLayer {
             }
             anchor_ += shear / fs_;
             const double xe = friction_.exciterPosition(), ve = friction_.exciterVelocity();
-            if (load <= 0.0) anchor_ = xe; // unloaded: the drag relaxes
+            if (load <= 0.0) { // unloaded: the drag and the bristles relax
+                friction_.relax();
+                anchor_ = xe;
+            }
             const double drive = driveStiffness_ * (anchor_ - xe) + driveDamping_ * (shear - ve);
             const double y = friction_.processSample(normalFraction_ * load, drive);
             out[i] += g * static_cast<float>(y);
-            quiet_ = (std::fabs(y) < 1e-7 && std::fabs(friction_.relativeVelocity()) < 1e-6)
-                         ? quiet_ + 1
-                         : 0;
+            const bool still = load <= 0.0 || std::fabs(friction_.relativeVelocity()) < 1e-6;
+            quiet_ = (std::fabs(y) < sleepVelocity_ && still) ? quiet_ + 1 : 0;
         }
         friction_.resonator().flushTinyState();
     }
     bool isSleeping() const noexcept override {
-        return quiet_ > static_cast<long>(fs_) && last_ <= 0.0;
+        return quiet_ > static_cast<long>(0.05 * fs_) && std::fabs(rate_) <= threshold_;
     }
     const char* kind() const noexcept override { return "friction"; }
 
   private:
     ElastoPlasticFriction friction_;
     double normalFraction_, driveStiffness_, driveDamping_, slipPerRate_, threshold_, gain_;
-    double fs_ = 48000, smooth_ = 0, last_ = 0, rate_ = 0, anchor_ = 0;
+    double fs_ = 48000, smooth_ = 0, last_ = 0, rate_ = 0, anchor_ = 0, sleepVelocity_ = 1e-7;
     long quiet_ = 1 << 30;
 };
 

@@ -43,7 +43,9 @@ toml::table parseFile(const std::string& file) {
 
 void Surface::loadLayers(const std::string& file, const toml::table& root,
                          const AccuracyOptions& options, int depth) {
-    PresetReader top(file, root, "", &params_);
+    // Parameters of a base preset's layers are named "<base id>:layer[i]...".
+    const std::string prefix = depth == 0 ? "" : fs::path(file).stem().string() + ":";
+    PresetReader top(file, root, prefix, &params_);
     // Header keys are read by loadSurfaceFromString() for the outermost file.
     for (const char* k : {"id", "name", "category", "description", "gain_db", "reverb", "base"})
         top.allow(k);

@@ -1,0 +1,268 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Every bundled surface: present, well described, deterministic, stable over randomized sweeps of
+// its documented parameter ranges, silent and asleep when nobody walks, allocation-free.
+#include "engine/render/AudioFeatures.h"
+#include "engine/render/Renderer.h"
+#include "engine/surfaces/Surface.h"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+namespace underfoot::test {
+extern std::atomic<long> allocationCount; // defined in test_aggregate_model.cpp
+extern std::atomic<bool> countAllocations;
+} // namespace underfoot::test
+
+using namespace underfoot::engine;
+
+namespace {
+// Every surface of the studies' answer lists (STUDIES.md) plus the reverb variants.
+const std::vector<std::string> kAnswerListSurfaces = {"beach_sand",
+                                                      "gravel",
+                                                      "dirt_pebbles",
+                                                      "deep_snow",
+                                                      "frozen_snow",
+                                                      "high_grass",
+                                                      "forest_underbrush",
+                                                      "dry_leaves",
+                                                      "wood",
+                                                      "creaking_wood",
+                                                      "metal",
+                                                      "concrete",
+                                                      "carpet",
+                                                      "puddles",
+                                                      "water",
+                                                      "wood_reverb",
+                                                      "creaking_wood_reverb",
+                                                      "metal_reverb"};
+
+GrfSignal shortWalk(double seconds, std::uint64_t seed = 3) {
+    WalkerParameters w;
+    w.cadenceStepsPerMin = 110;
+    return walkerGrf(w, seconds, 48000.0, seed);
+}
+
+// Sets the value at a path such as "layer[1].modes[2].freq_hz" (1-based indices, as ParamInfo
+// names them) in a parsed preset.
+void setAtPath(toml::table& root, const std::string& path, double value) {
+    toml::node* node = &root;
+    std::stringstream ss(path);
+    std::string part;
+    std::vector<std::string> parts;
+    while (std::getline(ss, part, '.')) parts.push_back(part);
+    for (std::size_t i = 0; i < parts.size(); ++i) {
+        std::string key = parts[i];
+        int index = -1;
+        if (auto b = key.find('['); b != std::string::npos) {
+            index = std::stoi(key.substr(b + 1)) - 1;
+            key = key.substr(0, b);
+        }
+        if (i + 1 == parts.size()) { // the parameter itself (absent when it has its default)
+            ASSERT_LT(index, 0) << "a parameter path cannot end in an array element: " << path;
+            node->as_table()->insert_or_assign(key, value);
+            return;
+        }
+        toml::node* child = node->as_table()->get(key);
+        ASSERT_NE(child, nullptr) << path;
+        if (index >= 0) child = child->as_array()->get(static_cast<std::size_t>(index));
+        ASSERT_NE(child, nullptr) << path;
+        node = child;
+    }
+}
+} // namespace
+
+TEST(SurfacePresets, EverySurfaceOfTheAnswerListsIsBundled) {
+    std::set<std::string> ids;
+    for (const auto& s : listSurfaces()) ids.insert(s.id);
+    for (const auto& id : kAnswerListSurfaces) EXPECT_TRUE(ids.count(id)) << id;
+}
+
+TEST(SurfacePresets, EveryPresetNamesItselfDescribesItselfAndEachLayer) {
+    for (const auto& s : listSurfaces()) {
+        EXPECT_EQ(std::filesystem::path(s.file).stem().string(), s.id);
+        EXPECT_GE(s.description.size(), 20u) << s.id;
+        EXPECT_FALSE(s.layerPurposes.empty()) << s.id;
+        for (const auto& p : s.layerPurposes) EXPECT_GT(p.size(), 15u) << s.id << ": " << p;
+        const auto surface = Surface::load(s.file);
+        for (const auto& p : surface->parameters()) {
+            EXPECT_LE(p.minValue, p.value) << s.id << " " << p.path;
+            EXPECT_LE(p.value, p.maxValue) << s.id << " " << p.path;
+            EXPECT_FALSE(p.help.empty()) << s.id << " " << p.path;
+        }
+    }
+}
+
+TEST(SurfacePresets, ReverbVariantsCarryAnImpulseResponseAndTheirBaseLayers) {
+    for (const std::string id : {"wood_reverb", "creaking_wood_reverb", "metal_reverb"}) {
+        const auto s = Surface::loadById(id);
+        ASSERT_TRUE(s->info().reverb.has_value()) << id;
+        const auto base = Surface::loadById(id.substr(0, id.size() - 7));
+        EXPECT_EQ(s->layerCount(), base->layerCount()) << id;
+    }
+}
+
+TEST(SurfacePresets, SameSeedSameSamplesOtherSeedOtherSamples) {
+    const auto grf = shortWalk(1.5);
+    RenderOptions options;
+    options.scene.reverb = ReverbMode::Off;
+    for (const auto& s : listSurfaces()) {
+        options.seed = 11;
+        const auto a = renderSurface(s.id, grf, options).audio.samples;
+        const auto b = renderSurface(s.id, grf, options).audio.samples;
+        ASSERT_EQ(a, b) << s.id;
+        options.seed = 12;
+        const auto c = renderSurface(s.id, grf, options).audio.samples;
+        EXPECT_NE(a, c) << s.id << " ignores its seed";
+    }
+}
+
+TEST(SurfacePresets, RandomizedSweepsWithinDocumentedRangesStayFiniteAndBounded) {
+    // For each preset, several variants with every parameter drawn within its documented range
+    // (log-uniform where the range spans decades). Variants that break a documented constraint
+    // between two parameters (e.g. dynamic > static friction) are refused by the loader with a
+    // message; they are counted, and most variants must load.
+    Random rng(20261121);
+    const auto grf = shortWalk(1.0, 5);
+    RenderOptions options;
+    options.scene.reverb = ReverbMode::Off;
+    int rendered = 0, refused = 0;
+    for (const auto& s : listSurfaces()) {
+        if (s.reverb) continue; // same layers as their base
+        const auto params = Surface::load(s.file)->parameters();
+        for (int variant = 0; variant < 3; ++variant) {
+            toml::table root = toml::parse_file(s.file);
+            for (const auto& p : params) {
+                // Sweep this file's layers (not the header, not a base preset's layers: those are
+                // swept with the base preset itself).
+                if (p.path.find("layer[") != 0) continue;
+                // Output gains scale the result linearly and cannot make a model unstable.
+                if (p.path.size() >= 7 && p.path.substr(p.path.size() - 7) == "gain_db") continue;
+                double v;
+                if (p.logScale && p.minValue > 0)
+                    v = std::exp(rng.uniform(std::log(p.minValue), std::log(p.maxValue)));
+                else
+                    v = rng.uniform(p.minValue, p.maxValue);
+                setAtPath(root, p.path, v);
+            }
+            std::ostringstream text;
+            text << root;
+            const std::string file =
+                (std::filesystem::temp_directory_path() / ("sweep_" + s.id + ".toml")).string();
+            std::unique_ptr<Surface> surface;
+            try {
+                surface = loadSurfaceFromString(text.str(), file);
+            } catch (const PresetError& e) {
+                ++refused;
+                EXPECT_NE(std::string(e.what()).find("expected"), std::string::npos) << e.what();
+                continue;
+            }
+            surface->prepare({48000.0, 256});
+            surface->reset(static_cast<std::uint64_t>(variant));
+            std::vector<float> out(256);
+            double peak = 0;
+            for (std::size_t i = 0; i + 256 <= grf.frames(); i += 256) {
+                surface->process(grf.channels[0].data() + i, out.data(), 256);
+                for (float x : out) {
+                    ASSERT_TRUE(std::isfinite(x)) << s.id << " variant " << variant << "\n"
+                                                  << text.str();
+                    peak = std::max(peak, double(std::fabs(x)));
+                }
+            }
+            // Bounded: a blow-up grows without limit; a passive model cannot exceed what its
+            // strikes put in. At the corners of the documented ranges (a 5 kg sole at 9 m/s on a
+            // 0.1 g mode) that energy bound is ~7e4 m/s at the pickup, i.e. below 1e5 here.
+            EXPECT_LT(peak, 1e5) << s.id << " variant " << variant << "\n" << text.str();
+            ++rendered;
+        }
+    }
+    EXPECT_GT(rendered, 2 * refused) << rendered << " rendered, " << refused << " refused";
+}
+
+TEST(SurfacePresets, NobodyWalkingMeansSilenceAndSleep) {
+    for (const auto& s : listSurfaces()) {
+        auto surface = Surface::load(s.file);
+        surface->prepare({48000.0, 512});
+        surface->reset(1);
+        std::vector<float> grf(512, 0.0f), out(512, 1.0f);
+        surface->process(grf.data(), out.data(), 512);
+        for (float v : out) ASSERT_EQ(v, 0.0f) << s.id;
+        EXPECT_TRUE(surface->isSleeping()) << s.id;
+    }
+}
+
+TEST(SurfacePresets, AfterTheLastStepEverySurfaceFallsSilentAndSleeps) {
+    auto grf = shortWalk(1.2);
+    for (auto& c : grf.channels) c.resize(c.size() + 48000 * 4, 0.0f); // 4 s of standing aside
+    for (const auto& s : listSurfaces()) {
+        auto surface = Surface::load(s.file);
+        surface->prepare({48000.0, 480});
+        surface->reset(2);
+        std::vector<float> out(480);
+        bool slept = false;
+        for (std::size_t i = 0; i + 480 <= grf.frames(); i += 480) {
+            surface->process(grf.channels[0].data() + i, out.data(), 480);
+            if (i > grf.frames() - 48000) { // the last second: silent, asleep
+                for (float v : out)
+                    ASSERT_EQ(v, 0.0f) << s.id << " still sounds at " << i / 48000.0 << " s";
+                slept = surface->isSleeping();
+            }
+        }
+        EXPECT_TRUE(slept) << s.id;
+    }
+}
+
+TEST(SurfacePresets, ProcessDoesNotAllocate) {
+    const auto grf = shortWalk(1.0);
+    for (const auto& s : listSurfaces()) {
+        FootstepScene scene;
+        scene.build(s.id, {});
+        scene.prepare({48000.0, 256});
+        scene.reset(4);
+        std::vector<float> l(256), r(256);
+        underfoot::test::allocationCount = 0;
+        for (std::size_t i = 0; i + 256 <= grf.frames(); i += 256) {
+            const float* in[2] = {grf.channels[0].data() + i, grf.channels[1].data() + i};
+            underfoot::test::countAllocations = true;
+            scene.process(in, l.data(), r.data(), 256);
+            underfoot::test::countAllocations = false;
+        }
+        EXPECT_EQ(underfoot::test::allocationCount.load(), 0) << s.id;
+    }
+}
+
+TEST(SurfacePresets, BrokenPresetsFailWithFileLineColumnAndWhatWasExpected) {
+    const std::string head =
+        "id = \"x\"\nname = \"X\"\ncategory = \"solid\"\ndescription = \"a test preset\"\n";
+    auto expectError = [&](const std::string& body, const std::string& fragment) {
+        try {
+            loadSurfaceFromString(head + body, "broken.toml");
+            ADD_FAILURE() << "no error for:\n" << body;
+        } catch (const PresetError& e) {
+            EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+            EXPECT_NE(std::string(e.what()).find("broken.toml:"), std::string::npos) << e.what();
+        }
+    };
+    const std::string modes = "modes = [{ freq_hz = 100, t60_s = 0.1 }]\n";
+    expectError(
+        "[[layer]]\ntype = \"impact\"\npurpose = \"strikes of the sole\"\nstiffness = -5\n" + modes,
+        "expected a number in [10000, 1e+11]");
+    expectError(
+        "[[layer]]\ntype = \"impact\"\npurpose = \"strikes of the sole\"\nstifness = 1e7\n" + modes,
+        "unknown key `layer[1].stifness`");
+    expectError("[[layer]]\ntype = \"impactt\"\npurpose = \"x\"\n", "expected a layer type");
+    expectError("[[layer]]\ntype = \"impact\"\npurpose = \"strikes of the sole\"\nalpha = nan\n" +
+                    modes,
+                "finite");
+    expectError("[[layer]]\ntype = \"impact\"\npurpose = \"strikes\"\nstiffness = \"hard\"\n" +
+                    modes,
+                "expected a number");
+    expectError("[[layer]]\ntype = \"impact\"\npurpose = \"strikes\"\n", "expected `modes");
+    expectError("", "expected at least one [[layer]]");
+    expectError("[[layer]\n", "broken.toml:5");
+}
