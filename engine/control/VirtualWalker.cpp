@@ -59,26 +59,34 @@ double VirtualWalker::dutyFactor(double cadenceStepsPerMin) noexcept {
 }
 
 StanceShape VirtualWalker::shapeFor(const WalkerParameters& p, double stepSeconds,
-                                    double peakScale) noexcept {
+                                    const StanceJitter& jitter) noexcept {
     StanceShape sh;
     const double c = p.cadenceStepsPerMin;
     const double duty = dutyFactor(c);
     sh.stanceSeconds = 2.0 * duty * stepSeconds;
-    sh.heelPeakBw = clampd(1.20 + 0.004 * (c - 110.0), 1.05, 1.40) * peakScale;
-    sh.pushOffPeakBw = clampd(1.12 + 0.002 * (c - 110.0), 1.04, 1.25) * peakScale;
+    const double heel = clampd(1.20 + 0.004 * (c - 110.0), 1.05, 1.40);
+    const double push = clampd(1.12 + 0.002 * (c - 110.0), 1.04, 1.25);
     // Heel-strike transient: 0.05 BW over 25 ms for a soft shoe up to 0.40 BW over 8 ms for a
     // hard one (Whittle 1999: larger and sharper with hard soles).
     sh.transientBw = 0.05 + 0.35 * p.shoeHardness;
     sh.transientSeconds = 0.025 - 0.017 * p.shoeHardness;
-    // Force balance: integral of one stance = BW x step time. Integral of the Hermite pieces
+    // Force balance: integral of one stance = BW x step time, i.e. a mean of step / stance
+    // = 1 / (2 duty) body weights over the stance. Integral of the Hermite pieces
     // (h (p0 + p1) / 2 + h^2 (m0 - m1) / 12 each) plus the bump (A D / 2), in units of stance.
     const double targetMean = stepSeconds / sh.stanceSeconds;
-    const double edges =
-        (0.125 + 0.0625 * kEdgeSlopeFactor / 12.0) * (sh.heelPeakBw + sh.pushOffPeakBw);
-    const double middle = 0.125 * (sh.heelPeakBw + sh.pushOffPeakBw);
     const double bump = 0.5 * sh.transientBw * sh.transientSeconds / sh.stanceSeconds;
-    const double valley = (targetMean - edges - middle - bump) / 0.25;
-    sh.valleyBw = clampd(valley, 0.3, std::min(sh.heelPeakBw, sh.pushOffPeakBw) - 0.02);
+    constexpr double kPeakWeight = 0.125 + 0.0625 * kEdgeSlopeFactor / 12.0 + 0.125;
+    const double valley = (targetMean - kPeakWeight * (heel + push) - bump) / 0.25;
+    // Jitter, then scale the curve so that the balance holds again.
+    const double h1 = heel * (1.0 + jitter.heel), p2 = push * (1.0 + jitter.pushOff);
+    // The valley stays between 35 % and 90 % of the peaks, before the scaling (which keeps
+    // ratios), so that every step is a double hump and the balance holds exactly.
+    const double v =
+        clampd(valley * (1.0 + jitter.valley), 0.35 * std::max(h1, p2), 0.9 * std::min(h1, p2));
+    const double k = (targetMean - bump) / (kPeakWeight * (h1 + p2) + 0.25 * v);
+    sh.heelPeakBw = k * h1;
+    sh.pushOffPeakBw = k * p2;
+    sh.valleyBw = k * v;
     return sh;
 }
 
@@ -114,12 +122,17 @@ void VirtualWalker::reset(std::uint64_t seed) noexcept {
 
 void VirtualWalker::scheduleStep(int foot) noexcept {
     const double v = params_.variability;
-    const double jitterTime = clampd(random_.gaussian(), -3.0, 3.0) * v;
-    const double jitterPeak = clampd(random_.gaussian(), -3.0, 3.0) * v;
+    // Step time: relative std = variability; shape: std = variability / 2 (peak forces vary
+    // less than timing between steps); both clamped at 2 sigma.
+    const double jitterTime = clampd(random_.gaussian(), -2.0, 2.0) * v;
+    StanceJitter jitter;
+    jitter.heel = clampd(random_.gaussian(), -2.0, 2.0) * 0.5 * v;
+    jitter.valley = clampd(random_.gaussian(), -2.0, 2.0) * 0.5 * v;
+    jitter.pushOff = clampd(random_.gaussian(), -2.0, 2.0) * 0.5 * v;
     const double step = 0.5 * strideSeconds() * (1.0 + jitterTime);
     Stance& st = stance_[foot];
     st.startSample = nextStepSample_;
-    st.shape = shapeFor(params_, step, 1.0 + jitterPeak);
+    st.shape = shapeFor(params_, step, jitter);
     st.lengthSamples = st.shape.stanceSeconds * sampleRateHz_;
     st.active = true;
     nextStepSample_ += step * sampleRateHz_;

@@ -26,8 +26,10 @@
 /// Force balance: over a stride the mean vertical GRF of both feet equals body weight (the centre
 /// of mass does not drift vertically), so the valley V is solved per step from that constraint
 /// instead of being set by hand; it comes out at 0.68-0.77 BW over 60-150 steps/min.
-/// Variability: each step's duration and peak heights get independent Gaussian relative jitter
-/// with the given standard deviation (seeded, engine/dsp/Random.h).
+/// Variability: each step's duration gets Gaussian relative jitter with the given standard
+/// deviation, its heel peak, valley and push-off peak independent jitter of half that (all
+/// clamped at 2 sigma; seeded, engine/dsp/Random.h); the jittered curve is rescaled so that the
+/// force balance still holds.
 #include "engine/dsp/ProcessSpec.h"
 #include "engine/dsp/Random.h"
 
@@ -68,6 +70,12 @@ struct StanceShape {
     double forceBw(double s) const noexcept;
 };
 
+/// Relative deviations of one step's heel peak, valley and push-off peak from the nominal shape
+/// (before the force-balance scaling).
+struct StanceJitter {
+    double heel = 0, valley = 0, pushOff = 0;
+};
+
 class VirtualWalker {
   public:
     explicit VirtualWalker(const WalkerParameters& parameters = {});
@@ -89,9 +97,12 @@ class VirtualWalker {
     double strideSeconds() const noexcept { return 120.0 / params_.cadenceStepsPerMin; }
     /// Stance duration as a fraction of the stride (duty factor).
     static double dutyFactor(double cadenceStepsPerMin) noexcept;
-    /// Nominal stance shape for a step of `stepSeconds` (half a stride) and the given peaks scale.
+    /// Stance shape for a step of `stepSeconds` (half a stride). Without jitter the valley is
+    /// solved from the force balance; with jitter the heel peak, nominal valley and push-off
+    /// peak are perturbed and the whole curve (not the transient) is then scaled so that the
+    /// balance still holds exactly.
     static StanceShape shapeFor(const WalkerParameters& p, double stepSeconds,
-                                double peakScale = 1.0) noexcept;
+                                const StanceJitter& jitter = {}) noexcept;
 
   private:
     struct Stance {

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "engine/control/VirtualWalker.h"
+#include "engine/dsp/Random.h"
 
 #include <gtest/gtest.h>
 
@@ -244,4 +245,42 @@ TEST(VirtualWalker, ParserReadsSpecsAndReportsErrors) {
     EXPECT_NE(message("mass=70,mass=80").find("twice"), std::string::npos);
     EXPECT_NE(message("mass=70,").find("expected key=value"), std::string::npos);
     EXPECT_THROW(VirtualWalker(WalkerParameters{10, 100, 0.5, 0}), std::invalid_argument);
+}
+
+TEST(VirtualWalker, JitteredStancesKeepForceBalanceAndAPlausibleShape) {
+    // Worst cases of the documented range: shape jitter of variability 0.2 / 2 clamped at
+    // 2 sigma = +-20 %.
+    for (double cadence : {60.0, 100.0, 150.0})
+        for (double h : {-0.2, 0.0, 0.2})
+            for (double v : {-0.2, 0.0, 0.2})
+                for (double pu : {-0.2, 0.0, 0.2}) {
+                    WalkerParameters p;
+                    p.cadenceStepsPerMin = cadence;
+                    const double step = 60.0 / cadence;
+                    const StanceShape sh = VirtualWalker::shapeFor(p, step, {h, v, pu});
+                    // Balance: mean force over the stance = step / stance body weights.
+                    double sum = 0;
+                    const int n = 200000;
+                    for (int i = 0; i < n; ++i) sum += sh.forceBw((i + 0.5) / n);
+                    EXPECT_NEAR(sum / n, step / sh.stanceSeconds, 1e-4)
+                        << cadence << " " << h << " " << v << " " << pu;
+                    // A double hump: the valley is below both peaks, not below 35 % of either.
+                    EXPECT_LE(sh.valleyBw, 0.9 * std::min(sh.heelPeakBw, sh.pushOffPeakBw) + 1e-12);
+                    EXPECT_GE(sh.valleyBw,
+                              0.35 * std::max(sh.heelPeakBw, sh.pushOffPeakBw) - 1e-12);
+                    EXPECT_GT(sh.valleyBw, 0.3);
+                    EXPECT_LT(std::max(sh.heelPeakBw, sh.pushOffPeakBw), 2.0);
+                }
+    // At the default 3 % (1.5 % on the shape) the valley of every step stays within 0.6-0.9 BW.
+    WalkerParameters p;
+    VirtualWalker w(p);
+    w.prepare({48000, 512});
+    w.reset(1);
+    Random r(3);
+    for (int i = 0; i < 1000; ++i) {
+        const StanceJitter j{0.015 * r.gaussian(), 0.015 * r.gaussian(), 0.015 * r.gaussian()};
+        const StanceShape sh = VirtualWalker::shapeFor(p, 0.6, j);
+        ASSERT_GT(sh.valleyBw, 0.6);
+        ASSERT_LT(sh.valleyBw, 0.9);
+    }
 }
