@@ -76,13 +76,26 @@ double ElastoPlasticFrictionT<Real>::processSample(double normal, double drive) 
                                                                     params_.stribeckVelocity))) /
                            params_.sigma0;
         const double zba = params_.breakAway * fc / params_.sigma0;
-        const double a = alphaOf(z0, v1, zss, zba);
-        // Backward Euler: z1 = z0 + T v1 (1 - a z1 / zss), linear in z1 (v1 / zss >= 0).
-        const double denom = 1.0 + (zss != 0.0 ? T * v1 * a / zss : 0.0);
-        return (z0 + T * v1) / denom;
+        // Backward Euler: z1 = z0 + T v1 (1 - a z1 / zss), linear in z1 for a given a
+        // (v1 / zss >= 0). alpha is taken at z0, then re-taken at the predicted z1 when the step
+        // crosses into the plastic region, so that a stiff bristle cannot overshoot z_ss within
+        // one sample (with a = 1, z1 is a weighted mean of z0 and z_ss).
+        if (zss == 0.0) return 0.0; // no friction capacity (mu_s = mu_d = 0)
+        if (zss == 0.0) return 0.0; // no friction capacity (mu_s = mu_d = 0)
+        auto step = [&](double a) { return (z0 + T * v1) / (1.0 + T * v1 * a / zss); };
+        const double a0 = alphaOf(z0, v1, zss, zba);
+        double z1 = step(a0);
+        if (a0 < 1.0) {
+            const double a1 = alphaOf(z1, v1, zss, zba);
+            if (a1 > a0) z1 = step(a1);
+        }
+        return z1;
     };
+    // No load, no contact: no friction at all (the bristles relax, see bristleAt).
+    const double inContact = N > 0.0 ? 1.0 : 0.0;
     auto forceAt = [&](double v1, double z1) {
-        return params_.sigma0 * z1 + params_.sigma1 * (z1 - z0) / T + params_.sigma2 * v1 + noise;
+        return inContact *
+               (params_.sigma0 * z1 + params_.sigma1 * (z1 - z0) / T + params_.sigma2 * v1 + noise);
     };
     // h(v) = v - (vRelPred - kd F(v)) is increasing in v; find its root.
     auto h = [&](double v1) { return v1 - vRelPred + kd_ * forceAt(v1, bristleAt(v1)); };
