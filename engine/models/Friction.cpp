@@ -81,7 +81,6 @@ double ElastoPlasticFrictionT<Real>::processSample(double normal, double drive) 
         // crosses into the plastic region, so that a stiff bristle cannot overshoot z_ss within
         // one sample (with a = 1, z1 is a weighted mean of z0 and z_ss).
         if (zss == 0.0) return 0.0; // no friction capacity (mu_s = mu_d = 0)
-        if (zss == 0.0) return 0.0; // no friction capacity (mu_s = mu_d = 0)
         auto step = [&](double a) { return (z0 + T * v1) / (1.0 + T * v1 * a / zss); };
         const double a0 = alphaOf(z0, v1, zss, zba);
         double z1 = step(a0);
