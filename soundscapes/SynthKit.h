@@ -71,8 +71,9 @@ inline double whiteNoise(engine::Random& rng) noexcept {
 class PinkNoise {
   public:
     void reset() noexcept { b0_ = b1_ = b2_ = 0.0; }
-    double next(engine::Random& rng) noexcept {
-        const double w = whiteNoise(rng);
+    double next(engine::Random& rng) noexcept { return process(whiteNoise(rng)); }
+    /// Filters a given white sample (to share one noise source between layers).
+    double process(double w) noexcept {
         b0_ = 0.99765 * b0_ + w * 0.0990460;
         b1_ = 0.96300 * b1_ + w * 0.2965164;
         b2_ = 0.57000 * b2_ + w * 1.0526913;
@@ -110,14 +111,23 @@ class SawOsc {
     double phase_ = 0.0;
 };
 
-/// Sine oscillator with a running phase (so that glides stay continuous).
+/// sin(2 pi phase): a parabola refined once (the classic "fast and accurate sine" of the
+/// music-dsp archive, N. Capens 2006); |error| < 0.0011, harmonics below -60 dB. Several times
+/// cheaper than std::sin, which matters for a dozen oscillators per sample.
+inline double fastSin2Pi(double phase) noexcept {
+    const double x = phase - std::floor(phase + 0.5); // [-0.5, 0.5)
+    const double y = 8.0 * x - 16.0 * x * std::fabs(x);
+    return 0.225 * (y * std::fabs(y) - y) + y;
+}
+
+/// Sine oscillator with a running phase (so that glides stay continuous), using fastSin2Pi.
 class SineOsc {
   public:
-    void reset(double phase = 0.0) noexcept { phase_ = phase; }
+    void reset(double phase = 0.0) noexcept { phase_ = phase - std::floor(phase); }
     double next(double frequencyHz, double sampleRateHz) noexcept {
-        const double y = std::sin(kTwoPi * phase_);
+        const double y = fastSin2Pi(phase_);
         phase_ += frequencyHz / sampleRateHz;
-        phase_ -= std::floor(phase_);
+        if (phase_ >= 1.0) phase_ -= std::floor(phase_);
         return y;
     }
     double phase() const noexcept { return phase_; }

@@ -38,19 +38,27 @@ class SeaBed final : public BedGenerator {
         prevPeak_ = 0.7;
         newWave();
         pos_ = static_cast<long>(rng_.uniform() * static_cast<double>(len_));
-        shift_ = 0.35;
         counter_ = 0;
+        envNow_[0] = envAt(static_cast<double>(pos_) / static_cast<double>(len_));
+        envNow_[1] = envAt(static_cast<double>(pos_) / static_cast<double>(len_) - shift_);
     }
     void process(float* left, float* right, int n) noexcept override {
         float* out[2] = {left, right};
         for (int i = 0; i < n; ++i) {
-            const double u = static_cast<double>(pos_) / static_cast<double>(len_);
-            const double env[2] = {envAt(u), envAt(u - shift_)};
             if (counter_-- <= 0) {
-                counter_ = kControlInterval;
-                for (int c = 0; c < 2; ++c)
-                    ch_[c].body.set(fs_, 120.0 + brightHz_ * env[c] * env[c], 0.6);
+                // Envelopes and filters at control rate, the gain ramped linearly in between.
+                counter_ = kControlInterval - 1;
+                const double u =
+                    static_cast<double>(pos_ + kControlInterval) / static_cast<double>(len_);
+                for (int c = 0; c < 2; ++c) {
+                    const double target = envAt(c == 0 ? u : u - shift_);
+                    envStep_[c] = (target - envNow_[c]) / kControlInterval;
+                    ch_[c].body.set(fs_, 120.0 + brightHz_ * target * target, 0.6);
+                }
             }
+            envNow_[0] += envStep_[0];
+            envNow_[1] += envStep_[1];
+            const double env[2] = {envNow_[0], envNow_[1]};
             for (int c = 0; c < 2; ++c) {
                 auto& s = ch_[c];
                 const double pink = s.pink.next(rng_);
@@ -99,6 +107,7 @@ class SeaBed final : public BedGenerator {
     std::array<Channel, 2> ch_{};
     long len_ = 1, pos_ = 0;
     double peak_ = 0.7, prevPeak_ = 0.7, shift_ = 0.05;
+    double envNow_[2] = {0, 0}, envStep_[2] = {0, 0};
     int counter_ = 0;
 };
 
@@ -112,8 +121,10 @@ class WindBed final : public BedGenerator {
         : centreHz_(p.get("centre_hz")), gust_(p.get("gustiness")), whistle_(p.get("whistle")) {}
     void prepare(const ProcessSpec& spec) override {
         fs_ = spec.sampleRateHz;
-        gustMod_.configure(2.5, 1.0, fs_);
-        for (auto& c : ch_) c.mod.configure(1.0, 0.4, fs_);
+        // Modulators run at the control rate (one step per kControlInterval samples).
+        const double controlRate = fs_ / kControlInterval;
+        gustMod_.configure(2.5, 1.0, controlRate);
+        for (auto& c : ch_) c.mod.configure(1.0, 0.4, controlRate);
     }
     void reset(std::uint64_t seed) noexcept override {
         rng_.setSeed(seed);
@@ -125,29 +136,37 @@ class WindBed final : public BedGenerator {
             c.rumble.reset();
             c.pink.reset();
             c.rumble.set(fs_, 140.0, 0.7);
+            c.amp = c.ampStep = c.wh = c.whStep = 0.0;
         }
         counter_ = 0;
     }
     void process(float* left, float* right, int n) noexcept override {
         float* out[2] = {left, right};
         for (int i = 0; i < n; ++i) {
-            const double g = gustMod_.next(rng_);
-            const bool retune = counter_-- <= 0;
-            if (retune) counter_ = kControlInterval;
-            for (int c = 0; c < 2; ++c) {
-                auto& s = ch_[c];
-                const double m = 0.75 * g + 0.25 * s.mod.next(rng_);
-                if (retune) {
+            if (counter_-- <= 0) {
+                counter_ = kControlInterval - 1;
+                const double g = gustMod_.next(rng_);
+                for (auto& s : ch_) {
+                    const double m = 0.75 * g + 0.25 * s.mod.next(rng_);
                     const double f = centreHz_ * std::exp2(1.6 * (m - 0.5));
                     s.band.set(fs_, f, 0.9);
-                    s.whistle.set(fs_, 3.1 * f, 14.0);
+                    if (whistle_ > 0.0) s.whistle.set(fs_, 3.1 * f, 14.0);
+                    const double amp = (1.0 - gust_) + gust_ * m * m * 1.8;
+                    s.ampStep = (amp - s.amp) / kControlInterval;
+                    s.whStep = (whistle_ * m * m * m * 0.6 - s.wh) / kControlInterval;
                 }
-                const double amp = (1.0 - gust_) + gust_ * m * m * 1.8;
+            }
+            for (int c = 0; c < 2; ++c) {
+                auto& s = ch_[c];
+                s.amp += s.ampStep;
+                s.wh += s.whStep;
                 const double w = whiteNoise(rng_);
-                const double body = s.band.bandNormalised(w) * amp;
-                const double rumble = s.rumble.process(s.pink.next(rng_)).low * amp * 0.8;
-                const double wh = s.whistle.bandNormalised(w) * whistle_ * m * m * m * 0.6;
-                out[c][i] = static_cast<float>(body + rumble + wh);
+                // The rumble is the pink-filtered same noise: its band (< 140 Hz) does not
+                // overlap the wind band, so one noise source serves both.
+                const double body =
+                    s.band.bandNormalised(w) + 0.8 * s.rumble.process(s.pink.process(w)).low;
+                const double wh = whistle_ > 0.0 ? s.whistle.bandNormalised(w) * s.wh : 0.0;
+                out[c][i] = static_cast<float>(body * s.amp + wh);
             }
         }
         for (auto& c : ch_) {
@@ -162,6 +181,7 @@ class WindBed final : public BedGenerator {
         SmoothRandom mod;
         Svf band, whistle, rumble;
         PinkNoise pink;
+        double amp = 0, ampStep = 0, wh = 0, whStep = 0;
     };
     double centreHz_, gust_, whistle_, fs_ = 48000.0;
     Random rng_;
@@ -352,8 +372,9 @@ class BabbleBed final : public BedGenerator {
           activity_(p.get("activity")), excitement_(p.get("excitement")) {}
     void prepare(const ProcessSpec& spec) override {
         fs_ = spec.sampleRateHz;
+        ft_ = 0.5 * fs_; // talkers run at half rate (their formants stay below 3 kHz)
         voices_.assign(static_cast<std::size_t>(talkers_), Talker{});
-        for (auto& v : voices_) v.contour.configure(0.6, 0.25, fs_);
+        for (auto& v : voices_) v.contour.configure(0.6, 0.25, ft_);
     }
     void reset(std::uint64_t seed) noexcept override {
         rng_.setSeed(seed);
@@ -365,13 +386,13 @@ class BabbleBed final : public BedGenerator {
             v.pitch = pitchHz_ * rng_.uniform(0.8, 1.25);
             panGains(rng_.uniform(-0.9, 0.9), v.gl, v.gr);
             v.speaking = rng_.uniform() < activity_;
-            v.left = static_cast<long>(rng_.uniform(0.2, 2.0) * fs_);
+            v.left = static_cast<long>(rng_.uniform(0.2, 2.0) * ft_);
             v.sylLen = 1;
             v.sylPos = 1;
             v.f1Hz = v.f1Target = 500;
             v.f2Hz = v.f2Target = 1500;
-            v.f1.set(fs_, v.f1Hz, 4.0); // a talker may start between two retunings
-            v.f2.set(fs_, v.f2Hz, 6.0);
+            v.f1.set(ft_, v.f1Hz, 4.0); // a talker may start between two retunings
+            v.f2.set(ft_, v.f2Hz, 6.0);
         }
         for (auto& d : dist_) {
             d.reset();
@@ -382,13 +403,24 @@ class BabbleBed final : public BedGenerator {
             d.set(fs_, distanceHz_ * 1.3, 0.6);
         }
         counter_ = 0;
+        odd_ = false;
+        prevL_ = prevR_ = 0.0;
     }
     void process(float* left, float* right, int n) noexcept override {
-        const double formantSmooth = std::exp(-kControlInterval / (0.03 * fs_));
+        const double formantSmooth = std::exp(-kControlInterval / (0.03 * ft_));
         for (int i = 0; i < n; ++i) {
+            // Half-rate talkers, upsampled by linear interpolation (one sample of delay); the
+            // distance low-pass below removes the images.
+            odd_ = !odd_;
+            if (!odd_) {
+                left[i] = static_cast<float>(dist2_[0].process(dist_[0].process(prevL_).low).low);
+                right[i] = static_cast<float>(dist2_[1].process(dist_[1].process(prevR_).low).low);
+                continue;
+            }
             const bool retune = counter_-- <= 0;
             if (retune) counter_ = kControlInterval;
             double l = 0, r = 0;
+            const double breath = 0.15 * whiteNoise(rng_); // shared: each talker filters it apart
             for (auto& v : voices_) {
                 if (--v.left <= 0) {
                     v.speaking = !v.speaking;
@@ -396,26 +428,31 @@ class BabbleBed final : public BedGenerator {
                     v.left = static_cast<long>((v.speaking ? utter
                                                            : utter * (1.0 - activity_) / activity_ *
                                                                  rng_.uniform(0.5, 1.5)) *
-                                                   fs_ +
+                                                   ft_ +
                                                1);
                 }
                 const double c = v.contour.next(rng_);
                 if (!v.speaking) continue;
                 if (++v.sylPos >= v.sylLen) newSyllable(v);
                 const double u = static_cast<double>(v.sylPos) / static_cast<double>(v.sylLen);
-                const double env = std::sqrt(hann(u)) * v.accent;
+                const double env = 4.0 * u * (1.0 - u) * v.accent; // about sin(pi u)
                 if (retune) {
                     v.f1Hz = v.f1Target + formantSmooth * (v.f1Hz - v.f1Target);
                     v.f2Hz = v.f2Target + formantSmooth * (v.f2Hz - v.f2Target);
-                    v.f1.set(fs_, v.f1Hz, 4.0);
-                    v.f2.set(fs_, v.f2Hz, 6.0);
+                    v.f1.set(ft_, v.f1Hz, 4.0);
+                    v.f2.set(ft_, v.f2Hz, 6.0);
                 }
                 const double f0 = v.pitch * (0.8 + 0.4 * c) * (1.0 + v.leap * u);
-                const double src = v.saw.next(f0, fs_) + 0.15 * whiteNoise(rng_);
+                const double src = v.saw.next(f0, ft_) + breath;
                 const double y = (v.f1.bandNormalised(src) + 0.6 * v.f2.bandNormalised(src)) * env;
                 l += y * v.gl;
                 r += y * v.gr;
             }
+            const double midL = 0.5 * (prevL_ + l), midR = 0.5 * (prevR_ + r);
+            prevL_ = l;
+            prevR_ = r;
+            l = midL;
+            r = midR;
             left[i] = static_cast<float>(dist2_[0].process(dist_[0].process(l).low).low);
             right[i] = static_cast<float>(dist2_[1].process(dist_[1].process(r).low).low);
         }
@@ -440,7 +477,7 @@ class BabbleBed final : public BedGenerator {
     };
     void newSyllable(Talker& v) noexcept {
         v.sylPos = 0;
-        v.sylLen = static_cast<long>(fs_ / (syllableHz_ * rng_.uniform(0.6, 1.5)));
+        v.sylLen = static_cast<long>(ft_ / (syllableHz_ * rng_.uniform(0.6, 1.5)));
         const double scale = std::pow(pitchHz_ / 150.0, 0.25); // smaller vocal tracts
         v.f1Target = rng_.uniform(300.0, 850.0) * scale;
         v.f2Target = rng_.uniform(900.0, 2300.0) * scale;
@@ -449,7 +486,9 @@ class BabbleBed final : public BedGenerator {
         v.leap = accent ? excitement_ * rng_.uniform(-0.2, 0.6) : 0.0;
     }
     int talkers_;
-    double pitchHz_, syllableHz_, distanceHz_, activity_, excitement_, fs_ = 48000.0;
+    double pitchHz_, syllableHz_, distanceHz_, activity_, excitement_, fs_ = 48000.0, ft_ = 24000.0;
+    double prevL_ = 0.0, prevR_ = 0.0;
+    bool odd_ = false;
     Random rng_;
     std::vector<Talker> voices_;
     std::array<Svf, 2> dist_{}, dist2_{};

@@ -133,8 +133,8 @@ class SongbirdVoice final : public VoiceBase {
         const double trill = c->c > 0 ? c->d * trill_.next(c->c, fs_) : 0.0;
         const double f = lerp(c->a, c->b, u) * (1.0 + trill);
         const double phase = osc_.phase();
-        const double y = osc_.next(f, fs_) + 0.15 * std::sin(2.0 * kTwoPi * phase);
-        return 0.8 * y * std::sqrt(hann(u));
+        const double y = osc_.next(f, fs_) + 0.15 * fastSin2Pi(2.0 * phase);
+        return 0.8 * y * 4.0 * u * (1.0 - u); // close to sqrt(hann(u)) = sin(pi u)
     }
 
   private:
@@ -237,7 +237,7 @@ class CuckooVoice final : public VoiceBase {
         if (!c) return 0.0;
         const double f = c->a * (1.0 - 0.04 * u);
         const double phase = osc_.phase();
-        const double y = osc_.next(f, fs_) + 0.12 * std::sin(2.0 * kTwoPi * phase);
+        const double y = osc_.next(f, fs_) + 0.12 * fastSin2Pi(2.0 * phase);
         const double env = std::min(1.0, u * c->dur / 0.02) * std::min(1.0, (1.0 - u) / 0.4);
         return 0.8 * y * env;
     }
@@ -530,7 +530,7 @@ class ShoutVoice final : public VoiceBase {
                 syllable_ = series_.current;
                 core_.setFormants(fs_, vowels_[syllable_][0], 4.0, vowels_[syllable_][1], 6.0);
             }
-            const double env = std::sqrt(hann(u));
+            const double env = 4.0 * u * (1.0 - u);
             y = env * core_.next(contour(*c, u), fs_, 0.1, noise_, 0.6);
         }
         return dist_.process(y).low;
@@ -591,8 +591,9 @@ class SwishVoice final : public VoiceBase {
         if (counter_-- <= 0) {
             counter_ = 16;
             band_.set(fs_, c->a * (0.5 + hann(u)), 1.2);
+            shape_ = std::pow(hann(u), 0.7);
         }
-        const double env = std::pow(hann(u), 0.7) * (0.6 + 0.4 * g);
+        const double env = shape_ * (0.6 + 0.4 * g);
         return env * (band_.bandNormalised(w) + 0.5 * carve_.process(w).low);
     }
     void snapState() noexcept override {
@@ -607,6 +608,7 @@ class SwishVoice final : public VoiceBase {
     Svf band_, carve_;
     SmoothRandom grain_;
     int counter_ = 0;
+    double shape_ = 0.0;
 };
 
 // Ski scrape on icy snow: 0.3-0.9 s of noise through two narrow resonances (the edge
@@ -625,6 +627,7 @@ class ScrapeVoice final : public VoiceBase {
         hp_.set(fs_, 1500.0, 0.7);
         chatterHz_ = rng.uniform(40.0, 80.0);
         chatter_.reset();
+        counter_ = 0;
         setLengthSeconds(dur_);
     }
 
@@ -633,7 +636,11 @@ class ScrapeVoice final : public VoiceBase {
         const double u = t / dur_;
         const double w = whiteNoise(noise_);
         const double ch = 0.5 + 0.5 * std::fabs(chatter_.next(chatterHz_, fs_));
-        const double env = std::min(1.0, t / 0.03) * std::pow(1.0 - u, 0.8);
+        if (counter_-- <= 0) {
+            counter_ = 16;
+            shape_ = std::pow(std::max(0.0, 1.0 - u), 0.8);
+        }
+        const double env = std::min(1.0, t / 0.03) * shape_;
         return env * (ch * (r1_.bandNormalised(w) + 0.7 * r2_.bandNormalised(w)) +
                       0.3 * hp_.process(w).high);
     }
@@ -644,9 +651,10 @@ class ScrapeVoice final : public VoiceBase {
     }
 
   private:
-    double brightHz_, dur_ = 0.5, chatterHz_ = 50;
+    double brightHz_, dur_ = 0.5, chatterHz_ = 50, shape_ = 0.0;
     Svf r1_, r2_, hp_;
     SineOsc chatter_;
+    int counter_ = 0;
 };
 
 // Chairlift pylon clank ("ka-chunk" of a chair's grip over the sheave train): two knocks 0.12-
