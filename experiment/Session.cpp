@@ -36,8 +36,12 @@ Session::Session(StudyStore& store, std::string participantCode, StimulusPlayer&
     participant_ = store_.participant(participantCode);
     trials_ = store_.trials(participantCode);
     const auto first = store_.firstUnanswered(participantCode);
-    if (!first)
+    if (!first) {
+        if (participant_.status == ParticipantStatus::Active ||
+            participant_.status == ParticipantStatus::Registered)
+            store_.markCompleted(participantCode);
         throw StoreError(fmt::format("participant '{}' has answered every trial", participantCode));
+    }
     sessionNumber_ = store_.startSession(participantCode, settings);
     participant_ = store_.participant(participantCode);
     position_ = static_cast<std::size_t>(*first);

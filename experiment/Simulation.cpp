@@ -304,9 +304,13 @@ int simulateStudy(StudyStore& store, const MatrixByGroup& matrices, int particip
     int completed = 0;
     for (const auto& p : store.participants()) {
         if (p.status == ParticipantStatus::Dropped) continue;
-        if (p.status != ParticipantStatus::Completed && store.firstUnanswered(p.code))
-            committed += runSimulatedSession(store, p.code, matrixFor(p.groupId), seed, settings,
-                                             onCommitted);
+        if (p.status != ParticipantStatus::Completed) {
+            if (store.firstUnanswered(p.code))
+                committed += runSimulatedSession(store, p.code, matrixFor(p.groupId), seed,
+                                                 settings, onCommitted);
+            else
+                store.markCompleted(p.code);
+        }
         ++completed;
     }
     int next = static_cast<int>(store.participants().size()) + 1;

@@ -660,6 +660,22 @@ void StudyStore::endSession(const std::string& code, int sessionNumber, bool com
     tx.commit();
 }
 
+void StudyStore::markCompleted(const std::string& code) {
+    SQLite::Transaction tx(*db_, SQLite::TransactionBehavior::IMMEDIATE);
+    const ParticipantInfo p = participant(code);
+    if (p.status == ParticipantStatus::Completed) return;
+    if (p.status == ParticipantStatus::Dropped)
+        throw StoreError(fmt::format("participant '{}' dropped out; not marked completed", code));
+    if (firstUnanswered(code))
+        throw StoreError(fmt::format("participant '{}' still has unanswered trials", code));
+    SQLite::Statement st(*db_, "UPDATE participants SET status = 'completed' WHERE id = ?");
+    st.bind(1, p.id);
+    st.exec();
+    appendEvent("participant_completed", p.id, std::nullopt,
+                jsonObject({{"note", "every trial answered; the session had not been closed"}}));
+    tx.commit();
+}
+
 namespace {
 constexpr const char* kTrialColumns =
     "t.id, p.code, t.trial_index, t.block, t.practice, t.stimulus, t.repetition, t.planned_seed, "

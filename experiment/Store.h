@@ -207,6 +207,10 @@ class StudyStore {
     /// Closes a session; `completed` also marks the participant completed.
     void endSession(const std::string& code, int sessionNumber, bool completed);
 
+    /// Marks a participant whose every trial is answered as completed (recovers a crash between
+    /// the last answer and the end of the session); journaled. No-op when already completed.
+    void markCompleted(const std::string& code);
+
     std::vector<TrialRecord> trials(const std::string& code) const;
     TrialRecord trial(const std::string& code, int trialIndex) const;
     /// Index of the first unanswered trial, or nullopt when all are answered.

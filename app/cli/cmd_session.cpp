@@ -95,8 +95,9 @@ int runInteractive(const Options& o) {
     const Questions& q = p.questions;
     fmt::print("{} — participant {} (group {}), session {}{}\n", p.title, o.participant,
                session.participant().groupId, session.sessionNumber(),
-               session.resumed() ? fmt::format(", resuming at trial {}", session.current().index)
-                                 : "");
+               session.resumed()
+                   ? fmt::format(", resuming at trial {}", session.current().index + 1)
+                   : "");
     try {
         while (session.phase() != SessionPhase::Finished) {
             switch (session.phase()) {

@@ -157,6 +157,9 @@ TEST(ExperimentCrash, SigkillAtRandomPointsLosesNoAcknowledgedAnswer) {
     const ChildRun last = runChild(study, matrix, registered + 1, -1);
     EXPECT_TRUE(last.finished);
     StudyStore after = StudyStore::open(study);
-    for (const auto& p : after.participants()) EXPECT_FALSE(after.firstUnanswered(p.code));
+    for (const auto& p : after.participants()) {
+        EXPECT_FALSE(after.firstUnanswered(p.code)) << p.code;
+        EXPECT_EQ(p.status, ParticipantStatus::Completed) << p.code;
+    }
     for (const auto& [code, index] : acknowledged) EXPECT_TRUE(after.trial(code, index).answered);
 }
