@@ -14,7 +14,7 @@ namespace underfoot::engine {
 namespace {
 constexpr int kLanes = 8;                 // resonator slots summed in parallel lanes
 constexpr int kMaxEventsPerSample = 8;    // bound on the work of one sample
-constexpr int kMaxBurstEvents = 256;      // bound on one burst
+constexpr int kMaxBurstEvents = 256;      // bound on pending burst micro-events
 constexpr double kMaxVoiceSeconds = 30.0; // no voice rings longer than this
 constexpr double kSilenceBelowMaxDb = -80.0;
 
@@ -208,6 +208,8 @@ void AggregateModel::process(const float* rateHz, const float* energyScale, floa
     const double meanBurst = params_.burstEvents;
     // Total rate = primary x (1 + mean burst): cap the primary so the total stays under the cap.
     const double primaryCap = rateCapHz_ / (1.0 + meanBurst);
+    // Each pending micro-event fires after its own exponential delay (mean burstMs): the pending
+    // pool drains at rate pending / burstMs, so bursts never queue up behind each other.
     const double burstExpected = dt * 1000.0 / params_.burstMs;
     const double burstP = meanBurst / (1.0 + meanBurst); // geometric: P(N = k) = (1-p) p^k
     const double logBurstP = burstP > 0 ? std::log(burstP) : 0.0;
@@ -237,8 +239,9 @@ void AggregateModel::process(const float* rateHz, const float* energyScale, floa
             }
         }
         if (burstRemaining_ > 0) {
-            const int b = std::min(
-                burstRemaining_, burstClock_.advance(burstExpected, random_, kMaxEventsPerSample));
+            const int b =
+                std::min(burstRemaining_, burstClock_.advance(burstExpected * burstRemaining_,
+                                                              random_, kMaxEventsPerSample));
             for (int e = 0; e < b; ++e)
                 spawn(burstScale_ *
                           random_.powerLaw(params_.gamma, params_.energyMin, params_.energyMax),

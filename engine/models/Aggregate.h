@@ -29,8 +29,8 @@
 ///    sum a_k^2 = E (peak amplitude sqrt(E): the energy an impact hands to a mode sets its
 ///    initial amplitude; the Q only sets how long it rings).
 ///  - Bursts (crumpling cascades): each event may be followed by a geometric number of
-///    micro-events (mean burstEvents) spaced by exponential gaps (mean burstMs), with the same
-///    energy scale: a crunch is a quick cascade of breaks.
+///    micro-events (mean burstEvents), each after its own exponential delay (mean burstMs), with
+///    the same energy scale: a crunch is a quick cascade of breaks.
 ///  - Voices: a pool allocated in prepare(); a voice frees itself when its slowest resonance has
 ///    decayed 80 dB below the loudest possible event (computed at spawn, so no per-sample test);
 ///    when the pool is full the quietest voice is replaced. process() never allocates.
@@ -53,7 +53,7 @@ struct AggregateParameters {
     double qMax = 20.0;
     int voices = 32;           ///< simultaneous events (pool size)
     double burstEvents = 0.0;  ///< mean number of follow-up micro-events per event
-    double burstMs = 2.0;      ///< mean gap between the micro-events of a burst
+    double burstMs = 2.0;      ///< mean delay of a burst's micro-events after their event
     double maxRateHz = 4000.0; ///< the layer's own cap on the event rate
     /// Throws std::invalid_argument naming the parameter when a value is not finite or out of its
     /// meaningful domain (positive energies, frequencies, Q; resonances 1..4; voices >= 1).

@@ -187,7 +187,8 @@ std::unique_ptr<SurfaceLayer> makeGrainsLayer(PresetReader& r, const AccuracyOpt
         r.number("q_max", 20.0, 0.5, 200.0, "", "highest quality factor", true));
     m.burstEvents = r.number("burst_events", 0.0, 0.0, 32.0, "events",
                              "mean number of micro-events following each event (a crunch)");
-    m.burstMs = r.number("burst_ms", 2.0, 0.1, 100.0, "ms", "mean gap inside a burst", true);
+    m.burstMs = r.number("burst_ms", 2.0, 0.1, 100.0, "ms",
+                         "mean delay of a burst's micro-events after their event", true);
     m.voices = r.integer("voices", 32, 1, 256, "simultaneous events");
     c.derivativeMs =
         r.number("derivative_ms", 5.0, 0.5, 50.0, "ms", "smoothing time constant of dF/dt", true);

@@ -149,6 +149,17 @@ TEST(AggregateModel, RateIsCappedIncludingBursts) {
     EXPECT_NEAR(primary, 2000.0, 4.0 * std::sqrt(2000.0));
     // Geometric counts with mean 3: variance 12 per primary event -> sd of the total ~155.
     EXPECT_NEAR(static_cast<double>(burst) / primary, 3.0, 0.3);
+    // Bursts stay local: dense primaries do not queue their bursts up; 50 ms after the rate drops
+    // to zero (100 x the mean delay) no micro-event is left.
+    AggregateParameters q;
+    q.burstEvents = 5.0;
+    q.burstMs = 0.5;
+    auto m3 = makeModel(q);
+    Collector c3;
+    m3.setEventObserver(&collect, &c3);
+    run(m3, 1.0, [](double t) { return t < 0.5 ? 500.0 : 0.0; });
+    ASSERT_GT(c3.events.size(), 1000u);
+    EXPECT_LT(c3.events.back().sample, static_cast<std::int64_t>(0.55 * kFs));
 }
 
 namespace {
