@@ -3,6 +3,8 @@
 
 #include <fmt/format.h>
 
+#include <set>
+
 namespace underfoot::experiment {
 
 std::string csvField(std::string_view value) {
@@ -89,17 +91,37 @@ int writeTrialsCsv(const StudyStore& store, std::ostream& out, ExportScope scope
 int writeRatingsCsv(const StudyStore& store, std::ostream& out, ExportScope scope) {
     const StudyInfo info = store.info();
     const Protocol& protocol = store.protocol();
-    writeRow(out, {"study", "participant", "group", "trial_index", "stimulus_id", "practice",
-                   "excluded", "scale", "value"});
+    // One column per factor of [[factorial]] stimuli (sorted), so that factorial designs can be
+    // analysed without decoding stimulus ids.
+    std::set<std::string> factorNames;
+    for (const auto& s : protocol.stimuli)
+        for (const auto& [name, level] : s.factors) factorNames.insert(name);
+    std::vector<std::string> header{"study",       "participant", "group",   "trial_index",
+                                    "stimulus_id", "practice",    "excluded"};
+    header.insert(header.end(), factorNames.begin(), factorNames.end());
+    header.push_back("scale");
+    header.push_back("value");
+    writeRow(out, header);
     int rows = 0;
     for (const auto& p : store.participants()) {
         const std::string group = protocol.design == DesignKind::Between ? p.groupId : "";
         for (const auto& t : store.trials(p.code)) {
             if (scope == ExportScope::Answered && !t.answered) continue;
             for (const auto& [scale, value] : t.answer.ratings) {
-                writeRow(out, {info.code, p.code, group, std::to_string(t.index), t.stimulus.id,
-                               t.practice ? "1" : "0", t.excluded ? "1" : "0", scale,
-                               std::to_string(value)});
+                std::vector<std::string> row{info.code,
+                                             p.code,
+                                             group,
+                                             std::to_string(t.index),
+                                             t.stimulus.id,
+                                             t.practice ? "1" : "0",
+                                             t.excluded ? "1" : "0"};
+                for (const auto& name : factorNames) {
+                    const auto it = t.stimulus.factors.find(name);
+                    row.push_back(it == t.stimulus.factors.end() ? "" : it->second);
+                }
+                row.push_back(scale);
+                row.push_back(std::to_string(value));
+                writeRow(out, row);
                 ++rows;
             }
         }
@@ -155,8 +177,9 @@ void writeCodebook(const StudyStore& store, std::ostream& out) {
     for (const auto& r : rows) out << fmt::format("| `{}` | {} | {} |\n", r[0], r[1], r[2]);
     out << "\n## ratings.csv — one row per rating\n\n"
            "Columns: study, participant, group, trial_index, stimulus_id, practice, excluded, "
-           "scale, value. Every scale of the protocol, including those without a column in "
-           "trials.csv.\n";
+           "one column per factor of the protocol's [[factorial]] stimuli (their level; empty "
+           "for other stimuli), scale, value. Every scale of the protocol, including those "
+           "without a column in trials.csv.\n";
     if (!p.questions.scales.empty()) {
         out << "\n## Scales\n\n| id | range | anchors | prompt |\n|---|---|---|---|\n";
         for (const auto& s : p.questions.scales)

@@ -53,8 +53,8 @@ std::string csvField(std::string_view value);
 /// Writes the trials CSV; returns the number of rows.
 int writeTrialsCsv(const StudyStore& store, std::ostream& out,
                    ExportScope scope = ExportScope::Answered);
-/// Writes every rating of every scale in long format
-/// (study,participant,group,trial_index,stimulus_id,scale,value); returns the number of rows.
+/// Writes every rating of every scale in long format (study, participant, group, trial_index,
+/// stimulus_id, practice, excluded, one column per factor, scale, value); returns the rows.
 int writeRatingsCsv(const StudyStore& store, std::ostream& out,
                     ExportScope scope = ExportScope::Answered);
 /// Writes the codebook (Markdown): every column, its type and meaning, and the value labels

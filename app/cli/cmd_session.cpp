@@ -154,8 +154,10 @@ int runInteractive(const Options& o) {
 int runSimulation(const Options& o) {
     StudyStore store = StudyStore::open(o.study);
     if (!o.protocol.empty()) store.verifyProtocol(loadProtocol(o.protocol));
-    if (o.confusion.empty())
-        throw UserError("--simulate needs at least one --confusion [GROUP=]FILE");
+    const bool needsMatrix = store.protocol().questions.asksSurface();
+    if (o.confusion.empty() && needsMatrix)
+        throw UserError("--simulate needs at least one --confusion [GROUP=]FILE (the protocol "
+                        "asks which surface)");
     MatrixByGroup matrices;
     for (const auto& spec : o.confusion) {
         const auto eq = spec.find('=');
@@ -170,8 +172,10 @@ int runSimulation(const Options& o) {
             throw UserError(e.what());
         }
     }
+    if (!needsMatrix) matrices.try_emplace(""); // ratings only: no matrix is consulted
     // Every group must be answerable before anything is written.
     for (const auto& g : store.protocol().groups) {
+        if (!needsMatrix) break;
         const auto it = matrices.count(g.id) ? matrices.find(g.id) : matrices.find("");
         if (it == matrices.end())
             throw UserError(fmt::format("no --confusion matrix for group '{}'", g.id));

@@ -182,3 +182,27 @@ TEST(ExperimentSimulation, BadMatricesAreReportedWithLine) {
         EXPECT_NE(std::string(e.what()).find("m.csv:3:"), std::string::npos) << e.what();
     }
 }
+
+TEST(ExperimentExport, RatingsCarryFactorLevels) {
+    TempDir dir;
+    StudyStore store = StudyStore::create(
+        dir.file("w.db"), loadProtocol(shipped("wading_listening.toml")), {"WAD", "lab", 8, "t"});
+    EXPECT_EQ(simulateStudy(store, {{"", ConfusionMatrix{}}}, 1, {}), 13);
+    std::ostringstream out;
+    EXPECT_EQ(writeRatingsCsv(store, out), 13 * 5);
+    const auto rows = readCsv(out.str());
+    EXPECT_EQ(rows[0], (std::vector<std::string>{"study", "participant", "group", "trial_index",
+                                                 "stimulus_id", "practice", "excluded", "cadence",
+                                                 "depth", "scale", "value"}));
+    for (std::size_t r = 1; r < rows.size(); ++r) {
+        const auto& row = rows[r];
+        if (row[4] == "practice_normal") {
+            EXPECT_EQ(row[7], "");
+            continue;
+        }
+        EXPECT_EQ(row[4], "wade_" + row[8] + "_" + row[7]);
+        const int value = std::stoi(row[10]);
+        EXPECT_GE(value, row[9] == "realism" ? 1 : 0);
+        EXPECT_LE(value, row[9] == "realism" ? 7 : 10);
+    }
+}
