@@ -258,3 +258,17 @@ TEST(ExperimentStore, ReplayInfoExclusionAndDroppedSessions) {
     s.dropParticipant("P07", "withdrew consent");
     EXPECT_THROW(s.startSession("P07", {}), StoreError);
 }
+
+TEST(ExperimentStore, ForeignSqliteFileIsNotAStudy) {
+    TempDir dir;
+    {
+        SQLite::Database db(dir.file("other.db"), SQLite::OPEN_READWRITE | SQLite::OPEN_CREATE);
+        db.exec("CREATE TABLE notes (text TEXT)");
+    }
+    try {
+        StudyStore::open(dir.file("other.db"));
+        FAIL();
+    } catch (const StoreError& e) {
+        EXPECT_NE(std::string(e.what()).find("not an Underfoot study"), std::string::npos);
+    }
+}
