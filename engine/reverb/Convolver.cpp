@@ -18,15 +18,27 @@
 
 namespace underfoot::engine {
 
-namespace {
-int partitionFor(std::size_t irLength) noexcept {
-    const double root = std::sqrt(static_cast<double>(irLength));
-    int q = 64;
-    while (q < 1024 && std::fabs(std::log2(q * 2.0 / root)) < std::fabs(std::log2(q / root)))
-        q *= 2;
-    return q;
-}
-} // namespace
+/// One uniformly partitioned FFT stage (a threadless zita-convolver instance).
+struct Convolver::Stage {
+    Convproc zita;
+    int partition = 0;
+    int fill = 0;                  // samples of the current block already consumed
+    std::vector<float> outL, outR; // this stage's output for the current block
+
+    ~Stage() {
+        if (zita.state() == Convproc::ST_PROC) zita.stop_process();
+        while (!zita.check_stop()) usleep(100); // no thread: returns at once
+        zita.cleanup();
+    }
+    void start() {
+        // quantum == minpart: start_process() starts no thread.
+        if (zita.start_process(0, SCHED_OTHER) != 0)
+            throw std::runtime_error("Convolver: zita-convolver could not start processing");
+        std::fill(outL.begin(), outL.end(), 0.0f);
+        std::fill(outR.begin(), outR.end(), 0.0f);
+        fill = 0;
+    }
+};
 
 Convolver::Convolver() = default;
 
@@ -35,12 +47,13 @@ Convolver::~Convolver() {
 }
 
 void Convolver::release() noexcept {
-    if (!zita_) return;
-    if (zita_->state() == Convproc::ST_PROC) zita_->stop_process();
-    // No level has a thread (single partition size), so this returns at once.
-    while (!zita_->check_stop()) usleep(100);
-    zita_->cleanup();
-    zita_.reset();
+    stages_.clear();
+}
+
+std::vector<int> Convolver::partitionSizes() const {
+    std::vector<int> sizes;
+    for (const auto& s : stages_) sizes.push_back(s->partition);
+    return sizes;
 }
 
 void Convolver::prepare(const AudioBuffer& impulseResponse, double sampleRateHz, int blockSize) {
@@ -83,58 +96,67 @@ void Convolver::prepare(const AudioBuffer& impulseResponse, double sampleRateHz,
     irLength_ = len;
 
     // Direct-form head, reversed.
-    q_ = partitionFor(len);
-    const int q = q_;
+    constexpr auto q = static_cast<std::size_t>(kHeadLength);
     headL_.assign(q, 0.0f);
     headR_.assign(q, 0.0f);
-    for (std::size_t k = 0; k < std::min<std::size_t>(len, q); ++k) {
+    for (std::size_t k = 0; k < std::min(len, q); ++k) {
         headL_[q - 1 - k] = left[k];
         headR_[q - 1 - k] = right[k];
     }
     history_.assign(2 * q, 0.0f);
     historyPos_ = 0;
-    tailL_.assign(q, 0.0f);
-    tailR_.assign(q, 0.0f);
-    fill_ = 0;
 
-    hasTail_ = len > static_cast<std::size_t>(q);
-    if (!hasTail_) return;
-    const auto tailLen = static_cast<std::uint32_t>(len - q);
-    zita_ = std::make_unique<Convproc>();
-    const auto part = static_cast<std::uint32_t>(q);
-    int err = zita_->configure(1, 2, tailLen, part, part, part, 0.0f);
-    if (err != 0)
-        throw std::runtime_error(fmt::format(
-            "Convolver: zita-convolver configure failed ({}) for an IR of {} samples", err, len));
-    std::vector<float> tail(left.begin() + q, left.end());
-    err = zita_->impdata_create(0, 0, 1, tail.data(), 0, static_cast<int>(tailLen));
-    if (err == 0) {
-        if (ir.channels == 2) {
-            tail.assign(right.begin() + q, right.end());
-            err = zita_->impdata_create(0, 1, 1, tail.data(), 0, static_cast<int>(tailLen));
-        } else {
-            err = zita_->impdata_link(0, 0, 0, 1);
+    // FFT stages: [64, 1024) with partition 64, [1024, end) with partition 1024.
+    struct Range {
+        std::size_t begin, end;
+        int partition;
+    };
+    std::vector<Range> ranges;
+    if (len > q) ranges.push_back({q, std::min<std::size_t>(len, kLongPartition), kHeadLength});
+    if (len > static_cast<std::size_t>(kLongPartition))
+        ranges.push_back({static_cast<std::size_t>(kLongPartition), len, kLongPartition});
+    for (const auto& r : ranges) {
+        auto stage = std::make_unique<Stage>();
+        stage->partition = r.partition;
+        const auto p = static_cast<std::size_t>(r.partition);
+        // Taps [begin, end) are loaded at positions [begin - P, end - P).
+        const auto first = static_cast<int>(r.begin - p), last = static_cast<int>(r.end - p);
+        int err = stage->zita.configure(
+            1, 2, static_cast<std::uint32_t>(last), static_cast<std::uint32_t>(p),
+            static_cast<std::uint32_t>(p), static_cast<std::uint32_t>(p), 0.0f);
+        if (err != 0)
+            throw std::runtime_error(fmt::format(
+                "Convolver: zita-convolver configure failed ({}) for an IR of {} samples", err,
+                len));
+        std::vector<float> taps(left.begin() + static_cast<long>(r.begin),
+                                left.begin() + static_cast<long>(r.end));
+        err = stage->zita.impdata_create(0, 0, 1, taps.data(), first, last);
+        if (err == 0) {
+            if (ir.channels == 2) {
+                taps.assign(right.begin() + static_cast<long>(r.begin),
+                            right.begin() + static_cast<long>(r.end));
+                err = stage->zita.impdata_create(0, 1, 1, taps.data(), first, last);
+            } else {
+                err = stage->zita.impdata_link(0, 0, 0, 1);
+            }
         }
+        if (err != 0)
+            throw std::runtime_error(
+                fmt::format("Convolver: zita-convolver could not load the IR ({})", err));
+        stage->outL.assign(p, 0.0f);
+        stage->outR.assign(p, 0.0f);
+        stage->start();
+        stages_.push_back(std::move(stage));
     }
-    if (err != 0)
-        throw std::runtime_error(
-            fmt::format("Convolver: zita-convolver could not load the IR ({})", err));
-    // quantum == minpart: start_process() starts no thread (the policy is never used; SCHED_OTHER
-    // in case a future version does).
-    if (zita_->start_process(0, SCHED_OTHER) != 0)
-        throw std::runtime_error("Convolver: zita-convolver could not start processing");
 }
 
 void Convolver::reset() {
     std::fill(history_.begin(), history_.end(), 0.0f);
-    std::fill(tailL_.begin(), tailL_.end(), 0.0f);
-    std::fill(tailR_.begin(), tailR_.end(), 0.0f);
     historyPos_ = 0;
-    fill_ = 0;
-    if (zita_ && hasTail_) {
-        if (zita_->state() == Convproc::ST_PROC) zita_->stop_process();
-        while (!zita_->check_stop()) usleep(100);
-        zita_->start_process(0, SCHED_OTHER); // clears zita's buffers
+    for (auto& s : stages_) {
+        if (s->zita.state() == Convproc::ST_PROC) s->zita.stop_process();
+        while (!s->zita.check_stop()) usleep(100);
+        s->start(); // start_process() clears zita's buffers
     }
 }
 
@@ -143,14 +165,13 @@ void Convolver::process(const float* in, float* outL, float* outR, int n) noexce
         for (int i = 0; i < n; ++i) outL[i] = outR[i] = 0.0f;
         return;
     }
-    const int q = q_;
+    constexpr int q = kHeadLength;
     for (int i = 0; i < n; ++i) {
         const float x = in[i];
         history_[static_cast<std::size_t>(historyPos_)] = x;
         history_[static_cast<std::size_t>(historyPos_ + q)] = x;
         const float* window = history_.data() + historyPos_ + 1;
-        // Float products summed in 8 independent float lanes (vectorisable); the error of a
-        // 1024-tap dot product stays near float rounding (see the accuracy test).
+        // Float products summed in 8 independent lanes (vectorisable).
         float accL[8] = {}, accR[8] = {};
         const float* hl = headL_.data();
         const float* hr = headR_.data();
@@ -162,16 +183,17 @@ void Convolver::process(const float* in, float* outL, float* outR, int n) noexce
         double yl = 0.0, yr = 0.0;
         for (int j = 0; j < 8; ++j) yl += accL[j], yr += accR[j];
         historyPos_ = (historyPos_ + 1) % q;
-        if (hasTail_) {
-            const auto f = static_cast<std::size_t>(fill_);
-            yl += tailL_[f];
-            yr += tailR_[f];
-            zita_->inpdata(0)[f] = x;
-            if (++fill_ == q) {
-                fill_ = 0;
-                zita_->process(true); // inline: no level has a thread
-                std::memcpy(tailL_.data(), zita_->outdata(0), sizeof(float) * q);
-                std::memcpy(tailR_.data(), zita_->outdata(1), sizeof(float) * q);
+        for (auto& sp : stages_) {
+            Stage& s = *sp;
+            const auto f = static_cast<std::size_t>(s.fill);
+            yl += s.outL[f];
+            yr += s.outR[f];
+            s.zita.inpdata(0)[f] = x;
+            if (++s.fill == s.partition) {
+                s.fill = 0;
+                s.zita.process(true); // inline: no level has a thread
+                std::memcpy(s.outL.data(), s.zita.outdata(0), sizeof(float) * s.outL.size());
+                std::memcpy(s.outR.data(), s.zita.outdata(1), sizeof(float) * s.outR.size());
             }
         }
         outL[i] = static_cast<float>(yl);
