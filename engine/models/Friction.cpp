@@ -96,59 +96,47 @@ double ElastoPlasticFrictionT<Real>::processSample(double normal, double drive) 
         return inContact *
                (params_.sigma0 * z1 + params_.sigma1 * (z1 - z0) / T + params_.sigma2 * v1 + noise);
     };
-    // h(v) = v - (vRelPred - kd F(v)) is increasing in v; find its root.
-    auto h = [&](double v1) { return v1 - vRelPred + kd_ * forceAt(v1, bristleAt(v1)); };
-    // Since dh/dv >= 1 wherever F is increasing, the root lies within |h(v0)| of v0: bracket
-    // it at once (widening only if the bristle model makes h locally non-monotone).
-    const double v0 = vRelPred, h0 = h(v0);
-    double lo = v0, hi = v0, hlo = h0, hhi = h0;
-    double width = std::max(std::fabs(h0), 1e-9);
-    for (int k = 0; k < 40; ++k) {
-        if (hlo > 0.0) {
-            lo = v0 - width;
-            hlo = h(lo);
-        }
-        if (hhi < 0.0) {
-            hi = v0 + width;
-            hhi = h(hi);
-        }
-        if (hlo <= 0.0 && hhi >= 0.0) break;
-        width *= 2.0;
-    }
-    double v1 = (h0 == 0.0) ? v0 : (hlo == 0.0 ? lo : hi);
-    if (h0 != 0.0 && hlo < 0.0 && hhi > 0.0) {
-        // Illinois variant of regula falsi: superlinear, never leaves the bracket.
-        int side = 0;
-        for (int it = 0; it < params_.maxIterations; ++it) {
-            const double x = lo - hlo * (hi - lo) / (hhi - hlo);
-            const double hx = h(x);
-            v1 = x;
-            if (hx == 0.0 || (hi - lo) < 1e-12 * (1.0 + std::fabs(x))) break;
-            if (hx < 0.0) {
-                lo = x;
-                hlo = hx;
-                if (side == -1) hhi *= 0.5;
-                side = -1;
-            } else {
-                hi = x;
-                hhi = hx;
-                if (side == 1) hlo *= 0.5;
-                side = 1;
-            }
-        }
+    // The relative velocity at n+1 solves h(v) = v - vRelPred + kd F(v) = 0. With the plastic
+    // factor alpha(z, v) / z_ss(v) taken at a trial velocity vp, backward Euler gives
+    // z1 = (z0 + T v1) / d with d = 1 + T vp alpha / z_ss >= 1, F is linear in v1 and h has a
+    // closed-form root. A few fixed-point passes (vp <- v1) make it consistent; each pass costs one
+    // exp and at most one sine, so the work per sample is bounded (no bracketing, no open loop).
+    // Sticking (alpha = 0) is exact in one pass.
+    const double zba = params_.breakAway * fc / params_.sigma0;
+    double v1 = vRelPred;
+    for (int pass = 0; pass < params_.maxIterations && inContact > 0.0; ++pass) {
+        const double vp = v1;
+        const double sgn = vp >= 0.0 ? 1.0 : -1.0;
+        const double vs = vp / params_.stribeckVelocity;
+        const double zss = sgn * (fc + (fs - fc) * std::exp(-vs * vs)) / params_.sigma0;
+        const double a = zss != 0.0 ? alphaOf(z0, vp, zss, zba) : 0.0;
+        const double d = 1.0 + (a > 0.0 ? T * vp * a / zss : 0.0);
+        const double constant =
+            params_.sigma0 * z0 / d + params_.sigma1 * (z0 / d - z0) / T + noise;
+        const double slope = params_.sigma0 * T / d + params_.sigma1 / d + params_.sigma2;
+        const double next = (vRelPred - kd_ * constant) / (1.0 + kd_ * slope);
+        const bool converged = std::fabs(next - v1) < 1e-9 || a == 0.0;
+        v1 = next;
+        if (converged && pass > 0) break;
     }
     const double z1 = bristleAt(v1);
-    const double f = forceAt(v1, z1);
+    commitSample(v1, z1, forceAt(v1, z1), xePred, vePred, drive);
+    return resonator_.velocity(0);
+}
 
-    // Commit: friction acts against the exciter's relative motion, with it on the resonator.
+template <typename Real>
+void ElastoPlasticFrictionT<Real>::commitSample(double v1, double z1, double f, double xePred,
+                                                double vePred, double drive) noexcept {
+    // Friction acts against the exciter's relative motion, with it on the resonator.
+    const double T = T_, M = params_.exciterMassKg;
     exciterX_ = xePred - T * T / (6.0 * M) * f;
     exciterV_ = vePred - 0.5 * T / M * f;
     resonator_.commit(0, f);
     z_ = snapToZero(z1);
     v_ = exciterV_ - resonator_.contactVelocity();
+    (void)v1;
     force_ = f;
     lastDrive_ = drive;
-    return resonator_.velocity(0);
 }
 
 template class ElastoPlasticFrictionT<double>;

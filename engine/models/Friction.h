@@ -16,8 +16,8 @@
 /// their instantaneous mobilities (exact first-order-hold integration, as in Impact.h); the
 /// bristle state is integrated with backward Euler (alpha taken at z_n), which is unconditionally
 /// stable — the forward Euler of the Sound Design Toolkit blows up for sigma0 above ~5e7. The
-/// relative velocity at n+1 is the root of a monotone scalar equation, bracketed and solved with
-/// at most `maxIterations` safeguarded secant steps (bounded work per sample).
+/// relative velocity at n+1 follows in closed form once the plastic factor alpha / z_ss is taken
+/// at a trial velocity; `maxIterations` fixed-point passes refine that trial (bounded work).
 #include "engine/dsp/Random.h"
 #include "engine/models/ModalResonator.h"
 
@@ -33,7 +33,7 @@ struct FrictionParams {
     double stribeckVelocity = 0.05;  ///< v_s, m/s
     double breakAway = 0.7;          ///< z_ba as a fraction of the static deflection f_c / sigma0
     double exciterMassKg = 0.05;     ///< mass of the rubbing body
-    int maxIterations = 12;
+    int maxIterations = 3;           ///< fixed-point passes per sample (bounded work)
 };
 
 template <typename Real>
@@ -60,6 +60,8 @@ class ElastoPlasticFrictionT {
 
   private:
     double alphaOf(double z, double v, double zss, double zba) const noexcept;
+    void commitSample(double v1, double z1, double f, double xePred, double vePred,
+                      double drive) noexcept;
 
     FrictionParams params_;
     ModalResonatorT<Real> resonator_;

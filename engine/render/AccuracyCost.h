@@ -1,0 +1,71 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+/// What accuracy costs in time: every accuracy knob of the engine measured against a
+/// high-accuracy reference in one run (the table printed by `underfoot bench`).
+///
+///  - impact: solver (explicit / Newton with n iterations), oversampling (1, 2, 4), float vs
+///    double state, against 8x oversampled double Newton (50 iterations): error of contact time,
+///    restitution and spectrum (1/3-octave log-spectral distance), CPU ns per output sample,
+///    median and worst 64-sample block;
+///  - modes: a surface's resonator truncated to its n lowest modes, against all of them;
+///  - particle event cap: a granular surface's events per second capped, against a high cap;
+///  - surfaces: real-time factor of one voice of every bundled surface.
+/// Timings are wall-clock on this machine and noisy: read them as ratios within one run.
+#include "engine/models/Impact.h"
+
+#include <string>
+#include <vector>
+
+namespace underfoot::engine {
+
+struct ImpactSetting {
+    std::string name;
+    ImpactSolver solver = ImpactSolver::Newton;
+    int iterations = 6;
+    int oversampling = 1;
+    bool floatState = false;
+};
+
+struct ImpactMeasurement {
+    ImpactSetting setting;
+    double contactTimeErrorPct = 0; ///< |t_c - t_ref| / t_ref
+    double restitutionError = 0;    ///< |e - e_ref|
+    double spectralDistanceDb = 0;  ///< RMS difference of 1/3-octave band levels, 50 Hz..16 kHz
+    double nsPerSample = 0;         ///< mean over a train of strikes (per-block minimum of 5 runs)
+    double medianBlockNs = 0;       ///< 64-sample blocks
+    double p99BlockNs = 0;
+    double maxBlockNs = 0;
+    double contactTimeMs = 0, restitution = 0;
+};
+
+struct SurfaceCost {
+    std::string id;
+    double realTimeFactor = 0; ///< audio seconds per CPU second, one voice
+    double nsPerSample = 0;
+};
+
+struct KnobMeasurement {
+    std::string knob, setting;
+    double spectralDistanceDb = 0; ///< against the knob's most accurate setting
+    double nsPerSample = 0;
+};
+
+/// The default settings compared (explicit, Newton 1/2/4/6 at 1x, Newton 6 at 2x/4x, float).
+std::vector<ImpactSetting> defaultImpactSettings();
+
+/// The benchmark's impact: a 0.1 kg sole, k = 2e9 N/m^1.5, mu = 0.6 s/m, 3 floor modes
+/// (180, 620, 1900 Hz), struck at 0.5 m/s, at 48 kHz.
+ImpactMeasurement measureImpact(const ImpactSetting& setting, double strikesSeconds = 5.0);
+
+/// 1/3-octave log-spectral distance between two signals at a rate (dB RMS over bands within
+/// 80 dB of the reference's loudest band).
+double spectralDistanceDb(const std::vector<float>& a, const std::vector<float>& reference,
+                          double sampleRateHz);
+
+/// One voice of each bundled surface walked by the virtual walker for `seconds`.
+std::vector<SurfaceCost> measureSurfaceCosts(double seconds = 10.0);
+
+/// Mode-count and event-cap knobs on bundled surfaces.
+std::vector<KnobMeasurement> measureKnobs(double seconds = 4.0);
+
+} // namespace underfoot::engine
