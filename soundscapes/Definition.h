@@ -13,7 +13,8 @@
 /// [[bed]]                            # a continuous layer, looped when from a file
 /// name = "canopy"
 /// generator = "leaves"               # or: file = "recordings/canopy.flac"
-/// level_db = 0.0                     # relative balance of the layers (power-normalised)
+/// level_db = 0.0                     # balance: a bed's long-term level, an event's level while
+///                                    # it sounds; the mix is then scaled to target_level_dbfs
 /// crossfade_s = 2.0                  # loop crossfade (file beds)
 /// params = { density = 1.5 }         # generator parameters (see `underfoot soundscape
 /// generators`)
@@ -58,7 +59,7 @@ struct LayerDefinition {
     ParamSet params;                ///< its parameters (defaults resolved through the catalogue)
     std::vector<std::string> files; ///< recordings (absolute or as written when no folder)
     std::string location;           ///< "file:line:column" of the layer, for later error messages
-    double levelDb = 0.0;           ///< relative balance among the layers
+    double levelDb = 0.0; ///< balance: beds' long-term level, events' level while sounding
     // Beds.
     double crossfadeSeconds = 2.0; ///< loop crossfade of file beds
     // Events.

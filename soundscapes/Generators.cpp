@@ -142,7 +142,9 @@ const std::vector<Entry>& entries() {
                   "Chairlift pylon clank: two metallic knocks into four free-bar modes and a low "
                   "thump.",
                   {{"base_hz", 420.0, 80.0, 3000.0, "lowest metal mode"}}, makeClank),
-            event("skitter", "Leaves skittering along a path: a 0.4-1.5 s burst of dry clicks.",
+            event("skitter",
+                  "Leaves skittering along a path: a 0.4-1.5 s burst of dry crackles (short noise "
+                  "grains).",
                   {{"brightness_hz", 4000.0, 800.0, 10000.0, "centre of the click band"}},
                   makeSkitter),
         };

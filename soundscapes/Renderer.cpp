@@ -51,7 +51,8 @@ struct SoundscapeRenderer::Layer {
     long long now = 0;       // samples since reset
 
     double gain = 1.0;
-    double unityPower = 0.0;
+    double unityPower = 0.0;     // long-term mean channel power at unity gain
+    double referencePower = 0.0; // what level_db refers to (beds: long-term; events: sounding)
     LayerStats stats;
 
     double drawInterval() noexcept {
@@ -187,31 +188,36 @@ void SoundscapeRenderer::prepare(const engine::ProcessSpec& spec) {
         }
     }
 
-    // Level calibration (see the header): unity powers, then gains.
-    double weightSum = 0.0;
+    // Level calibration (see the header): balance on the reference powers, then one common
+    // factor so that the long-term powers add up to the target.
+    double longTermSum = 0.0;
     for (auto& lp : layers_) {
-        lp->unityPower = calibrate(*lp);
-        if (!(lp->unityPower > 0.0) || !std::isfinite(lp->unityPower))
+        const Calibration c = calibrate(*lp);
+        lp->unityPower = c.longTermPower;
+        lp->referencePower = c.referencePower;
+        if (!(c.longTermPower > 0.0 && c.referencePower > 0.0) || !std::isfinite(c.longTermPower) ||
+            !std::isfinite(c.referencePower))
             throw DefinitionError(fmt::format("{}: layer '{}' renders silence or non-finite audio "
                                               "at calibration (expected an audible layer)",
                                               lp->def->location, lp->def->name));
-        weightSum += std::pow(10.0, lp->def->levelDb / 10.0);
+        lp->gain = std::pow(10.0, lp->def->levelDb / 10.0) / c.referencePower; // power gain
+        longTermSum += lp->gain * c.longTermPower;
     }
-    const double target = std::pow(10.0, definition_.targetLevelDbfs / 10.0);
-    for (auto& lp : layers_) {
-        const double w = std::pow(10.0, lp->def->levelDb / 10.0);
-        lp->gain = std::sqrt(w * target / (weightSum * lp->unityPower));
-    }
+    const double scale = std::pow(10.0, definition_.targetLevelDbfs / 10.0) / longTermSum;
+    for (auto& lp : layers_) lp->gain = std::sqrt(lp->gain * scale);
     prepared_ = true;
     reset(0);
 }
 
-double SoundscapeRenderer::calibrate(Layer& layer) {
+SoundscapeRenderer::Calibration SoundscapeRenderer::calibrate(Layer& layer) {
     const LayerDefinition& d = *layer.def;
     const double fs = spec_.sampleRateHz;
     const int block = spec_.maxBlockSize;
     if (d.kind == LayerKind::Bed) {
-        if (!layer.bed) return 0.5 * (meanSquare(layer.loopL) + meanSquare(layer.loopR));
+        if (!layer.bed) {
+            const double p = 0.5 * (meanSquare(layer.loopL) + meanSquare(layer.loopR));
+            return {p, p};
+        }
         layer.bed->reset(kCalibrationSeed);
         const auto warm = static_cast<long>(kBedWarmupSeconds * fs);
         const auto total = warm + static_cast<long>(kBedCalibrationSeconds * fs);
@@ -227,13 +233,18 @@ double SoundscapeRenderer::calibrate(Layer& layer) {
                 ++measured;
             }
         }
-        return sum / static_cast<double>(measured);
+        const double p = sum / static_cast<double>(measured);
+        return {p, p};
     }
-    // Events: mean energy per event (mono samples squared).
-    double energy = 0.0;
+    // Events: mean energy (mono samples squared) and mean duration (samples) per event.
+    double energy = 0.0, frames = 0.0;
     if (d.source == LayerSource::Recording) {
-        for (const auto& c : layer.clips) energy += meanSquare(c) * static_cast<double>(c.size());
+        for (const auto& c : layer.clips) {
+            energy += meanSquare(c) * static_cast<double>(c.size());
+            frames += static_cast<double>(c.size());
+        }
         energy /= static_cast<double>(layer.clips.size());
+        frames /= static_cast<double>(layer.clips.size());
     } else {
         EventVoice& v = *layer.voices.front().synth;
         v.reset(kCalibrationSeed, kCalibrationSeed + 1);
@@ -249,8 +260,10 @@ double SoundscapeRenderer::calibrate(Layer& layer) {
                     energy += static_cast<double>(scratchMono_[i]) * scratchMono_[i];
                 done += got;
             }
+            frames += static_cast<double>(done);
         }
         energy /= kCalibrationEvents;
+        frames /= kCalibrationEvents;
     }
     // E[g^2] for a gain uniform in dB over [a, b]: mean of 10^(x/10).
     const double a = d.gainDbMin, b = d.gainDbMax;
@@ -259,7 +272,8 @@ double SoundscapeRenderer::calibrate(Layer& layer) {
         (b - a) < 1e-9 ? std::exp(k * a) : (std::exp(k * b) - std::exp(k * a)) / (k * (b - a));
     // Equal-power panning: (gL^2 + gR^2) / 2 = 1/2 per event, whatever the position.
     const double eventsPerSample = d.ratePerMinute / 60.0 / fs;
-    return eventsPerSample * energy * meanG2 * 0.5;
+    return {eventsPerSample * energy * meanG2 * 0.5,
+            frames > 0.0 ? energy / frames * meanG2 * 0.5 : 0.0};
 }
 
 void SoundscapeRenderer::reset(std::uint64_t seed) noexcept {

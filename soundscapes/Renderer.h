@@ -9,12 +9,14 @@
 /// deterministically; `process()` runs on the audio thread without allocating, locking,
 /// logging or throwing.
 ///
-/// Levels: each layer's long-term power at unity gain is measured in `prepare()` (beds: a
-/// 20 s calibration render; procedural events: the mean energy of 32 calibration events times
-/// the declared rate and the mean per-event gain; recordings: their measured power), always
-/// with the same calibration seed, so the balance does not depend on the playback seed. Layer
-/// gains are then set so that the layers' powers follow their `level_db` balance and sum to
-/// `target_level_dbfs` (mean channel power of the mix).
+/// Levels: each layer is measured in `prepare()` with a fixed calibration seed, so the balance
+/// does not depend on the playback seed (beds: a 20 s render; procedural events: 32 calibration
+/// events; recordings: their samples). `level_db` sets the balance of the layers' *reference*
+/// powers: a bed's long-term power, an event's power while it sounds (its energy over its
+/// duration, times the mean per-event gain), so "gulls at -6 dB" means a gull call is 6 dB
+/// below a bed at 0 dB whatever the call rate. One common factor then scales all layers so
+/// that their long-term powers (events: energy x rate) add up to `target_level_dbfs` (mean
+/// channel power of the mix, i.e. its Leq).
 #include "engine/dsp/ProcessSpec.h"
 #include "soundscapes/Definition.h"
 
@@ -64,7 +66,11 @@ class SoundscapeRenderer {
     void processChunk(float* left, float* right, int n) noexcept;
     void startEvent(Layer& layer) noexcept;
     void renderVoices(Layer& layer, float* left, float* right, int from, int to) noexcept;
-    double calibrate(Layer& layer);
+    struct Calibration {
+        double longTermPower = 0.0;  ///< mean channel power over time at unity gain
+        double referencePower = 0.0; ///< the power `level_db` refers to
+    };
+    Calibration calibrate(Layer& layer);
 
     SoundscapeDefinition definition_;
     engine::ProcessSpec spec_{};

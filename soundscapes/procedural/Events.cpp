@@ -699,8 +699,9 @@ class ClankVoice final : public VoiceBase {
     Resonator thump_;
 };
 
-// Leaves skittering over a path: 0.4-1.5 s bursts of Poisson clicks (80-300 per second) ringing
-// a dry band near `brightness_hz`, swelling and fading like a gust pushing a leaf along.
+// Leaves skittering over a path: 0.4-1.5 s bursts of Poisson crackles (80-300 per second), each
+// a 1.5 ms decaying noise grain (a leaf edge scraping) ringing a dry band near `brightness_hz`,
+// swelling and fading like a gust pushing a leaf along.
 class SkitterVoice final : public VoiceBase {
   public:
     explicit SkitterVoice(const ParamSet& p) : brightHz_(p.get("brightness_hz")) {}
@@ -709,19 +710,22 @@ class SkitterVoice final : public VoiceBase {
         rate_ = rng.uniform(80.0, 300.0);
         band_.reset();
         band_.set(fs_, brightHz_ * rng.uniform(0.8, 1.25), 1.2);
+        grain_ = 0.0;
+        decay_ = std::exp(-1.0 / (0.0015 * fs_));
         setLengthSeconds(dur_);
     }
 
   protected:
     double sample(double t) noexcept override {
         const double env = hann(t / dur_);
-        const double click = noise_.uniform() < rate_ * env / fs_ ? noise_.bipolar() * 10.0 : 0.0;
-        return band_.bandNormalised(click);
+        if (noise_.uniform() < rate_ * env / fs_) grain_ = noise_.uniform(0.3, 1.0);
+        grain_ *= decay_;
+        return band_.bandNormalised(grain_ * whiteNoise(noise_));
     }
     void snapState() noexcept override { band_.snap(); }
 
   private:
-    double brightHz_, dur_ = 1, rate_ = 100;
+    double brightHz_, dur_ = 1, rate_ = 100, grain_ = 0, decay_ = 0.99;
     Svf band_;
 };
 
