@@ -29,6 +29,17 @@ fs::path tempDir() {
     return dir;
 }
 
+// Removes the scratch folder when the test program ends.
+struct RemoveTempDir : ::testing::Environment {
+    void TearDown() override {
+        std::error_code ec;
+        fs::remove_all(
+            fs::temp_directory_path() / ("underfoot_test_grf_" + std::to_string(getpid())), ec);
+    }
+};
+[[maybe_unused]] ::testing::Environment* const removeTempDir =
+    ::testing::AddGlobalTestEnvironment(new RemoveTempDir);
+
 std::string writeText(const std::string& name, const std::string& text) {
     const auto path = (tempDir() / name).string();
     std::ofstream(path, std::ios::binary) << text;

@@ -25,6 +25,17 @@ fs::path tempDir() {
     return dir;
 }
 
+// Removes the scratch folder when the test program ends.
+struct RemoveTempDir : ::testing::Environment {
+    void TearDown() override {
+        std::error_code ec;
+        fs::remove_all(
+            fs::temp_directory_path() / ("underfoot_test_io_" + std::to_string(getpid())), ec);
+    }
+};
+[[maybe_unused]] ::testing::Environment* const removeTempDir =
+    ::testing::AddGlobalTestEnvironment(new RemoveTempDir);
+
 AudioBuffer sine(double rateHz, double freqHz, double amplitude, std::size_t frames,
                  int channels = 1) {
     AudioBuffer b;
