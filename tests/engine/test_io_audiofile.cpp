@@ -128,6 +128,26 @@ TEST(AudioFile, PcmRoundTripWithinQuantisationStep) {
     }
 }
 
+TEST(AudioFile, ReadsOggVorbis) {
+    // Written through libsndfile's Vorbis encoder (lossy: compare level and frequency only).
+    const auto path = (tempDir() / "sine.ogg").string();
+    const AudioBuffer b = sine(48000, 440, 0.5, 48000);
+    SF_INFO info{};
+    info.samplerate = 48000;
+    info.channels = 1;
+    info.format = SF_FORMAT_OGG | SF_FORMAT_VORBIS;
+    SNDFILE* f = sf_open(path.c_str(), SFM_WRITE, &info);
+    ASSERT_NE(f, nullptr) << sf_strerror(nullptr);
+    sf_writef_float(f, b.samples.data(), 48000);
+    sf_close(f);
+    const AudioBuffer r = readAudioFile(path);
+    EXPECT_EQ(r.sampleRateHz, 48000);
+    ASSERT_GE(r.frames(), 47000u);
+    const auto x = r.channel(0);
+    EXPECT_NEAR(amplitudeAt(x, 48000, 440, 4800, 43200), 0.5, 0.01);
+    EXPECT_NEAR(zeroCrossingFrequency(x, 48000, 4800, 43200), 440.0, 0.05);
+}
+
 TEST(AudioFile, PcmClippingIsAnErrorNamingThePlace) {
     const auto path = (tempDir() / "clip.wav").string();
     fs::remove(path);
