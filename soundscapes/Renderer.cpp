@@ -308,6 +308,7 @@ void SoundscapeRenderer::reset(std::uint64_t seed) noexcept {
 }
 
 void SoundscapeRenderer::process(float* left, float* right, int n) noexcept {
+    if (n <= 0) return;
     std::fill(left, left + n, 0.0f);
     std::fill(right, right + n, 0.0f);
     if (!prepared_) return;
