@@ -284,3 +284,40 @@ TEST(VirtualWalker, JitteredStancesKeepForceBalanceAndAPlausibleShape) {
         ASSERT_LT(sh.valleyBw, 0.9);
     }
 }
+
+TEST(VirtualWalker, TenMinutesWithoutDrift) {
+    // Minute 1 and minute 10 of a walk: same mean force (= body weight), same step count, same
+    // peak range (the step clock is a double sample position: no accumulated rounding).
+    WalkerParameters p; // default 3 % variability
+    VirtualWalker w(p);
+    w.prepare({48000, 4096});
+    w.reset(9);
+    const std::size_t minute = 48000 * 60;
+    std::vector<float> l(minute), r(minute);
+    struct Stats {
+        double mean = 0;
+        int steps = 0;
+    };
+    auto run = [&] {
+        w.process(l.data(), r.data(), static_cast<int>(minute));
+        Stats s;
+        bool on = false;
+        for (std::size_t i = 0; i < minute; ++i) {
+            s.mean += double(l[i]) + r[i];
+            if (!on && l[i] > 0)
+                on = true, ++s.steps;
+            else if (on && l[i] <= 0)
+                on = false;
+        }
+        s.mean /= double(minute);
+        return s;
+    };
+    const Stats first = run();
+    for (int m = 1; m < 9; ++m) run();
+    const Stats last = run();
+    const double bw = 70 * kGravity;
+    EXPECT_NEAR(first.mean / bw, 1.0, 0.002);
+    EXPECT_NEAR(last.mean / bw, 1.0, 0.002);
+    EXPECT_NEAR(first.steps, 50, 1); // 100 steps/min = 50 left steps per minute
+    EXPECT_NEAR(last.steps, 50, 1);
+}
