@@ -121,6 +121,7 @@ void Convolver::prepare(const AudioBuffer& impulseResponse, double sampleRateHz,
         const auto p = static_cast<std::size_t>(r.partition);
         // Taps [begin, end) are loaded at positions [begin - P, end - P).
         const auto first = static_cast<int>(r.begin - p), last = static_cast<int>(r.end - p);
+        stage->zita.set_options(Convproc::OPT_VECTOR_MODE); // SIMD multiply-add when built in
         int err = stage->zita.configure(
             1, 2, static_cast<std::uint32_t>(last), static_cast<std::uint32_t>(p),
             static_cast<std::uint32_t>(p), static_cast<std::uint32_t>(p), 0.0f);
