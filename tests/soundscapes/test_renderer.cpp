@@ -145,10 +145,10 @@ TEST(SoundscapeRenderer, OutputDoesNotDependOnTheBlockSize) {
 }
 
 TEST(SoundscapeRenderer, ShippedEventLayersOccurAtTheirDeclaredRates) {
-    // Over 5 minutes each Poisson layer's onset count (started + dropped) must fall within
+    // Over 4 minutes each Poisson layer's onset count (started + dropped) must fall within
     // 4.5 standard deviations of its expectation 1 + rate * (T - first onset) (a first onset
     // window forces the first event; the rest are Poisson, variance = mean).
-    const double seconds = 300.0;
+    const double seconds = 240.0;
     for (const auto& id : kIds) {
         auto& r = shipped(id);
         r.reset(11);
