@@ -29,7 +29,20 @@ template <typename Real>
 void ElastoPlasticFrictionT<Real>::prepare(double fs) {
     T_ = 1.0 / fs;
     resonator_.prepare(fs);
-    kd_ = T_ / (2.0 * params_.exciterMassKg) + resonator_.mobility(0);
+    // Exciter with the drive spring k and damper c taken at n+1 (first-order hold as elsewhere):
+    //   [1 + T^2 k/6M, T^2 c/6M; T k/2M, 1 + T c/2M] [x1; v1] = [r1 - s1 F; r2 - s2 F]
+    // with s1 = T^2/6M, s2 = T/2M; so x1 = X - px F and v1 = V - pv F.
+    const double T = T_, M = params_.exciterMassKg, k = params_.driveStiffness,
+                 c = params_.driveDamping;
+    m11_ = 1.0 + T * T * k / (6.0 * M);
+    m12_ = T * T * c / (6.0 * M);
+    m21_ = T * k / (2.0 * M);
+    m22_ = 1.0 + T * c / (2.0 * M);
+    det_ = m11_ * m22_ - m12_ * m21_;
+    const double s1 = T * T / (6.0 * M), s2 = T / (2.0 * M);
+    px_ = (m22_ * s1 - m12_ * s2) / det_;
+    pv_ = (m11_ * s2 - m21_ * s1) / det_;
+    kd_ = pv_ + resonator_.mobility(0);
     reset(0);
 }
 
@@ -37,7 +50,7 @@ template <typename Real>
 void ElastoPlasticFrictionT<Real>::reset(std::uint64_t seed) noexcept {
     resonator_.reset();
     rng_.setSeed(seed);
-    z_ = v_ = force_ = exciterX_ = exciterV_ = lastDrive_ = 0;
+    z_ = v_ = force_ = exciterX_ = exciterV_ = lastExternal_ = 0;
 }
 
 template <typename Real>
@@ -51,7 +64,8 @@ double ElastoPlasticFrictionT<Real>::alphaOf(double z, double v, double zss,
 }
 
 template <typename Real>
-double ElastoPlasticFrictionT<Real>::processSample(double normal, double drive) noexcept {
+double ElastoPlasticFrictionT<Real>::processSample(double normal, double drive, double anchorX,
+                                                   double anchorV) noexcept {
     const double T = T_, M = params_.exciterMassKg;
     const double N = std::max(0.0, normal);
     const double fc = params_.dynamicCoefficient * N, fs = params_.staticCoefficient * N;
@@ -59,84 +73,58 @@ double ElastoPlasticFrictionT<Real>::processSample(double normal, double drive) 
     const double noise = N > 0.0 ? params_.sigma3 * rng_.bipolar() : 0.0;
 
     // Predictions without a new friction force (old force held, drive ramped).
-    const double aNow = (lastDrive_ - force_) / M;
-    const double aNextExt = drive / M;
-    const double vePred = exciterV_ + 0.5 * T * (aNow + aNextExt);
-    const double xePred = exciterX_ + T * exciterV_ + T * T * (aNow / 3.0 + aNextExt / 6.0);
+    const double k = params_.driveStiffness, c = params_.driveDamping;
+    const double aNow = (lastExternal_ - force_) / M;
+    const double g0 = (drive + k * anchorX + c * anchorV) / M; // external push at n+1, per kg
+    const double r1 = exciterX_ + T * exciterV_ + T * T * (aNow / 3.0 + g0 / 6.0);
+    const double r2 = exciterV_ + 0.5 * T * (aNow + g0);
+    const double xePred = (m22_ * r1 - m12_ * r2) / det_; // exciter at n+1 without friction
+    const double vePred = (m11_ * r2 - m21_ * r1) / det_;
     resonator_.predict();
     const double vRelPred = vePred - resonator_.predictedVelocity(0);
 
     // Friction force as a function of the relative velocity at n+1.
     const double z0 = z_;
-    auto bristleAt = [&](double v1) {
-        if (N <= 0.0) return 0.0; // no load: the bristles relax completely
-        const double s = (v1 >= 0.0) ? 1.0 : -1.0;
-        const double zss = s *
-                           (fc + (fs - fc) * std::exp(-(v1 * v1) / (params_.stribeckVelocity *
-                                                                    params_.stribeckVelocity))) /
-                           params_.sigma0;
-        const double zba = params_.breakAway * fc / params_.sigma0;
-        // Backward Euler: z1 = z0 + T v1 (1 - a z1 / zss), linear in z1 for a given a
-        // (v1 / zss >= 0). alpha is taken at z0, then re-taken at the predicted z1 when the step
-        // crosses into the plastic region, so that a stiff bristle cannot overshoot z_ss within
-        // one sample (with a = 1, z1 is a weighted mean of z0 and z_ss).
-        if (zss == 0.0) return 0.0; // no friction capacity (mu_s = mu_d = 0)
-        auto step = [&](double a) { return (z0 + T * v1) / (1.0 + T * v1 * a / zss); };
-        const double a0 = alphaOf(z0, v1, zss, zba);
-        double z1 = step(a0);
-        if (a0 < 1.0) {
-            const double a1 = alphaOf(z1, v1, zss, zba);
-            if (a1 > a0) z1 = step(a1);
-        }
-        return z1;
-    };
-    // No load, no contact: no friction at all (the bristles relax, see bristleAt).
-    const double inContact = N > 0.0 ? 1.0 : 0.0;
-    auto forceAt = [&](double v1, double z1) {
-        return inContact *
-               (params_.sigma0 * z1 + params_.sigma1 * (z1 - z0) / T + params_.sigma2 * v1 + noise);
-    };
-    // The relative velocity at n+1 solves h(v) = v - vRelPred + kd F(v) = 0. With the plastic
-    // factor alpha(z, v) / z_ss(v) taken at a trial velocity vp, backward Euler gives
-    // z1 = (z0 + T v1) / d with d = 1 + T vp alpha / z_ss >= 1, F is linear in v1 and h has a
-    // closed-form root. A few fixed-point passes (vp <- v1) make it consistent; each pass costs one
-    // exp and at most one sine, so the work per sample is bounded (no bracketing, no open loop).
-    // Sticking (alpha = 0) is exact in one pass.
+    const double inContact = N > 0.0 ? 1.0 : 0.0; // no load, no contact: no friction at all
+    // The relative velocity at n+1 solves h(v) = v - vRelPred + kd F(v) = 0, with the bristle
+    // integrated by backward Euler, z1 = z0 + T v1 (1 - alpha z1 / z_ss). With the plastic factor
+    // alpha / z_ss taken at a trial state (vp, zp), z1 = (z0 + T v1) / d with
+    // d = 1 + T vp alpha / z_ss >= 1 (vp / z_ss >= 0): F is linear in v1 and h has a closed-form
+    // root. Fixed-point passes refine the trial; alpha is taken at the larger of its values at z0
+    // and at the trial z1, so a stiff bristle cannot overshoot z_ss within a sample (with
+    // alpha = 1, z1 is a weighted mean of z0 and z_ss). The force applied is exactly the one the
+    // root was solved with (consistency keeps the coupling stable). Each pass costs one exp and
+    // at most two sines: bounded work per sample. Sticking (alpha = 0) is exact in one pass.
     const double zba = params_.breakAway * fc / params_.sigma0;
-    double v1 = vRelPred;
+    double v1 = vRelPred, z1 = 0.0, force = 0.0, zp = z0;
     for (int pass = 0; pass < params_.maxIterations && inContact > 0.0; ++pass) {
         const double vp = v1;
         const double sgn = vp >= 0.0 ? 1.0 : -1.0;
         const double vs = vp / params_.stribeckVelocity;
         const double zss = sgn * (fc + (fs - fc) * std::exp(-vs * vs)) / params_.sigma0;
-        const double a = zss != 0.0 ? alphaOf(z0, vp, zss, zba) : 0.0;
+        double a = 0.0;
+        if (zss != 0.0) a = std::max(alphaOf(z0, vp, zss, zba), alphaOf(zp, vp, zss, zba));
         const double d = 1.0 + (a > 0.0 ? T * vp * a / zss : 0.0);
         const double constant =
             params_.sigma0 * z0 / d + params_.sigma1 * (z0 / d - z0) / T + noise;
         const double slope = params_.sigma0 * T / d + params_.sigma1 / d + params_.sigma2;
         const double next = (vRelPred - kd_ * constant) / (1.0 + kd_ * slope);
-        const bool converged = std::fabs(next - v1) < 1e-9 || a == 0.0;
+        const bool converged = std::fabs(next - v1) < 1e-9;
         v1 = next;
+        z1 = (z0 + T * v1) / d;
+        force = constant + slope * v1;
+        zp = z1;
         if (converged && pass > 0) break;
     }
-    const double z1 = bristleAt(v1);
-    commitSample(v1, z1, forceAt(v1, z1), xePred, vePred, drive);
-    return resonator_.velocity(0);
-}
-
-template <typename Real>
-void ElastoPlasticFrictionT<Real>::commitSample(double v1, double z1, double f, double xePred,
-                                                double vePred, double drive) noexcept {
-    // Friction acts against the exciter's relative motion, with it on the resonator.
-    const double T = T_, M = params_.exciterMassKg;
-    exciterX_ = xePred - T * T / (6.0 * M) * f;
-    exciterV_ = vePred - 0.5 * T / M * f;
-    resonator_.commit(0, f);
+    // Commit: friction acts against the exciter's relative motion, with it on the resonator.
+    exciterX_ = xePred - px_ * force;
+    exciterV_ = vePred - pv_ * force;
+    resonator_.commit(0, force);
     z_ = snapToZero(z1);
     v_ = exciterV_ - resonator_.contactVelocity();
-    (void)v1;
-    force_ = f;
-    lastDrive_ = drive;
+    force_ = force;
+    lastExternal_ = drive + k * (anchorX - exciterX_) + c * (anchorV - exciterV_);
+    return resonator_.velocity(0);
 }
 
 template class ElastoPlasticFrictionT<double>;

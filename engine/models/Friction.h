@@ -33,6 +33,8 @@ struct FrictionParams {
     double stribeckVelocity = 0.05;  ///< v_s, m/s
     double breakAway = 0.7;          ///< z_ba as a fraction of the static deflection f_c / sigma0
     double exciterMassKg = 0.05;     ///< mass of the rubbing body
+    double driveStiffness = 0.0;     ///< N/m: spring dragging the rubbing body from an anchor
+    double driveDamping = 0.0;       ///< N s/m: damper in parallel with that spring
     int maxIterations = 3;           ///< fixed-point passes per sample (bounded work)
 };
 
@@ -45,11 +47,14 @@ class ElastoPlasticFrictionT {
     void reset(std::uint64_t seed) noexcept;
 
     /// One sample: `normalForceN` presses the bodies together, `driveForceN` pushes the exciter
-    /// tangentially. Returns the resonator's velocity at pickup 0 (m/s).
-    double processSample(double normalForceN, double driveForceN) noexcept;
+    /// tangentially and the drive spring/damper pulls it towards an anchor at `anchorPosition`
+    /// moving at `anchorVelocity` (integrated implicitly: an explicit stiff drag would delay its
+    /// force by a sample and pump energy in). Returns the resonator's velocity at pickup 0 (m/s).
+    double processSample(double normalForceN, double driveForceN, double anchorPosition = 0.0,
+                         double anchorVelocity = 0.0) noexcept;
 
     /// Unloaded surfaces: the bristles relax and the rubbing mass stops (keeps the ringing).
-    void relax() noexcept { z_ = exciterV_ = force_ = lastDrive_ = v_ = 0.0; }
+    void relax() noexcept { z_ = exciterV_ = force_ = lastExternal_ = v_ = 0.0; }
     double frictionForce() const noexcept { return force_; }
     double bristle() const noexcept { return z_; }
     double relativeVelocity() const noexcept { return v_; }
@@ -60,15 +65,15 @@ class ElastoPlasticFrictionT {
 
   private:
     double alphaOf(double z, double v, double zss, double zba) const noexcept;
-    void commitSample(double v1, double z1, double f, double xePred, double vePred,
-                      double drive) noexcept;
 
     FrictionParams params_;
     ModalResonatorT<Real> resonator_;
     Random rng_;
     double T_ = 1.0 / 48000.0;
     double kd_ = 0.0;
-    double z_ = 0, v_ = 0, force_ = 0, exciterX_ = 0, exciterV_ = 0, lastDrive_ = 0;
+    double m11_ = 1, m12_ = 0, m21_ = 0, m22_ = 1, det_ = 1; // implicit drive (see .cpp)
+    double px_ = 0, pv_ = 0; // exciter compliance / mobility to the friction force
+    double z_ = 0, v_ = 0, force_ = 0, exciterX_ = 0, exciterV_ = 0, lastExternal_ = 0;
 };
 
 using ElastoPlasticFriction = ElastoPlasticFrictionT<double>;

@@ -88,7 +88,7 @@ void FootstepScene::process(const float* const* grf, float* outL, float* outR, i
     if (measure_) {
         const auto t2 = Clock::now();
         cost_.voiceSeconds += std::chrono::duration<double>(t1 - t0).count();
-        cost_.reverbSeconds += std::chrono::duration<double>(t2 - t1).count();
+        if (reverb_) cost_.reverbSeconds += std::chrono::duration<double>(t2 - t1).count();
     }
     ++cost_.blocks;
 }

@@ -34,7 +34,7 @@ GrfSignal walkerGrf(const WalkerParameters& walker, double seconds, double fs, s
         std::size_t k = frames;
         while (k < c.size() && c[k] > 0.0f) ++k; // finish the stance under way
         std::fill(c.begin() + static_cast<long>(k), c.end(), 0.0f);
-        end = std::max(end, k);
+        end = std::max(end, k + 1); // keep one sample of the swing: the signal ends at rest
     }
     for (auto& c : grf.channels) c.resize(end);
     return grf;

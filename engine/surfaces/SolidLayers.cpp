@@ -77,6 +77,7 @@ class StepGestures {
         last_ = rate_ = 0.0;
         offSeconds_ = sinceStrike_ = 1e9;
         down_ = false;
+        started_ = false;
         rearmed_ = true;
     }
     /// Returns a strike strength factor (> 0) when a strike happens at this sample, else 0.
@@ -86,6 +87,14 @@ class StepGestures {
         rate_ = d + smooth_ * (rate_ - d);
         sinceStrike_ += 1.0;
         double strike = 0.0;
+        if (!started_) {
+            // A signal that starts with the foot already loaded (a walk joined mid-stance) holds
+            // no landing: the foot is down, nothing strikes.
+            started_ = true;
+            down_ = grf >= releaseN;
+            rate_ = 0.0;
+            return 0.0;
+        }
         if (!down_) {
             if (grf < releaseN) offSeconds_ += 1.0 / fs_;
             if (grf >= onsetN) {
@@ -128,7 +137,7 @@ class StepGestures {
     double offSeconds_ = 1e9, sinceStrike_ = 1e9; // time off the floor, samples since a strike
     double toeCountdown_ = -1.0, toeLevel_ = 0.0; // pending forefoot strike
     Random rng_;
-    bool down_ = false, rearmed_ = true;
+    bool down_ = false, rearmed_ = true, started_ = false;
 };
 
 void readGestures(PresetReader& r, StepGestures& g) {
@@ -252,6 +261,8 @@ class FrictionLayer final : public SurfaceLayer {
         gain_ = dbToGain(
             r.number("gain_db", 20.0, -40.0, 80.0, "dB", "output gain (0 dB: 1 m/s = full scale)"));
         sleepVelocity_ = 1e-6 / gain_; // asleep below -120 dBFS at the output
+        p.driveStiffness = driveStiffness_;
+        p.driveDamping = driveDamping_;
         friction_.configure(p, std::move(modes), {gains});
     }
     void prepare(const ProcessSpec& spec) override {
@@ -279,13 +290,12 @@ class FrictionLayer final : public SurfaceLayer {
                 continue;
             }
             anchor_ += shear / fs_;
-            const double xe = friction_.exciterPosition(), ve = friction_.exciterVelocity();
+            const double xe = friction_.exciterPosition();
             if (load <= 0.0) { // unloaded: the drag and the bristles relax
                 friction_.relax();
                 anchor_ = xe;
             }
-            const double drive = driveStiffness_ * (anchor_ - xe) + driveDamping_ * (shear - ve);
-            const double y = friction_.processSample(normalFraction_ * load, drive);
+            const double y = friction_.processSample(normalFraction_ * load, 0.0, anchor_, shear);
             out[i] += g * static_cast<float>(y);
             const bool still = load <= 0.0 || std::fabs(friction_.relativeVelocity()) < 1e-6;
             quiet_ = (std::fabs(y) < sleepVelocity_ && still) ? quiet_ + 1 : 0;
