@@ -460,7 +460,7 @@ std::string renderHtml(const AnalysisReport& r) {
         "caption{text-align:left;font-weight:600;padding-bottom:0.4em}\n"
         "th,td{padding:0.25em 0.6em;border-bottom:1px solid #ddd}\n"
         "thead th{border-bottom:2px solid #444}\n"
-        ".num{text-align:right;font-variant-numeric:tabular-nums}\n"
+        ".num{text-align:right;font-variant-numeric:tabular-nums;white-space:nowrap}\n"
         "figure{margin:1em 0 2em 0}\nfigcaption{font-weight:600}\n"
         "</style>\n</head>\n<body>\n<h1>" +
         xmlEscape(title) + "</h1>\n";
@@ -489,7 +489,11 @@ std::string renderHtml(const AnalysisReport& r) {
 } // namespace
 
 std::string confusionHeatMapSvg(const ConfusionMatrix& m) {
-    constexpr int cell = 34, left = 230, top = 70, right = 50;
+    constexpr int cell = 34, top = 70, right = 50;
+    std::size_t longestLabel = 0;
+    for (const auto& row : m.rows) longestLabel = std::max(longestLabel, stimulusLabel(row).size());
+    // about 7 px per character at 12 px sans-serif, plus a gap before the first cell
+    const int left = std::max(120, static_cast<int>(longestLabel) * 7 + 16);
     const int columns = static_cast<int>(m.columns.options.size());
     const int rows = static_cast<int>(m.rows.size());
     const int width = left + cell * columns + right, height = top + cell * rows + 10;

@@ -7,11 +7,18 @@
 #include <cmath>
 #include <numeric>
 
+#include <fmt/format.h>
+
 namespace underfoot::analysis {
 
 using namespace numerics;
 
 namespace {
+
+// Limits of the exact distributions when the caller forces exact p-values beyond R's defaults
+// (n < 50): counts stay finite in double and the time stays under about a second.
+constexpr std::size_t kMaxExactSignedRankN = 1000;
+constexpr std::size_t kMaxExactRankSumProduct = 10000;
 
 /// Exact null distribution of the signed-rank statistic V for n untied, non-zero values:
 /// counts of subsets of {1..n} with each sum (exact in double for n < 50: at most 2^49).
@@ -111,6 +118,10 @@ TestResult signedRank(std::vector<double> x, const WilcoxonOptions& o) {
     r.statistic = v;
     const bool ties = hasTies(ranks);
     if (exact && !ties && !zeroes) {
+        if (count > kMaxExactSignedRankN)
+            return failedTest(r.method, fmt::format("exact p-value available for n <= {} only; "
+                                                    "use the normal approximation",
+                                                    kMaxExactSignedRankN));
         r.method = "Wilcoxon signed rank exact test";
         const auto counts = signedRankCounts(count);
         switch (o.alternative) {
@@ -184,6 +195,10 @@ TestResult wilcoxonTest(std::span<const double> x, std::span<const double> y,
     r.statistic = w;
     const bool ties = hasTies(ranks);
     if (exact && !ties) {
+        if (xs.size() * ys.size() > kMaxExactRankSumProduct)
+            return failedTest(r.method, fmt::format("exact p-value available for m * n <= {} only; "
+                                                    "use the normal approximation",
+                                                    kMaxExactRankSumProduct));
         r.method = "Wilcoxon rank sum exact test";
         const auto counts = rankSumCounts(xs.size(), ys.size());
         switch (o.alternative) {

@@ -621,3 +621,19 @@ TEST(EffectSizes, PhiCramersVAndCohensD) {
     // = -1.58 / sqrt((var(x)+var(y))/2) = -0.83218108134954
     expectRel(cohensD(kSleep1, kSleep2), -0.83218108134954, 1e-9);
 }
+
+TEST(WilcoxonTest, ForcedExactBeyondTheSupportedSizeIsAClearError) {
+    std::vector<double> x, y;
+    for (int i = 0; i < 150; ++i) {
+        x.push_back(i * 1.5 + 0.25);
+        y.push_back(i * 1.7 + 0.5);
+    }
+    WilcoxonOptions exact;
+    exact.exactness = Exactness::Exact;
+    const auto r = wilcoxonTest(x, y, exact); // 150 x 150 > 10000
+    EXPECT_FALSE(r.ok());
+    EXPECT_NE(r.error.find("m * n <= 10000"), std::string::npos);
+    // R: wilcox.test(x, y, exact=FALSE) works at any size
+    exact.exactness = Exactness::Approximate;
+    EXPECT_TRUE(wilcoxonTest(x, y, exact).ok());
+}
