@@ -637,3 +637,23 @@ TEST(WilcoxonTest, ForcedExactBeyondTheSupportedSizeIsAClearError) {
     exact.exactness = Exactness::Approximate;
     EXPECT_TRUE(wilcoxonTest(x, y, exact).ok());
 }
+
+TEST(WilcoxonTest, ForcedExactDistributionsMatchRBeyondTheDefaultSizes) {
+    // R: x <- (0:99)*1.5+0.25; y <- (0:99)*1.7+0.5; wilcox.test(x, y, exact=TRUE)$p.value
+    std::vector<double> x, y;
+    for (int i = 0; i < 100; ++i) {
+        x.push_back(i * 1.5 + 0.25);
+        y.push_back(i * 1.7 + 0.5);
+    }
+    WilcoxonOptions exact;
+    exact.exactness = Exactness::Exact;
+    const auto r = wilcoxonTest(x, y, exact);
+    EXPECT_EQ(r.method, "Wilcoxon rank sum exact test");
+    expectRel(r.p, 0.14525018504351, 1e-12);
+    // R: i <- 1:1000; z <- i*ifelse(i%%3==0,-1,1)+0.001*i; wilcox.test(z, exact=TRUE)$p.value
+    std::vector<double> z;
+    for (int i = 1; i <= 1000; ++i) z.push_back(i * (i % 3 == 0 ? -1.0 : 1.0) + 0.001 * i);
+    const auto s = wilcoxonTest(z, exact);
+    EXPECT_EQ(s.method, "Wilcoxon signed rank exact test");
+    expectRel(s.p, 1.94234194595631e-20, 1e-9);
+}
