@@ -5,9 +5,16 @@
 
 #include <chrono>
 #include <cmath>
+#include <ctime>
 #include <stdexcept>
 
 namespace underfoot::engine {
+
+double threadCpuSeconds() noexcept {
+    timespec ts{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
 
 GrfSignal walkerGrf(const WalkerParameters& walker, double seconds, double fs, std::uint64_t seed) {
     if (!(seconds > 0.0 && seconds <= 24 * 3600.0))
@@ -67,7 +74,7 @@ RenderResult renderSurface(const std::string& surface, const GrfSignal& grf,
     std::vector<std::vector<float>> in(grf.channels.size(), std::vector<float>(bs));
     std::vector<const float*> inPtr(grf.channels.size());
     std::vector<float> l(bs), r(bs);
-    const auto t0 = std::chrono::steady_clock::now();
+    const double t0 = threadCpuSeconds();
     for (std::size_t start = 0; start < frames; start += bs) {
         const std::size_t n = std::min(bs, frames - start);
         for (std::size_t c = 0; c < grf.channels.size(); ++c) {
@@ -83,8 +90,7 @@ RenderResult renderSurface(const std::string& surface, const GrfSignal& grf,
             result.audio.samples[2 * (start + i) + 1] = r[i];
         }
     }
-    result.cpuSeconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    result.cpuSeconds = threadCpuSeconds() - t0;
     result.realTimeFactor =
         (double(frames) / options.sampleRateHz) / std::max(result.cpuSeconds, 1e-9);
     result.cost = scene.cost();

@@ -27,6 +27,9 @@ struct RenderResult {
     SceneCost cost;
 };
 
+/// CPU time consumed by the calling thread (immune to other processes on a shared machine).
+double threadCpuSeconds() noexcept;
+
 /// The walker's GRF (left, right feet): it walks for `seconds`, then finishes the stances under
 /// way (so the signal may be a little longer) and stops.
 GrfSignal walkerGrf(const WalkerParameters& walker, double seconds, double sampleRateHz,
