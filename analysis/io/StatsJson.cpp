@@ -17,7 +17,7 @@ using nlohmann::json;
 const std::vector<std::string>& statsTestNames() {
     static const std::vector<std::string> names{
         "binom",    "chisq", "chisq_gof", "fisher",   "friedman", "kruskal",  "levene",
-        "p_adjust", "prop",  "shapiro",   "spearman", "t",        "wilcoxon", "wilson"};
+        "p_adjust", "pairwise_wilcoxon", "prop", "shapiro", "spearman", "t", "wilcoxon", "wilson"};
     return names;
 }
 
@@ -161,6 +161,16 @@ Continuity continuity(const Request& q) {
     return q.flag("correct", true) ? Continuity::Corrected : Continuity::Uncorrected;
 }
 
+PAdjustMethod adjustMethod(const std::string& m) {
+    if (m == "holm") return PAdjustMethod::Holm;
+    if (m == "bonferroni") return PAdjustMethod::Bonferroni;
+    if (m == "hochberg") return PAdjustMethod::Hochberg;
+    if (m == "BH" || m == "fdr") return PAdjustMethod::BenjaminiHochberg;
+    if (m == "none") return PAdjustMethod::None;
+    throw RequestError(
+        "'method' must be \"holm\", \"bonferroni\", \"hochberg\", \"BH\" or \"none\"");
+}
+
 json run(const std::string& test, const json& body) {
     if (test == "chisq") {
         const Request q(body, {"table", "correct"});
@@ -204,6 +214,30 @@ json run(const std::string& test, const json& body) {
         }
         return resultJson(test, wilcoxonTest(q.numbers("x"), q.numbers("y"), o));
     }
+    if (test == "pairwise_wilcoxon") {
+        const Request q(body, {"groups", "paired", "correct", "exact", "method"});
+        WilcoxonOptions o;
+        o.pairing = q.flag("paired", false) ? Pairing::Paired : Pairing::Independent;
+        o.continuity = continuity(q);
+        o.exactness = q.exactness();
+        const std::string m = q.text("method", "holm");
+        const auto method = adjustMethod(m);
+        json pairs = json::array();
+        for (const auto& r : pairwiseWilcoxon(q.matrix("groups"), method, o)) {
+            if (!r.test.ok())
+                throw RequestError(fmt::format("groups {} and {}: {}", r.first, r.second,
+                                               r.test.error));
+            pairs.push_back(json{{"first", r.first},
+                                 {"second", r.second},
+                                 {"method", r.test.method},
+                                 {"statistic", number(r.test.statistic)},
+                                 {"statistic_name", r.test.statisticName},
+                                 {"p", number(r.test.p)},
+                                 {"p_adjusted", number(r.pAdjusted)},
+                                 {"warnings", r.test.warnings}});
+        }
+        return json{{"test", test}, {"adjust_method", m}, {"pairs", pairs}};
+    }
     if (test == "kruskal") {
         const Request q(body, {"groups"});
         return resultJson(test, kruskalTest(q.matrix("groups")));
@@ -222,20 +256,7 @@ json run(const std::string& test, const json& body) {
     if (test == "p_adjust") {
         const Request q(body, {"p", "method"});
         const std::string m = q.text("method", "holm");
-        PAdjustMethod method = PAdjustMethod::Holm;
-        if (m == "holm")
-            method = PAdjustMethod::Holm;
-        else if (m == "bonferroni")
-            method = PAdjustMethod::Bonferroni;
-        else if (m == "hochberg")
-            method = PAdjustMethod::Hochberg;
-        else if (m == "BH" || m == "fdr")
-            method = PAdjustMethod::BenjaminiHochberg;
-        else if (m == "none")
-            method = PAdjustMethod::None;
-        else
-            throw RequestError(
-                "'method' must be \"holm\", \"bonferroni\", \"hochberg\", \"BH\" or \"none\"");
+        const auto method = adjustMethod(m);
         const auto p = q.numbers("p");
         for (double v : p)
             if (!std::isnan(v) && !(v >= 0 && v <= 1))

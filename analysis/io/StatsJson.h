@@ -22,6 +22,7 @@ const std::vector<std::string>& statsTestNames();
 /// t {x, y?, paired, var_equal, mu, conf_level, alternative},
 /// wilcoxon {x, y?, paired, correct, exact?, mu, alternative}, kruskal {groups},
 /// friedman {y}, spearman {x, y, alternative, exact?}, p_adjust {p, method},
+/// pairwise_wilcoxon {groups, paired, correct, exact?, method},
 /// shapiro {x}, levene {groups, center}, binom {x, n, p, conf_level, alternative},
 /// prop {x, n, p, correct, conf_level, alternative}, wilson {x, n, conf_level, correct}.
 /// null in a numeric array is a missing value (R's NA). Output: statistic, statistic_name, df

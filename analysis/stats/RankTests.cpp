@@ -227,6 +227,20 @@ TestResult wilcoxonTest(std::span<const double> x, std::span<const double> y,
     return r;
 }
 
+std::vector<PairwiseResult> pairwiseWilcoxon(const std::vector<std::vector<double>>& groups,
+                                             PAdjustMethod method, const WilcoxonOptions& options) {
+    std::vector<PairwiseResult> out;
+    for (std::size_t second = 0; second + 1 < groups.size(); ++second)
+        for (std::size_t first = second + 1; first < groups.size(); ++first)
+            out.push_back({first, second, wilcoxonTest(groups[first], groups[second], options),
+                           kNaN});
+    std::vector<double> p;
+    for (const auto& r : out) p.push_back(r.test.ok() ? r.test.p : kNaN);
+    const auto adjusted = pAdjust(p, method);
+    for (std::size_t i = 0; i < out.size(); ++i) out[i].pAdjusted = adjusted[i];
+    return out;
+}
+
 TestResult kruskalTest(const std::vector<std::vector<double>>& groups) {
     const std::string method = "Kruskal-Wallis rank sum test";
     if (groups.size() < 2) return failedTest(method, "'x' must be a list with at least 2 elements");

@@ -7,6 +7,7 @@
 /// carries R's message in `error`; where R returns NaN or NA, so does the result.
 #include "analysis/stats/TestResult.h"
 
+#include <limits>
 #include <span>
 #include <vector>
 
@@ -65,6 +66,21 @@ TestResult wilcoxonTest(std::span<const double> x, const WilcoxonOptions& option
 /// wilcox.test(x, y): rank-sum test, or signed-rank on x - y when paired.
 TestResult wilcoxonTest(std::span<const double> x, std::span<const double> y,
                         const WilcoxonOptions& options = {});
+
+/// One pair of a pairwise comparison: group `first` against group `second` (first > second).
+struct PairwiseResult {
+    std::size_t first = 0;
+    std::size_t second = 0;
+    TestResult test;
+    double pAdjusted = std::numeric_limits<double>::quiet_NaN();
+};
+
+/// pairwise.wilcox.test(x, g, paired, p.adjust.method): every later group against every earlier
+/// one, in R's order ((2,1), (3,1), (3,2), ...; 0-based here), p-values adjusted together.
+/// With `Pairing::Paired` the groups are conditions measured on the same subjects, in order.
+std::vector<PairwiseResult> pairwiseWilcoxon(const std::vector<std::vector<double>>& groups,
+                                             PAdjustMethod method = PAdjustMethod::Holm,
+                                             const WilcoxonOptions& options = {});
 
 /// kruskal.test(list(...)): Kruskal-Wallis rank sum test over groups.
 TestResult kruskalTest(const std::vector<std::vector<double>>& groups);

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The table of layer kinds. Each kind's factory lives beside its layer.
-#include "engine/surfaces/Layer.h"
 #include "engine/surfaces/GranularLayers.h"
+#include "engine/surfaces/Layer.h"
 #include "engine/surfaces/LiquidLayers.h"
 #include "engine/surfaces/SolidLayers.h"
 

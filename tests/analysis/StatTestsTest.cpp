@@ -657,3 +657,36 @@ TEST(WilcoxonTest, ForcedExactDistributionsMatchRBeyondTheDefaultSizes) {
     EXPECT_EQ(s.method, "Wilcoxon signed rank exact test");
     expectRel(s.p, 1.94234194595631e-20, 1e-9);
 }
+
+TEST(PairwiseWilcoxon, PairedConditionsWithHolmMatchPairwiseWilcoxTest) {
+    const std::vector<double> a{6.1, 5.2, 7.3, 4.8, 6.6, 5.9, 7.0, 6.4, 5.5, 6.8};
+    const std::vector<double> b{5.0, 5.1, 6.2, 4.1, 6.0, 5.3, 6.1, 5.7, 5.6, 5.9};
+    const std::vector<double> c{7.2, 6.0, 7.9, 5.5, 7.1, 6.9, 7.6, 7.7, 6.3, 7.4};
+    // R: x <- c(a,b,c); g <- factor(rep(c("a","b","c"), each=10))
+    //    pairwise.wilcox.test(x, g, paired=TRUE, p.adjust.method="holm")
+    //    raw: wilcox.test(b, a, paired=TRUE) 0.00796348920654999, (c, a) 0.00585709908528413,
+    //         (c, b) 0.00588927004181748; all Holm-adjusted to 0.0175712972558524
+    WilcoxonOptions paired;
+    paired.pairing = Pairing::Paired;
+    const auto r = pairwiseWilcoxon({a, b, c}, PAdjustMethod::Holm, paired);
+    ASSERT_EQ(r.size(), 3u);
+    EXPECT_EQ(r[0].first, 1u);
+    EXPECT_EQ(r[0].second, 0u);
+    EXPECT_EQ(r[2].first, 2u);
+    EXPECT_EQ(r[2].second, 1u);
+    expectRel(r[0].test.p, 0.00796348920654999);
+    expectRel(r[1].test.p, 0.00585709908528413);
+    expectRel(r[2].test.p, 0.00588927004181748);
+    for (const auto& pair : r) expectRel(pair.pAdjusted, 0.0175712972558524);
+    // R: pairwise.wilcox.test(x, g, p.adjust.method="bonferroni") (rank-sum)
+    const auto u = pairwiseWilcoxon({a, b, c}, PAdjustMethod::Bonferroni);
+    expectRel(u[0].pAdjusted, 0.266198401539789);
+    expectRel(u[1].pAdjusted, 0.12352130258131);
+    expectRel(u[2].pAdjusted, 0.00579632568310356);
+    // R: friedman.test(cbind(a,b,c)) -> 18.2, p 0.000111665808490115
+    std::vector<std::vector<double>> rows;
+    for (std::size_t i = 0; i < a.size(); ++i) rows.push_back({a[i], b[i], c[i]});
+    const auto f = friedmanTest(rows);
+    expectRel(f.statistic, 18.2);
+    expectRel(f.p, 0.000111665808490115);
+}

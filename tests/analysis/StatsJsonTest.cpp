@@ -237,3 +237,16 @@ TEST(AnalyzeCommand, BadInputIsReportedWithFileAndLine) {
     const auto format = runProgram("analyze --counts x.csv --format pdf", "");
     EXPECT_NE(format.err.find("--format pdf"), std::string::npos) << format.err;
 }
+
+TEST(StatsJson, PairwiseWilcoxonAdjustsAllPairsTogether) {
+    // R: pairwise.wilcox.test(x, g, paired=TRUE, p.adjust.method="holm") (see StatTestsTest)
+    const auto r = ok("pairwise_wilcoxon", R"({"groups": [[6.1,5.2,7.3,4.8,6.6,5.9,7.0,6.4,5.5,6.8],
+        [5.0,5.1,6.2,4.1,6.0,5.3,6.1,5.7,5.6,5.9], [7.2,6.0,7.9,5.5,7.1,6.9,7.6,7.7,6.3,7.4]],
+        "paired": true, "method": "holm"})");
+    ASSERT_EQ(r["pairs"].size(), 3u);
+    EXPECT_EQ(r["pairs"][0]["first"], 1);
+    EXPECT_NEAR(r["pairs"][2]["p_adjusted"].get<double>(), 0.0175712972558524, 1e-14);
+    EXPECT_NE(error("pairwise_wilcoxon", R"({"groups": [[1,2,3],[1,2]], "paired": true})")
+                  .find("same length"),
+              std::string::npos);
+}
