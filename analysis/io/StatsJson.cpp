@@ -15,9 +15,11 @@ namespace underfoot::analysis {
 using nlohmann::json;
 
 const std::vector<std::string>& statsTestNames() {
-    static const std::vector<std::string> names{
-        "binom",    "chisq", "chisq_gof", "fisher",   "friedman", "kruskal",  "levene",
-        "p_adjust", "pairwise_wilcoxon", "prop", "shapiro", "spearman", "t", "wilcoxon", "wilson"};
+    static const std::vector<std::string> names{"binom",  "chisq",    "chisq_gof",
+                                                "fisher", "friedman", "kruskal",
+                                                "levene", "p_adjust", "pairwise_wilcoxon",
+                                                "prop",   "shapiro",  "spearman",
+                                                "t",      "wilcoxon", "wilson"};
     return names;
 }
 
@@ -225,8 +227,8 @@ json run(const std::string& test, const json& body) {
         json pairs = json::array();
         for (const auto& r : pairwiseWilcoxon(q.matrix("groups"), method, o)) {
             if (!r.test.ok())
-                throw RequestError(fmt::format("groups {} and {}: {}", r.first, r.second,
-                                               r.test.error));
+                throw RequestError(
+                    fmt::format("groups {} and {}: {}", r.first, r.second, r.test.error));
             pairs.push_back(json{{"first", r.first},
                                  {"second", r.second},
                                  {"method", r.test.method},

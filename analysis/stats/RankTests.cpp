@@ -232,8 +232,8 @@ std::vector<PairwiseResult> pairwiseWilcoxon(const std::vector<std::vector<doubl
     std::vector<PairwiseResult> out;
     for (std::size_t second = 0; second + 1 < groups.size(); ++second)
         for (std::size_t first = second + 1; first < groups.size(); ++first)
-            out.push_back({first, second, wilcoxonTest(groups[first], groups[second], options),
-                           kNaN});
+            out.push_back(
+                {first, second, wilcoxonTest(groups[first], groups[second], options), kNaN});
     std::vector<double> p;
     for (const auto& r : out) p.push_back(r.test.ok() ? r.test.p : kNaN);
     const auto adjusted = pAdjust(p, method);
