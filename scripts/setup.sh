@@ -16,6 +16,8 @@ PACKAGES=(
   libboost-dev
   # storage
   libsqlite3-dev libsqlitecpp-dev sqlite3
+  # SHA-256 of protocol texts (experiment/)
+  libssl-dev
   # GUI
   qt6-base-dev qt6-charts-dev libqt6opengl6-dev libqt6sql6-sqlite libgl-dev xvfb xauth
   # tests and benchmarks
