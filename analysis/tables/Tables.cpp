@@ -313,8 +313,14 @@ std::vector<ComparisonRow> compare(const std::vector<Cell>& cells,
     return out;
 }
 
-std::vector<std::string> sortedGroups(std::set<std::string> groups) {
-    return {groups.begin(), groups.end()};
+std::vector<std::string> sortedGroups(const std::set<std::string>& groups,
+                                      const std::vector<std::string>& order) {
+    std::vector<std::string> out;
+    for (const auto& g : order)
+        if (groups.count(g) && std::find(out.begin(), out.end(), g) == out.end()) out.push_back(g);
+    for (const auto& g : groups)
+        if (std::find(out.begin(), out.end(), g) == out.end()) out.push_back(g);
+    return out;
 }
 
 } // namespace
@@ -358,7 +364,7 @@ AnalysisReport analyzeTrials(std::span<const TrialRecord> trials, const Analysis
         }
         if (!std::isnan(t.realism) || !std::isnan(t.quality)) report.hasRatings = true;
     }
-    report.groups = sortedGroups(groupSet);
+    report.groups = sortedGroups(groupSet, options.groupOrder);
     report.notes.push_back(fmt::format(
         "{} trials of {} participants enter the tables; left out: {} practice, {} excluded, {} "
         "unanswered.",

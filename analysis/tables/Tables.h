@@ -101,6 +101,8 @@ struct AnalysisOptions {
     AnswerList answers = defaultAnswerList();
     SoundscapeSplit split = SoundscapeSplit::BySoundscape;
     bool byGroup = false; ///< per-group tables and between-group comparisons
+    /// Order of the groups in tables and comparisons; unlisted groups follow alphabetically.
+    std::vector<std::string> groupOrder;
     double confLevel = 0.95;
 };
 

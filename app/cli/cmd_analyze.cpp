@@ -10,6 +10,7 @@
 #include <fmt/core.h>
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <limits>
@@ -28,6 +29,8 @@ struct AnalyzeOptions {
     std::string format = "markdown";
     std::string output;
     std::string title;
+    std::vector<std::string> groupOrder;
+    std::vector<std::string> answers;
     bool poolSoundscapes = false;
     double confLevel = 0.95;
 };
@@ -57,6 +60,21 @@ int analyze(const AnalyzeOptions& o) {
     options.split = o.poolSoundscapes ? analysis::SoundscapeSplit::Pooled
                                       : analysis::SoundscapeSplit::BySoundscape;
     options.confLevel = o.confLevel;
+    options.groupOrder = o.groupOrder;
+    if (!o.answers.empty()) {
+        options.answers.options.clear();
+        for (const auto& id : o.answers) {
+            if (id.empty() || options.answers.indexOf(id) ||
+                std::count(o.answers.begin(), o.answers.end(), id) > 1)
+                throw cli::UserError(fmt::format(
+                    "--answers: '{}' is empty or listed twice (expected answer ids)", id));
+            if (id != analysis::kDontKnowId)
+                options.answers.options.push_back({id, analysis::labelFor(id)});
+        }
+        // "I don't know" is always the last column
+        options.answers.options.push_back(
+            {std::string(analysis::kDontKnowId), analysis::labelFor(analysis::kDontKnowId)});
+    }
     analysis::AnalysisReport report;
     try {
         if (!o.trials.empty()) {
@@ -109,6 +127,13 @@ const cli::CommandRegistrar registrar("analyze", [](CLI::App& app, int& exitCode
     cmd->add_option("--title", o->title, "Report title");
     cmd->add_option("--conf-level", o->confLevel, "Confidence level of the intervals")
         ->capture_default_str();
+    cmd->add_option("--group-order", o->groupOrder,
+                    "Order of the groups (e.g. none,coherent,incoherent); others follow")
+        ->delimiter(',');
+    cmd->add_option("--answers", o->answers,
+                    "Answer-list order of the protocol for --trials (comma-separated ids; "
+                    "dont_know is put last when missing); default: the TVCG 2011 answer sheet")
+        ->delimiter(',');
     cmd->add_flag("--pool-soundscapes", o->poolSoundscapes,
                   "One row per surface instead of one per surface and soundscape");
     cmd->callback([&exitCode, o] { exitCode = analyze(*o); });

@@ -222,3 +222,16 @@ TEST(Comparisons, PublishedGravelTestIsReproducedFromTrialRecords) {
             EXPECT_EQ(row.test.error, "data are essentially constant");
         }
 }
+
+TEST(Summary, GroupOrderCanFollowTheProtocol) {
+    AnalysisOptions o;
+    o.byGroup = true;
+    o.groupOrder = {"B", "A", "missing"};
+    const auto trials = smallStudy();
+    const auto r = analyzeTrials(trials, o);
+    EXPECT_EQ(r.groups, (std::vector<std::string>{"B", "A"}));
+    EXPECT_EQ(r.summary.front().group, "B");
+    EXPECT_EQ(r.confusions.front().group, "B");
+    ASSERT_FALSE(r.comparisons.empty());
+    EXPECT_EQ(r.comparisons.front().groupA, "B");
+}

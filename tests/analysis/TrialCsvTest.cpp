@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "analysis/io/TrialCsv.h"
 #include "analysis/io/Csv.h"
+#include "analysis/model/Catalog.h"
+#include "analysis/tables/ScoringRules.h"
 
 #include <gtest/gtest.h>
 
@@ -118,4 +120,26 @@ TEST(TrialCsv, FormattedRecordsReadBackUnchanged) {
     EXPECT_TRUE(std::isnan(back[0].quality));
     EXPECT_TRUE(back[0].practice);
     EXPECT_EQ(back[0].trialIndex, 12);
+}
+
+TEST(TrialCsv, ExperimentLayerExportAgreesWithTheScoringRules) {
+    // First 120 trials of `underfoot export` on a study of protocols/tvcg2011_exp2.toml with
+    // participants simulated from the published confusion matrices (`underfoot session
+    // --simulate`): CRLF line ends, the full header, recorded correctness.
+    const auto trials = readTrialCsv(std::string(UNDERFOOT_SOURCE_DIR) +
+                                     "/tests/analysis/data/export_tvcg2011_exp2_simulated.csv");
+    ASSERT_EQ(trials.size(), 120u);
+    int soundscapeChecked = 0;
+    for (const auto& t : trials) {
+        ASSERT_TRUE(t.recordedCorrect.has_value());
+        EXPECT_EQ(*t.recordedCorrect, answerIsCorrect(t.surfaceId, t.answerId))
+            << t.participant << " " << t.trialIndex;
+        if (t.recordedSoundscapeCorrect) {
+            TrialRecord derived = t;
+            derived.recordedSoundscapeCorrect.reset();
+            EXPECT_EQ(rules::soundscapeCorrect(derived), t.recordedSoundscapeCorrect);
+            ++soundscapeChecked;
+        }
+    }
+    EXPECT_GT(soundscapeChecked, 0);
 }
