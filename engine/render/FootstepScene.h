@@ -52,6 +52,8 @@ class FootstepScene {
     /// Measured cost per node, when `measure` is on (off by default: no clock reads).
     void setMeasureCost(bool on) noexcept { measure_ = on; }
     const SceneCost& cost() const noexcept { return cost_; }
+    /// Whether denormals were flushed to zero during the last process() (checked each block).
+    bool flushedDenormals() const noexcept { return flushingDenormals_; }
 
   private:
     std::vector<std::unique_ptr<Surface>> voices_;
@@ -61,6 +63,7 @@ class FootstepScene {
     double wet_ = 0, dry_ = 1;
     std::vector<float> mono_, voiceOut_, wetL_, wetR_;
     bool measure_ = false;
+    bool flushingDenormals_ = false;
     SceneCost cost_;
 };
 

@@ -94,6 +94,7 @@ RenderResult renderSurface(const std::string& surface, const GrfSignal& grf,
     result.realTimeFactor =
         (double(frames) / options.sampleRateHz) / std::max(result.cpuSeconds, 1e-9);
     result.cost = scene.cost();
+    result.flushedDenormals = scene.flushedDenormals();
     for (float v : result.audio.samples)
         if (!std::isfinite(v))
             throw std::runtime_error("render produced a non-finite sample (engine bug)");

@@ -25,6 +25,7 @@ struct RenderResult {
     double cpuSeconds = 0;     ///< processing time of the scene
     double realTimeFactor = 0; ///< audio seconds per CPU second
     SceneCost cost;
+    bool flushedDenormals = false; ///< FTZ/DAZ was in effect while the scene ran
 };
 
 /// CPU time consumed by the calling thread (immune to other processes on a shared machine).

@@ -83,8 +83,9 @@ TEST(Renderer, EverySampleRateFrom22To192kHzGivesFiniteSimilarSound) {
             EXPECT_GT(f.peakDb, -40.0) << surface << " " << fs;
             EXPECT_LT(f.peakDb, 0.0) << surface << " " << fs;
             if (fs == 48000.0) centroid48 = f.centroidHz;
-            if (fs >= 48000.0) // the same sound, within the band 48 kHz can hold
+            if (fs >= 48000.0) { // the same sound, within the band 48 kHz can hold
                 EXPECT_NEAR(f.centroidHz / centroid48, 1.0, 0.35) << surface << " " << fs;
+            }
         }
     }
 }
@@ -97,6 +98,8 @@ TEST(Renderer, LongRenderHasNoLevelDriftAndFlushesDenormals) {
     const auto grf = walkerGrf({}, minutes * 60.0, 48000.0, 9);
     RenderOptions options;
     const auto r = renderSurface("wood", grf, options);
+    EXPECT_TRUE(r.flushedDenormals);
+    EXPECT_FALSE(ScopedFlushDenormals::active()); // restored afterwards
     AudioBuffer first, last;
     first.sampleRateHz = last.sampleRateHz = 48000.0;
     first.channels = last.channels = 2;

@@ -209,7 +209,8 @@ TEST(SurfacePresets, AfterTheLastStepEverySurfaceFallsSilentAndSleeps) {
             surface->process(grf.channels[0].data() + i, out.data(), 480);
             if (i > grf.frames() - 48000) { // the last second: silent, asleep
                 for (float v : out)
-                    ASSERT_EQ(v, 0.0f) << s.id << " still sounds at " << i / 48000.0 << " s";
+                    ASSERT_EQ(v, 0.0f)
+                        << s.id << " still sounds at " << double(i) / 48000.0 << " s";
                 slept = surface->isSleeping();
             }
         }
