@@ -28,7 +28,12 @@ void FootstepScene::build(const std::string& surface, const SceneOptions& option
     }
     reverb_.reset();
     const auto& info = voices_.front()->info();
-    if (options.reverb == ReverbMode::AsPreset && info.reverb) {
+    if (options.reverb == ReverbMode::AsPreset && !options.impulseResponse.empty()) {
+        impulse_ = readAudioFile(findImpulseResponse(options.impulseResponse));
+        reverb_ = std::make_unique<Convolver>();
+        wet_ = dbToGain(options.impulseWetDb);
+        dry_ = 1.0;
+    } else if (options.reverb == ReverbMode::AsPreset && info.reverb) {
         impulse_ = readAudioFile(findImpulseResponse(info.reverb->impulseResponse));
         reverb_ = std::make_unique<Convolver>();
         wet_ = dbToGain(info.reverb->wetDb);

@@ -26,6 +26,9 @@ struct SceneOptions {
     int voices = 2;         ///< one surface instance per foot / GRF channel
     double panSpread = 0.3; ///< voice i of N is panned in [-spread, +spread]
     ReverbMode reverb = ReverbMode::AsPreset;
+    /// An impulse response (name or file) to use instead of the preset's; empty: the preset's.
+    std::string impulseResponse;
+    double impulseWetDb = -6.0; ///< wet level when `impulseResponse` is given
     AccuracyOptions accuracy;
 };
 
