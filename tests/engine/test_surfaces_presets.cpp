@@ -267,3 +267,22 @@ TEST(SurfacePresets, BrokenPresetsFailWithFileLineColumnAndWhatWasExpected) {
     expectError("", "expected at least one [[layer]]");
     expectError("[[layer]\n", "broken.toml:5");
 }
+
+TEST(SurfacePresets, EverySurfaceIsCalibratedToARealisticFootstepLevel) {
+    // A 70 kg walker at 100 steps/min: every dry surface's render peaks near -12 dBFS (median
+    // over three seeds within 3 dB), so switching surfaces in an experiment does not jump in level.
+    const auto grf = walkerGrf({}, 6.0, 48000.0, 7);
+    RenderOptions options;
+    options.scene.reverb = ReverbMode::Off;
+    for (const auto& s : listSurfaces()) {
+        if (s.reverb) continue;
+        std::vector<double> peaks;
+        for (std::uint64_t seed : {7u, 8u, 9u}) {
+            options.seed = seed;
+            peaks.push_back(computeFeatures(renderSurface(s.id, grf, options).audio).peakDb);
+        }
+        std::sort(peaks.begin(), peaks.end());
+        EXPECT_NEAR(peaks[1], -12.0, 3.0) << s.id;
+        EXPECT_LT(peaks[2], -3.0) << s.id;
+    }
+}
