@@ -7,8 +7,14 @@
 #include "analysis/tables/Tables.h"
 #include "app/cli/CommandRegistry.h"
 
+#include "experiment/Export.h"
+#include "experiment/Store.h"
+
+#include <filesystem>
 #include <fmt/core.h>
 #include <fmt/format.h>
+#include <fstream>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -22,6 +28,7 @@ namespace {
 using namespace underfoot;
 
 struct AnalyzeOptions {
+    std::string study;
     std::string trials;
     std::vector<std::string> counts;
     std::vector<double> presentations;
@@ -36,8 +43,9 @@ struct AnalyzeOptions {
 };
 
 int analyze(const AnalyzeOptions& o) {
-    if (o.trials.empty() == o.counts.empty())
-        throw cli::UserError("give either --trials FILE or one or more --counts FILE");
+    if (int(!o.study.empty()) + int(!o.trials.empty()) + int(!o.counts.empty()) != 1)
+        throw cli::UserError(
+            "give one source: --study FILE (a study store), --trials FILE or --counts FILE...");
     if (!o.by.empty() && o.by != "group")
         throw cli::UserError(fmt::format("--by {}: expected 'group'", o.by));
     const auto format = analysis::parseReportFormat(o.format);
@@ -77,7 +85,31 @@ int analyze(const AnalyzeOptions& o) {
     }
     analysis::AnalysisReport report;
     try {
-        if (!o.trials.empty()) {
+        if (!o.study.empty()) {
+            // Straight from the study store: its trials, exported in the long format the
+            // analysis reads, with the protocol's answer-list order unless --answers says else.
+            const auto store = experiment::StudyStore::open(o.study);
+            const auto dir = std::filesystem::temp_directory_path() /
+                             fmt::format("underfoot_analyze_{}", ::getpid());
+            std::filesystem::create_directories(dir);
+            const auto csv = (dir / "trials.csv").string();
+            {
+                std::ofstream out(csv);
+                experiment::writeTrialsCsv(store, out);
+            }
+            const auto trials = analysis::readTrialCsv(csv);
+            std::filesystem::remove_all(dir);
+            if (o.answers.empty() && !store.protocol().questions.surfaceOptions.empty()) {
+                options.answers.options.clear();
+                for (const auto& a : store.protocol().questions.surfaceOptions)
+                    if (a.id != analysis::kDontKnowId)
+                        options.answers.options.push_back({a.id, a.label});
+                options.answers.options.push_back({std::string(analysis::kDontKnowId),
+                                                   analysis::labelFor(analysis::kDontKnowId)});
+            }
+            report = analysis::analyzeTrials(trials, options);
+            report.source = o.study;
+        } else if (!o.trials.empty()) {
             const auto trials = analysis::readTrialCsv(o.trials);
             report = analysis::analyzeTrials(trials, options);
             report.source = o.trials;
@@ -113,6 +145,7 @@ const cli::CommandRegistrar registrar("analyze", [](CLI::App& app, int& exitCode
         "analyze", "Confusion matrices, per-stimulus summaries and between-group tests of a "
                    "study (trial CSV or published count tables)");
     auto o = std::make_shared<AnalyzeOptions>();
+    cmd->add_option("--study", o->study, "A study store (.db): analyse its answered trials");
     cmd->add_option("--trials", o->trials, "Long-format trial CSV written by `underfoot export`");
     cmd->add_option("--counts", o->counts,
                     "Count table(s) in the format of data/published/*_confusion.csv; one group "

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: GPL-3.0-or-later
-# Replay end to end through the `underfoot` program: a study whose stimuli are driven by the
+# Replay (and analysis of a study store) end to end through the `underfoot` program: a study whose stimuli are driven by the
 # virtual walker is run (simulated participant), then each trial is re-rendered from the store.
 # A replay must be identical to itself and to `underfoot render` with the stored seed; a trial
 # driven by a live sensor with no GRF recording must be refused with a clear message.
@@ -25,6 +25,10 @@ cmp a.wav b.wav
 "$underfoot" render --surface gravel --walker cadence=100,mass=70 --seconds 10 --seed "$seed" \
   --tail 1 --format float -q -o rendered.wav
 cmp a.wav rendered.wav
+
+# The study store analyses directly, columns in the protocol's answer order.
+"$underfoot" analyze --study walk.db --format markdown > analysis.md
+grep -q "| Stimulus | BS | GL | WD | DK | n |" analysis.md
 
 # Every trial replays (reverb and soundscape stimuli included).
 for t in 0 1 2; do
