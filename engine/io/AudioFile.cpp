@@ -207,6 +207,9 @@ void writeAudioFile(const std::string& path, const AudioBuffer& buffer, SampleFo
             throw FileError(
                 fmt::format("{}: cannot open for writing ({})", path, sf_strerror(nullptr)));
         sf_command(file.get(), SFC_SET_CLIPPING, nullptr, SF_TRUE);
+        // No PEAK chunk: it carries a timestamp, so the same samples would give different bytes
+        // (a replayed trial must be byte-identical to its render).
+        sf_command(file.get(), SFC_SET_ADD_PEAK_CHUNK, nullptr, SF_FALSE);
         const auto frames = static_cast<sf_count_t>(buffer.frames());
         const sf_count_t written = sf_writef_float(file.get(), buffer.samples.data(), frames);
         if (written != frames) {
