@@ -50,8 +50,8 @@ void surfaceVoice(benchmark::State& state, const char* id, int maxEventsPerSecon
     state.SetItemsProcessed(samples);
     state.counters["ns/sample"] = benchmark::Counter(
         static_cast<double>(samples), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
-    state.counters["xRT"] = benchmark::Counter(static_cast<double>(samples) / kFs,
-                                               benchmark::Counter::kIsRate);
+    state.counters["xRT"] =
+        benchmark::Counter(static_cast<double>(samples) / kFs, benchmark::Counter::kIsRate);
 }
 } // namespace
 
