@@ -2,9 +2,11 @@
 // The parts are independent libraries, each with its own list of surfaces and soundscapes (the
 // experiment validates protocols, the analysis scores answers, the engine renders, the
 // soundscapes library plays backgrounds). They must name the same things.
+#include "analysis/io/TrialCsv.h"
 #include "analysis/model/Catalog.h"
 #include "engine/surfaces/Surface.h"
 #include "experiment/Catalogue.h"
+#include "experiment/Export.h"
 #include "soundscapes/Library.h"
 
 #include <gtest/gtest.h>
@@ -42,4 +44,12 @@ TEST(Catalogues, SoundscapesAgreeEverywhere) {
     for (const auto& s : analysis::soundscapeCatalog()) ana.insert(s.id);
     EXPECT_EQ(lib, exp);
     EXPECT_EQ(lib, ana);
+}
+
+TEST(Catalogues, TheAnalysisReadsExactlyTheColumnsTheExperimentExports) {
+    // The long-format trials CSV is the contract between the two parts.
+    const auto& read = analysis::trialCsvColumns();
+    ASSERT_EQ(read.size(), experiment::kTrialColumns.size());
+    for (std::size_t i = 0; i < read.size(); ++i)
+        EXPECT_EQ(read[i], std::string(experiment::kTrialColumns[i])) << "column " << i + 1;
 }
