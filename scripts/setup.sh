@@ -43,4 +43,4 @@ fi
 
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo
 cmake --build build --parallel "$(nproc)"
-echo "setup: built into build/ (programs: build/app/cli/underfoot, build/app/gui/underfoot-gui)"
+echo "setup: built into build/ (program: build/app/cli/underfoot)"
