@@ -157,10 +157,9 @@ void ModalResonatorT<Real>::predict(double heldScale) noexcept {
 template <typename Real>
 double ModalResonatorT<Real>::predictedPosition(int p) const noexcept {
     if (p == 0) return predictedX0_;
-    const std::size_t n = q_.size(), off = static_cast<std::size_t>(p) * n;
     double x = 0;
-    for (std::size_t i = 0; i < n; ++i) x += gains_[static_cast<std::size_t>(p)][i] * qh_[i];
-    (void)off;
+    for (std::size_t i = 0; i < q_.size(); ++i)
+        x += gains_[static_cast<std::size_t>(p)][i] * qh_[i];
     return x;
 }
 
