@@ -11,42 +11,9 @@
 #include <new>
 #include <vector>
 
+#include "tests/common/AllocationTrap.h"
+
 using namespace underfoot::engine;
-
-// ---- a binary-wide allocation counter (test_engine has no other global operator new) ----
-namespace underfoot::test {
-std::atomic<long> allocationCount{0};
-std::atomic<bool> countAllocations{false};
-} // namespace underfoot::test
-
-// The replacements pair malloc with free; GCC cannot see that once they are inlined here.
-#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
-namespace {
-void* countedAllocation(std::size_t size) {
-    if (underfoot::test::countAllocations.load(std::memory_order_relaxed))
-        underfoot::test::allocationCount.fetch_add(1, std::memory_order_relaxed);
-    if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
-    throw std::bad_alloc();
-}
-} // namespace
-void* operator new(std::size_t size) {
-    return countedAllocation(size);
-}
-void* operator new[](std::size_t size) {
-    return countedAllocation(size);
-}
-void operator delete(void* p) noexcept {
-    std::free(p);
-}
-void operator delete[](void* p) noexcept {
-    std::free(p);
-}
-void operator delete(void* p, std::size_t) noexcept {
-    std::free(p);
-}
-void operator delete[](void* p, std::size_t) noexcept {
-    std::free(p);
-}
 
 namespace {
 constexpr double kFs = 48000.0;

@@ -15,30 +15,16 @@
 
 #include <unistd.h>
 
+#include "tests/common/ScratchDir.h"
+
 using namespace underfoot::engine;
 namespace fs = std::filesystem;
 
 namespace {
 
 fs::path tempDir() {
-    static const fs::path dir = [] {
-        fs::path d = fs::temp_directory_path() / ("underfoot_test_grf_" + std::to_string(getpid()));
-        fs::create_directories(d);
-        return d;
-    }();
-    return dir;
+    return underfoot::test::scratchDir("test_grf");
 }
-
-// Removes the scratch folder when the test program ends.
-struct RemoveTempDir : ::testing::Environment {
-    void TearDown() override {
-        std::error_code ec;
-        fs::remove_all(
-            fs::temp_directory_path() / ("underfoot_test_grf_" + std::to_string(getpid())), ec);
-    }
-};
-[[maybe_unused]] ::testing::Environment* const removeTempDir =
-    ::testing::AddGlobalTestEnvironment(new RemoveTempDir);
 
 std::string writeText(const std::string& name, const std::string& text) {
     const auto path = (tempDir() / name).string();

@@ -17,10 +17,7 @@
 
 using namespace underfoot::engine;
 
-namespace underfoot::test {
-extern std::atomic<long> allocationCount; // defined in test_aggregate_model.cpp
-extern std::atomic<bool> countAllocations;
-} // namespace underfoot::test
+#include "tests/common/AllocationTrap.h"
 
 namespace {
 constexpr double kFs = 48000.0;

@@ -11,30 +11,16 @@
 
 #include <unistd.h>
 
+#include "tests/common/ScratchDir.h"
+
 using namespace underfoot::engine;
 namespace fs = std::filesystem;
 
 namespace {
 
 fs::path tempDir() {
-    static const fs::path dir = [] {
-        fs::path d = fs::temp_directory_path() / ("underfoot_test_io_" + std::to_string(getpid()));
-        fs::create_directories(d);
-        return d;
-    }();
-    return dir;
+    return underfoot::test::scratchDir("test_io");
 }
-
-// Removes the scratch folder when the test program ends.
-struct RemoveTempDir : ::testing::Environment {
-    void TearDown() override {
-        std::error_code ec;
-        fs::remove_all(
-            fs::temp_directory_path() / ("underfoot_test_io_" + std::to_string(getpid())), ec);
-    }
-};
-[[maybe_unused]] ::testing::Environment* const removeTempDir =
-    ::testing::AddGlobalTestEnvironment(new RemoveTempDir);
 
 AudioBuffer sine(double rateHz, double freqHz, double amplitude, std::size_t frames,
                  int channels = 1) {

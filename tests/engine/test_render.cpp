@@ -6,6 +6,8 @@
 #include "engine/render/AudioFeatures.h"
 #include "engine/render/Renderer.h"
 
+#include "tests/common/ScratchDir.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -33,9 +35,7 @@ CommandResult run(const std::string& args) {
     return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
 }
 fs::path tempDir() {
-    auto d = fs::temp_directory_path() / ("underfoot_render_" + std::to_string(::getpid()));
-    fs::create_directories(d);
-    return d;
+    return underfoot::test::scratchDir("test_render");
 }
 } // namespace
 

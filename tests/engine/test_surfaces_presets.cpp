@@ -14,10 +14,7 @@
 #include <set>
 #include <sstream>
 
-namespace underfoot::test {
-extern std::atomic<long> allocationCount; // defined in test_aggregate_model.cpp
-extern std::atomic<bool> countAllocations;
-} // namespace underfoot::test
+#include "tests/common/AllocationTrap.h"
 
 using namespace underfoot::engine;
 
@@ -285,4 +282,12 @@ TEST(SurfacePresets, EverySurfaceIsCalibratedToARealisticFootstepLevel) {
         EXPECT_NEAR(peaks[1], -12.0, 3.0) << s.id;
         EXPECT_LT(peaks[2], -3.0) << s.id;
     }
+}
+
+TEST(SurfacePresets, TheAllocationTrapSeesAnAllocation) {
+    // So that the zero counts of the no-allocation tests mean something.
+    underfoot::test::AllocationTrap trap;
+    int* volatile p = new int(3); // volatile: the allocation cannot be elided
+    delete p;
+    EXPECT_EQ(trap.count(), 1);
 }

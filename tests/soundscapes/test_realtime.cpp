@@ -1,9 +1,10 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The soundscape renderer's process() runs on the audio thread: prove that it never allocates
-// by replacing the global allocation functions of this test program with counting ones that
-// are armed only around process() (JUCE's convolution test does the same).
+// with the counting allocation functions of tests/common/AllocationTrap.cpp, armed only around
+// process().
 #include "soundscapes/Library.h"
 #include "soundscapes/Renderer.h"
+#include "tests/common/AllocationTrap.h"
 
 #include <gtest/gtest.h>
 
@@ -11,43 +12,7 @@
 #include <cstdlib>
 #include <new>
 
-namespace {
-std::atomic<bool> gArmed{false};
-std::atomic<long> gAllocations{0};
-
-void* countedAlloc(std::size_t size) {
-    if (gArmed.load(std::memory_order_relaxed)) gAllocations.fetch_add(1);
-    if (void* p = std::malloc(size ? size : 1)) return p;
-    throw std::bad_alloc();
-}
-
-struct AllocationTrap {
-    AllocationTrap() {
-        gAllocations = 0;
-        gArmed = true;
-    }
-    ~AllocationTrap() { gArmed = false; }
-};
-} // namespace
-
-void* operator new(std::size_t size) {
-    return countedAlloc(size);
-}
-void* operator new[](std::size_t size) {
-    return countedAlloc(size);
-}
-void operator delete(void* p) noexcept {
-    std::free(p);
-}
-void operator delete[](void* p) noexcept {
-    std::free(p);
-}
-void operator delete(void* p, std::size_t) noexcept {
-    std::free(p);
-}
-void operator delete[](void* p, std::size_t) noexcept {
-    std::free(p);
-}
+using underfoot::test::AllocationTrap;
 
 using namespace underfoot::soundscapes;
 
@@ -55,9 +20,9 @@ TEST(SoundscapeRealtime, TheTrapSeesAnAllocation) {
     long seen = 0;
     {
         AllocationTrap trap;
-        auto* p = new int(3);
+        int* volatile p = new int(3); // volatile: the allocation cannot be elided
         delete p;
-        seen = gAllocations.load();
+        seen = trap.count();
     }
     EXPECT_EQ(seen, 1); // the trap works, so the zero below means something
 }
@@ -75,7 +40,7 @@ TEST(SoundscapeRealtime, ProcessNeverAllocatesInAnyEnvironment) {
             // 30 s in odd-sized blocks (some longer than the prepared block size), so that
             // many events start and end inside blocks.
             for (int b = 0; b < 1500; ++b) r.process(l.data(), rr.data(), b % 3 == 0 ? 1000 : 960);
-            allocations = gAllocations.load();
+            allocations = trap.count();
         }
         EXPECT_EQ(allocations, 0);
     }
