@@ -143,13 +143,6 @@ void GrainsLayer::processChunk(const float* grf, float* out, int n) noexcept {
     }
 }
 
-namespace {
-/// Reads a [lo, hi] pair; a reversed pair is accepted and swapped (sweeps draw them separately).
-std::pair<double, double> orderedPair(double a, double b) {
-    return {std::min(a, b), std::max(a, b)};
-}
-} // namespace
-
 std::unique_ptr<SurfaceLayer> makeGrainsLayer(PresetReader& r, const AccuracyOptions& options) {
     AggregateParameters m;
     GrainsControl c;

@@ -11,11 +11,13 @@
 #include "engine/dsp/ProcessSpec.h"
 #include "engine/surfaces/Preset.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <functional>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace underfoot::engine {
@@ -54,6 +56,12 @@ struct LayerKind {
 
 /// Every layer kind the engine knows (engine/surfaces/LayerKinds.cpp holds the table).
 const std::vector<LayerKind>& layerKinds();
+
+/// A [lo, hi] range read as two parameters; a reversed pair is accepted and swapped (the
+/// stability sweeps draw the two ends independently).
+inline std::pair<double, double> orderedPair(double a, double b) noexcept {
+    return {std::min(a, b), std::max(a, b)};
+}
 
 /// Common helper: linear gain from decibels.
 inline double dbToGain(double db) noexcept {

@@ -161,12 +161,6 @@ void BubblesLayer::processChunk(const float* grf, float* out, int n) noexcept {
     }
 }
 
-namespace {
-std::pair<double, double> orderedPair(double a, double b) {
-    return {std::min(a, b), std::max(a, b)};
-}
-} // namespace
-
 std::unique_ptr<SurfaceLayer> makeBubblesLayer(PresetReader& r, const AccuracyOptions& options) {
     BubbleStreamParameters s;
     BubblesControl c;
