@@ -1,0 +1,161 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+/// The live engine: owns the audio stream (RtAudio, duplex, planar float) and runs the current
+/// LiveScene in its callback.
+///
+/// Threads (docs/live.md):
+///  - main thread: open / start / stop, builds scenes (LiveScene::create) and submit()s them,
+///    reads meters(), releases retired scenes (collectRetired(), also done by submit and stop);
+///  - audio thread: the callback. It takes commands from an SPSC queue (scene swaps, fade-outs,
+///    latency probes), runs the scenes, crossfades a swap over AudioSettings::crossfadeMs,
+///    hands the old scene back through a second SPSC queue, and publishes meters through
+///    atomics. It never allocates, locks, logs, throws or frees a scene.
+/// Without a device (openOffline) the same callback body runs from processBlock(): tests and
+/// benchmarks drive it block by block.
+#include "engine/io/AudioDevice.h"
+#include "engine/scene/LiveScene.h"
+
+#include <array>
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace underfoot::engine {
+
+/// A snapshot of the published meters (any thread).
+struct LiveMeters {
+    static constexpr int kMaxChannels = 16;
+    int outputChannels = 0;
+    /// Peak |x| and RMS of the last block, per device output channel.
+    std::array<float, kMaxChannels> outputPeak{}, outputRms{};
+    /// Peak |x| of the last block per device input channel.
+    std::array<float, kMaxChannels> inputPeak{};
+    int inputChannels = 0;
+    float grfPeakNewtons = 0;          ///< loudest GRF sample of the current scene's last block
+    std::uint64_t xruns = 0;           ///< device over/underflows reported to the callback
+    std::uint64_t blocks = 0;          ///< callbacks run
+    std::uint64_t frames = 0;          ///< frames processed
+    double lastBlockSeconds = 0;       ///< time spent in the last callback
+    double maxBlockSeconds = 0;        ///< worst callback since start / resetPeaks()
+    double loadPercent = 0;            ///< last callback time / block period x 100
+    double maxLoadPercent = 0;         ///< worst of it
+    double averageLoadPercent = 0;     ///< total callback time / total audio time x 100
+    std::uint64_t scenesSwapped = 0;   ///< scenes that became current
+    std::uint64_t droppedCommands = 0; ///< submit() calls refused because the queue was full
+    /// Last latency-probe result: frames from the probe impulse leaving an output to it arriving
+    /// at an input; -1 = none measured (or still waiting).
+    long long probeLatencyFrames = -1;
+};
+
+/// Hooks run by the callback on the audio thread at its start and end (tests arm an
+/// allocation trap with them); plain function pointers, set before start().
+struct CallbackHooks {
+    void (*enter)() = nullptr;
+    void (*leave)() = nullptr;
+};
+
+class LiveEngine {
+  public:
+    LiveEngine();
+    /// Stops and closes the stream and releases every scene.
+    ~LiveEngine();
+    LiveEngine(const LiveEngine&) = delete;
+    LiveEngine& operator=(const LiveEngine&) = delete;
+
+    /// Validates the settings and opens the device (stream not running yet). Throws
+    /// AudioSettingsError naming the device / API and listing what exists when a device is
+    /// unknown, and when RtAudio refuses the stream (with its message).
+    void open(const AudioSettings& settings);
+    /// No device: the callback body runs from processBlock() with these settings.
+    void openOffline(const AudioSettings& settings);
+    /// Starts the stream (device mode). Throws AudioSettingsError when RtAudio fails.
+    void start();
+    /// Stops the stream (drains nothing: the current scene keeps its place) and releases
+    /// retired scenes.
+    void stop();
+    /// Stops and closes; scenes are released.
+    void close();
+    bool isOpen() const noexcept;
+    bool isRunning() const noexcept;
+
+    /// The settings in use (after open; the rate and block size the device accepted).
+    const AudioSettings& settings() const noexcept { return settings_; }
+    /// Rate and largest block, for LiveScene::create.
+    ProcessSpec processSpec() const noexcept;
+    /// Device channels opened.
+    int outputChannels() const noexcept { return numOutputs_; }
+    int inputChannels() const noexcept { return numInputs_; }
+    /// The API and device actually opened ("jack", "system").
+    const std::string& openedApi() const noexcept { return openedApi_; }
+    const std::string& openedDevice() const noexcept { return openedDevice_; }
+    /// Latency the device reports (RtAudio getStreamLatency), frames; 0 when unknown.
+    long deviceLatencyFrames() const;
+
+    /// Swaps `scene` in with the crossfade (nullptr: fade the current scene out to silence).
+    /// The scene must have been created with processSpec() and settings().channels. Returns
+    /// false (and keeps nothing) when the command queue is full. Releases retired scenes.
+    bool submit(std::unique_ptr<LiveScene> scene);
+    /// Releases scenes the audio thread handed back; returns how many.
+    int collectRetired();
+    /// Whether the audio thread has taken every submitted command and retired every faded
+    /// scene (so that a recorder fed by a retired scene can be finished).
+    bool idle() const noexcept;
+    /// Waits (sleeping) until idle() or the timeout; returns idle().
+    bool waitIdle(double timeoutSeconds);
+
+    /// Emits one impulse on `outputChannel` and watches `inputChannel` for it (threshold 0.5);
+    /// the result appears in meters().probeLatencyFrames. Returns false when the queue is full.
+    bool probeLatency(int outputChannel, int inputChannel);
+
+    /// Snapshot of the meters.
+    LiveMeters meters() const noexcept;
+    /// Resets the worst-case figures (max block time / load).
+    void resetPeaks() noexcept;
+
+    void setCallbackHooks(const CallbackHooks& hooks) noexcept { hooks_ = hooks; }
+
+    /// The callback body (device callback or offline): planar inputs/outputs with
+    /// inputChannels() / outputChannels() channels, n <= block size. `xrun` marks a device
+    /// over/underflow reported for this block.
+    void processBlock(const float* const* inputs, float* const* outputs, int n,
+                      bool xrun = false) noexcept;
+
+  private:
+    struct Device;
+    struct Command;
+    struct Queues;
+    void openCommon(const AudioSettings& settings);
+    void releaseAll();
+
+    AudioSettings settings_;
+    std::unique_ptr<Device> device_;
+    std::unique_ptr<Queues> queues_;
+    int numOutputs_ = 0, numInputs_ = 0;
+    std::string openedApi_, openedDevice_;
+    bool offline_ = false;
+    CallbackHooks hooks_{};
+
+    // audio-thread state
+    LiveScene* current_ = nullptr;
+    LiveScene* fading_ = nullptr;
+    LiveScene* pendingRetire_ = nullptr; ///< faded out but the return queue was full
+    int crossfadeFrames_ = 0;
+    std::vector<const float*> inPtr_;
+    std::vector<float*> outPtr_;
+    std::vector<std::vector<float>> planarIn_, planarOut_; ///< device mode (interleaving)
+    std::vector<float> silence_;
+    struct Probe {
+        int out = -1, in = -1;
+        long long emittedAt = -1;
+        bool active = false;
+    } probe_;
+
+    // published (atomics)
+    struct Published;
+    std::unique_ptr<Published> pub_;
+    std::atomic<std::uint64_t> submitted_{0}, taken_{0};
+};
+
+} // namespace underfoot::engine
