@@ -138,13 +138,16 @@ class LiveEngine {
     CallbackHooks hooks_{};
 
     // audio-thread state
+    friend struct DeviceCallback;
+    void retire(LiveScene* scene) noexcept;
     LiveScene* current_ = nullptr;
     LiveScene* fading_ = nullptr;
-    LiveScene* pendingRetire_ = nullptr; ///< faded out but the return queue was full
+    std::array<LiveScene*, 8> pending_{}; ///< faded out, but the return queue was full
+    std::atomic<std::uint64_t> leaked_{0};
     int crossfadeFrames_ = 0;
-    std::vector<const float*> inPtr_;
-    std::vector<float*> outPtr_;
-    std::vector<std::vector<float>> planarIn_, planarOut_; ///< device mode (interleaving)
+    std::uint64_t framesTotal_ = 0;
+    std::array<const float*, 64> callbackIn_{};
+    std::array<float*, 64> callbackOut_{};
     std::vector<float> silence_;
     struct Probe {
         int out = -1, in = -1;

@@ -25,7 +25,7 @@
 #include "engine/dsp/ProcessSpec.h"
 #include "engine/io/AudioDevice.h"
 #include "engine/io/AudioRecorder.h"
-#include "engine/render/AccuracyCost.h"
+#include "engine/surfaces/Layer.h"
 
 #include <array>
 #include <cstdint>
@@ -105,12 +105,21 @@ struct LiveSceneDescription {
     std::shared_ptr<GrfSource> external; ///< ControlKind::External
 
     std::uint64_t seed = 1; ///< render seed (voices, walker, ambience)
-    /// Recording of the GRF channels (newtons / 1000) from the scene's first sample; optional.
+    /// Recording of the GRF channels from the scene's first sample (made by makeGrfRecorder,
+    /// as many channels as the control has: walker 2, microphones 1, replay/external theirs).
     std::shared_ptr<AudioRecorder> grfRecorder;
     /// Recording of the scene's headphone output after its fade gain (what it added to the
     /// device's headphone channels); optional.
     std::shared_ptr<AudioRecorder> outputRecorder;
 };
+
+/// Full scale of GRF recordings (engine/control/GrfFile.h: a sample of 1.0 is 1000 N).
+inline constexpr double kGrfFileFullScaleNewtons = 1000.0;
+
+/// A recorder for a scene's GRF channels (`LiveSceneDescription::grfRecorder`): a float WAV
+/// that loadGrfFile / `underfoot replay` read back. Throws FileError.
+std::shared_ptr<AudioRecorder> makeGrfRecorder(const std::string& path, int channels,
+                                               double sampleRateHz);
 
 /// The nodes of a scene, for cost reports.
 enum class SceneNode { Control, Voices, Reverb, Ambience, Haptics, Mix, Count };
@@ -151,6 +160,11 @@ class LiveScene {
     /// True once a fade-out has reached 0 (the engine then retires the scene).
     bool fadedOut() const noexcept;
 
+    /// The GRF the voices hear for a computed `newtons`: the value a GRF recording stores
+    /// (`stored` = newtons / kGrfFileFullScaleNewtons as float) read back as loadGrfFile reads
+    /// it, so that replaying the recording drives the voices with identical numbers.
+    static float quantizeGrf(float newtons, float& stored) noexcept;
+
     /// Samples processed since the scene started.
     std::int64_t framesProcessed() const noexcept { return frames_; }
     /// Loudest GRF sample of the last block (newtons), for the meters.
@@ -188,8 +202,8 @@ class LiveScene {
     std::vector<int> micChannels_;
     GrfSignal replay_;
     std::shared_ptr<GrfSource> external_;
-    std::vector<std::vector<float>> grf_;
-    std::vector<float*> grfPtr_;
+    std::vector<std::vector<float>> grf_, grfScaled_;
+    std::vector<float*> grfPtr_, grfScaledPtr_;
     std::vector<const float*> micPtr_;
     std::vector<float> zeros_;
 
@@ -216,11 +230,12 @@ class LiveScene {
 
     // recordings
     std::shared_ptr<AudioRecorder> grfRecorder_, outputRecorder_;
+    std::vector<float> recL_, recR_;
 
     // fade
     std::vector<float> gain_;
-    float fadeStart_ = 0.0f, fadeTarget_ = 1.0f;
-    int fadeLength_ = 0, fadePos_ = 0;
+    float fadeStart_ = 0.0f;
+    int fadeInFrames_ = 0, fadeLength_ = 0, fadePos_ = 0;
     bool fadingOut_ = false;
 
     std::int64_t frames_ = 0;
