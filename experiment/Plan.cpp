@@ -23,6 +23,53 @@ bool feasible(const std::vector<int>& counts, int remaining, int last) {
     }
     return true;
 }
+/// A random sequence of `items`, each `reps` times; with `noRepeat` no two equal neighbours (nor
+/// `last`, the element before the sequence, first). Sequential draw weighted by remaining counts,
+/// restricted to choices that keep the rest feasible.
+std::vector<int> drawSequence(const std::vector<int>& items, int reps, bool noRepeat, int last,
+                              Rng& rng) {
+    std::vector<int> out;
+    if (!noRepeat) {
+        for (int r = 0; r < reps; ++r) out.insert(out.end(), items.begin(), items.end());
+        rng.shuffle(out);
+        return out;
+    }
+    const int k = static_cast<int>(items.size());
+    std::vector<int> counts(items.size(), reps);
+    int remaining = k * reps;
+    int lastLocal = -1;
+    for (int x = 0; x < k; ++x)
+        if (items[static_cast<std::size_t>(x)] == last) lastLocal = x;
+    if (!feasible(counts, remaining, lastLocal))
+        throw std::invalid_argument("impossible ordering constraint: no_immediate_repeat");
+    while (remaining > 0) {
+        std::vector<int> weights(items.size(), 0);
+        int total = 0;
+        for (int x = 0; x < k; ++x) {
+            auto& c = counts[static_cast<std::size_t>(x)];
+            if (c == 0 || x == lastLocal) continue;
+            --c;
+            if (feasible(counts, remaining - 1, x)) {
+                weights[static_cast<std::size_t>(x)] = c + 1;
+                total += c + 1;
+            }
+            ++c;
+        }
+        if (total == 0)
+            throw std::invalid_argument("impossible ordering constraint: no_immediate_repeat");
+        auto pick = static_cast<int>(rng.below(static_cast<std::uint64_t>(total)));
+        int chosen = 0;
+        for (; chosen < k; ++chosen) {
+            pick -= weights[static_cast<std::size_t>(chosen)];
+            if (pick < 0) break;
+        }
+        --counts[static_cast<std::size_t>(chosen)];
+        --remaining;
+        lastLocal = chosen;
+        out.push_back(items[static_cast<std::size_t>(chosen)]);
+    }
+    return out;
+}
 } // namespace
 
 std::uint64_t participantSeed(std::uint64_t studySeed, int participantIndex) {
@@ -60,7 +107,28 @@ std::vector<PlannedTrial> generatePlan(const Protocol& protocol, const std::stri
     // Main sequence: (stimulus index, block).
     std::vector<std::pair<int, int>> sequence;
     sequence.reserve(static_cast<std::size_t>(k * reps));
-    if (o.order == OrderKind::Fixed) {
+    if (o.blocks == BlockKind::Scale) {
+        // One block per scale: the stimuli that scale rates, `reps` times each, in a new order.
+        const auto& scales = protocol.questions.scales;
+        for (std::size_t b = 0; b < scales.size(); ++b) {
+            std::vector<int> items;
+            for (int i = 0; i < k; ++i)
+                if (scales[b].asksFor(stimuli[static_cast<std::size_t>(i)].id)) items.push_back(i);
+            if (items.empty()) continue;
+            std::vector<int> order;
+            if (o.order == OrderKind::Fixed) {
+                for (int r = 0; r < reps; ++r)
+                    order.insert(order.end(), items.begin(), items.end());
+            } else {
+                if (o.noImmediateRepeat && items.size() < 2 && reps > 1)
+                    throw std::invalid_argument("impossible ordering constraint: "
+                                                "no_immediate_repeat with a single stimulus");
+                order = drawSequence(items, reps, o.noImmediateRepeat,
+                                     sequence.empty() ? -1 : sequence.back().first, rng);
+            }
+            for (int i : order) sequence.emplace_back(i, static_cast<int>(b) + 1);
+        }
+    } else if (o.order == OrderKind::Fixed) {
         for (int r = 1; r <= reps; ++r)
             for (int i = 0; i < k; ++i)
                 sequence.emplace_back(i, o.blocks == BlockKind::Repetition ? r : 1);
@@ -142,8 +210,13 @@ std::vector<PlannedTrial> generatePlan(const Protocol& protocol, const std::stri
     }
     std::vector<int> seen(static_cast<std::size_t>(k), 0);
     const int mainTotal = static_cast<int>(sequence.size());
+    int previousBlock = 0;
     for (int m = 0; m < mainTotal; ++m) {
         const auto [si, block] = sequence[static_cast<std::size_t>(m)];
+        // Per-scale blocks count repetitions within each block (every block hears each clip).
+        if (o.blocks == BlockKind::Scale && block != previousBlock)
+            std::fill(seen.begin(), seen.end(), 0);
+        previousBlock = block;
         PlannedTrial t;
         t.index = index;
         t.block = block;
@@ -168,7 +241,12 @@ PlanSummary summarizePlans(const Protocol& protocol, std::uint64_t studySeed,
         table.groupId = g.id;
         table.stimulusIds = g.stimuli;
         const std::size_t k = g.stimuli.size();
-        const std::size_t positions = k * static_cast<std::size_t>(protocol.ordering.repetitions);
+        std::size_t positions = k * static_cast<std::size_t>(protocol.ordering.repetitions);
+        if (protocol.ordering.blocks == BlockKind::Scale) {
+            positions = 0;
+            for (const auto& t : generatePlan(protocol, g.id, studySeed, 0))
+                positions += t.practice ? 0 : 1;
+        }
         table.counts.assign(k, std::vector<int>(positions, 0));
         for (int p = 0; p < participantsPerGroup; ++p, ++participantIndex) {
             const auto plan = generatePlan(protocol, g.id, studySeed, participantIndex);

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "experiment/Protocol.h"
 
+#include "experiment/Random.h"
+
 #include <fmt/format.h>
 #include <openssl/evp.h>
 #include <toml++/toml.h>
@@ -8,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <set>
 #include <sstream>
 #include <tuple>
@@ -53,6 +56,68 @@ const Scale* Questions::scale(const std::string& scaleId) const {
     for (const auto& s : scales)
         if (s.id == scaleId) return &s;
     return nullptr;
+}
+
+bool Scale::asksFor(const std::string& stimulusId) const {
+    return stimuli.empty() ||
+           std::find(stimuli.begin(), stimuli.end(), stimulusId) != stimuli.end();
+}
+
+const ParticipantField* Protocol::participantField(const std::string& fieldId) const {
+    for (const auto& f : participantFields)
+        if (f.id == fieldId) return &f;
+    return nullptr;
+}
+
+std::vector<const Scale*> askedScales(const Protocol& protocol, const Stimulus& stimulus,
+                                      int block) {
+    std::vector<const Scale*> out;
+    const auto& scales = protocol.questions.scales;
+    if (protocol.ordering.blocks == BlockKind::Scale && block >= 1 &&
+        block <= static_cast<int>(scales.size())) {
+        const Scale& s = scales[static_cast<std::size_t>(block - 1)];
+        if (s.asksFor(stimulus.id)) out.push_back(&s);
+        return out;
+    }
+    for (const auto& s : scales)
+        if (s.asksFor(stimulus.id)) out.push_back(&s);
+    return out;
+}
+
+std::string clipPath(const Stimulus& stimulus, const std::string& clipDir) {
+    const std::string name = stimulus.clip ? *stimulus.clip : stimulus.id + ".wav";
+    if (clipDir.empty()) return name;
+    return clipDir.back() == '/' ? clipDir + name : clipDir + "/" + name;
+}
+
+std::uint64_t clipSeed(const Protocol& protocol, const Stimulus& stimulus) {
+    // FNV-1a of the id: stable across platforms and independent of the order of stimuli.
+    std::uint64_t h = 14695981039346656037ULL;
+    for (const char c : stimulus.id) {
+        h ^= static_cast<unsigned char>(c);
+        h *= 1099511628211ULL;
+    }
+    return deriveSeed(protocol.clips.seed, {h, 0xC11F});
+}
+
+std::vector<ProtocolProblem> checkClipFiles(const Protocol& protocol, const std::string& clipDir) {
+    std::vector<ProtocolProblem> problems;
+    for (const auto& s : protocol.stimuli) {
+        if (!s.clip) continue;
+        const std::string path = clipPath(s, clipDir);
+        std::ifstream in(path, std::ios::binary);
+        if (in && in.peek() != std::ifstream::traits_type::eof()) continue;
+        const auto place = protocol.clipPlaces.find(s.id);
+        const int line = place == protocol.clipPlaces.end() ? 0 : place->second.first;
+        const int column = place == protocol.clipPlaces.end() ? 0 : place->second.second;
+        problems.push_back(
+            {protocol.sourceName, line, column,
+             fmt::format("stimulus '{}' plays the lab-supplied clip '{}', but {} {}; expected "
+                         "the lab's recording there (an audio file readable by libsndfile)",
+                         s.id, *s.clip, path,
+                         in ? "is empty" : "does not exist or cannot be read")});
+    }
+    return problems;
 }
 
 const Stimulus* Protocol::stimulus(const std::string& stimulusId) const {
@@ -485,6 +550,46 @@ std::vector<AnswerOption> readOptions(Reader& r, const toml::table& t, std::stri
     return options;
 }
 
+/// Williams design: rows of a Latin square in which every condition follows every other equally
+/// often (k rows for even k; k rows and their mirror images for odd k).
+std::vector<std::vector<std::size_t>> williamsRows(std::size_t k) {
+    std::vector<std::size_t> first;
+    for (std::size_t i = 0, lo = 1, hi = k - 1; i < k; ++i) {
+        if (i == 0)
+            first.push_back(0);
+        else if (i % 2 == 1)
+            first.push_back(lo++);
+        else
+            first.push_back(hi--);
+    }
+    std::vector<std::vector<std::size_t>> rows;
+    for (std::size_t r = 0; r < k; ++r) {
+        std::vector<std::size_t> row;
+        for (std::size_t c : first) row.push_back((c + r) % k);
+        rows.push_back(row);
+    }
+    if (k % 2 == 1)
+        for (std::size_t r = 0; r < k; ++r) rows.emplace_back(rows[r].rbegin(), rows[r].rend());
+    return rows;
+}
+
+/// Replaces the implicit group "all" by one group per Williams row, each in a fixed order.
+void applyLatinSquare(Protocol& p) {
+    if (p.groups.size() != 1 || p.groups.front().stimuli.size() < 2) return;
+    const std::vector<std::string> conditions = p.groups.front().stimuli;
+    std::vector<Group> groups;
+    const auto rows = williamsRows(conditions.size());
+    for (std::size_t r = 0; r < rows.size(); ++r) {
+        Group g;
+        g.id = fmt::format("order{}", r + 1);
+        for (std::size_t c : rows[r]) g.stimuli.push_back(conditions[c]);
+        g.label = "order " + joinList(g.stimuli);
+        groups.push_back(std::move(g));
+    }
+    p.groups = std::move(groups);
+    p.ordering.order = OrderKind::Fixed;
+}
+
 /// Number of trials per group for the break check, and the feasibility of no-immediate-repeat.
 void checkOrdering(Reader& r, const toml::table* orderingTable, const toml::table& root,
                    const Protocol& p) {
@@ -493,7 +598,10 @@ void checkOrdering(Reader& r, const toml::table* orderingTable, const toml::tabl
     int largestTrials = 0;
     for (const auto& g : p.groups) {
         const int distinct = static_cast<int>(g.stimuli.size());
-        const int trials = distinct * o.repetitions;
+        const int blocks = o.blocks == BlockKind::Scale
+                               ? std::max(1, static_cast<int>(p.questions.scales.size()))
+                               : 1;
+        const int trials = distinct * o.repetitions * blocks;
         largestTrials = std::max(largestTrials, trials);
         if (distinct == 0 || !o.noImmediateRepeat) continue;
         const std::string whose = p.design == DesignKind::Between ? fmt::format("group '{}'", g.id)
@@ -548,7 +656,7 @@ Protocol parseProtocol(const std::string& text, const std::string& sourceName,
 
     r.checkKeys(root,
                 {"protocol", "design", "timing", "input", "stimuli", "factorial", "groups",
-                 "ordering", "questions", "rules"},
+                 "ordering", "questions", "rules", "laps", "clips", "participant_fields"},
                 "the protocol file");
 
     // [protocol]
@@ -609,12 +717,42 @@ Protocol parseProtocol(const std::string& text, const std::string& sourceName,
                     fmt::format("[[stimuli]] #{}", stimulusPlace.size() + 1);
                 r.checkKeys(t,
                             {"id", "label", "surface", "soundscape", "modalities", "reverb",
-                             "input", "wading", "practice_only"},
+                             "input", "wading", "practice_only", "clip", "factors"},
                             context);
                 Stimulus s;
                 s.id = r.id(t, "id", context, true).value_or("");
                 s.practiceOnly = r.boolean(t, "practice_only", context).value_or(false);
                 readStimulusFields(r, t, context, catalogue, defaultInput, s);
+                if (auto clip = r.string(t, "clip", context, false)) {
+                    const toml::node& where = *t.get("clip");
+                    if (clip->empty() || clip->front() == '/' ||
+                        clip->find("..") != std::string::npos)
+                        r.problem(where, fmt::format("'clip' in {} is '{}'; expected a file name "
+                                                     "relative to the clip folder (no '..', not "
+                                                     "absolute)",
+                                                     context, *clip));
+                    else {
+                        s.clip = *clip;
+                        if (!s.id.empty())
+                            p.clipPlaces[s.id] = {static_cast<int>(where.source().begin.line),
+                                                  static_cast<int>(where.source().begin.column)};
+                    }
+                    if (t.get("wading"))
+                        r.problem(where, fmt::format("{} has both a lab-supplied 'clip' and "
+                                                     "'wading' settings; expected one of them",
+                                                     context));
+                }
+                if (auto f = r.table(t, "factors", context, false)) {
+                    for (auto&& [key, levelNode] : *f) {
+                        const std::string level = levelText(levelNode);
+                        if (level.empty() || levelNode.is_array() || levelNode.is_table())
+                            r.problem(levelNode, fmt::format("factor '{}' in {}.factors must be a "
+                                                             "string, number or boolean level",
+                                                             key.str(), context));
+                        else
+                            s.factors[std::string(key.str())] = level;
+                    }
+                }
                 addStimulus(std::move(s), t.source());
             }
     }
@@ -780,18 +918,42 @@ Protocol parseProtocol(const std::string& text, const std::string& sourceName,
     if (orderingTable) {
         const toml::table& t = *orderingTable;
         const char* ctx = "[ordering]";
-        r.checkKeys(
-            t, {"repetitions", "order", "blocks", "no_immediate_repeat", "practice", "break_every"},
-            ctx);
+        r.checkKeys(t,
+                    {"repetitions", "order", "blocks", "no_immediate_repeat", "practice",
+                     "break_every", "counterbalance"},
+                    ctx);
         p.ordering.repetitions =
             static_cast<int>(r.integer(t, "repetitions", ctx, false, 1, 1000).value_or(1));
         if (auto o = r.choice<OrderKind>(
                 t, "order", ctx, {{"random", OrderKind::Random}, {"fixed", OrderKind::Fixed}}))
             p.ordering.order = *o;
-        if (auto b = r.choice<BlockKind>(
-                t, "blocks", ctx,
-                {{"none", BlockKind::None}, {"repetition", BlockKind::Repetition}}))
+        if (auto b = r.choice<BlockKind>(t, "blocks", ctx,
+                                         {{"none", BlockKind::None},
+                                          {"repetition", BlockKind::Repetition},
+                                          {"scale", BlockKind::Scale}}))
             p.ordering.blocks = *b;
+        if (auto c = r.choice<Counterbalance>(
+                t, "counterbalance", ctx,
+                {{"none", Counterbalance::None}, {"latin_square", Counterbalance::LatinSquare}})) {
+            p.ordering.counterbalance = *c;
+            if (*c == Counterbalance::LatinSquare) {
+                if (p.design != DesignKind::Within)
+                    r.problem(*t.get("counterbalance"),
+                              "counterbalance = \"latin_square\" balances the order of "
+                              "conditions within subjects; expected design type = \"within\"");
+                else if (t.get("order") && p.ordering.order == OrderKind::Random)
+                    r.problem(*t.get("order"),
+                              "order = \"random\" contradicts counterbalance = "
+                              "\"latin_square\" (each Latin-square row is a fixed order); "
+                              "remove 'order'");
+                else if (t.get("blocks") && p.ordering.blocks == BlockKind::Scale)
+                    r.problem(*t.get("blocks"),
+                              "blocks = \"scale\" cannot be combined with counterbalance = "
+                              "\"latin_square\"");
+                else
+                    applyLatinSquare(p);
+            }
+        }
         p.ordering.noImmediateRepeat = r.boolean(t, "no_immediate_repeat", ctx).value_or(false);
         for (const auto& [sid, where] : r.strings(t, "practice", ctx)) {
             if (!p.stimulus(sid))
@@ -804,8 +966,6 @@ Protocol parseProtocol(const std::string& text, const std::string& sourceName,
         p.ordering.breakEvery =
             static_cast<int>(r.integer(t, "break_every", ctx, false, 0, 100000).value_or(0));
     }
-    checkOrdering(r, orderingTable, root, p);
-
     // [questions]
     if (auto t = r.table(root, "questions", "the protocol file", true)) {
         r.checkKeys(*t, {"surface", "scales", "soundscape", "comment"}, "[questions]");
@@ -837,7 +997,10 @@ Protocol parseProtocol(const std::string& text, const std::string& sourceName,
                     const toml::table& st = *element.as_table();
                     const std::string ctx =
                         fmt::format("[[questions.scales]] #{}", p.questions.scales.size() + 1);
-                    r.checkKeys(st, {"id", "prompt", "min", "max", "min_label", "max_label"}, ctx);
+                    r.checkKeys(st,
+                                {"id", "prompt", "min", "max", "min_label", "max_label", "anchors",
+                                 "stimuli"},
+                                ctx);
                     Scale sc;
                     sc.id = r.id(st, "id", ctx, true).value_or("");
                     sc.prompt = r.string(st, "prompt", ctx, true).value_or("");
@@ -851,6 +1014,60 @@ Protocol parseProtocol(const std::string& text, const std::string& sourceName,
                         r.problem(st, fmt::format("scale '{}' has min {} >= max {}; expected "
                                                   "min < max",
                                                   sc.id, sc.min, sc.max));
+                    if (auto anchors = r.table(st, "anchors", ctx, false)) {
+                        for (auto&& [key, node] : *anchors) {
+                            const std::string k(key.str());
+                            int value = 0;
+                            std::size_t used = 0;
+                            bool isNumber = !k.empty();
+                            try {
+                                value = std::stoi(k, &used);
+                            } catch (const std::exception&) {
+                                isNumber = false;
+                            }
+                            const auto& where =
+                                key.source().begin.line ? key.source() : node.source();
+                            if (!isNumber || used != k.size())
+                                r.problem(where, fmt::format("anchor '{}' of scale '{}' is not a "
+                                                             "whole number; expected a scale "
+                                                             "point such as {} = \"...\"",
+                                                             k, sc.id, sc.min));
+                            else if (value < sc.min || value > sc.max)
+                                r.problem(where, fmt::format("anchor {} of scale '{}' is outside "
+                                                             "its range; expected {} to {}",
+                                                             value, sc.id, sc.min, sc.max));
+                            else if (!node.is_string() || node.as_string()->get().empty())
+                                r.problem(node, fmt::format("anchor {} of scale '{}' must be a "
+                                                            "non-empty string",
+                                                            value, sc.id));
+                            else
+                                sc.anchors[value] = node.as_string()->get();
+                        }
+                        if (sc.minLabel.empty() && sc.anchors.count(sc.min))
+                            sc.minLabel = sc.anchors[sc.min];
+                        if (sc.maxLabel.empty() && sc.anchors.count(sc.max))
+                            sc.maxLabel = sc.anchors[sc.max];
+                    }
+                    if (!sc.minLabel.empty()) sc.anchors.try_emplace(sc.min, sc.minLabel);
+                    if (!sc.maxLabel.empty()) sc.anchors.try_emplace(sc.max, sc.maxLabel);
+                    for (const auto& [sid, where] : r.strings(st, "stimuli", ctx)) {
+                        const Stimulus* target = p.stimulus(sid);
+                        if (!target)
+                            r.problem(where, fmt::format("scale '{}' names unknown stimulus "
+                                                         "'{}'; expected one of the stimulus ids",
+                                                         sc.id, sid));
+                        else if (std::find(sc.stimuli.begin(), sc.stimuli.end(), sid) !=
+                                 sc.stimuli.end())
+                            r.problem(where, fmt::format("scale '{}' lists stimulus '{}' twice",
+                                                         sc.id, sid));
+                        else
+                            sc.stimuli.push_back(sid);
+                    }
+                    if (st.get("stimuli") && sc.stimuli.empty() && st.get("stimuli")->is_array())
+                        r.problem(*st.get("stimuli"),
+                                  fmt::format("scale '{}' has an empty 'stimuli' list; expected "
+                                              "stimulus ids, or no list for every stimulus",
+                                              sc.id));
                     if (!sc.id.empty() && p.questions.scale(sc.id))
                         r.problem(st, fmt::format("scale id '{}' is used twice", sc.id));
                     else
@@ -882,6 +1099,85 @@ Protocol parseProtocol(const std::string& text, const std::string& sourceName,
             p.questions.soundscapeOptions.empty())
             r.problem(*t, "[questions] asks nothing; expected a surface question, scales or a "
                           "soundscape question");
+    }
+
+    if (p.ordering.blocks == BlockKind::Scale && p.questions.scales.empty())
+        r.problem(orderingTable ? orderingTable->source() : root.source(),
+                  "blocks = \"scale\" needs [[questions.scales]]; expected at least one scale");
+    if (p.ordering.blocks == BlockKind::Scale && p.questions.asksSurface())
+        r.problem(orderingTable ? orderingTable->source() : root.source(),
+                  "blocks = \"scale\" asks one scale per block; the surface question would be "
+                  "asked in every block — remove [questions.surface] or the scale blocks");
+    checkOrdering(r, orderingTable, root, p);
+
+    // [laps]
+    if (auto t = r.table(root, "laps", "the protocol file", false)) {
+        r.checkKeys(*t, {"baseline", "feedback"}, "[laps]");
+        p.laps.baseline =
+            static_cast<int>(r.integer(*t, "baseline", "[laps]", false, 0, 100).value_or(0));
+        p.laps.feedback =
+            static_cast<int>(r.integer(*t, "feedback", "[laps]", true, 1, 100).value_or(1));
+    }
+
+    // [clips]
+    if (auto t = r.table(root, "clips", "the protocol file", false)) {
+        r.checkKeys(*t, {"seconds", "seed", "replay"}, "[clips]");
+        p.clips.enabled = true;
+        p.clips.seconds = r.number(*t, "seconds", "[clips]", 0.5, 600).value_or(10.0);
+        p.clips.seed = static_cast<std::uint64_t>(
+            r.integer(*t, "seed", "[clips]", false, 0, std::numeric_limits<std::int64_t>::max())
+                .value_or(1));
+        p.clips.replay = r.boolean(*t, "replay", "[clips]").value_or(true);
+        if (p.laps.total() > 0)
+            r.problem(*t, "[clips] (a listening test) and [laps] (an interactive test) exclude "
+                          "each other; expected one of them");
+    }
+    // A lab-supplied clip makes the protocol a listening test even without a [clips] table.
+    for (const auto& s : p.stimuli)
+        if (s.clip) p.clips.enabled = true;
+    if (p.clips.enabled && p.laps.total() > 0 && !root.get("clips"))
+        r.problem(*root.get("laps"), "[laps] (an interactive test) cannot be combined with "
+                                     "lab-supplied clips (a listening test)");
+
+    // [[participant_fields]]
+    if (const toml::node* node = root.get("participant_fields")) {
+        if (!node->is_array_of_tables())
+            r.problem(*node, "'participant_fields' must be an array of tables "
+                             "([[participant_fields]])");
+        else
+            for (const toml::node& element : *node->as_array()) {
+                const toml::table& t = *element.as_table();
+                const std::string ctx =
+                    fmt::format("[[participant_fields]] #{}", p.participantFields.size() + 1);
+                r.checkKeys(t, {"id", "label", "options", "required"}, ctx);
+                ParticipantField f;
+                f.id = r.id(t, "id", ctx, true).value_or("");
+                f.label = r.string(t, "label", ctx, false).value_or(f.id);
+                f.required = r.boolean(t, "required", ctx).value_or(true);
+                std::set<std::string> seen;
+                for (const auto& [option, where] : r.strings(t, "options", ctx)) {
+                    if (option.empty() || !seen.insert(option).second)
+                        r.problem(where, fmt::format("option '{}' of {} is empty or listed twice",
+                                                     option, ctx));
+                    else
+                        f.options.push_back(option);
+                }
+                if (t.get("options") && f.options.empty() && t.get("options")->is_array())
+                    r.problem(*t.get("options"),
+                              fmt::format("'options' of {} is empty; expected the allowed "
+                                          "answers, or no 'options' for free text",
+                                          ctx));
+                static const std::set<std::string> kBuiltIn = {"code",  "age",     "gender",
+                                                               "shoes", "hearing", "group"};
+                if (kBuiltIn.count(f.id))
+                    r.problem(t, fmt::format("participant field '{}' is built in; expected "
+                                             "another id",
+                                             f.id));
+                else if (!f.id.empty() && p.participantField(f.id))
+                    r.problem(t, fmt::format("participant field '{}' is declared twice", f.id));
+                else if (!f.id.empty())
+                    p.participantFields.push_back(std::move(f));
+            }
     }
 
     // [rules]
@@ -966,6 +1262,7 @@ std::string stimulusToToml(const Stimulus& s) {
     t.insert("input", std::move(input));
     if (!s.wading.empty()) t.insert("wading", parametersToToml(s.wading));
     if (s.practiceOnly) t.insert("practice_only", true);
+    if (s.clip) t.insert("clip", *s.clip);
     if (!s.factors.empty()) {
         toml::table f;
         for (const auto& [k, v] : s.factors) f.insert(k, v);
@@ -1003,6 +1300,7 @@ Stimulus stimulusFromToml(const std::string& text) {
     s.input.walker = parametersFromToml(t["input"]["walker"].as_table());
     s.wading = parametersFromToml(t["wading"].as_table());
     s.practiceOnly = t["practice_only"].value_or(false);
+    if (auto v = t["clip"].value<std::string>()) s.clip = *v;
     if (const toml::table* f = t["factors"].as_table())
         for (auto&& [k, v] : *f) s.factors[std::string(k.str())] = v.value_or(std::string{});
     if (s.id.empty() || s.surface.empty())

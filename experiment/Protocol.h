@@ -7,6 +7,7 @@
 /// every problem found, each with file:line:column and what was expected.
 #include "experiment/Catalogue.h"
 
+#include <cstdint>
 #include <map>
 #include <optional>
 #include <stdexcept>
@@ -26,8 +27,13 @@ enum class SensorKind { None, Microphones, Fsr, Gyro };
 enum class DesignKind { Within, Between };
 /// Random order per participant or the declared order.
 enum class OrderKind { Random, Fixed };
-/// No blocks, or one block per repetition (each block presents every stimulus once).
-enum class BlockKind { None, Repetition };
+/// No blocks, one block per repetition (each block presents every stimulus once), or one block
+/// per rating scale (block b asks only scale b, over every stimulus that scale rates, in a new
+/// random order: the listening-test layout "clips in random order per scale").
+enum class BlockKind { None, Repetition, Scale };
+/// How the order of conditions is balanced across participants: not at all (the declared or
+/// random order), or a Williams Latin square (one generated group per row, filled in turn).
+enum class Counterbalance { None, LatinSquare };
 /// When an answer can no longer be changed.
 enum class LockRule { NextTrialStart, OnAnswer };
 
@@ -60,6 +66,8 @@ struct Stimulus {
     std::map<std::string, std::string> factors;
     /// Only presented as a practice trial (never part of a group's main trials).
     bool practiceOnly = false;
+    /// A lab-supplied audio file (path relative to the clip folder) played instead of a render.
+    std::optional<std::string> clip;
     bool operator==(const Stimulus&) const = default;
 };
 
@@ -90,6 +98,13 @@ struct Scale {
     int max = 7;
     std::string minLabel;
     std::string maxLabel;
+    /// Named anchor points (value -> wording), e.g. 1 "much less effort", 4 "no change",
+    /// 7 "much more effort"; min and max anchors also set minLabel / maxLabel.
+    std::map<int, std::string> anchors;
+    /// Stimulus ids this scale is asked for (empty: every stimulus).
+    std::vector<std::string> stimuli;
+    /// Whether this scale is asked after `stimulusId`.
+    bool asksFor(const std::string& stimulusId) const;
 };
 
 /// The questions asked after every trial.
@@ -126,6 +141,39 @@ struct Ordering {
     std::vector<std::string> practice;
     /// A break after every N main trials (0: no breaks).
     int breakEvery = 0;
+    /// Counterbalancing of condition order across participants.
+    Counterbalance counterbalance = Counterbalance::None;
+};
+
+/// Laps walked per condition in an interactive test: `baseline` silent laps, then `feedback`
+/// laps with sound; the questions are answered after the last lap. Zero laps: no lap structure.
+struct Laps {
+    int baseline = 0;
+    int feedback = 0;
+    int total() const { return baseline + feedback; }
+    /// Whether lap `lap` (1-based) is a silent baseline lap.
+    bool silent(int lap) const { return lap >= 1 && lap <= baseline; }
+};
+
+/// Pre-rendered clips of a listening test: every participant hears the same files.
+struct ClipSettings {
+    /// Whether the protocol is a listening test of pre-rendered / lab-supplied clips.
+    bool enabled = false;
+    /// Length of rendered clips (lab-supplied files keep their own length).
+    double seconds = 10.0;
+    /// Seed from which each rendered clip's seed is derived (with its stimulus id).
+    std::uint64_t seed = 1;
+    /// Whether participants may replay a clip (every replay is counted).
+    bool replay = true;
+};
+
+/// A participant field asked at registration (e.g. expertise, listening device).
+struct ParticipantField {
+    std::string id;
+    std::string label;
+    /// Allowed answers, in their natural order (empty: free text).
+    std::vector<std::string> options;
+    bool required = true;
 };
 
 /// Durations used to estimate a session's length.
@@ -149,6 +197,14 @@ struct Protocol {
     Questions questions;
     LockRule lock = LockRule::NextTrialStart;
     Timing timing;
+    /// Lap structure of interactive conditions (zero: none).
+    Laps laps;
+    /// Listening-test clips ([clips]).
+    ClipSettings clips;
+    /// Fields asked at registration ([[participant_fields]]).
+    std::vector<ParticipantField> participantFields;
+    /// Where each `clip = "..."` was written (stimulus id -> line, column), for messages.
+    std::map<std::string, std::pair<int, int>> clipPlaces;
     /// The exact file text and its SHA-256 (lower-case hex).
     std::string sourceText;
     std::string hash;
@@ -156,6 +212,7 @@ struct Protocol {
 
     const Stimulus* stimulus(const std::string& stimulusId) const;
     const Group* group(const std::string& groupId) const;
+    const ParticipantField* participantField(const std::string& fieldId) const;
 };
 
 /// One problem found while loading a protocol.
@@ -185,6 +242,22 @@ Protocol parseProtocol(const std::string& text, const std::string& sourceName,
 
 /// Reads and parses a protocol file. Throws ProtocolError (also when the file cannot be read).
 Protocol loadProtocol(const std::string& path, const Catalogue& catalogue = defaultCatalogue());
+
+/// The scales asked after a trial of `stimulus` in `block` (per-scale blocks ask one scale; a
+/// scale restricted to some stimuli is asked only after those).
+std::vector<const Scale*> askedScales(const Protocol& protocol, const Stimulus& stimulus,
+                                      int block);
+
+/// Checks that every lab-supplied clip of the protocol exists below `clipDir`; one problem per
+/// missing or unreadable file, at the place of its `clip = "..."` in the protocol file.
+std::vector<ProtocolProblem> checkClipFiles(const Protocol& protocol, const std::string& clipDir);
+
+/// The file of a stimulus's clip: `clipDir/<clip>` for lab-supplied clips, otherwise
+/// `clipDir/<stimulus id>.wav` (written by `underfoot clips`).
+std::string clipPath(const Stimulus& stimulus, const std::string& clipDir);
+
+/// The seed a rendered clip is made with (protocol clip seed and stimulus id; stable).
+std::uint64_t clipSeed(const Protocol& protocol, const Stimulus& stimulus);
 
 /// SHA-256 of a text, lower-case hex.
 std::string sha256Hex(const std::string& text);

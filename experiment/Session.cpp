@@ -81,6 +81,8 @@ void Session::play() {
     const TrialRecord& t = current();
     if (playing_) throw std::logic_error("play() while the stimulus is already playing");
     if (closed_) throw std::logic_error("play() on a closed session");
+    const Protocol& protocol = store_.protocol();
+    if (protocol.laps.total() > 0) player_.setMuted(protocol.laps.silent(t.lapsDone + 1));
     const StimulusStart started = player_.start(t.stimulus, t.plannedSeed);
     playing_ = true;
     try {
@@ -109,6 +111,7 @@ void Session::answer(const TrialAnswer& answer) {
     trials_[position_].answered = true;
     trials_[position_].answer = answer;
     trials_[position_].responseTimeS = rt;
+    pending_.clear();
     advance();
 }
 
@@ -144,6 +147,88 @@ void Session::interrupt() {
     store_.endSession(participant_.code, sessionNumber_, false);
     closed_ = true;
     phase_ = SessionPhase::Finished;
+}
+
+} // namespace underfoot::experiment
+
+namespace underfoot::experiment {
+
+std::vector<const Scale*> Session::askedScales() const {
+    const TrialRecord& t = current();
+    return experiment::askedScales(store_.protocol(), t.stimulus, t.block);
+}
+
+void Session::presentClip() {
+    const TrialRecord& t = current();
+    if (!playing_) {
+        play();
+        return;
+    }
+    store_.recordReplay(participant_.code, t.index);
+    player_.stop();
+    player_.start(t.stimulus, t.renderSeed.value_or(t.plannedSeed));
+    ++trials_[position_].replays;
+}
+
+int Session::replayCount() const {
+    return current().replays;
+}
+
+void Session::rate(const std::string& scaleId, int value) {
+    const TrialRecord& t = current();
+    for (const Scale* s : askedScales()) {
+        if (s->id != scaleId) continue;
+        if (value < s->min || value > s->max)
+            throw StoreError(fmt::format("participant '{}' trial {}: rating '{}' is {}; expected "
+                                         "{} to {}",
+                                         participant_.code, t.index, scaleId, value, s->min,
+                                         s->max));
+        pending_[scaleId] = value;
+        return;
+    }
+    throw StoreError(fmt::format("participant '{}' trial {}: scale '{}' is not asked in this "
+                                 "trial",
+                                 participant_.code, t.index, scaleId));
+}
+
+bool Session::ratingsComplete() const {
+    for (const Scale* s : askedScales())
+        if (!pending_.count(s->id)) return false;
+    return true;
+}
+
+void Session::submitRatings(const std::string& comment) {
+    TrialAnswer a;
+    a.ratings = pending_;
+    a.comment = comment;
+    answer(a);
+}
+
+int Session::lapCount() const {
+    return store_.protocol().laps.total();
+}
+
+int Session::lapsDone() const {
+    return current().lapsDone;
+}
+
+bool Session::currentLapSilent() const {
+    return store_.protocol().laps.silent(current().lapsDone + 1);
+}
+
+void Session::completeLap() {
+    const TrialRecord& t = current();
+    const Laps& laps = store_.protocol().laps;
+    if (laps.total() == 0) throw std::logic_error("completeLap() in a protocol without [laps]");
+    if (!playing_)
+        throw std::logic_error(
+            fmt::format("completeLap() for trial {} before its condition started", t.index));
+    if (t.lapsDone >= laps.total())
+        throw std::logic_error(
+            fmt::format("completeLap(): all {} laps of trial {} are done", laps.total(), t.index));
+    store_.recordLap(participant_.code, t.index, t.lapsDone + 1);
+    const int done = ++trials_[position_].lapsDone;
+    if (done < laps.total()) player_.setMuted(laps.silent(done + 1));
 }
 
 } // namespace underfoot::experiment

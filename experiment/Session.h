@@ -10,6 +10,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <optional>
 #include <string>
 
@@ -32,6 +33,9 @@ class StimulusPlayer {
     virtual StimulusStart start(const Stimulus& stimulus, std::uint64_t plannedSeed) = 0;
     /// Stops the current stimulus (no-op when none plays).
     virtual void stop() = 0;
+    /// Mutes or unmutes the running stimulus (silent baseline laps keep the simulation running
+    /// without sound). The default does nothing (players without a live output).
+    virtual void setMuted(bool muted) { (void)muted; }
 };
 
 /// A player that renders nothing and reports the planned seed (headless runs, simulation).
@@ -83,6 +87,37 @@ class Session {
     /// Stops the stimulus and closes the session as interrupted (resume later).
     void interrupt();
 
+    // Listening-test mode: clips played on demand and rated scale by scale.
+
+    /// The scales asked after the current trial (one per block with per-scale blocks).
+    std::vector<const Scale*> askedScales() const;
+    /// Presents the current trial's clip: the first call starts it (as play()); every later call
+    /// replays it from the start, counted and journaled (refused when [clips] replay = false).
+    void presentClip();
+    /// Replays of the current trial's clip so far.
+    int replayCount() const;
+    /// Sets one rating of the current trial (kept until submitRatings(); may be changed).
+    /// Throws StoreError for a scale not asked in this trial or a value outside its range.
+    void rate(const std::string& scaleId, int value);
+    /// Ratings given so far for the current trial.
+    const std::map<std::string, int>& pendingRatings() const { return pending_; }
+    /// Whether every asked scale has a rating.
+    bool ratingsComplete() const;
+    /// Commits the pending ratings (and a comment) as the current trial's answer, like answer().
+    void submitRatings(const std::string& comment = {});
+
+    // Interactive tests with laps ([laps]): silent baseline laps, then laps with sound.
+
+    /// Laps per condition (0: no lap structure).
+    int lapCount() const;
+    /// Laps completed in the current trial.
+    int lapsDone() const;
+    /// Whether the lap being walked now is a silent baseline lap.
+    bool currentLapSilent() const;
+    /// Completes the current lap (stored and journaled); the next lap starts, with sound once
+    /// the baseline laps are done. The questions can be answered after the last lap.
+    void completeLap();
+
   private:
     void advance();
 
@@ -98,6 +133,7 @@ class Session {
     bool playing_ = false;
     bool closed_ = false;
     double startedAtS_ = 0.0;
+    std::map<std::string, int> pending_;
 };
 
 } // namespace underfoot::experiment

@@ -213,10 +213,29 @@ TrialAnswer SimulatedParticipant::answer(const TrialRecord& trial) {
         a.answer = matrix_.answers[chosen];
         correct = answerIsCorrect(a.answer, trial.stimulus.surface);
     }
-    for (const auto& scale : q.scales) {
-        const double mid = 0.5 * (scale.min + scale.max);
-        const double spread = 0.2 * (scale.max - scale.min);
-        const double value = mid + (correct ? 0.5 : 0.0) + spread * rng_.gaussian();
+    for (const Scale* asked : askedScales(protocol_, trial.stimulus, trial.block)) {
+        const Scale& scale = *asked;
+        const RatingModel* model = settings_.ratingModel.get();
+        const double expected =
+            model ? model->expected(scale.id, trial.stimulus, fields_) : std::nan("");
+        double value = 0.0;
+        if (!std::isnan(expected)) {
+            const ScaleRatingModel& m = model->scales.at(scale.id);
+            auto bias = biases_.find(scale.id);
+            if (bias == biases_.end()) {
+                // A constant per participant and scale, from its own stream (resume-safe).
+                std::uint64_t h = 1469598103934665603ULL;
+                for (const char c : scale.id)
+                    h = (h ^ static_cast<unsigned char>(c)) * 1099511628211ULL;
+                Rng biasRng(deriveSeed(biasSeed_, {h}));
+                bias = biases_.emplace(scale.id, m.participantSd * biasRng.gaussian()).first;
+            }
+            value = expected + bias->second + m.noiseSd * rng_.gaussian();
+        } else {
+            const double mid = 0.5 * (scale.min + scale.max);
+            const double spread = 0.2 * (scale.max - scale.min);
+            value = mid + (correct ? 0.5 : 0.0) + spread * rng_.gaussian();
+        }
         a.ratings[scale.id] =
             std::clamp(static_cast<int>(std::lround(value)), scale.min, scale.max);
     }
@@ -234,6 +253,13 @@ TrialAnswer SimulatedParticipant::answer(const TrialRecord& trial) {
         }
     }
     return a;
+}
+
+void SimulatedParticipant::setParticipant(std::uint64_t biasSeed,
+                                          std::map<std::string, std::string> fields) {
+    biasSeed_ = biasSeed;
+    fields_ = std::move(fields);
+    biases_.clear();
 }
 
 double SimulatedParticipant::responseTimeS() {
@@ -258,6 +284,14 @@ int runSimulatedSession(StudyStore& store, const std::string& code, const Confus
                                   deriveSeed(seed, {static_cast<std::uint64_t>(info.index),
                                                     static_cast<std::uint64_t>(*first)}),
                                   settings);
+    answerer.setParticipant(deriveSeed(seed, {static_cast<std::uint64_t>(info.index), 0xB1A5}),
+                            info.fields);
+    const Protocol& protocol = store.protocol();
+    // Replays and laps draw from their own stream so that they never shift the answers.
+    Rng listening(deriveSeed(seed, {static_cast<std::uint64_t>(info.index),
+                                    static_cast<std::uint64_t>(*first), 0x11571}));
+    const double replayProbability =
+        settings.ratingModel ? settings.ratingModel->replayProbability : 0.2;
     double simulatedTimeS = 0.0;
     SilentPlayer player;
     Session session(
@@ -276,10 +310,29 @@ int runSimulatedSession(StudyStore& store, const std::string& code, const Confus
         case SessionPhase::Practice:
         case SessionPhase::Trial: {
             const TrialRecord trial = session.current();
-            session.play();
-            const TrialAnswer a = answerer.answer(trial);
-            simulatedTimeS += answerer.responseTimeS();
-            session.answer(a);
+            if (protocol.clips.enabled) {
+                // Listening-test mode: the clip on demand, replays counted, scale by scale.
+                session.presentClip();
+                for (int n = 0;
+                     protocol.clips.replay && n < 5 && listening.uniform() < replayProbability;
+                     ++n) {
+                    simulatedTimeS += protocol.clips.seconds;
+                    session.presentClip();
+                }
+                const TrialAnswer a = answerer.answer(trial);
+                simulatedTimeS += answerer.responseTimeS();
+                for (const auto& [scaleId, value] : a.ratings) session.rate(scaleId, value);
+                session.submitRatings(a.comment);
+            } else {
+                session.play();
+                for (int lap = 0; lap < session.lapCount(); ++lap) {
+                    simulatedTimeS += 30.0 * std::exp(0.1 * listening.gaussian());
+                    session.completeLap();
+                }
+                const TrialAnswer a = answerer.answer(trial);
+                simulatedTimeS += answerer.responseTimeS();
+                session.answer(a);
+            }
             ++committed;
             if (onCommitted) onCommitted(code, trial.index);
             break;
@@ -326,8 +379,16 @@ int simulateStudy(StudyStore& store, const MatrixByGroup& matrices, int particip
                 return false;
             }
         }());
+        // Participant fields drawn uniformly from their options (free text: "simulated").
+        std::map<std::string, std::string> fields;
+        Rng fieldRng(deriveSeed(seed, {static_cast<std::uint64_t>(next), 0xF1E1D}));
+        for (const auto& f : store.protocol().participantFields)
+            fields[f.id] =
+                f.options.empty()
+                    ? std::string("simulated")
+                    : f.options[static_cast<std::size_t>(fieldRng.below(f.options.size()))];
         const ParticipantInfo p =
-            store.registerParticipant({code, std::nullopt, "", "", "", {}, ""});
+            store.registerParticipant({code, std::nullopt, "", "", "", {}, ""}, fields);
         committed +=
             runSimulatedSession(store, p.code, matrixFor(p.groupId), seed, settings, onCommitted);
         ++completed;

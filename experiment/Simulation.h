@@ -4,10 +4,12 @@
 /// produced end to end (CI, demos, analysis tests).
 #include "experiment/Protocol.h"
 #include "experiment/Random.h"
+#include "experiment/RatingModel.h"
 #include "experiment/Store.h"
 
 #include <functional>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -50,6 +52,9 @@ struct SimulationSettings {
     double soundscapeAccuracy = 0.85;
     /// Median response time (log-normal, sigma 0.4).
     double medianResponseS = 8.0;
+    /// How ratings depend on the stimulus (null: around the middle of each scale, half a point
+    /// higher after a correct surface answer). Also gives the replay probability of clips.
+    std::shared_ptr<const RatingModel> ratingModel;
 };
 
 /// One synthetic participant: draws answers from the matrix row of each stimulus.
@@ -62,6 +67,9 @@ class SimulatedParticipant {
     TrialAnswer answer(const TrialRecord& trial);
     /// Response time for the last answer (seconds).
     double responseTimeS();
+    /// Who this participant is for the rating model: a seed for its constant per-scale biases
+    /// (the same in every session of the participant) and its participant-field answers.
+    void setParticipant(std::uint64_t biasSeed, std::map<std::string, std::string> fields);
 
   private:
     const ConfusionMatrix& matrix_;
@@ -69,6 +77,9 @@ class SimulatedParticipant {
     std::string groupId_;
     Rng rng_;
     SimulationSettings settings_;
+    std::uint64_t biasSeed_ = 0;
+    std::map<std::string, std::string> fields_;
+    std::map<std::string, double> biases_;
 };
 
 } // namespace underfoot::experiment

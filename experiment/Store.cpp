@@ -110,6 +110,17 @@ CREATE TRIGGER events_no_update BEFORE UPDATE ON events
 CREATE TRIGGER events_no_delete BEFORE DELETE ON events
   BEGIN SELECT RAISE(ABORT, 'the event journal is append-only'); END;
 )sql",
+    // 1 -> 2: listening tests and interactive laps; participant fields.
+    R"sql(
+ALTER TABLE trials ADD COLUMN replays INTEGER NOT NULL DEFAULT 0;
+ALTER TABLE trials ADD COLUMN laps_done INTEGER NOT NULL DEFAULT 0;
+CREATE TABLE participant_fields (
+  participant_id INTEGER NOT NULL REFERENCES participants(id),
+  name TEXT NOT NULL,
+  value TEXT NOT NULL,
+  PRIMARY KEY (participant_id, name)
+);
+)sql",
 };
 constexpr int kMigrationCount = static_cast<int>(sizeof(kMigrations) / sizeof(kMigrations[0]));
 static_assert(kMigrationCount == kSchemaVersion);
@@ -247,7 +258,7 @@ void StudyStore::configure() {
         SQLite::Transaction tx(*db_, SQLite::TransactionBehavior::IMMEDIATE);
         db_->exec(kMigrations[v]);
         db_->exec(fmt::format("PRAGMA user_version = {}", v + 1));
-        if (v > 0) // a real migration of an existing study is journaled
+        if (version > 0) // a real migration of an existing study is journaled
             appendEvent("schema_migrated", std::nullopt, std::nullopt,
                         jsonObject({{"from", std::to_string(v)}, {"to", std::to_string(v + 1)}}));
         tx.commit();
@@ -410,6 +421,14 @@ std::int64_t StudyStore::participantId(const std::string& code) const {
     return q.getColumn(0).getInt64();
 }
 
+namespace {
+void readFields(SQLite::Database& db, ParticipantInfo& p) {
+    SQLite::Statement q(db, "SELECT name, value FROM participant_fields WHERE participant_id = ?");
+    q.bind(1, p.id);
+    while (q.executeStep()) p.fields[q.getColumn(0).getString()] = q.getColumn(1).getString();
+}
+} // namespace
+
 ParticipantInfo StudyStore::participant(const std::string& code) const {
     SQLite::Statement q(
         *db_, fmt::format("SELECT {} FROM participants WHERE code = ?", kParticipantColumns));
@@ -417,7 +436,9 @@ ParticipantInfo StudyStore::participant(const std::string& code) const {
     if (!q.executeStep())
         throw StoreError(
             fmt::format("{}: no participant '{}'; expected a registered code", path_, code));
-    return readParticipant(q);
+    ParticipantInfo p = readParticipant(q);
+    readFields(*db_, p);
+    return p;
 }
 
 std::vector<ParticipantInfo> StudyStore::participants() const {
@@ -425,7 +446,38 @@ std::vector<ParticipantInfo> StudyStore::participants() const {
     SQLite::Statement q(
         *db_, fmt::format("SELECT {} FROM participants ORDER BY idx", kParticipantColumns));
     while (q.executeStep()) out.push_back(readParticipant(q));
+    for (auto& p : out) readFields(*db_, p);
     return out;
+}
+
+std::vector<std::string>
+StudyStore::checkParticipantFields(const std::map<std::string, std::string>& fields) const {
+    std::vector<std::string> problems;
+    for (const auto& [name, value] : fields) {
+        const ParticipantField* f = protocol_->participantField(name);
+        if (!f) {
+            std::string known;
+            for (const auto& pf : protocol_->participantFields)
+                known += (known.empty() ? "" : ", ") + pf.id;
+            problems.push_back(fmt::format("unknown participant field '{}'; expected one of: {}",
+                                           name, known.empty() ? "(none declared)" : known));
+            continue;
+        }
+        if (!f->options.empty() && !value.empty() &&
+            std::find(f->options.begin(), f->options.end(), value) == f->options.end()) {
+            std::string allowed;
+            for (const auto& o : f->options) allowed += (allowed.empty() ? "" : ", ") + o;
+            problems.push_back(fmt::format("participant field '{}' is '{}'; expected one of: {}",
+                                           name, value, allowed));
+        }
+    }
+    for (const auto& f : protocol_->participantFields) {
+        const auto it = fields.find(f.id);
+        if (f.required && (it == fields.end() || it->second.empty()))
+            problems.push_back(
+                fmt::format("participant field '{}' ({}) is required", f.id, f.label));
+    }
+    return problems;
 }
 
 std::vector<GroupCount> StudyStore::groupCounts() const {
@@ -474,6 +526,20 @@ std::string StudyStore::nextGroup(int participantIndex) const {
 
 std::vector<std::string> StudyStore::checkAnswer(const std::string& groupId,
                                                  const TrialAnswer& answer) const {
+    std::vector<const Scale*> all;
+    for (const auto& s : protocol_->questions.scales) all.push_back(&s);
+    return checkAnswerScales(groupId, answer, all);
+}
+
+std::vector<std::string> StudyStore::checkAnswer(const std::string& groupId,
+                                                 const TrialAnswer& answer,
+                                                 const Stimulus& stimulus, int block) const {
+    return checkAnswerScales(groupId, answer, askedScales(*protocol_, stimulus, block));
+}
+
+std::vector<std::string>
+StudyStore::checkAnswerScales(const std::string& groupId, const TrialAnswer& answer,
+                              const std::vector<const Scale*>& asked) const {
     std::vector<std::string> problems;
     const Questions& q = protocol_->questions;
     if (q.asksSurface()) {
@@ -485,17 +551,21 @@ std::vector<std::string> StudyStore::checkAnswer(const std::string& groupId,
     } else if (!answer.answer.empty()) {
         problems.push_back("this protocol asks no surface question");
     }
-    for (const auto& scale : q.scales) {
-        const auto it = answer.ratings.find(scale.id);
+    for (const Scale* scale : asked) {
+        const auto it = answer.ratings.find(scale->id);
         if (it == answer.ratings.end())
-            problems.push_back(fmt::format("the rating '{}' is missing", scale.id));
-        else if (it->second < scale.min || it->second > scale.max)
-            problems.push_back(fmt::format("rating '{}' is {}; expected {} to {}", scale.id,
-                                           it->second, scale.min, scale.max));
+            problems.push_back(fmt::format("the rating '{}' is missing", scale->id));
+        else if (it->second < scale->min || it->second > scale->max)
+            problems.push_back(fmt::format("rating '{}' is {}; expected {} to {}", scale->id,
+                                           it->second, scale->min, scale->max));
     }
-    for (const auto& [scaleId, value] : answer.ratings)
+    for (const auto& [scaleId, value] : answer.ratings) {
         if (!q.scale(scaleId))
             problems.push_back(fmt::format("unknown scale '{}' (value {})", scaleId, value));
+        else if (std::none_of(asked.begin(), asked.end(),
+                              [&](const Scale* s) { return s->id == scaleId; }))
+            problems.push_back(fmt::format("scale '{}' is not asked in this trial", scaleId));
+    }
     if (q.asksSoundscape(groupId)) {
         if (answer.soundscapeAnswer.empty())
             problems.push_back("the soundscape answer is missing");
@@ -510,6 +580,16 @@ std::vector<std::string> StudyStore::checkAnswer(const std::string& groupId,
 }
 
 ParticipantInfo StudyStore::registerParticipant(const NewParticipant& np) {
+    return registerParticipant(np, {});
+}
+
+ParticipantInfo StudyStore::registerParticipant(const NewParticipant& np,
+                                                const std::map<std::string, std::string>& fields) {
+    if (const auto problems = checkParticipantFields(fields); !problems.empty()) {
+        std::string all;
+        for (const auto& s : problems) all += (all.empty() ? "" : "; ") + s;
+        throw StoreError(fmt::format("participant {}: {}", np.code, all));
+    }
     if (np.code.empty() || np.code.size() > 32 ||
         !std::all_of(np.code.begin(), np.code.end(), [](char c) {
             return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-';
@@ -562,6 +642,17 @@ ParticipantInfo StudyStore::registerParticipant(const NewParticipant& np) {
     ins.bind(11, at);
     ins.exec();
     const std::int64_t pid = db_->getLastInsertRowid();
+    SQLite::Statement field(*db_, "INSERT INTO participant_fields (participant_id, name, value) "
+                                  "VALUES (?, ?, ?)");
+    std::string fieldsText;
+    for (const auto& [name, value] : fields) {
+        field.reset();
+        field.bind(1, pid);
+        field.bind(2, name);
+        field.bind(3, value);
+        field.exec();
+        fieldsText += fmt::format("{}{}={}", fieldsText.empty() ? "" : " ", name, value);
+    }
     SQLite::Statement trial(*db_, "INSERT INTO trials (participant_id, trial_index, block, "
                                   "practice, stimulus_id, stimulus, repetition, break_after, "
                                   "planned_seed) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?)");
@@ -585,6 +676,7 @@ ParticipantInfo StudyStore::registerParticipant(const NewParticipant& np) {
                     {"group", groupId},
                     {"assignment", assignment == Assignment::Override ? "override" : "balanced"},
                     {"reason", np.overrideReason},
+                    {"fields", fieldsText},
                     {"trials", std::to_string(plan.size())}}));
     tx.commit();
     return participant(np.code);
@@ -681,7 +773,7 @@ constexpr const char* kTrialColumns =
     "t.id, p.code, t.trial_index, t.block, t.practice, t.stimulus, t.repetition, t.planned_seed, "
     "t.render_seed, t.grf_recording, t.session_number, t.started_at, t.answered_at, "
     "t.response_time_s, t.answer, t.soundscape_answer, t.comment, t.excluded, "
-    "t.exclusion_reason, t.break_after";
+    "t.exclusion_reason, t.break_after, t.replays, t.laps_done";
 
 TrialRecord readTrial(SQLite::Database& db, SQLite::Statement& q) {
     TrialRecord r;
@@ -706,6 +798,8 @@ TrialRecord readTrial(SQLite::Database& db, SQLite::Statement& q) {
     r.excluded = q.getColumn(17).getInt() != 0;
     r.exclusionReason = q.getColumn(18).getString();
     r.breakAfter = q.getColumn(19).getInt() != 0;
+    r.replays = q.getColumn(20).getInt();
+    r.lapsDone = q.getColumn(21).getInt();
     if (r.answered) {
         SQLite::Statement rq(db, "SELECT scale, value FROM ratings WHERE trial_id = ?");
         rq.bind(1, trialId);
@@ -792,18 +886,26 @@ void StudyStore::commitAnswer(const std::string& code, int trialIndex, const Tri
                                      code, trialIndex));
     SQLite::Transaction tx(*db_, SQLite::TransactionBehavior::IMMEDIATE);
     const ParticipantInfo p = participant(code);
-    if (const auto problems = checkAnswer(p.groupId, answer); !problems.empty()) {
-        std::string all;
-        for (const auto& s : problems) all += (all.empty() ? "" : "; ") + s;
-        throw StoreError(fmt::format("participant '{}' trial {}: {}", code, trialIndex, all));
-    }
-    SQLite::Statement cur(*db_, "SELECT id, started_at, answered_at FROM trials WHERE "
-                                "participant_id = ? AND trial_index = ?");
+    SQLite::Statement cur(*db_, "SELECT id, started_at, answered_at, stimulus, block, laps_done "
+                                "FROM trials WHERE participant_id = ? AND trial_index = ?");
     cur.bind(1, p.id);
     cur.bind(2, trialIndex);
     if (!cur.executeStep())
         throw StoreError(
             fmt::format("{}: participant '{}' has no trial {}", path_, code, trialIndex));
+    const Stimulus trialStimulus = stimulusFromToml(cur.getColumn(3).getString());
+    if (const auto problems =
+            checkAnswer(p.groupId, answer, trialStimulus, cur.getColumn(4).getInt());
+        !problems.empty()) {
+        std::string all;
+        for (const auto& s : problems) all += (all.empty() ? "" : "; ") + s;
+        throw StoreError(fmt::format("participant '{}' trial {}: {}", code, trialIndex, all));
+    }
+    if (const int laps = protocol_->laps.total();
+        laps > 0 && !cur.getColumn(1).isNull() && cur.getColumn(5).getInt() < laps)
+        throw StoreError(fmt::format("participant '{}' trial {}: {} of {} laps walked; expected "
+                                     "every lap (baseline and feedback) before the questions",
+                                     code, trialIndex, cur.getColumn(5).getInt(), laps));
     const std::int64_t trialId = cur.getColumn(0).getInt64();
     if (cur.getColumn(1).isNull())
         throw StoreError(fmt::format("participant '{}' trial {} has not started; expected its "
@@ -853,6 +955,74 @@ void StudyStore::commitAnswer(const std::string& code, int trialIndex, const Tri
                             {"comment", answer.comment},
                             {"response_time_s",
                              responseTimeS ? fmt::format("{:.3f}", *responseTimeS) : ""}}));
+    tx.commit();
+}
+
+void StudyStore::recordReplay(const std::string& code, int trialIndex) {
+    if (!protocol_->clips.replay)
+        throw StoreError(fmt::format("participant '{}' trial {}: the protocol does not allow "
+                                     "replays ([clips] replay = false)",
+                                     code, trialIndex));
+    SQLite::Transaction tx(*db_, SQLite::TransactionBehavior::IMMEDIATE);
+    const std::int64_t pid = participantId(code);
+    SQLite::Statement cur(*db_, "SELECT started_at, answered_at, replays FROM trials WHERE "
+                                "participant_id = ? AND trial_index = ?");
+    cur.bind(1, pid);
+    cur.bind(2, trialIndex);
+    if (!cur.executeStep())
+        throw StoreError(
+            fmt::format("{}: participant '{}' has no trial {}", path_, code, trialIndex));
+    if (cur.getColumn(0).isNull())
+        throw StoreError(fmt::format("participant '{}' trial {}: replay before the first "
+                                     "presentation; expected play() first",
+                                     code, trialIndex));
+    if (!cur.getColumn(1).isNull())
+        throw StoreError(
+            fmt::format("participant '{}' trial {} is already answered", code, trialIndex));
+    const int replays = cur.getColumn(2).getInt() + 1;
+    SQLite::Statement q(*db_, "UPDATE trials SET replays = ? WHERE participant_id = ? AND "
+                              "trial_index = ?");
+    q.bind(1, replays);
+    q.bind(2, pid);
+    q.bind(3, trialIndex);
+    q.exec();
+    appendEvent("clip_replayed", pid, trialIndex,
+                jsonObject({{"replays", std::to_string(replays)}}));
+    tx.commit();
+}
+
+void StudyStore::recordLap(const std::string& code, int trialIndex, int lap) {
+    const Laps& laps = protocol_->laps;
+    if (lap < 1 || lap > laps.total())
+        throw StoreError(fmt::format("participant '{}' trial {}: lap {} is outside 1 to {}", code,
+                                     trialIndex, lap, laps.total()));
+    SQLite::Transaction tx(*db_, SQLite::TransactionBehavior::IMMEDIATE);
+    const std::int64_t pid = participantId(code);
+    SQLite::Statement cur(*db_, "SELECT started_at, answered_at, laps_done FROM trials WHERE "
+                                "participant_id = ? AND trial_index = ?");
+    cur.bind(1, pid);
+    cur.bind(2, trialIndex);
+    if (!cur.executeStep())
+        throw StoreError(
+            fmt::format("{}: participant '{}' has no trial {}", path_, code, trialIndex));
+    if (cur.getColumn(0).isNull() || !cur.getColumn(1).isNull())
+        throw StoreError(fmt::format("participant '{}' trial {}: laps are recorded between the "
+                                     "start of a condition and its answer",
+                                     code, trialIndex));
+    if (cur.getColumn(2).getInt() != lap - 1)
+        throw StoreError(fmt::format("participant '{}' trial {}: lap {} completed after {} laps; "
+                                     "expected lap {}",
+                                     code, trialIndex, lap, cur.getColumn(2).getInt(),
+                                     cur.getColumn(2).getInt() + 1));
+    SQLite::Statement q(*db_, "UPDATE trials SET laps_done = ? WHERE participant_id = ? AND "
+                              "trial_index = ?");
+    q.bind(1, lap);
+    q.bind(2, pid);
+    q.bind(3, trialIndex);
+    q.exec();
+    appendEvent("lap_completed", pid, trialIndex,
+                jsonObject({{"lap", std::to_string(lap)},
+                            {"sound", laps.silent(lap) ? "silent baseline" : "feedback"}}));
     tx.commit();
 }
 

@@ -31,7 +31,9 @@ struct StoreError : std::runtime_error {
 };
 
 /// Current schema version written by this code.
-inline constexpr int kSchemaVersion = 1;
+/// Version 2 adds clip replay counts and laps walked per trial, and participant fields
+/// (expertise, listening device...); version-1 studies are migrated when opened.
+inline constexpr int kSchemaVersion = 2;
 
 /// Time source (injectable for tests).
 struct Clock {
@@ -95,6 +97,8 @@ struct ParticipantInfo {
     std::string overrideReason;
     ParticipantStatus status = ParticipantStatus::Registered;
     std::string registeredAt;
+    /// Answers to the protocol's [[participant_fields]] (field id -> answer).
+    std::map<std::string, std::string> fields;
 };
 
 /// Participants per group (dropouts excluded) against the target.
@@ -145,6 +149,10 @@ struct TrialRecord {
     bool excluded = false;
     std::string exclusionReason;
     bool breakAfter = false;
+    /// How many times the clip was played again after its first presentation.
+    int replays = 0;
+    /// Laps completed (interactive tests with [laps]).
+    int lapsDone = 0;
 };
 
 /// Everything needed to re-render a trial exactly.
@@ -194,6 +202,13 @@ class StudyStore {
     /// Registers a participant: assigns a group (balanced, or the override with its reason),
     /// generates and stores the plan, journals it; all in one transaction.
     ParticipantInfo registerParticipant(const NewParticipant& participant);
+    /// Registers a participant with answers to the protocol's [[participant_fields]]; unknown
+    /// fields, answers outside a field's options and missing required fields are refused.
+    ParticipantInfo registerParticipant(const NewParticipant& participant,
+                                        const std::map<std::string, std::string>& fields);
+    /// Problems of participant field answers against the protocol (empty: valid).
+    std::vector<std::string>
+    checkParticipantFields(const std::map<std::string, std::string>& fields) const;
     /// Marks a participant as dropped out (frees its group slot); journaled.
     void dropParticipant(const std::string& code, const std::string& reason);
     ParticipantInfo participant(const std::string& code) const;
@@ -223,6 +238,12 @@ class StudyStore {
     /// Validates and commits an answer in its own durable transaction.
     void commitAnswer(const std::string& code, int trialIndex, const TrialAnswer& answer,
                       std::optional<double> responseTimeS);
+    /// Counts one more replay of a started, unanswered trial's clip; journaled. Throws StoreError
+    /// when the trial has not started, is answered, or the protocol forbids replays.
+    void recordReplay(const std::string& code, int trialIndex);
+    /// Records that lap `lap` (1-based) of a started trial was completed (silent or with sound);
+    /// journaled. Laps must be completed in order.
+    void recordLap(const std::string& code, int trialIndex, int lap);
     /// Excludes (or re-includes with an empty reason) a trial from analysis; journaled.
     void setExcluded(const std::string& code, int trialIndex, bool excluded,
                      const std::string& reason);
@@ -240,12 +261,19 @@ class StudyStore {
     /// Validation of an answer against the protocol; returns the problems (empty: valid).
     std::vector<std::string> checkAnswer(const std::string& groupId,
                                          const TrialAnswer& answer) const;
+    /// Validation of an answer to one trial: only the scales asked after that stimulus in that
+    /// block (per-scale blocks, scales restricted to some stimuli) are expected.
+    std::vector<std::string> checkAnswer(const std::string& groupId, const TrialAnswer& answer,
+                                         const Stimulus& stimulus, int block) const;
 
   private:
     StudyStore(std::string path, std::unique_ptr<SQLite::Database> db, Clock clock);
     void configure();
     void loadProtocol(const Catalogue& catalogue);
     std::int64_t participantId(const std::string& code) const;
+    std::vector<std::string> checkAnswerScales(const std::string& groupId,
+                                               const TrialAnswer& answer,
+                                               const std::vector<const Scale*>& asked) const;
     void appendEvent(const std::string& kind, std::optional<std::int64_t> participantId,
                      std::optional<int> trialIndex, const std::string& detail);
     std::string now() const;

@@ -186,7 +186,7 @@ TEST(ExperimentSimulation, BadMatricesAreReportedWithLine) {
 TEST(ExperimentExport, RatingsCarryFactorLevels) {
     TempDir dir;
     StudyStore store = StudyStore::create(
-        dir.file("w.db"), loadProtocol(shipped("wading_listening.toml")), {"WAD", "lab", 8, "t"});
+        dir.file("w.db"), loadProtocol(dataFile("wading_factorial.toml")), {"WAD", "lab", 8, "t"});
     EXPECT_EQ(simulateStudy(store, {{"", ConfusionMatrix{}}}, 1, {}), 13);
     std::ostringstream out;
     EXPECT_EQ(writeRatingsCsv(store, out), 13 * 5);

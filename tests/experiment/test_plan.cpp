@@ -131,7 +131,7 @@ TEST(ExperimentPlan, UnknownGroupIsRefused) {
 }
 
 TEST(ExperimentPlan, SummaryCountsTrialsBreaksAndDuration) {
-    const Protocol p = loadProtocol(shipped("wading_listening.toml"));
+    const Protocol p = loadProtocol(dataFile("wading_factorial.toml"));
     const PlanSummary s = summarizePlans(p, 1, 10);
     ASSERT_EQ(s.groups.size(), 1u);
     EXPECT_EQ(s.groups[0].practiceTrials, 1);

@@ -113,7 +113,7 @@ TEST(ExperimentProtocol, Eurohaptics2010GroupsOverrideModalities) {
 }
 
 TEST(ExperimentProtocol, WadingFactorialGeneratesSixWaterConditionsAndPractice) {
-    const Protocol p = loadProtocol(shipped("wading_listening.toml"));
+    const Protocol p = loadProtocol(dataFile("wading_factorial.toml"));
     EXPECT_FALSE(p.questions.asksSurface());
     ASSERT_EQ(p.groups.size(), 1u);
     ASSERT_EQ(p.groups[0].stimuli.size(), 6u);
@@ -243,7 +243,7 @@ TEST(ExperimentProtocol, ScalesAndOptionsAreChecked) {
 }
 
 TEST(ExperimentProtocol, StimulusTomlRoundTrip) {
-    const Protocol p = loadProtocol(shipped("wading_listening.toml"));
+    const Protocol p = loadProtocol(dataFile("wading_factorial.toml"));
     for (const auto& s : p.stimuli) EXPECT_EQ(stimulusFromToml(stimulusToToml(s)), s) << s.id;
     const Protocol e = loadProtocol(shipped("tvcg2011_exp2.toml"));
     for (const auto& s : e.stimuli) EXPECT_EQ(stimulusFromToml(stimulusToToml(s)), s) << s.id;
