@@ -63,6 +63,7 @@ int channelAt(const toml::node& node, const std::string& file, const std::string
 void rejectUnknownKeys(const toml::table& table, const std::string& file,
                        std::initializer_list<std::string_view> known, const std::string& section) {
     for (const auto& [key, node] : table) {
+        (void)node;
         if (std::find(known.begin(), known.end(), key.str()) == known.end()) {
             std::string list;
             for (auto k : known) list += fmt::format("{}{}", list.empty() ? "" : ", ", k);

@@ -63,7 +63,7 @@ struct LiveEngine::Queues {
 struct LiveEngine::Published {
     std::array<std::atomic<float>, LiveMeters::kMaxChannels> outPeak{}, outRms{}, inPeak{};
     std::atomic<float> grfPeak{0};
-    std::atomic<std::uint64_t> xruns{0}, blocks{0}, frames{0}, swapped{0}, dropped{0};
+    std::atomic<std::uint64_t> xruns{0}, blocks{0}, frames{0}, swapped{0}, retired{0}, dropped{0};
     std::atomic<double> lastBlock{0}, maxBlock{0}, totalBlock{0}, lastLoad{0}, maxLoad{0};
     std::atomic<long long> probe{-1};
     std::atomic<bool> busy{false}; ///< a scene is fading or waits to be handed back
@@ -362,6 +362,7 @@ LiveMeters LiveEngine::meters() const noexcept {
         audioSeconds > 0 ? 100.0 * pub_->totalBlock.load(std::memory_order_relaxed) / audioSeconds
                          : 0.0;
     m.scenesSwapped = pub_->swapped.load(std::memory_order_relaxed);
+    m.scenesRetired = pub_->retired.load(std::memory_order_relaxed);
     m.droppedCommands = pub_->dropped.load(std::memory_order_relaxed);
     m.probeLatencyFrames = pub_->probe.load(std::memory_order_relaxed);
     return m;
@@ -374,6 +375,7 @@ void LiveEngine::resetPeaks() noexcept {
 
 void LiveEngine::retire(LiveScene* scene) noexcept {
     if (!scene) return;
+    pub_->retired.fetch_add(1, std::memory_order_relaxed);
     if (queues_->retired.push(scene)) return;
     for (auto*& p : pending_)
         if (!p) {

@@ -43,6 +43,7 @@ struct LiveMeters {
     double maxLoadPercent = 0;         ///< worst of it
     double averageLoadPercent = 0;     ///< total callback time / total audio time x 100
     std::uint64_t scenesSwapped = 0;   ///< scenes that became current
+    std::uint64_t scenesRetired = 0;   ///< scenes handed back to the main thread
     std::uint64_t droppedCommands = 0; ///< submit() calls refused because the queue was full
     /// Last latency-probe result: frames from the probe impulse leaving an output to it arriving
     /// at an input; -1 = none measured (or still waiting).

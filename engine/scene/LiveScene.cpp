@@ -229,7 +229,7 @@ std::unique_ptr<LiveScene> LiveScene::create(LiveSceneDescription d, const Proce
         s->hapticPairs_ = d.hapticPairs;
         s->hapticGain_ = static_cast<float>(dbToGain(d.hapticGainDb));
         for (auto& f : s->hapticFilter_)
-            f.design(FilterType::Bandpass, 2, spec.sampleRateHz, d.hapticLowHz, d.hapticHighHz);
+            f.design(FilterType::Bandpass, 4, spec.sampleRateHz, d.hapticLowHz, d.hapticHighHz);
         for (auto& b : s->shoe_) b.assign(block, 0.0f);
         for (int v = 0; v < voices; ++v)
             s->voiceShoe_.push_back(voices == 1 ? 2 : (v < voices / 2 ? 0 : 1));

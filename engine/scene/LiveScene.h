@@ -13,7 +13,8 @@
 ///                Convolver), and only when the headphones are in use;
 ///   ambience  -> only with a soundscape (an AmbienceSource the app adapts), only for headphones;
 ///   haptics   -> only when the modality includes haptics: per shoe, that foot's dry voice sum
-///                band-limited to 50-500 Hz (Butterworth, 2nd order per edge) to heel / toe.
+///                band-limited to 50-500 Hz (Butterworth, 4th order per edge: 24 dB/octave) to heel
+///                / toe.
 /// The headphone mix is computed exactly as FootstepScene computes it (same seeds, pan, gains,
 /// order of operations), so a render of the recorded GRF with the same seed is the same samples.
 ///
