@@ -62,10 +62,22 @@ StepCalibrationResult calibrateSteps(const std::vector<ShoeFrame>& recording,
         }
         std::vector<double> d(x.size(), 0.0);
         for (std::size_t i = span; i < x.size(); ++i) d[i] = (x[i] - x[i - span]) * perSecond;
+        // Derivative noise at rest: frames inside a run of at least 2 x 30 frames below
+        // rest + 0.1 range, 30 frames away from both ends (so no rise or fall is included).
         std::vector<double> restNoise;
         const double quiet = st.restLevel + 0.1 * range;
-        for (std::size_t i = span; i < x.size(); ++i)
-            if (x[i] < quiet && x[i - span] < quiet) restNoise.push_back(std::fabs(d[i]));
+        constexpr std::size_t margin = 30;
+        for (std::size_t i = 0; i < x.size();) {
+            if (x[i] >= quiet) {
+                ++i;
+                continue;
+            }
+            std::size_t end = i;
+            while (end < x.size() && x[end] < quiet) ++end;
+            for (std::size_t k = std::max(i + margin, span); k + margin < end; ++k)
+                restNoise.push_back(std::fabs(d[k]));
+            i = end;
+        }
         st.noiseDerivativePerS = percentile(restNoise, 0.999);
         // Strikes: from below low to above mid; derivative peak over the rise.
         const double low = st.restLevel + 0.2 * range, mid = st.restLevel + 0.5 * range;
@@ -97,7 +109,7 @@ StepCalibrationResult calibrateSteps(const std::vector<ShoeFrame>& recording,
         th.restLevel = st.restLevel;
         th.peakLevel = st.peakLevel;
         const double fromStrikes = 0.35 * st.strikePeakP10PerS;
-        const double fromNoise = 3 * st.noiseDerivativePerS;
+        const double fromNoise = 2 * st.noiseDerivativePerS;
         th.onsetDerivativePerS = std::max({fromStrikes, fromNoise, 1.0});
         if (fromNoise >= fromStrikes)
             result.warnings.push_back(fmt::format(

@@ -8,8 +8,9 @@
 ///   rest  = 5th percentile of the pressure, peak = 99th percentile, range = peak - rest
 ///   strikes = rises from below rest + 0.2 range to above rest + 0.5 range; each strike's
 ///             derivative peak is taken over the rise
-///   onset_derivative = max(0.35 x the 10th percentile of strike peaks, 3 x the derivative noise
-///             at rest (99.9th percentile of |d| while below rest + 0.1 range))
+///   onset_derivative = max(0.35 x the 10th percentile of strike peaks, 2 x the derivative noise
+///             at rest (99.9th percentile of |d| inside runs below rest + 0.1 range, 30 frames
+///             away from their ends, so that no rise or fall counts as noise))
 ///   contact = rest + 0.08 range, release = rest + 0.25 range,
 ///   reference_derivative = median strike peak (strength 1).
 /// Thresholds are saved and loaded as TOML, one file per participant.

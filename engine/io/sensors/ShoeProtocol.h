@@ -20,8 +20,8 @@ namespace underfoot::engine {
 
 /// Protocol version this reader understands.
 inline constexpr int kShoeProtocolVersion = 1;
-/// Longest accepted line in bytes (a v1 frame is at most 30).
-inline constexpr std::size_t kShoeMaxLineBytes = 64;
+/// Longest accepted line in bytes (a v1 frame is at most 30, the header about 70).
+inline constexpr std::size_t kShoeMaxLineBytes = 128;
 
 /// What one line was.
 enum class ShoeLineKind : std::uint8_t { Frame, Header, Comment, Rejected };
