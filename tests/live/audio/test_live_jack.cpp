@@ -1,0 +1,345 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The full live path through a real sound server: a JACK server with the dummy driver
+// (`jackd --no-realtime -d dummy -r 48000 -p 64 -C 4 -P 6`) under a server name of its own
+// stands in for the sound card; RtAudio's JACK API opens it as the device "system" (4 in, 6
+// out). Skipped (with the reason) only when jackd is not installed.
+#include "engine/control/GrfFile.h"
+#include "engine/render/Renderer.h"
+#include "engine/scene/LiveEngine.h"
+#include "tests/common/AllocationTrap.h"
+#include "tests/common/ScratchDir.h"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+#include <thread>
+
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+extern char** environ;
+
+namespace eng = underfoot::engine;
+using namespace std::chrono_literals;
+
+namespace {
+
+constexpr int kPeriod = 64;
+
+std::string findProgram(const std::string& name) {
+    const char* path = std::getenv("PATH");
+    std::string p = path ? path : "/usr/bin:/bin";
+    std::size_t start = 0;
+    while (start <= p.size()) {
+        const std::size_t colon = std::min(p.find(':', start), p.size());
+        const auto candidate = std::filesystem::path(p.substr(start, colon - start)) / name;
+        if (access(candidate.c_str(), X_OK) == 0) return candidate.string();
+        start = colon + 1;
+    }
+    return {};
+}
+
+/// Runs a command (argv) to completion; returns its exit status and stdout.
+int run(const std::vector<std::string>& args, std::string* output = nullptr) {
+    std::string cmd;
+    for (const auto& a : args) cmd += "'" + a + "' ";
+    cmd += "2>&1";
+    FILE* f = popen(cmd.c_str(), "r");
+    if (!f) return -1;
+    char buf[512];
+    std::string out;
+    while (std::fgets(buf, sizeof buf, f)) out += buf;
+    const int status = pclose(f);
+    if (output) *output = out;
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+class JackServer : public ::testing::Test {
+  protected:
+    static void SetUpTestSuite() {
+        jackd_ = findProgram("jackd");
+        if (jackd_.empty()) return;
+        serverName_ = "underfoot_test_" + std::to_string(getpid());
+        setenv("JACK_DEFAULT_SERVER", serverName_.c_str(), 1);
+        setenv("JACK_NO_START_SERVER", "1", 1);
+        std::vector<std::string> args{jackd_, "--no-realtime",         "-d", "dummy", "-r", "48000",
+                                      "-p",   std::to_string(kPeriod), "-C", "4",     "-P", "6"};
+        std::vector<char*> argv;
+        for (auto& a : args) argv.push_back(a.data());
+        argv.push_back(nullptr);
+        const auto log = underfoot::test::scratchDir("live_jack") / "jackd.log";
+        posix_spawn_file_actions_t actions;
+        posix_spawn_file_actions_init(&actions);
+        posix_spawn_file_actions_addopen(&actions, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
+                                         0644);
+        posix_spawn_file_actions_adddup2(&actions, 1, 2);
+        if (posix_spawn(&pid_, jackd_.c_str(), &actions, nullptr, argv.data(), environ) != 0)
+            pid_ = -1;
+        posix_spawn_file_actions_destroy(&actions);
+        // Wait (up to 10 s) until the server lists the dummy driver's ports.
+        for (int i = 0; i < 100 && pid_ > 0; ++i) {
+            std::string out;
+            if (run({findProgram("jack_lsp")}, &out) == 0 &&
+                out.find("system:playback_6") != std::string::npos) {
+                ready_ = true;
+                break;
+            }
+            std::this_thread::sleep_for(100ms);
+        }
+    }
+    static void TearDownTestSuite() {
+        if (pid_ > 0) {
+            kill(pid_, SIGTERM);
+            int status = 0;
+            for (int i = 0; i < 50 && waitpid(pid_, &status, WNOHANG) == 0; ++i)
+                std::this_thread::sleep_for(100ms);
+            if (waitpid(pid_, &status, WNOHANG) == 0) {
+                kill(pid_, SIGKILL);
+                waitpid(pid_, &status, 0);
+            }
+            pid_ = -1;
+        }
+    }
+    void SetUp() override {
+        if (jackd_.empty()) GTEST_SKIP() << "jackd is not installed (Debian package jackd2)";
+        ASSERT_TRUE(ready_) << "jackd (server " << serverName_
+                            << ") did not come up within 10 s; see its log in the scratch dir";
+    }
+
+    static eng::AudioSettings settings(const std::string& client) {
+        eng::AudioSettings s;
+        s.api = "jack";
+        s.device = "system";
+        s.sampleRateHz = 48000;
+        s.blockSize = kPeriod;
+        s.channels.headphonesLeft = 0;
+        s.channels.headphonesRight = 1;
+        s.channels.haptic[0] = {2, 3};
+        s.channels.haptic[1] = {4, 5};
+        s.channels.microphones = {0, 1, 2, 3};
+        s.clientName = client;
+        s.portConnection = eng::AudioSettings::PortConnection::Manual;
+        return s;
+    }
+
+    static std::string jackd_, serverName_;
+    static pid_t pid_;
+    static bool ready_;
+};
+
+std::string JackServer::jackd_, JackServer::serverName_;
+pid_t JackServer::pid_ = -1;
+bool JackServer::ready_ = false;
+
+std::unique_ptr<eng::LiveScene> heaviestScene(const eng::LiveEngine& e, std::uint64_t seed) {
+    eng::LiveSceneDescription d;
+    d.surface = "creaking_wood";
+    d.impulseResponse = "hall";
+    d.modality = eng::OutputModality::AudioHaptic;
+    d.seed = seed;
+    return eng::LiveScene::create(std::move(d), e.processSpec(), e.settings().channels);
+}
+
+} // namespace
+
+TEST_F(JackServer, ListsTheDummyDriverAsADevice) {
+    const auto devices = eng::listAudioDevices("jack");
+    bool found = false;
+    for (const auto& d : devices)
+        if (d.name == "system") {
+            found = true;
+            EXPECT_EQ(d.api, "jack");
+            EXPECT_EQ(d.inputChannels, 4);
+            EXPECT_EQ(d.outputChannels, 6);
+            EXPECT_NE(std::find(d.sampleRatesHz.begin(), d.sampleRatesHz.end(), 48000),
+                      d.sampleRatesHz.end());
+        }
+    EXPECT_TRUE(found) << "no JACK device named system";
+}
+
+TEST_F(JackServer, UnknownDeviceAndTooManyChannelsAreClearErrors) {
+    eng::LiveEngine engine;
+    auto s = settings("uf_err");
+    s.device = "no_such_card";
+    try {
+        engine.open(s);
+        FAIL() << "opened an unknown device";
+    } catch (const eng::AudioSettingsError& e) {
+        const std::string msg = e.what();
+        EXPECT_NE(msg.find("\"no_such_card\" not found"), std::string::npos) << msg;
+        EXPECT_NE(msg.find("\"system\" (4 in, 6 out)"), std::string::npos) << msg;
+    }
+    s = settings("uf_err");
+    s.channels.haptic[1].toe = 7; // the dummy card has 6 outputs
+    try {
+        engine.open(s);
+        FAIL() << "opened 8 outputs on a 6-output device";
+    } catch (const eng::AudioSettingsError& e) {
+        EXPECT_NE(std::string(e.what()).find("has 6 output channels"), std::string::npos)
+            << e.what();
+    }
+}
+
+TEST_F(JackServer, RunsTheHeaviestSceneAndPublishesMeters) {
+    eng::LiveEngine engine;
+    engine.open(settings("uf_run"));
+    EXPECT_EQ(engine.openedApi(), "jack");
+    EXPECT_EQ(engine.settings().blockSize, kPeriod);
+    EXPECT_EQ(engine.outputChannels(), 6);
+    EXPECT_EQ(engine.inputChannels(), 4);
+    engine.start();
+    ASSERT_TRUE(engine.submit(heaviestScene(engine, 7)));
+    std::this_thread::sleep_for(3s);
+    const auto m = engine.meters();
+    engine.stop();
+    EXPECT_GT(m.frames, 48000u * 2) << "the dummy driver runs in real time";
+    EXPECT_GT(m.outputPeak[0] + m.outputPeak[1], 0.0f) << "headphones silent?";
+    EXPECT_GT(m.averageLoadPercent, 0.0);
+    EXPECT_GT(m.maxBlockSeconds, 0.0);
+    std::printf("[ jack     ] heaviest scene, 3 s: %llu blocks, %llu xruns, load avg %.1f %% "
+                "max %.1f %%, worst block %.3f ms\n",
+                static_cast<unsigned long long>(m.blocks), static_cast<unsigned long long>(m.xruns),
+                m.averageLoadPercent, m.maxLoadPercent, m.maxBlockSeconds * 1e3);
+    engine.close();
+}
+
+TEST_F(JackServer, LoopbackLatencyIsOneBlock) {
+    eng::LiveEngine engine;
+    engine.open(settings("uf_loop"));
+    engine.start();
+    // Our first output into our first input.
+    std::string out;
+    ASSERT_EQ(run({findProgram("jack_connect"), "uf_loop:outport 0", "uf_loop:inport 0"}, &out), 0)
+        << out;
+    std::this_thread::sleep_for(200ms);
+    std::vector<long long> measured;
+    for (int k = 0; k < 5; ++k) {
+        ASSERT_TRUE(engine.probeLatency(0, 0));
+        long long v = -1;
+        for (int i = 0; i < 200 && v < 0; ++i) {
+            std::this_thread::sleep_for(10ms);
+            v = engine.meters().probeLatencyFrames;
+        }
+        measured.push_back(v);
+    }
+    engine.close();
+    std::printf("[ jack     ] loopback output 1 -> input 1 latency (frames):");
+    for (auto v : measured) std::printf(" %lld", v);
+    std::printf("  (period %d)\n", kPeriod);
+    for (auto v : measured)
+        EXPECT_EQ(v, kPeriod) << "JACK hands a client's output to a connected input one period "
+                                 "later; anything more is latency we added";
+}
+
+namespace {
+std::atomic<bool> trapArmed{false};
+void armTrap() {
+    if (trapArmed.load(std::memory_order_relaxed))
+        underfoot::test::countAllocations.store(true, std::memory_order_relaxed);
+}
+void disarmTrap() {
+    underfoot::test::countAllocations.store(false, std::memory_order_relaxed);
+}
+} // namespace
+
+TEST_F(JackServer, CallbackDoesNotAllocateAcrossSwapsAndMeterReads) {
+    eng::LiveEngine engine;
+    engine.open(settings("uf_alloc"));
+    engine.setCallbackHooks({&armTrap, &disarmTrap});
+    engine.start();
+    std::vector<std::unique_ptr<eng::LiveScene>> scenes;
+    for (int k = 0; k < 8; ++k) {
+        if (k % 2 == 0) {
+            scenes.push_back(heaviestScene(engine, static_cast<std::uint64_t>(k)));
+        } else {
+            eng::LiveSceneDescription d;
+            d.surface = k % 4 == 1 ? "gravel" : "wood";
+            d.control = k == 3 ? eng::ControlKind::Microphones : eng::ControlKind::Walker;
+            d.seed = static_cast<std::uint64_t>(k);
+            scenes.push_back(eng::LiveScene::create(std::move(d), engine.processSpec(),
+                                                    engine.settings().channels));
+        }
+    }
+    // Counts only while the callback runs (the hooks arm and disarm the counter); the main
+    // thread meanwhile only submits pre-built scenes, reads meters and frees retired scenes.
+    underfoot::test::allocationCount = 0;
+    trapArmed = true;
+    const auto blocksBefore = engine.meters().blocks;
+    for (auto& s : scenes) {
+        ASSERT_TRUE(engine.submit(std::move(s)));
+        for (int i = 0; i < 25; ++i) {
+            std::this_thread::sleep_for(10ms);
+            (void)engine.meters();
+        }
+    }
+    engine.submit(nullptr);
+    EXPECT_TRUE(engine.waitIdle(2.0));
+    trapArmed = false;
+    const auto m = engine.meters();
+    engine.close();
+    const long allocations = underfoot::test::allocationCount.load();
+    const auto blocks = m.blocks - blocksBefore;
+    std::printf("[ jack     ] %llu callbacks, 8 swaps + fade-out, %ld allocations, %llu xruns\n",
+                static_cast<unsigned long long>(blocks), allocations,
+                static_cast<unsigned long long>(m.xruns));
+    EXPECT_GT(blocks, 1000u);
+    EXPECT_EQ(m.scenesSwapped, 8u);
+    EXPECT_EQ(m.scenesRetired, 8u);
+    EXPECT_EQ(allocations, 0);
+}
+
+TEST_F(JackServer, RecordedLiveTrialReplaysToWhatWasPlayed) {
+    eng::LiveEngine engine;
+    engine.open(settings("uf_rec"));
+    const auto dir = underfoot::test::scratchDir("live_jack");
+    const auto grfPath = (dir / "trial_grf.wav").string();
+    const auto outPath = (dir / "trial_out.wav").string();
+    eng::LiveSceneDescription d;
+    d.surface = "metal";
+    d.seed = 99;
+    d.grfRecorder = eng::makeGrfRecorder(grfPath, 2, 48000);
+    d.outputRecorder = std::make_shared<eng::AudioRecorder>(outPath, 2, 48000);
+    auto grfRec = d.grfRecorder;
+    auto outRec = d.outputRecorder;
+    engine.start();
+    ASSERT_TRUE(engine.submit(
+        eng::LiveScene::create(std::move(d), engine.processSpec(), engine.settings().channels)));
+    std::this_thread::sleep_for(2500ms);
+    engine.submit(nullptr);
+    ASSERT_TRUE(engine.waitIdle(2.0));
+    engine.close();
+    grfRec->finish();
+    outRec->finish();
+    EXPECT_EQ(grfRec->droppedFrames(), 0u);
+    ASSERT_GT(grfRec->writtenFrames(), 48000u * 2);
+
+    // The recording holds the fade-in at the start and the fade-out at the end; the replay
+    // applies the fade-in identically and is compared up to where the fade-out began
+    // (the output recording's last crossfade_ms).
+    const auto grf = eng::loadGrfFile(grfPath);
+    const auto played = eng::readAudioFile(outPath);
+    eng::RenderOptions o;
+    o.blockSize = kPeriod;
+    o.seed = 99;
+    const auto replay = eng::renderSurface("metal", grf, o);
+    ASSERT_EQ(replay.audio.frames(), played.frames());
+    const int fade = 480;
+    const std::size_t compare =
+        played.frames() - static_cast<std::size_t>((fade + kPeriod - 1) / kPeriod * kPeriod);
+    std::size_t mismatches = 0;
+    for (std::size_t i = 0; i < compare; ++i)
+        for (int c = 0; c < 2; ++c)
+            if (eng::LiveScene::fadeGain(static_cast<std::int64_t>(i), fade) *
+                    replay.audio.at(i, c) !=
+                played.at(i, c))
+                ++mismatches;
+    EXPECT_EQ(mismatches, 0u) << "of " << compare << " frames";
+}
