@@ -62,7 +62,7 @@ class AudioRecorder {
     std::atomic<bool> stop_{false};
     std::string error_;
     std::thread writer_;
-    bool finished_ = false;
+    std::atomic<bool> finished_{false};
 };
 
 } // namespace underfoot::engine

@@ -1,0 +1,216 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "app/wiring/Players.h"
+
+#include "app/wiring/Adapters.h"
+#include "engine/render/Renderer.h"
+#include "soundscapes/Library.h"
+#include "soundscapes/Renderer.h"
+
+#include <fmt/format.h>
+
+#include <filesystem>
+#include <stdexcept>
+
+namespace underfoot::wiring {
+
+namespace fs = std::filesystem;
+namespace exp = underfoot::experiment;
+namespace eng = underfoot::engine;
+
+eng::WalkerParameters walkerFromStimulus(const exp::Parameters& p) {
+    std::string spec;
+    for (const auto& [key, value] : p) {
+        if (!(key == "cadence" || key == "mass" || key == "shoe" || key == "variability"))
+            throw std::invalid_argument(
+                fmt::format("walker parameter `{}` is not one the engine's virtual walker knows "
+                            "(cadence, mass, shoe, variability)",
+                            key));
+        const double* v = std::get_if<double>(&value);
+        if (!v)
+            throw std::invalid_argument(fmt::format("walker parameter `{}` must be a number", key));
+        spec += fmt::format("{}{}={}", spec.empty() ? "" : ",", key, *v);
+    }
+    return spec.empty() ? eng::WalkerParameters{} : eng::WalkerParameters::parse(spec);
+}
+
+eng::LiveSceneDescription describeStimulus(const exp::Stimulus& s, std::uint64_t seed,
+                                           const StimulusSceneOptions& o) {
+    eng::LiveSceneDescription d;
+    d.surface = s.surface;
+    d.seed = seed;
+    if (s.reverb) d.impulseResponse = *s.reverb;
+    switch (s.modalities) {
+    case exp::Modalities::Audio:
+        d.modality = eng::OutputModality::Audio;
+        break;
+    case exp::Modalities::Haptic:
+        d.modality = eng::OutputModality::Haptic;
+        break;
+    case exp::Modalities::AudioHaptic:
+        d.modality = eng::OutputModality::AudioHaptic;
+        break;
+    }
+    if (s.soundscape && d.modality != eng::OutputModality::Haptic)
+        d.ambience = makeSoundscapeAmbience(*s.soundscape);
+    d.hapticPairs = o.hapticPairs;
+    d.hapticGainDb = o.hapticGainDb;
+    if (s.input.kind == exp::InputKind::Walker) {
+        d.control = eng::ControlKind::Walker;
+        d.walker = walkerFromStimulus(s.input.walker);
+        return d;
+    }
+    switch (s.input.sensor) {
+    case exp::SensorKind::Microphones:
+        d.control = eng::ControlKind::Microphones;
+        d.microphones.gain = o.microphoneNewtonsPerFullScale;
+        break;
+    case exp::SensorKind::Fsr:
+        if (!o.fsrSource)
+            throw std::invalid_argument(fmt::format(
+                "stimulus `{}` is driven by the FSR shoes, but no shoe source is connected", s.id));
+        d.control = eng::ControlKind::External;
+        d.external = o.fsrSource;
+        break;
+    case exp::SensorKind::Gyro:
+        if (!o.gyroSource)
+            throw std::invalid_argument(fmt::format(
+                "stimulus `{}` is driven by gyroscopes, but no gyroscope source is connected",
+                s.id));
+        d.control = eng::ControlKind::External;
+        d.external = o.gyroSource;
+        break;
+    case exp::SensorKind::None:
+        throw std::invalid_argument(
+            fmt::format("stimulus `{}` has a sensor input without a sensor kind", s.id));
+    }
+    return d;
+}
+
+LivePlayer::LivePlayer(eng::LiveEngine& engine, LivePlayerOptions options)
+    : engine_(engine), options_(std::move(options)) {}
+
+LivePlayer::~LivePlayer() {
+    try {
+        stop();
+    } catch (...) {
+    }
+}
+
+namespace {
+std::string safeName(const std::string& id) {
+    std::string out;
+    for (char c : id)
+        out += (std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_') ? c : '_';
+    return out.empty() ? "stimulus" : out;
+}
+} // namespace
+
+exp::StimulusStart LivePlayer::start(const exp::Stimulus& stimulus, std::uint64_t plannedSeed) {
+    if (!engine_.isOpen()) throw std::runtime_error("live player: the audio engine is not open");
+    stop();
+    auto d = describeStimulus(stimulus, plannedSeed, options_.scene);
+    const int grfChannels = d.control == eng::ControlKind::Walker ? 2
+                            : d.control == eng::ControlKind::Microphones
+                                ? 1
+                                : d.external->channelCount();
+    exp::StimulusStart result;
+    result.renderSeed = plannedSeed;
+    std::string path;
+    if (!options_.recordingFolder.empty()) {
+        fs::create_directories(options_.recordingFolder);
+        for (int attempt = 0;; ++attempt) {
+            path = (fs::path(options_.recordingFolder) /
+                    fmt::format("grf_{}_{:03d}_seed{}{}.wav", safeName(stimulus.id), ++counter_,
+                                plannedSeed, attempt ? fmt::format("_{}", attempt) : ""))
+                       .string();
+            if (!fs::exists(path)) break;
+        }
+        d.grfRecorder = eng::makeGrfRecorder(path, grfChannels, engine_.processSpec().sampleRateHz);
+    }
+    auto recorder = d.grfRecorder;
+    std::unique_ptr<eng::LiveScene> scene;
+    try {
+        scene = eng::LiveScene::create(std::move(d), engine_.processSpec(),
+                                       engine_.settings().channels);
+    } catch (...) {
+        if (recorder) {
+            recorder->finish();
+            std::error_code ec;
+            fs::remove(path, ec);
+        }
+        throw;
+    }
+    summary_ = scene->summary();
+    if (!engine_.submit(std::move(scene))) {
+        if (recorder) {
+            recorder->finish();
+            std::error_code ec;
+            fs::remove(path, ec);
+        }
+        throw std::runtime_error("live player: the audio thread did not take the scene (command "
+                                 "queue full: is the stream running?)");
+    }
+    recorder_ = recorder;
+    recordingPath_ = path;
+    playing_ = true;
+    if (!path.empty()) {
+        std::string ref = path;
+        if (!options_.studyFolder.empty()) {
+            const auto rel = fs::path(path).lexically_relative(options_.studyFolder);
+            if (!rel.empty() && *rel.begin() != "..") ref = rel.string();
+        }
+        result.grfRecording = ref;
+    }
+    return result;
+}
+
+void LivePlayer::stop() {
+    if (!playing_) return;
+    playing_ = false;
+    engine_.submit(nullptr);
+    // Crossfade plus a margin; a stopped stream hands nothing back (then nothing pushes).
+    engine_.waitIdle(engine_.settings().crossfadeMs * 1e-3 + 2.0);
+    if (recorder_) {
+        recorder_->finish();
+        lastDropped_ = recorder_->droppedFrames();
+        const std::string error = recorder_->error();
+        recorder_.reset();
+        if (!error.empty()) throw std::runtime_error("live player: GRF recording: " + error);
+    }
+}
+
+eng::AudioBuffer renderStimulus(const exp::Stimulus& stimulus, std::uint64_t seed, double seconds,
+                                double rate, int blockSize) {
+    const auto walker = stimulus.input.kind == exp::InputKind::Walker
+                            ? walkerFromStimulus(stimulus.input.walker)
+                            : eng::WalkerParameters{};
+    const auto grf = eng::walkerGrf(walker, seconds, rate, seed);
+    eng::RenderOptions options;
+    options.sampleRateHz = rate;
+    options.blockSize = blockSize;
+    options.seed = seed;
+    options.tailSeconds = 1.0;
+    if (stimulus.reverb) options.scene.impulseResponse = *stimulus.reverb;
+    auto r = eng::renderSurface(stimulus.surface, grf, options);
+    if (stimulus.soundscape && stimulus.modalities != exp::Modalities::Haptic) {
+        // As `underfoot replay` mixes it: same seed, unity gain.
+        soundscapes::SoundscapeRenderer ambience(soundscapes::loadSoundscape(*stimulus.soundscape));
+        ambience.prepare({rate, 1024});
+        ambience.reset(seed);
+        const std::size_t n = r.audio.frames();
+        std::vector<float> l(n), rr(n);
+        ambience.process(l.data(), rr.data(), static_cast<int>(n));
+        for (std::size_t i = 0; i < n; ++i) {
+            r.audio.samples[2 * i] += l[i];
+            r.audio.samples[2 * i + 1] += rr[i];
+        }
+    }
+    return std::move(r.audio);
+}
+
+exp::StimulusStart OfflinePlayer::start(const exp::Stimulus& stimulus, std::uint64_t plannedSeed) {
+    last_ = renderStimulus(stimulus, plannedSeed, seconds_, rate_);
+    return {plannedSeed, std::nullopt};
+}
+
+} // namespace underfoot::wiring

@@ -1,0 +1,106 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+/// The experiment's StimulusPlayer wired to the engine.
+///
+///  - LivePlayer: each start() builds a LiveScene from the stimulus (surface, soundscape,
+///    reverb, modalities, input) off the audio thread, records its GRF channels to a WAV file
+///    next to the study (the path StimulusStart::grfRecording returns, relative to the study's
+///    folder, so `underfoot replay` re-renders the trial), and submits it to a running
+///    LiveEngine with the engine's crossfade; stop() fades it out, waits for the audio thread to
+///    hand it back and closes the recording.
+///  - OfflinePlayer: renders a stimulus to memory (the GUI palette's preview, headless runs):
+///    the virtual walker for `seconds`, the offline renderer, the soundscape mixed in as
+///    `underfoot replay` does. Sensor stimuli are previewed with the default walker.
+#include "engine/io/AudioFile.h"
+#include "engine/scene/LiveEngine.h"
+#include "experiment/Session.h"
+
+#include <array>
+#include <memory>
+#include <optional>
+#include <string>
+
+namespace underfoot::wiring {
+
+/// What the stimulus description does not say.
+struct StimulusSceneOptions {
+    /// GRF sources for sensor inputs (null: such stimuli are refused with a clear error).
+    std::shared_ptr<engine::GrfSource> fsrSource, gyroSource;
+    /// Actuator pairs driven when the stimulus has haptics.
+    std::array<engine::HapticPairs, 2> hapticPairs{engine::HapticPairs::Both,
+                                                   engine::HapticPairs::Both};
+    double hapticGainDb = 0.0;
+    /// Newtons per unit of |x| of the microphones' envelope.
+    double microphoneNewtonsPerFullScale = 1000.0;
+};
+
+/// The engine's walker parameters from a stimulus's `walker = {...}` table. Throws
+/// std::invalid_argument naming the key and what was expected.
+engine::WalkerParameters walkerFromStimulus(const experiment::Parameters& walker);
+
+/// The scene description of a stimulus (the soundscape is loaded here). Throws
+/// std::invalid_argument / DefinitionError / PresetError with a clear message.
+engine::LiveSceneDescription describeStimulus(const experiment::Stimulus& stimulus,
+                                              std::uint64_t seed,
+                                              const StimulusSceneOptions& options = {});
+
+struct LivePlayerOptions {
+    /// Folder receiving the GRF recordings ("" = no recording: replay then needs a walker).
+    std::string recordingFolder;
+    /// Recording paths are returned relative to this folder when they lie inside it (the
+    /// study file's folder, which `underfoot replay` resolves them against).
+    std::string studyFolder;
+    StimulusSceneOptions scene;
+};
+
+/// Plays stimuli live through a LiveEngine that the caller opened and started.
+class LivePlayer final : public experiment::StimulusPlayer {
+  public:
+    LivePlayer(engine::LiveEngine& engine, LivePlayerOptions options);
+    ~LivePlayer() override;
+    /// Throws std::runtime_error (building the scene, creating the recording, a full command
+    /// queue) with the reason; nothing plays then.
+    experiment::StimulusStart start(const experiment::Stimulus& stimulus,
+                                    std::uint64_t plannedSeed) override;
+    void stop() override;
+
+    bool playing() const noexcept { return playing_; }
+    /// The running (or last) scene's one-line summary.
+    const std::string& sceneSummary() const noexcept { return summary_; }
+    /// The absolute path of the running (or last) GRF recording ("" when none).
+    const std::string& recordingPath() const noexcept { return recordingPath_; }
+    /// Frames of the last recording lost to a full ring (0 = complete), after stop().
+    std::uint64_t lastDroppedFrames() const noexcept { return lastDropped_; }
+
+  private:
+    engine::LiveEngine& engine_;
+    LivePlayerOptions options_;
+    std::shared_ptr<engine::AudioRecorder> recorder_;
+    std::string summary_, recordingPath_;
+    std::uint64_t lastDropped_ = 0;
+    int counter_ = 0;
+    bool playing_ = false;
+};
+
+/// Renders `stimulus` offline: `seconds` of the walker (the stimulus's, or the default walker
+/// for sensor inputs) plus a 1 s tail, stereo at `sampleRateHz`, block `blockSize`.
+engine::AudioBuffer renderStimulus(const experiment::Stimulus& stimulus, std::uint64_t seed,
+                                   double seconds, double sampleRateHz = 48000.0,
+                                   int blockSize = 64);
+
+/// A player that renders each started stimulus to memory (lastRender()).
+class OfflinePlayer final : public experiment::StimulusPlayer {
+  public:
+    explicit OfflinePlayer(double seconds = 10.0, double sampleRateHz = 48000.0)
+        : seconds_(seconds), rate_(sampleRateHz) {}
+    experiment::StimulusStart start(const experiment::Stimulus& stimulus,
+                                    std::uint64_t plannedSeed) override;
+    void stop() override {}
+    const engine::AudioBuffer& lastRender() const noexcept { return last_; }
+
+  private:
+    double seconds_, rate_;
+    engine::AudioBuffer last_;
+};
+
+} // namespace underfoot::wiring
