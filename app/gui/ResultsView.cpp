@@ -1,0 +1,374 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "app/gui/ResultsView.h"
+
+#include "analysis/io/TrialCsv.h"
+#include "analysis/report/Export.h"
+#include "app/gui/HeatMap.h"
+#include "app/gui/Replay.h"
+#include "app/gui/StudyContext.h"
+#include "experiment/Export.h"
+
+#include <QComboBox>
+#include <QDir>
+#include <QFile>
+#include <QFileDialog>
+#include <QGroupBox>
+#include <QHBoxLayout>
+#include <QHeaderView>
+#include <QLabel>
+#include <QMetaObject>
+#include <QPointer>
+#include <QProgressBar>
+#include <QPushButton>
+#include <QShortcut>
+#include <QSpinBox>
+#include <QSplitter>
+#include <QTabWidget>
+#include <QTableWidget>
+#include <QVBoxLayout>
+#include <QtConcurrent/QtConcurrent>
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+namespace underfoot::gui {
+
+namespace exp = underfoot::experiment;
+namespace an = underfoot::analysis;
+
+namespace {
+QString q(const std::string& s) {
+    return QString::fromStdString(s);
+}
+QString num(double v, int decimals = 1) {
+    return std::isfinite(v) ? QString::number(v, 'f', decimals) : QString("—");
+}
+QString pval(double p) {
+    if (!std::isfinite(p)) return "—";
+    return p < 0.0001 ? QString("< 0.0001") : QString::number(p, 'g', 3);
+}
+} // namespace
+
+an::AnalysisReport analyzeStudy(const exp::StudyStore& store) {
+    std::ostringstream csv;
+    exp::writeTrialsCsv(store, csv);
+    const auto trials = an::parseTrialCsv(csv.str(), store.path());
+    an::AnalysisOptions options;
+    const auto& p = store.protocol();
+    options.byGroup = p.design == exp::DesignKind::Between;
+    for (const auto& g : p.groups) options.groupOrder.push_back(g.id);
+    if (p.questions.asksSurface()) {
+        options.answers.options.clear();
+        for (const auto& a : p.questions.surfaceOptions)
+            if (a.id != an::kDontKnowId) options.answers.options.push_back({a.id, a.label});
+        options.answers.options.push_back(
+            {std::string(an::kDontKnowId), an::labelFor(an::kDontKnowId)});
+    }
+    auto report = an::analyzeTrials(trials, options);
+    report.title = p.title;
+    report.source = store.path();
+    return report;
+}
+
+QString exportStudy(const QString& studyPath, const QString& folder,
+                    const std::function<void(int, int)>& progress) {
+    try {
+        if (!QDir().mkpath(folder))
+            return QObject::tr("%1: cannot create the folder; choose a writable one.").arg(folder);
+        const auto store = exp::StudyStore::open(studyPath.toStdString());
+        const QDir dir(folder);
+        const int total = 7;
+        int done = 0;
+        const auto write = [&](const QString& name, const auto& fn) {
+            const std::string path = dir.filePath(name).toStdString();
+            std::ofstream out(path, std::ios::binary);
+            if (!out) throw std::runtime_error(path + ": cannot open for writing");
+            fn(out);
+            if (!out.flush()) throw std::runtime_error(path + ": write failed (disk full?)");
+            if (progress) progress(++done, total);
+        };
+        write("trials.csv", [&](std::ostream& o) { exp::writeTrialsCsv(store, o); });
+        write("ratings.csv", [&](std::ostream& o) { exp::writeRatingsCsv(store, o); });
+        write("codebook.md", [&](std::ostream& o) { exp::writeCodebook(store, o); });
+        const auto report = analyzeStudy(store);
+        const std::pair<const char*, an::ReportFormat> formats[] = {
+            {"report.csv", an::ReportFormat::Csv},
+            {"report.md", an::ReportFormat::Markdown},
+            {"report.html", an::ReportFormat::Html},
+            {"report.tex", an::ReportFormat::Latex}};
+        for (const auto& [name, format] : formats)
+            write(name, [&](std::ostream& o) { o << an::renderReport(report, format); });
+    } catch (const std::exception& e) {
+        return QObject::tr("%1\nThe export stopped; files written so far are complete.")
+            .arg(QString::fromStdString(e.what()));
+    }
+    return {};
+}
+
+ResultsView::ResultsView(StudyContext& context, QWidget* parent)
+    : QWidget(parent), context_(context) {
+    group_ = new QComboBox(this);
+    group_->setAccessibleName(tr("Group of the confusion matrix"));
+    auto* groupLabel = new QLabel(tr("&Group:"), this);
+    groupLabel->setBuddy(group_);
+    status_ = new QLabel(this);
+    status_->setAccessibleName(tr("Answers analysed"));
+    exportButton_ = new QPushButton(tr("E&xport all…  (Ctrl+S)"), this);
+    exportButton_->setAccessibleName(tr("Export every table"));
+    exportButton_->setToolTip(tr("trials.csv, ratings.csv, codebook.md and the report as tidy "
+                                 "CSV, Markdown, HTML (heat maps) and LaTeX"));
+    progress_ = new QProgressBar(this);
+    progress_->setAccessibleName(tr("Progress of the export or replay"));
+    progress_->hide();
+    workLabel_ = new QLabel(this);
+    workLabel_->setWordWrap(true);
+    workLabel_->setTextInteractionFlags(Qt::TextSelectableByMouse);
+    auto* top = new QHBoxLayout;
+    top->addWidget(groupLabel);
+    top->addWidget(group_);
+    top->addWidget(status_, 1);
+    top->addWidget(progress_);
+    top->addWidget(exportButton_);
+
+    heatMap_ = new HeatMap(this);
+
+    summary_ = new QTableWidget(0, 9, this);
+    summary_->setHorizontalHeaderLabels({tr("Group"), tr("Surface"), tr("Soundscape"), tr("n"),
+                                         tr("% correct"), tr("% wrong"), tr("% don't know"),
+                                         tr("Realism (correct)"), tr("Quality (all but DK)")});
+    summary_->setAccessibleName(tr("Summary per stimulus"));
+    tests_ = new QTableWidget(0, 10, this);
+    tests_->setHorizontalHeaderLabels({tr("Measure"), tr("Surface"), tr("Groups"), tr("Value A"),
+                                       tr("Value B"), tr("Test"), tr("Statistic"), tr("df"),
+                                       tr("p"), tr("p (Holm)")});
+    tests_->setAccessibleName(tr("Between-group tests"));
+    for (auto* t : {summary_, tests_}) {
+        t->setEditTriggers(QAbstractItemView::NoEditTriggers);
+        t->verticalHeader()->setVisible(false);
+        t->horizontalHeader()->setStretchLastSection(true);
+        t->setAlternatingRowColors(true);
+    }
+
+    auto* replay = new QWidget(this);
+    auto* rl = new QHBoxLayout(replay);
+    replayParticipant_ = new QComboBox(replay);
+    replayParticipant_->setAccessibleName(tr("Participant to replay"));
+    replayTrial_ = new QSpinBox(replay);
+    replayTrial_->setRange(1, 9999);
+    replayTrial_->setAccessibleName(tr("Trial number to replay"));
+    replayButton_ = new QPushButton(tr("Render the trial to WAV…  (Ctrl+Shift+R)"), replay);
+    replayButton_->setAccessibleName(tr("Replay the trial"));
+    auto* pl = new QLabel(tr("P&articipant:"), replay);
+    pl->setBuddy(replayParticipant_);
+    auto* tl = new QLabel(tr("T&rial:"), replay);
+    tl->setBuddy(replayTrial_);
+    rl->addWidget(pl);
+    rl->addWidget(replayParticipant_);
+    rl->addWidget(tl);
+    rl->addWidget(replayTrial_);
+    rl->addWidget(replayButton_);
+    rl->addStretch();
+
+    auto* lower = new QTabWidget(this);
+    lower->addTab(summary_, tr("Summary"));
+    lower->addTab(tests_, tr("Between-group tests"));
+    lower->addTab(replay, tr("Replay"));
+
+    auto* split = new QSplitter(Qt::Vertical, this);
+    split->addWidget(heatMap_);
+    split->addWidget(lower);
+    split->setStretchFactor(0, 3);
+    split->setStretchFactor(1, 2);
+
+    auto* layout = new QVBoxLayout(this);
+    layout->addLayout(top);
+    layout->addWidget(split, 1);
+    layout->addWidget(workLabel_);
+
+    exportWatcher_ = new QFutureWatcher<QString>(this);
+    replayWatcher_ = new QFutureWatcher<QString>(this);
+    connect(exportWatcher_, &QFutureWatcher<QString>::finished, this, [this] {
+        const QString error = exportWatcher_->result();
+        setBusy(false, error.isEmpty() ? tr("Export finished.") : error);
+        emit exportFinished(error);
+    });
+    connect(replayWatcher_, &QFutureWatcher<QString>::finished, this, [this] {
+        const QString text = replayWatcher_->result();
+        const bool ok = text.startsWith("ok:");
+        setBusy(false, ok ? text.mid(3) : text);
+        emit replayFinished(ok ? QString() : text);
+    });
+    connect(group_, &QComboBox::currentIndexChanged, this, &ResultsView::showMatrix);
+    connect(exportButton_, &QPushButton::clicked, this, &ResultsView::chooseExport);
+    connect(replayButton_, &QPushButton::clicked, this, &ResultsView::chooseReplay);
+    auto* scExport = new QShortcut(QKeySequence(Qt::CTRL | Qt::Key_S), this);
+    scExport->setContext(Qt::WidgetWithChildrenShortcut);
+    connect(scExport, &QShortcut::activated, this, &ResultsView::chooseExport);
+    auto* scReplay = new QShortcut(QKeySequence(Qt::CTRL | Qt::SHIFT | Qt::Key_R), this);
+    scReplay->setContext(Qt::WidgetWithChildrenShortcut);
+    connect(scReplay, &QShortcut::activated, this, &ResultsView::chooseReplay);
+    connect(&context_, &StudyContext::dataChanged, this, &ResultsView::refresh);
+    refresh();
+}
+
+QString ResultsView::statusText() const {
+    return status_->text();
+}
+
+bool ResultsView::busy() const {
+    return exportWatcher_->isRunning() || replayWatcher_->isRunning();
+}
+
+void ResultsView::refresh() {
+    report_ = {};
+    summary_->setRowCount(0);
+    tests_->setRowCount(0);
+    const QString previous = group_->currentText();
+    group_->blockSignals(true);
+    group_->clear();
+    if (!context_.hasStudy()) {
+        group_->blockSignals(false);
+        status_->setText(tr("No study open."));
+        heatMap_->setMatrix({});
+        fillReplayParticipants();
+        return;
+    }
+    try {
+        report_ = analyzeStudy(context_.store());
+    } catch (const std::exception& e) {
+        group_->blockSignals(false);
+        status_->setText(tr("The analysis failed: %1").arg(q(e.what())));
+        heatMap_->setMatrix({});
+        return;
+    }
+    for (const auto& c : report_.confusions) group_->addItem(q(c.group));
+    const int again = group_->findText(previous);
+    group_->setCurrentIndex(again >= 0 ? again : 0);
+    group_->blockSignals(false);
+    double n = 0;
+    for (const auto& s : report_.summary) n += s.n;
+    status_->setText(
+        tr("%1 answered trials analysed (practice and excluded trials left out)").arg(n));
+    summary_->setRowCount(static_cast<int>(report_.summary.size()));
+    for (std::size_t i = 0; i < report_.summary.size(); ++i) {
+        const auto& s = report_.summary[i];
+        const QStringList cells = {q(s.group),
+                                   q(s.stimulus.surfaceId),
+                                   q(s.stimulus.soundscapeId),
+                                   QString::number(s.n),
+                                   num(s.correct.percent),
+                                   num(s.wrong.percent),
+                                   num(s.dontKnow.percent),
+                                   num(s.realism.mean, 2),
+                                   num(s.quality.mean, 2)};
+        for (int c = 0; c < cells.size(); ++c)
+            summary_->setItem(static_cast<int>(i), c, new QTableWidgetItem(cells[c]));
+    }
+    summary_->resizeColumnsToContents();
+    tests_->setRowCount(static_cast<int>(report_.comparisons.size()));
+    for (std::size_t i = 0; i < report_.comparisons.size(); ++i) {
+        const auto& c = report_.comparisons[i];
+        QString df;
+        for (double d : c.test.df) df += (df.isEmpty() ? "" : ", ") + num(d, 2);
+        const QStringList cells = {q(an::measureName(c.measure)),
+                                   c.surfaceId.empty() ? tr("(all)") : q(c.surfaceId),
+                                   q(c.groupA) + " vs " + q(c.groupB),
+                                   num(c.valueA, 2),
+                                   num(c.valueB, 2),
+                                   c.test.ok() ? q(c.test.method) : q(c.test.error),
+                                   num(c.test.statistic, 3),
+                                   df,
+                                   pval(c.test.p),
+                                   pval(c.pHolm)};
+        for (int col = 0; col < cells.size(); ++col)
+            tests_->setItem(static_cast<int>(i), col, new QTableWidgetItem(cells[col]));
+    }
+    tests_->resizeColumnsToContents();
+    showMatrix();
+    fillReplayParticipants();
+}
+
+void ResultsView::showMatrix() {
+    const int i = group_->currentIndex();
+    if (i < 0 || i >= static_cast<int>(report_.confusions.size())) {
+        heatMap_->setMatrix({});
+        return;
+    }
+    heatMap_->setMatrix(report_.confusions[static_cast<std::size_t>(i)]);
+}
+
+void ResultsView::fillReplayParticipants() {
+    const QString previous = replayParticipant_->currentText();
+    replayParticipant_->clear();
+    if (!context_.hasStudy()) return;
+    for (const auto& p : context_.store().participants()) replayParticipant_->addItem(q(p.code));
+    const int again = replayParticipant_->findText(previous);
+    if (again >= 0) replayParticipant_->setCurrentIndex(again);
+}
+
+void ResultsView::setBusy(bool busy, const QString& what) {
+    exportButton_->setEnabled(!busy);
+    replayButton_->setEnabled(!busy);
+    progress_->setVisible(busy);
+    workLabel_->setText(what);
+}
+
+void ResultsView::startExport(const QString& folder) {
+    if (!context_.hasStudy() || busy()) return;
+    setBusy(true, tr("Exporting to %1…").arg(QDir::toNativeSeparators(folder)));
+    progress_->setRange(0, 7);
+    progress_->setValue(0);
+    QPointer<QProgressBar> bar = progress_;
+    const QString study = context_.path();
+    exportWatcher_->setFuture(QtConcurrent::run([study, folder, bar] {
+        return exportStudy(study, folder, [bar](int done, int total) {
+            QMetaObject::invokeMethod(
+                bar,
+                [bar, done, total] {
+                    if (!bar) return;
+                    bar->setRange(0, total);
+                    bar->setValue(done);
+                },
+                Qt::QueuedConnection);
+        });
+    }));
+}
+
+void ResultsView::chooseExport() {
+    if (!context_.hasStudy()) return;
+    const QString folder = QFileDialog::getExistingDirectory(
+        this, tr("Export into folder"), QFileInfo(context_.path()).dir().path());
+    if (!folder.isEmpty()) startExport(folder);
+}
+
+void ResultsView::startReplay(const QString& participant, int trialIndex, const QString& wavPath) {
+    if (!context_.hasStudy() || busy()) return;
+    setBusy(true, tr("Rendering trial %1 of %2…").arg(trialIndex + 1).arg(participant));
+    progress_->setRange(0, 0); // busy indicator: the render reports no steps
+    const QString study = context_.path();
+    replayWatcher_->setFuture(QtConcurrent::run([study, participant, trialIndex, wavPath] {
+        const ReplayResult r = renderTrial(study, participant, trialIndex, wavPath);
+        if (!r.error.isEmpty()) return r.error;
+        return QString("ok:") + QObject::tr("%1 — %2 s written to %3")
+                                    .arg(r.description)
+                                    .arg(r.seconds, 0, 'f', 1)
+                                    .arg(QDir::toNativeSeparators(wavPath));
+    }));
+}
+
+void ResultsView::chooseReplay() {
+    if (!context_.hasStudy() || replayParticipant_->currentText().isEmpty()) {
+        workLabel_->setText(tr("Choose a participant and a trial in the Replay tab first."));
+        return;
+    }
+    const QString code = replayParticipant_->currentText();
+    const int trial = replayTrial_->value();
+    const QString suggested =
+        QFileInfo(context_.path()).dir().filePath(QString("%1_trial%2.wav").arg(code).arg(trial));
+    const QString file =
+        QFileDialog::getSaveFileName(this, tr("Render trial to"), suggested, tr("WAV (*.wav)"));
+    if (!file.isEmpty()) startReplay(code, trial - 1, file);
+}
+
+} // namespace underfoot::gui

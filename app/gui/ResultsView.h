@@ -1,0 +1,83 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+/// The Results view: the confusion matrix of the stored answers as a heat map (updated after
+/// every committed answer), the per-stimulus summary, the between-group tests, replay of any
+/// trial to a WAV file, and export of every table (CSV, ratings, codebook, report in tidy CSV,
+/// Markdown, HTML, LaTeX) on a worker thread with a progress bar.
+#include "analysis/tables/Tables.h"
+#include "experiment/Store.h"
+
+#include <QFutureWatcher>
+#include <QWidget>
+
+class QComboBox;
+class QLabel;
+class QTableWidget;
+class QSpinBox;
+class QProgressBar;
+class QPushButton;
+
+namespace underfoot::gui {
+
+class StudyContext;
+class HeatMap;
+
+/// The analysis of a study's answered trials (the protocol's answer order; by group for
+/// between-subject designs), as `underfoot analyze --study` computes it.
+analysis::AnalysisReport analyzeStudy(const experiment::StudyStore& store);
+
+/// Writes every export of the study at `studyPath` into `folder`; `progress(done, total)` is
+/// called after each file. Returns an empty string or what went wrong.
+QString exportStudy(const QString& studyPath, const QString& folder,
+                    const std::function<void(int, int)>& progress);
+
+class ResultsView : public QWidget {
+    Q_OBJECT
+  public:
+    explicit ResultsView(StudyContext& context, QWidget* parent = nullptr);
+
+    /// Recomputes the tables from the store (called after every change).
+    void refresh();
+    /// Starts the export into `folder` on a worker thread; emits exportFinished.
+    void startExport(const QString& folder);
+    /// Starts rendering the selected trial to `wavPath` on a worker thread; emits
+    /// replayFinished.
+    void startReplay(const QString& participant, int trialIndex, const QString& wavPath);
+    bool busy() const;
+
+    HeatMap* heatMap() const { return heatMap_; }
+    QTableWidget* summaryTable() const { return summary_; }
+    QTableWidget* testsTable() const { return tests_; }
+    QComboBox* groupBox() const { return group_; }
+    const analysis::AnalysisReport& report() const { return report_; }
+    QString statusText() const;
+
+  signals:
+    void exportFinished(const QString& error);
+    void replayFinished(const QString& error);
+
+  private:
+    void showMatrix();
+    void chooseExport();
+    void chooseReplay();
+    void fillReplayParticipants();
+    void setBusy(bool busy, const QString& what);
+
+    StudyContext& context_;
+    analysis::AnalysisReport report_;
+    QComboBox* group_;
+    QLabel* status_;
+    HeatMap* heatMap_;
+    QTableWidget* summary_;
+    QTableWidget* tests_;
+    QComboBox* replayParticipant_;
+    QSpinBox* replayTrial_;
+    QPushButton* exportButton_;
+    QPushButton* replayButton_;
+    QProgressBar* progress_;
+    QLabel* workLabel_;
+    QFutureWatcher<QString>* exportWatcher_;
+    QFutureWatcher<QString>* replayWatcher_;
+};
+
+} // namespace underfoot::gui

@@ -1,0 +1,1059 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "app/gui/RunView.h"
+
+#include "app/gui/StudyContext.h"
+#include "app/gui/WalkerPlayer.h"
+#include "experiment/Catalogue.h"
+
+#include <QComboBox>
+#include <QCoreApplication>
+#include <QElapsedTimer>
+#include <QEventLoop>
+#include <QFormLayout>
+#include <QGridLayout>
+#include <QGroupBox>
+#include <QHBoxLayout>
+#include <QInputDialog>
+#include <QKeyEvent>
+#include <QLabel>
+#include <QLineEdit>
+#include <QListWidget>
+#include <QProgressBar>
+#include <QPushButton>
+#include <QRegularExpressionValidator>
+#include <QScrollArea>
+#include <QShortcut>
+#include <QSpinBox>
+#include <QStackedWidget>
+#include <QTimer>
+#include <QVBoxLayout>
+
+namespace underfoot::gui {
+
+namespace exp = underfoot::experiment;
+
+namespace {
+QString q(const std::string& s) {
+    return QString::fromStdString(s);
+}
+
+QString surfaceLabel(const std::string& id) {
+    if (const auto* e = exp::defaultCatalogue().surface(id)) return q(e->label);
+    return q(id);
+}
+QString soundscapeLabel(const std::string& id) {
+    if (const auto* e = exp::defaultCatalogue().soundscape(id)) return q(e->label);
+    return q(id);
+}
+
+enum Page { StartPage, BriefingPage, TrialPage, BreakPage, FinishedPage };
+
+QFont bigFont(const QWidget* w, double factor) {
+    QFont f = w->font();
+    f.setPointSizeF(f.pointSizeF() * factor);
+    return f;
+}
+} // namespace
+
+/// The trial page: receives the trial keys when it (or a child that ignores them) has focus.
+class TrialPanel : public QWidget {
+  public:
+    TrialPanel(RunView* view, QWidget* parent) : QWidget(parent), view_(view) {
+        setFocusPolicy(Qt::StrongFocus);
+    }
+
+  protected:
+    void keyPressEvent(QKeyEvent* event) override {
+        if (view_->handleTrialKey(event->key(), event->modifiers(), event->text()))
+            event->accept();
+        else
+            QWidget::keyPressEvent(event);
+    }
+
+  private:
+    RunView* view_;
+};
+
+RunView::RunView(StudyContext& context, QWidget* parent) : QWidget(parent), context_(context) {
+    player_ = new WalkerPlayer(this);
+    pages_ = new QStackedWidget(this);
+    buildStartPage();
+
+    // Briefing.
+    auto* briefingPage = new QWidget(pages_);
+    auto* bl = new QVBoxLayout(briefingPage);
+    briefing_ = new QLabel(briefingPage);
+    briefing_->setWordWrap(true);
+    briefing_->setTextFormat(Qt::RichText);
+    briefing_->setAccessibleName(tr("Briefing"));
+    auto* startTrials = new QPushButton(tr("Start the trials  (Enter)"), briefingPage);
+    startTrials->setDefault(true);
+    startTrials->setMinimumHeight(48);
+    startTrials->setAccessibleName(tr("Start the trials"));
+    bl->addWidget(briefing_, 1);
+    bl->addWidget(startTrials);
+    pages_->addWidget(briefingPage);
+    connect(startTrials, &QPushButton::clicked, this, [this] {
+        if (!session_ || session_->phase() != exp::SessionPhase::Briefing) return;
+        session_->finishBriefing();
+        showPhase();
+    });
+
+    buildTrialPage();
+
+    // Break.
+    auto* breakPage = new QWidget(pages_);
+    auto* brl = new QVBoxLayout(breakPage);
+    breakLabel_ = new QLabel(breakPage);
+    breakLabel_->setAlignment(Qt::AlignCenter);
+    breakLabel_->setFont(bigFont(this, 1.6));
+    breakLabel_->setAccessibleName(tr("Break"));
+    auto* cont = new QPushButton(tr("Continue after the break  (Enter)"), breakPage);
+    cont->setMinimumHeight(48);
+    cont->setAccessibleName(tr("Continue after the break"));
+    brl->addWidget(breakLabel_, 1);
+    brl->addWidget(cont);
+    pages_->addWidget(breakPage);
+    connect(cont, &QPushButton::clicked, this, [this] {
+        if (!session_ || session_->phase() != exp::SessionPhase::Break) return;
+        session_->finishBreak();
+        showPhase();
+    });
+
+    // Finished.
+    auto* finishedPage = new QWidget(pages_);
+    auto* fl = new QVBoxLayout(finishedPage);
+    finishedLabel_ = new QLabel(finishedPage);
+    finishedLabel_->setAlignment(Qt::AlignCenter);
+    finishedLabel_->setFont(bigFont(this, 1.4));
+    finishedLabel_->setWordWrap(true);
+    auto* again = new QPushButton(tr("Next participant  (Enter)"), finishedPage);
+    again->setMinimumHeight(48);
+    again->setAccessibleName(tr("Next participant"));
+    fl->addWidget(finishedLabel_, 1);
+    fl->addWidget(again);
+    pages_->addWidget(finishedPage);
+    connect(again, &QPushButton::clicked, this, [this] {
+        session_.reset();
+        emit context_.sessionActiveChanged(false);
+        pages_->setCurrentIndex(StartPage);
+        refreshStart();
+        code_->setFocus();
+    });
+
+    // Enter on the briefing, break and finished pages presses their button.
+    for (auto [page, button] : {std::pair{briefingPage, startTrials}, std::pair{breakPage, cont},
+                                std::pair{finishedPage, again}}) {
+        for (auto key : {Qt::Key_Return, Qt::Key_Enter}) {
+            auto* sc = new QShortcut(QKeySequence(key), page);
+            sc->setContext(Qt::WidgetWithChildrenShortcut);
+            connect(sc, &QShortcut::activated, button, &QPushButton::click);
+        }
+        page->setFocusPolicy(Qt::StrongFocus);
+    }
+
+    auto* layout = new QVBoxLayout(this);
+    layout->setContentsMargins(0, 0, 0, 0);
+    layout->addWidget(pages_);
+    connect(player_, &WalkerPlayer::meter, this, &RunView::onMeter);
+    connect(&context_, &StudyContext::studyChanged, this, [this] {
+        closeSession();
+        pages_->setCurrentIndex(StartPage);
+    });
+    connect(&context_, &StudyContext::dataChanged, this, [this] {
+        if (pages_->currentIndex() == StartPage) refreshStart();
+    });
+    refreshStart();
+}
+
+RunView::~RunView() {
+    closeSession();
+}
+
+QWidget* RunView::trialPanel() const {
+    return trial_;
+}
+QString RunView::trialMessage() const {
+    return message_->text();
+}
+
+QString RunView::pageName() const {
+    static const char* names[] = {"start", "briefing", "trial", "break", "finished"};
+    return names[pages_->currentIndex()];
+}
+
+void RunView::buildStartPage() {
+    auto* page = new QWidget(pages_);
+    auto* reg = new QGroupBox(tr("Register a participant"), page);
+    auto* fl = new QFormLayout(reg);
+    const auto addRow = [&](const QString& label, QWidget* field, const QString& name) {
+        auto* l = new QLabel(label, reg);
+        l->setBuddy(field);
+        field->setAccessibleName(name);
+        fl->addRow(l, field);
+    };
+    code_ = new QLineEdit(reg);
+    code_->setPlaceholderText(tr("pseudonymous code, e.g. P014 (never a name)"));
+    code_->setValidator(
+        new QRegularExpressionValidator(QRegularExpression("[A-Za-z0-9_.-]{0,32}"), code_));
+    code_->setAccessibleDescription(tr("Letters, digits, dot, dash, underscore; up to 32"));
+    addRow(tr("&Code:"), code_, tr("Participant code"));
+    age_ = new QSpinBox(reg);
+    age_->setRange(0, 120);
+    age_->setSpecialValueText(tr("not given"));
+    addRow(tr("&Age:"), age_, tr("Age in years"));
+    gender_ = new QComboBox(reg);
+    gender_->setEditable(true);
+    gender_->addItems({"", "female", "male", "non-binary", "prefer not to say"});
+    addRow(tr("&Gender:"), gender_, tr("Gender"));
+    shoes_ = new QLineEdit(reg);
+    shoes_->setPlaceholderText(tr("e.g. trainers, leather soles, sandals"));
+    addRow(tr("S&hoes:"), shoes_, tr("Shoe type"));
+    hearing_ = new QComboBox(reg);
+    hearing_->setEditable(true);
+    hearing_->addItems({"", "normal (self-reported)", "impairment reported", "tested normal"});
+    addRow(tr("Hea&ring:"), hearing_, tr("Hearing"));
+    group_ = new QComboBox(reg);
+    addRow(tr("Gro&up:"), group_, tr("Group assignment"));
+    overrideReason_ = new QLineEdit(reg);
+    overrideReason_->setPlaceholderText(tr("needed when a group is chosen by hand"));
+    addRow(tr("Override r&eason:"), overrideReason_, tr("Reason for overriding the group"));
+    experimenter_ = new QLineEdit(reg);
+    experimenter_->setPlaceholderText(tr("recorded with the session"));
+    addRow(tr("E&xperimenter:"), experimenter_, tr("Experimenter"));
+    auto* registerButton = new QPushButton(tr("Register and start  (Ctrl+Enter)"), reg);
+    registerButton->setMinimumHeight(40);
+    registerButton->setAccessibleName(tr("Register and start"));
+    fl->addRow(registerButton);
+
+    auto* resume = new QGroupBox(tr("Resume or continue a participant"), page);
+    auto* rl = new QVBoxLayout(resume);
+    resumeBanner_ = new QLabel(resume);
+    resumeBanner_->setWordWrap(true);
+    resumeBanner_->setStyleSheet("QLabel { background: #fff3cd; color: #5c4400; padding: 8px; "
+                                 "border: 1px solid #e0c36a; }");
+    resumeBanner_->setAccessibleName(tr("Interrupted session"));
+    resumeList_ = new QListWidget(resume);
+    resumeList_->setAccessibleName(tr("Participants who have not finished"));
+    auto* resumeButton = new QPushButton(tr("Resume selected  (Ctrl+R)"), resume);
+    resumeButton->setMinimumHeight(40);
+    resumeButton->setAccessibleName(tr("Resume the selected participant"));
+    rl->addWidget(resumeBanner_);
+    rl->addWidget(resumeList_, 1);
+    rl->addWidget(resumeButton);
+
+    startMessage_ = new QLabel(page);
+    startMessage_->setWordWrap(true);
+    startMessage_->setAccessibleName(tr("Message"));
+    startMessage_->setTextInteractionFlags(Qt::TextSelectableByMouse);
+
+    auto* top = new QHBoxLayout;
+    top->addWidget(reg, 1);
+    top->addWidget(resume, 1);
+    auto* pl = new QVBoxLayout(page);
+    pl->addLayout(top, 1);
+    pl->addWidget(startMessage_);
+    pages_->addWidget(page);
+
+    connect(registerButton, &QPushButton::clicked, this, &RunView::registerAndStart);
+    for (auto key : {Qt::Key_Return, Qt::Key_Enter}) {
+        auto* sc = new QShortcut(QKeySequence(Qt::CTRL | key), page);
+        sc->setContext(Qt::WidgetWithChildrenShortcut);
+        connect(sc, &QShortcut::activated, this, &RunView::registerAndStart);
+    }
+    const auto resumeSelected = [this] {
+        auto* item = resumeList_->currentItem();
+        if (!item) {
+            startMessage_->setText(tr("Select a participant in the list first (Up/Down)."));
+            return;
+        }
+        startSession(item->data(Qt::UserRole).toString());
+    };
+    connect(resumeButton, &QPushButton::clicked, this, resumeSelected);
+    connect(resumeList_, &QListWidget::itemActivated, this, resumeSelected);
+    auto* scR = new QShortcut(QKeySequence(Qt::CTRL | Qt::Key_R), page);
+    scR->setContext(Qt::WidgetWithChildrenShortcut);
+    connect(scR, &QShortcut::activated, this, resumeSelected);
+}
+
+void RunView::buildTrialPage() {
+    trial_ = new TrialPanel(this, pages_);
+    trial_->setAccessibleName(tr("Trial"));
+    trial_->setAccessibleDescription(
+        tr("Space starts the stimulus; letters choose the answer; digits the rating; Enter "
+           "commits the answer and goes to the next trial"));
+    header_ = new QLabel(trial_);
+    header_->setFont(bigFont(this, 1.5));
+    header_->setAccessibleName(tr("Trial number"));
+    stimulus_ = new QLabel(trial_);
+    stimulus_->setFont(bigFont(this, 1.15));
+    stimulus_->setWordWrap(true);
+    stimulus_->setAccessibleName(tr("What is playing"));
+    lockRule_ = new QLabel(trial_);
+    lockRule_->setStyleSheet("color: palette(mid);");
+
+    auto* meters = new QGroupBox(tr("Walker / sensors"), trial_);
+    auto* ml = new QGridLayout(meters);
+    leftMeter_ = new QProgressBar(meters);
+    rightMeter_ = new QProgressBar(meters);
+    for (auto* m : {leftMeter_, rightMeter_}) {
+        m->setRange(0, 150);
+        m->setFormat("%v % BW");
+        m->setMinimumWidth(160);
+    }
+    leftMeter_->setAccessibleName(tr("Left foot force"));
+    rightMeter_->setAccessibleName(tr("Right foot force"));
+    stepLabel_ = new QLabel(meters);
+    stepLabel_->setFont(bigFont(this, 1.3));
+    stepLabel_->setAccessibleName(tr("Step indicator"));
+    engineLabel_ = new QLabel(meters);
+    engineLabel_->setWordWrap(true);
+    engineLabel_->setAccessibleName(tr("Audio engine status"));
+    ml->addWidget(new QLabel(tr("Left GRF"), meters), 0, 0);
+    ml->addWidget(leftMeter_, 0, 1);
+    ml->addWidget(new QLabel(tr("Right GRF"), meters), 1, 0);
+    ml->addWidget(rightMeter_, 1, 1);
+    ml->addWidget(stepLabel_, 0, 2, 2, 1);
+    ml->addWidget(engineLabel_, 2, 0, 1, 3);
+    ml->setColumnStretch(1, 1);
+
+    playButton_ = new QPushButton(tr("Start stimulus  (Space)"), trial_);
+    playButton_->setMinimumHeight(44);
+    playButton_->setFocusPolicy(Qt::NoFocus);
+    playButton_->setAccessibleName(tr("Start the stimulus"));
+    pausedLabel_ = new QLabel(tr("PAUSED — Ctrl+P resumes"), trial_);
+    pausedLabel_->setStyleSheet("QLabel { background: #ffd7d7; color: #700; padding: 6px; "
+                                "font-weight: bold; }");
+    pausedLabel_->hide();
+
+    sectionsHost_ = new QWidget(trial_);
+    new QVBoxLayout(sectionsHost_);
+    auto* scroll = new QScrollArea(trial_);
+    scroll->setWidget(sectionsHost_);
+    scroll->setWidgetResizable(true);
+    scroll->setFrameShape(QFrame::NoFrame);
+    scroll->setFocusPolicy(Qt::NoFocus);
+
+    comment_ = new QLineEdit(trial_);
+    comment_->setAccessibleName(tr("Comment"));
+    comment_->setPlaceholderText(tr("optional; Enter commits the answer, Esc goes back to the "
+                                    "answer keys"));
+    auto* commentLabel = new QLabel(tr("Co&mment:"), trial_);
+    commentLabel->setBuddy(comment_);
+
+    nextButton_ = new QPushButton(tr("Next  (Enter)"), trial_);
+    nextButton_->setMinimumHeight(44);
+    nextButton_->setFocusPolicy(Qt::NoFocus);
+    nextButton_->setAccessibleName(tr("Commit the answer and go to the next trial"));
+    pauseButton_ = new QPushButton(tr("Pause  (Ctrl+P)"), trial_);
+    pauseButton_->setFocusPolicy(Qt::NoFocus);
+    pauseButton_->setAccessibleName(tr("Pause or resume"));
+    auto* exclude = new QPushButton(tr("Exclude trial…  (Ctrl+E)"), trial_);
+    exclude->setFocusPolicy(Qt::NoFocus);
+    exclude->setAccessibleName(tr("Exclude this trial"));
+    auto* stop = new QPushButton(tr("End session for now  (Ctrl+W)"), trial_);
+    stop->setFocusPolicy(Qt::NoFocus);
+    stop->setAccessibleName(tr("End the session; it can be resumed"));
+    message_ = new QLabel(trial_);
+    message_->setWordWrap(true);
+    message_->setAccessibleName(tr("Message"));
+
+    planList_ = new QListWidget(trial_);
+    planList_->setFocusPolicy(Qt::NoFocus);
+    planList_->setAccessibleName(tr("Trials of this session"));
+    planList_->setMaximumWidth(230);
+
+    auto* left = new QVBoxLayout;
+    left->addWidget(header_);
+    left->addWidget(stimulus_);
+    left->addWidget(lockRule_);
+    auto* topRow = new QHBoxLayout;
+    topRow->addWidget(meters, 1);
+    auto* playCol = new QVBoxLayout;
+    playCol->addWidget(playButton_);
+    playCol->addWidget(pausedLabel_);
+    topRow->addLayout(playCol);
+    left->addLayout(topRow);
+    left->addWidget(scroll, 1);
+    auto* commentRow = new QHBoxLayout;
+    commentRow->addWidget(commentLabel);
+    commentRow->addWidget(comment_, 1);
+    left->addLayout(commentRow);
+    auto* buttons = new QHBoxLayout;
+    buttons->addWidget(nextButton_, 2);
+    buttons->addWidget(pauseButton_);
+    buttons->addWidget(exclude);
+    buttons->addWidget(stop);
+    left->addLayout(buttons);
+    left->addWidget(message_);
+    auto* row = new QHBoxLayout(trial_);
+    row->addLayout(left, 1);
+    row->addWidget(planList_);
+    pages_->addWidget(trial_);
+
+    connect(playButton_, &QPushButton::clicked, this, &RunView::play);
+    connect(nextButton_, &QPushButton::clicked, this, &RunView::next);
+    connect(pauseButton_, &QPushButton::clicked, this, &RunView::togglePause);
+    connect(exclude, &QPushButton::clicked, this, [this] { askExclusion(false); });
+    connect(stop, &QPushButton::clicked, this, [this] { closeSession(); });
+    connect(comment_, &QLineEdit::returnPressed, this, &RunView::next);
+    auto* esc = new QShortcut(QKeySequence(Qt::Key_Escape), comment_);
+    esc->setContext(Qt::WidgetShortcut);
+    connect(esc, &QShortcut::activated, trial_, [this] { trial_->setFocus(); });
+    const auto shortcut = [this](QKeySequence seq, auto fn) {
+        auto* sc = new QShortcut(seq, trial_);
+        sc->setContext(Qt::WidgetWithChildrenShortcut);
+        connect(sc, &QShortcut::activated, this, fn);
+    };
+    shortcut(QKeySequence(Qt::CTRL | Qt::Key_P), [this] { togglePause(); });
+    shortcut(QKeySequence(Qt::CTRL | Qt::Key_E), [this] { askExclusion(false); });
+    shortcut(QKeySequence(Qt::CTRL | Qt::SHIFT | Qt::Key_E), [this] { askExclusion(true); });
+    shortcut(QKeySequence(Qt::CTRL | Qt::Key_W), [this] { closeSession(); });
+}
+
+bool RunView::hasResumable() const {
+    if (!context_.hasStudy()) return false;
+    for (const auto& p : context_.store().participants())
+        if (p.status == exp::ParticipantStatus::Active) return true;
+    return false;
+}
+
+void RunView::refreshStart() {
+    resumeList_->clear();
+    group_->clear();
+    resumeBanner_->hide();
+    if (!context_.hasStudy()) {
+        startMessage_->setText(tr("No study open: create or open one in the Study view (Ctrl+1)."));
+        return;
+    }
+    const auto& store = context_.store();
+    const auto people = store.participants();
+    try {
+        const QString next = q(store.nextGroup(static_cast<int>(people.size())));
+        group_->addItem(tr("balanced assignment (next: %1)").arg(next), QString());
+    } catch (const std::exception& e) {
+        group_->addItem(tr("balanced assignment"), QString());
+        startMessage_->setText(q(e.what()));
+    }
+    for (const auto& g : store.protocol().groups)
+        group_->addItem(tr("override: %1 — %2").arg(q(g.id), q(g.label)), q(g.id));
+    const auto counts = store.progressCounts();
+    QStringList interrupted;
+    for (const auto& p : people) {
+        if (p.status == exp::ParticipantStatus::Completed ||
+            p.status == exp::ParticipantStatus::Dropped)
+            continue;
+        const auto it = counts.find(p.code);
+        const int answered = it == counts.end() ? 0 : it->second.first;
+        const int planned = it == counts.end() ? 0 : it->second.second;
+        auto* item = new QListWidgetItem(tr("%1 — group %2 — %3 of %4 answered (%5)")
+                                             .arg(q(p.code), q(p.groupId))
+                                             .arg(answered)
+                                             .arg(planned)
+                                             .arg(q(exp::toString(p.status))),
+                                         resumeList_);
+        item->setData(Qt::UserRole, q(p.code));
+        if (p.status == exp::ParticipantStatus::Active) {
+            interrupted << tr("%1 at trial %2 of %3").arg(q(p.code)).arg(answered + 1).arg(planned);
+            if (!resumeList_->currentItem()) resumeList_->setCurrentItem(item);
+        }
+    }
+    if (!interrupted.isEmpty()) {
+        resumeBanner_->setText(tr("Interrupted session: %1. Every answer given so far is stored. "
+                                  "Press Ctrl+R to resume.")
+                                   .arg(interrupted.join(", ")));
+        resumeBanner_->show();
+    }
+}
+
+bool RunView::registerAndStart() {
+    if (!context_.hasStudy()) {
+        startMessage_->setText(tr("No study open: create or open one in the Study view (Ctrl+1)."));
+        return false;
+    }
+    if (session_) return false;
+    exp::NewParticipant np;
+    np.code = code_->text().trimmed().toStdString();
+    if (np.code.empty()) {
+        startMessage_->setText(tr("Type the participant's pseudonymous code first (Alt+C)."));
+        code_->setFocus();
+        return false;
+    }
+    if (age_->value() > 0) np.age = age_->value();
+    np.gender = gender_->currentText().trimmed().toStdString();
+    np.shoes = shoes_->text().trimmed().toStdString();
+    np.hearing = hearing_->currentText().trimmed().toStdString();
+    const QString group = group_->currentData().toString();
+    if (!group.isEmpty()) {
+        np.groupOverride = group.toStdString();
+        np.overrideReason = overrideReason_->text().trimmed().toStdString();
+        if (np.overrideReason.empty()) {
+            startMessage_->setText(tr("A group chosen by hand needs a reason (Alt+E), or choose "
+                                      "balanced assignment."));
+            overrideReason_->setFocus();
+            return false;
+        }
+    }
+    try {
+        context_.store().registerParticipant(np);
+    } catch (const std::exception& e) {
+        startMessage_->setText(tr("%1\nNothing was registered; correct the form and press "
+                                  "Ctrl+Enter again.")
+                                   .arg(q(e.what())));
+        return false;
+    }
+    code_->clear();
+    age_->setValue(0);
+    overrideReason_->clear();
+    context_.notifyDataChanged();
+    return startSession(q(np.code));
+}
+
+bool RunView::startSession(const QString& code) {
+    if (!context_.hasStudy() || session_) return false;
+    exp::SessionSettings settings;
+    settings.experimenter = experimenter_->text().trimmed().toStdString();
+    settings.audioConfig = "underfoot-gui: virtual walker meters (no live audio engine in build)";
+    settings.sensorConfig = "none";
+    settings.appVersion = UNDERFOOT_VERSION;
+    try {
+        session_ = std::make_unique<exp::Session>(context_.store(), code.toStdString(), *player_,
+                                                  settings);
+    } catch (const std::exception& e) {
+        startMessage_->setText(q(e.what()));
+        context_.notifyDataChanged();
+        return false;
+    }
+    startMessage_->clear();
+    paused_ = false;
+    emit context_.sessionActiveChanged(true);
+    context_.notifyDataChanged();
+    showPhase();
+    return true;
+}
+
+void RunView::showPhase() {
+    if (!session_) return;
+    const auto& p = context_.store().protocol();
+    switch (session_->phase()) {
+    case exp::SessionPhase::Briefing: {
+        const auto& part = session_->participant();
+        int practice = 0;
+        for (const auto& t : context_.store().trials(part.code)) practice += t.practice ? 1 : 0;
+        briefing_->setText(
+            tr("<h2>%1</h2><p>Participant <b>%2</b>, group <b>%3</b>, session "
+               "%4: %5 trials (%6 practice).</p><p>%7</p><p>Press Enter when the "
+               "briefing is done.</p>")
+                .arg(q(p.title).toHtmlEscaped(), q(part.code).toHtmlEscaped(), q(part.groupId))
+                .arg(session_->sessionNumber())
+                .arg(session_->trialCount())
+                .arg(practice)
+                .arg(q(p.description).toHtmlEscaped().replace("\n", " ")));
+        pages_->setCurrentIndex(BriefingPage);
+        pages_->currentWidget()->setFocus();
+        break;
+    }
+    case exp::SessionPhase::Practice:
+    case exp::SessionPhase::Trial:
+        showTrial();
+        break;
+    case exp::SessionPhase::Break:
+        breakLabel_->setText(tr("Break — %1 of %2 trials answered.\nThe participant may rest. "
+                                "Press Enter to continue.")
+                                 .arg(session_->answeredCount())
+                                 .arg(session_->trialCount()));
+        pages_->setCurrentIndex(BreakPage);
+        pages_->currentWidget()->setFocus();
+        break;
+    case exp::SessionPhase::Finished:
+        finishedLabel_->setText(tr("Session complete: %1 answers stored for %2.\nResults are in "
+                                   "the Results view (Ctrl+3).")
+                                    .arg(session_->answeredCount())
+                                    .arg(q(session_->participant().code)));
+        pages_->setCurrentIndex(FinishedPage);
+        pages_->currentWidget()->setFocus();
+        emit context_.sessionActiveChanged(false);
+        break;
+    }
+}
+
+void RunView::showTrial() {
+    const auto& t = session_->current();
+    const auto& p = context_.store().protocol();
+    header_->setText(tr("%1 %2 of %3 · participant %4 · group %5")
+                         .arg(t.practice ? tr("Practice trial") : tr("Trial"))
+                         .arg(t.index + 1)
+                         .arg(session_->trialCount())
+                         .arg(q(session_->participant().code), q(session_->participant().groupId)));
+    const auto& s = t.stimulus;
+    QString what = tr("<b>%1</b>").arg(surfaceLabel(s.surface).toHtmlEscaped());
+    if (s.soundscape)
+        what += tr(" · soundscape <b>%1</b>").arg(soundscapeLabel(*s.soundscape).toHtmlEscaped());
+    what += tr(" · %1").arg(q(exp::toString(s.modalities)));
+    if (s.reverb) what += tr(" · reverb %1").arg(q(*s.reverb));
+    if (s.input.kind == exp::InputKind::Walker) {
+        QString params;
+        try {
+            params = q(walkerParametersOf(s).toString());
+        } catch (const std::exception&) {
+            params = tr("protocol parameters");
+        }
+        what += tr(" · virtual walker (%1)").arg(params);
+    } else {
+        what += tr(" · sensor: %1").arg(q(exp::toString(s.input.sensor)));
+    }
+    what += tr(" · stimulus <tt>%1</tt>, repetition %2").arg(q(s.id)).arg(t.repetition);
+    stimulus_->setText(what);
+    lockRule_->setText(p.lock == exp::LockRule::OnAnswer
+                           ? tr("Answers are locked once committed (protocol rule).")
+                           : tr("The answer can be changed until the next stimulus starts "
+                                "(protocol rule); Next commits it now."));
+    surface_.clear();
+    soundscape_.clear();
+    ratings_.clear();
+    comment_->clear();
+    pendingDigits_ = -1;
+    rebuildAnswerSections();
+    setActive(0);
+    message_->clear();
+    leftMeter_->setValue(0);
+    rightMeter_->setValue(0);
+    stepLabel_->setText(tr("steps: 0"));
+    playButton_->setEnabled(true);
+    playButton_->setText(tr("Start stimulus  (Space)"));
+    engineLabel_->setText(
+        tr("Audio: no live audio engine in this build — meters follow the virtual walker; xruns "
+           "and CPU load appear here when the live engine is wired in."));
+    // The session's plan, with answered trials ticked.
+    planList_->clear();
+    const auto trials = context_.store().trials(session_->participant().code);
+    for (const auto& tr_ : trials) {
+        auto* item =
+            new QListWidgetItem(QString("%1 %2%3 %4")
+                                    .arg(tr_.answered ? QString::fromUtf8("\u2713") : QString("  "))
+                                    .arg(tr_.index + 1)
+                                    .arg(tr_.practice ? tr(" (practice)") : QString())
+                                    .arg(q(tr_.stimulus.id)),
+                                planList_);
+        if (tr_.excluded) item->setForeground(Qt::gray);
+        if (tr_.index == t.index) {
+            planList_->setCurrentItem(item);
+            QFont f = item->font();
+            f.setBold(true);
+            item->setFont(f);
+        }
+    }
+    pages_->setCurrentIndex(TrialPage);
+    trial_->setFocus();
+}
+
+void RunView::rebuildAnswerSections() {
+    auto* layout = static_cast<QVBoxLayout*>(sectionsHost_->layout());
+    for (auto& s : sections_) delete s.box;
+    sections_.clear();
+    while (auto* item = layout->takeAt(0)) delete item;
+    const auto& q_ = context_.store().protocol().questions;
+    const std::string group = session_->participant().groupId;
+    const auto addOptions = [&](SectionKind kind, const QString& prompt,
+                                const std::vector<exp::AnswerOption>& options) {
+        Section s;
+        s.kind = kind;
+        s.box = new QGroupBox(prompt, sectionsHost_);
+        auto* grid = new QGridLayout(s.box);
+        const int columns = 4;
+        for (std::size_t i = 0; i < options.size(); ++i) {
+            const auto& o = options[i];
+            auto* b =
+                new QPushButton(QString("%1   %2").arg(QChar(o.letter)).arg(q(o.label)), s.box);
+            b->setCheckable(true);
+            b->setFocusPolicy(Qt::NoFocus);
+            b->setMinimumHeight(40);
+            b->setFont(bigFont(this, 1.1));
+            b->setStyleSheet("QPushButton { text-align: left; padding-left: 10px; } "
+                             "QPushButton:checked { background: #1f6feb; color: white; "
+                             "font-weight: bold; }");
+            b->setAccessibleName(tr("Answer %1: %2").arg(QChar(o.letter)).arg(q(o.label)));
+            const char letter = o.letter;
+            connect(b, &QPushButton::clicked, this, [this, kind, letter] {
+                chooseOption(kind, letter);
+                trial_->setFocus();
+            });
+            grid->addWidget(b, static_cast<int>(i) / columns, static_cast<int>(i) % columns);
+            s.buttons.push_back(b);
+        }
+        layout->addWidget(s.box);
+        sections_.push_back(std::move(s));
+    };
+    if (q_.asksSurface())
+        addOptions(SectionKind::Surface,
+                   tr("%1  (keys a–%2)")
+                       .arg(q(q_.surfacePrompt))
+                       .arg(QChar(q_.surfaceOptions.back().letter)),
+                   q_.surfaceOptions);
+    for (std::size_t i = 0; i < q_.scales.size(); ++i) {
+        const auto& sc = q_.scales[i];
+        Section s;
+        s.kind = SectionKind::Scale;
+        s.scale = static_cast<int>(i);
+        s.box = new QGroupBox(tr("%1  (digits %2–%3; %2 = %4, %3 = %5)")
+                                  .arg(q(sc.prompt))
+                                  .arg(sc.min)
+                                  .arg(sc.max)
+                                  .arg(q(sc.minLabel), q(sc.maxLabel)),
+                              sectionsHost_);
+        auto* row = new QHBoxLayout(s.box);
+        for (int v = sc.min; v <= sc.max; ++v) {
+            auto* b = new QPushButton(QString::number(v), s.box);
+            b->setCheckable(true);
+            b->setFocusPolicy(Qt::NoFocus);
+            b->setMinimumSize(48, 40);
+            b->setFont(bigFont(this, 1.1));
+            b->setStyleSheet("QPushButton:checked { background: #1f6feb; color: white; "
+                             "font-weight: bold; }");
+            b->setAccessibleName(tr("%1: %2").arg(q(sc.id)).arg(v));
+            const int section = static_cast<int>(sections_.size());
+            connect(b, &QPushButton::clicked, this, [this, section, v, id = sc.id] {
+                ratings_[id] = v;
+                setActive(section);
+                renderDraft();
+                trial_->setFocus();
+            });
+            row->addWidget(b);
+            s.buttons.push_back(b);
+        }
+        row->addStretch();
+        layout->addWidget(s.box);
+        sections_.push_back(std::move(s));
+    }
+    if (q_.asksSoundscape(group))
+        addOptions(SectionKind::Soundscape,
+                   tr("%1  (keys a–%2 when this section is active; Down moves here)")
+                       .arg(q(q_.soundscapePrompt))
+                       .arg(QChar(q_.soundscapeOptions.back().letter)),
+                   q_.soundscapeOptions);
+    layout->addStretch();
+    comment_->setVisible(q_.comment);
+}
+
+void RunView::setActive(int section) {
+    if (sections_.empty()) return;
+    active_ = std::clamp(section, 0, static_cast<int>(sections_.size()) - 1);
+    pendingDigits_ = -1;
+    for (int i = 0; i < static_cast<int>(sections_.size()); ++i)
+        sections_[static_cast<std::size_t>(i)].box->setStyleSheet(
+            i == active_ ? "QGroupBox { border: 2px solid #1f6feb; border-radius: 4px; "
+                           "margin-top: 1.4em; font-weight: bold; } QGroupBox::title { "
+                           "subcontrol-origin: margin; left: 8px; }"
+                         : "QGroupBox { border: 1px solid palette(mid); border-radius: 4px; "
+                           "margin-top: 1.4em; } QGroupBox::title { subcontrol-origin: margin; "
+                           "left: 8px; }");
+    renderDraft();
+}
+
+void RunView::renderDraft() {
+    const auto& q_ = context_.store().protocol().questions;
+    for (auto& s : sections_) {
+        if (s.kind == SectionKind::Scale) {
+            const auto& sc = q_.scales[static_cast<std::size_t>(s.scale)];
+            const auto it = ratings_.find(sc.id);
+            for (std::size_t i = 0; i < s.buttons.size(); ++i)
+                s.buttons[i]->setChecked(it != ratings_.end() &&
+                                         it->second == sc.min + static_cast<int>(i));
+        } else {
+            const auto& options =
+                s.kind == SectionKind::Surface ? q_.surfaceOptions : q_.soundscapeOptions;
+            const std::string& chosen = s.kind == SectionKind::Surface ? surface_ : soundscape_;
+            for (std::size_t i = 0; i < s.buttons.size(); ++i)
+                s.buttons[i]->setChecked(options[i].id == chosen);
+        }
+    }
+}
+
+void RunView::chooseOption(SectionKind kind, char letter) {
+    const auto& q_ = context_.store().protocol().questions;
+    const exp::AnswerOption* o = kind == SectionKind::Surface ? q_.surfaceOptionByLetter(letter)
+                                                              : q_.soundscapeOptionByLetter(letter);
+    if (!o) {
+        setMessage(tr("No answer has the letter '%1' here.").arg(QChar(letter)));
+        return;
+    }
+    (kind == SectionKind::Surface ? surface_ : soundscape_) = o->id;
+    message_->clear();
+    // Move on to the next section that still needs an answer.
+    for (int i = 0; i < static_cast<int>(sections_.size()); ++i)
+        if (sections_[static_cast<std::size_t>(i)].kind == kind) {
+            setActive(std::min(i + 1, static_cast<int>(sections_.size()) - 1));
+            break;
+        }
+}
+
+void RunView::typeDigit(int digit) {
+    if (sections_.empty()) return;
+    int section = active_;
+    if (sections_[static_cast<std::size_t>(section)].kind != SectionKind::Scale) {
+        section = -1;
+        const auto& q_ = context_.store().protocol().questions;
+        for (int i = 0; i < static_cast<int>(sections_.size()); ++i) {
+            const auto& s = sections_[static_cast<std::size_t>(i)];
+            if (s.kind == SectionKind::Scale &&
+                !ratings_.count(q_.scales[static_cast<std::size_t>(s.scale)].id)) {
+                section = i;
+                break;
+            }
+        }
+        if (section < 0) return;
+        setActive(section);
+    }
+    const auto& sc = context_.store().protocol().questions.scales[static_cast<std::size_t>(
+        sections_[static_cast<std::size_t>(section)].scale)];
+    // Two-digit values (0–10 scales): "1" then "0" gives 10.
+    int value = digit;
+    if (pendingDigits_ >= 0 && pendingDigits_ * 10 + digit <= sc.max)
+        value = pendingDigits_ * 10 + digit;
+    if (value < sc.min || value > sc.max) {
+        setMessage(tr("%1 is outside the scale %2–%3.").arg(value).arg(sc.min).arg(sc.max));
+        pendingDigits_ = -1;
+        return;
+    }
+    ratings_[sc.id] = value;
+    message_->clear();
+    if (value != 0 && value * 10 <= sc.max) {
+        pendingDigits_ = value; // a second digit may follow
+        renderDraft();
+    } else {
+        setActive(section + 1 < static_cast<int>(sections_.size()) ? section + 1 : section);
+    }
+}
+
+void RunView::adjustRating(int delta) {
+    if (sections_.empty()) return;
+    const auto& s = sections_[static_cast<std::size_t>(active_)];
+    if (s.kind != SectionKind::Scale) return;
+    const auto& sc =
+        context_.store().protocol().questions.scales[static_cast<std::size_t>(s.scale)];
+    const auto it = ratings_.find(sc.id);
+    const int from = it == ratings_.end() ? (sc.min + sc.max) / 2 - delta : it->second;
+    ratings_[sc.id] = std::clamp(from + delta, sc.min, sc.max);
+    pendingDigits_ = -1;
+    renderDraft();
+}
+
+bool RunView::handleTrialKey(int key, Qt::KeyboardModifiers modifiers, const QString& text) {
+    if (!session_ || pages_->currentIndex() != TrialPage) return false;
+    if (modifiers & (Qt::ControlModifier | Qt::AltModifier | Qt::MetaModifier)) return false;
+    if (key == Qt::Key_Return || key == Qt::Key_Enter) {
+        next();
+        return true;
+    }
+    if (paused_) {
+        setMessage(tr("Paused: press Ctrl+P to resume first."));
+        return true;
+    }
+    if (key == Qt::Key_Space) {
+        play();
+        return true;
+    }
+    if (key == Qt::Key_Up || key == Qt::Key_Down) {
+        setActive(active_ + (key == Qt::Key_Down ? 1 : -1));
+        return true;
+    }
+    if (key == Qt::Key_Left || key == Qt::Key_Right) {
+        adjustRating(key == Qt::Key_Right ? 1 : -1);
+        return true;
+    }
+    if (text.size() == 1) {
+        const QChar c = text.at(0).toLower();
+        if (c >= 'a' && c <= 'z') {
+            const bool soundscapeActive =
+                !sections_.empty() &&
+                sections_[static_cast<std::size_t>(active_)].kind == SectionKind::Soundscape;
+            const bool hasSurface =
+                !sections_.empty() && sections_.front().kind == SectionKind::Surface;
+            if (soundscapeActive)
+                chooseOption(SectionKind::Soundscape, c.toLatin1());
+            else if (hasSurface)
+                chooseOption(SectionKind::Surface, c.toLatin1());
+            return true;
+        }
+        if (c >= '0' && c <= '9') {
+            typeDigit(c.digitValue());
+            return true;
+        }
+    }
+    return false;
+}
+
+void RunView::play() {
+    if (!session_ || paused_) return;
+    if (session_->phase() != exp::SessionPhase::Trial &&
+        session_->phase() != exp::SessionPhase::Practice)
+        return;
+    if (session_->playing()) return;
+    try {
+        session_->play();
+    } catch (const std::exception& e) {
+        setMessage(tr("%1\nThe stimulus did not start; check the Setup view, then press Space "
+                      "again.")
+                       .arg(q(e.what())));
+        return;
+    }
+    playButton_->setEnabled(false);
+    playButton_->setText(tr("Playing…"));
+    if (!player_->hasSource())
+        engineLabel_->setText(tr("No sensor stream in this build: the stimulus is recorded as "
+                                 "started; enter the participant's answer as usual."));
+    context_.notifyDataChanged();
+}
+
+void RunView::next() {
+    if (!session_ || pages_->currentIndex() != TrialPage) return;
+    if (paused_) {
+        setMessage(tr("Paused: press Ctrl+P to resume first."));
+        return;
+    }
+    if (!session_->playing()) {
+        setMessage(tr("Start the stimulus first (Space); the answer belongs to what was heard."));
+        return;
+    }
+    exp::TrialAnswer a;
+    a.answer = surface_;
+    a.soundscapeAnswer = soundscape_;
+    a.ratings = ratings_;
+    a.comment = comment_->text().trimmed().toStdString();
+    const auto problems = context_.store().checkAnswer(session_->participant().groupId, a);
+    if (!problems.empty()) {
+        QStringList list;
+        for (const auto& p : problems) list << q(p);
+        setMessage(
+            tr("Not stored yet: %1. Complete the answer, then press Enter.").arg(list.join("; ")));
+        return;
+    }
+    QElapsedTimer timer;
+    timer.start();
+    try {
+        session_->answer(a);
+    } catch (const std::exception& e) {
+        setMessage(tr("Not stored: %1").arg(q(e.what())));
+        return;
+    }
+    lastCommitMs_ = static_cast<double>(timer.nsecsElapsed()) * 1e-6;
+    context_.notifyDataChanged();
+    showPhase();
+    if (pages_->currentIndex() == TrialPage)
+        setMessage(tr("Answer stored (%1 ms).").arg(lastCommitMs_, 0, 'f', 1), false);
+}
+
+void RunView::togglePause() {
+    if (!session_ || pages_->currentIndex() != TrialPage) return;
+    paused_ = !paused_;
+    player_->setPaused(paused_);
+    pausedLabel_->setVisible(paused_);
+    pauseButton_->setText(paused_ ? tr("Resume  (Ctrl+P)") : tr("Pause  (Ctrl+P)"));
+    sectionsHost_->setEnabled(!paused_);
+    try {
+        context_.store().journal(paused_ ? "paused" : "resumed", session_->participant().code,
+                                 session_->current().index, "{}");
+    } catch (const std::exception& e) {
+        setMessage(q(e.what()));
+    }
+}
+
+bool RunView::excludeTrial(const QString& reason, bool previous) {
+    if (!session_ || !context_.hasStudy()) return false;
+    if (reason.trimmed().isEmpty()) {
+        setMessage(tr("An exclusion needs a reason (e.g. \"participant stopped walking\")."));
+        return false;
+    }
+    int index = -1;
+    const auto code = session_->participant().code;
+    if (previous) {
+        for (const auto& t : context_.store().trials(code))
+            if (t.answered) index = std::max(index, t.index);
+        if (index < 0) {
+            setMessage(tr("No trial has been answered yet in this session."));
+            return false;
+        }
+    } else {
+        if (session_->phase() != exp::SessionPhase::Trial &&
+            session_->phase() != exp::SessionPhase::Practice)
+            return false;
+        index = session_->current().index;
+    }
+    try {
+        context_.store().setExcluded(code, index, true, reason.trimmed().toStdString());
+    } catch (const std::exception& e) {
+        setMessage(q(e.what()));
+        return false;
+    }
+    setMessage(tr("Trial %1 excluded: %2 (re-include it in the Study view).")
+                   .arg(index + 1)
+                   .arg(reason.trimmed()),
+               false);
+    context_.notifyDataChanged();
+    return true;
+}
+
+void RunView::askExclusion(bool previous) {
+    if (!session_ || pages_->currentIndex() != TrialPage) return;
+    bool ok = false;
+    const QString reason = QInputDialog::getText(
+        this, previous ? tr("Exclude the previous trial") : tr("Exclude this trial"),
+        tr("Reason (stored with the trial; the trial is left out of the analysis):"),
+        QLineEdit::Normal, QString(), &ok);
+    if (ok) excludeTrial(reason, previous);
+    trial_->setFocus();
+}
+
+void RunView::onMeter(const GrfMeter& m) {
+    leftMeter_->setValue(static_cast<int>(std::lround(m.leftBw * 100)));
+    rightMeter_->setValue(static_cast<int>(std::lround(m.rightBw * 100)));
+    QString step = tr("steps: %1").arg(m.steps);
+    if (m.leftStrike) step += QString::fromUtf8("   \u25cf L");
+    if (m.rightStrike) step += QString::fromUtf8("   \u25cf R");
+    stepLabel_->setText(step);
+}
+
+void RunView::setMessage(const QString& text, bool error) {
+    message_->setText(text);
+    message_->setStyleSheet(error ? "QLabel { color: #a00; font-weight: bold; }"
+                                  : "QLabel { color: #176f2c; }");
+}
+
+void RunView::closeSession() {
+    if (!session_) return;
+    try {
+        if (session_->phase() != exp::SessionPhase::Finished) session_->interrupt();
+    } catch (const std::exception&) {
+        // The answers are committed already; only the session row's end could not be written.
+    }
+    session_.reset();
+    player_->stop();
+    paused_ = false;
+    pausedLabel_->hide();
+    sectionsHost_->setEnabled(true);
+    emit context_.sessionActiveChanged(false);
+    if (context_.hasStudy()) context_.notifyDataChanged();
+    pages_->setCurrentIndex(StartPage);
+    refreshStart();
+}
+
+bool RunView::startDemoTrialForScreenshot() {
+    code_->setText("P001");
+    age_->setValue(27);
+    gender_->setCurrentText("female");
+    shoes_->setText("trainers");
+    experimenter_->setText("demo");
+    if (!registerAndStart()) return false;
+    if (session_->phase() == exp::SessionPhase::Briefing) session_->finishBriefing();
+    showPhase();
+    play();
+    handleTrialKey(Qt::Key_B, Qt::NoModifier, "b");
+    handleTrialKey(Qt::Key_5, Qt::NoModifier, "5");
+    // Let the walker run a little so the meters show a step.
+    QElapsedTimer t;
+    t.start();
+    while (t.elapsed() < 700) QCoreApplication::processEvents(QEventLoop::AllEvents, 50);
+    return true;
+}
+
+} // namespace underfoot::gui

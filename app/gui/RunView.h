@@ -1,0 +1,161 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+/// The Run view: register a participant (pseudonymous code, demographics, group) or resume an
+/// interrupted session, then run the trials from the keyboard.
+///
+/// Keyboard map of a trial (also shown on the buttons):
+///   Space         start the stimulus            a–p     surface answer (soundscape answer
+///   1–9, 0        rating of the active scale            when its section is active)
+///   Up / Down     previous / next answer section Left / Right  lower / raise the active rating
+///   Enter         Next: commit the answer        Alt+M   comment field (Esc leaves it)
+///   Ctrl+P        pause / resume                 Ctrl+E  exclude this trial (with a reason)
+///   Ctrl+Shift+E  exclude the previous trial     Ctrl+W  end the session for now (resumable)
+/// Every answer is committed to the study file (durably) by Next before anything else happens.
+#include "experiment/Session.h"
+
+#include <QWidget>
+
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+class QLabel;
+class QLineEdit;
+class QComboBox;
+class QSpinBox;
+class QPushButton;
+class QStackedWidget;
+class QListWidget;
+class QProgressBar;
+class QGroupBox;
+class QPlainTextEdit;
+
+namespace underfoot::gui {
+
+class StudyContext;
+class WalkerPlayer;
+struct GrfMeter;
+class TrialPanel;
+
+class RunView : public QWidget {
+    Q_OBJECT
+  public:
+    explicit RunView(StudyContext& context, QWidget* parent = nullptr);
+    ~RunView() override;
+
+    /// Whether the open study has a participant whose session was interrupted.
+    bool hasResumable() const;
+    /// Registers the participant described by the form and starts the session.
+    bool registerAndStart();
+    /// Starts (or resumes) the session of an existing participant.
+    bool startSession(const QString& code);
+    /// Ends the running session as interrupted (answers are already stored); no-op otherwise.
+    void closeSession();
+    /// Excludes the current (or, with `previous`, the last answered) trial with `reason`.
+    bool excludeTrial(const QString& reason, bool previous = false);
+    /// For screenshots: registers a scratch participant and shows a trial with an answer chosen.
+    bool startDemoTrialForScreenshot();
+
+    /// The running session (nullptr when none).
+    experiment::Session* session() const { return session_.get(); }
+    /// The widget that receives the trial keys (answer letters, digits, Enter, Space).
+    QWidget* trialPanel() const;
+    /// Milliseconds the last Next took to commit the answer to the store.
+    double lastCommitMs() const { return lastCommitMs_; }
+    /// The message line of the trial page (errors say what to do next).
+    QString trialMessage() const;
+    /// Which page is shown: "start", "briefing", "trial", "break", "finished".
+    QString pageName() const;
+
+    // Form fields (exposed for tests).
+    QLineEdit* codeEdit() const { return code_; }
+    QSpinBox* ageBox() const { return age_; }
+    QComboBox* genderBox() const { return gender_; }
+    QComboBox* groupBox() const { return group_; }
+    QListWidget* resumeList() const { return resumeList_; }
+    QLabel* resumeBanner() const { return resumeBanner_; }
+
+  private:
+    friend class TrialPanel;
+    enum class SectionKind { Surface, Scale, Soundscape };
+    struct Section {
+        SectionKind kind = SectionKind::Surface;
+        int scale = -1; ///< index into the protocol's scales
+        QGroupBox* box = nullptr;
+        std::vector<QPushButton*> buttons;
+    };
+
+    void buildStartPage();
+    void buildTrialPage();
+    void refreshStart();
+    void showPhase();
+    void showTrial();
+    void rebuildAnswerSections();
+    void renderDraft();
+    bool handleTrialKey(int key, Qt::KeyboardModifiers modifiers, const QString& text);
+    void chooseOption(SectionKind kind, char letter);
+    void typeDigit(int digit);
+    void adjustRating(int delta);
+    void setActive(int section);
+    void play();
+    void next();
+    void togglePause();
+    void askExclusion(bool previous);
+    void onMeter(const GrfMeter& meter);
+    void setMessage(const QString& text, bool error = true);
+    void endSessionUi();
+
+    StudyContext& context_;
+    WalkerPlayer* player_ = nullptr;
+    std::unique_ptr<experiment::Session> session_;
+    QStackedWidget* pages_ = nullptr;
+
+    // Start page.
+    QLineEdit* code_ = nullptr;
+    QSpinBox* age_ = nullptr;
+    QComboBox* gender_ = nullptr;
+    QLineEdit* shoes_ = nullptr;
+    QComboBox* hearing_ = nullptr;
+    QComboBox* group_ = nullptr;
+    QLineEdit* overrideReason_ = nullptr;
+    QLineEdit* experimenter_ = nullptr;
+    QListWidget* resumeList_ = nullptr;
+    QLabel* resumeBanner_ = nullptr;
+    QLabel* startMessage_ = nullptr;
+
+    // Briefing, break and finished pages.
+    QLabel* briefing_ = nullptr;
+    QLabel* breakLabel_ = nullptr;
+    QLabel* finishedLabel_ = nullptr;
+
+    // Trial page.
+    TrialPanel* trial_ = nullptr;
+    QLabel* header_ = nullptr;
+    QLabel* stimulus_ = nullptr;
+    QLabel* lockRule_ = nullptr;
+    QProgressBar* leftMeter_ = nullptr;
+    QProgressBar* rightMeter_ = nullptr;
+    QLabel* stepLabel_ = nullptr;
+    QLabel* engineLabel_ = nullptr;
+    QPushButton* playButton_ = nullptr;
+    QPushButton* nextButton_ = nullptr;
+    QPushButton* pauseButton_ = nullptr;
+    QLabel* pausedLabel_ = nullptr;
+    QLineEdit* comment_ = nullptr;
+    QLabel* message_ = nullptr;
+    QListWidget* planList_ = nullptr;
+    QWidget* sectionsHost_ = nullptr;
+    std::vector<Section> sections_;
+    int active_ = 0;
+    int pendingDigits_ = -1;
+    bool paused_ = false;
+
+    // The answer being entered for the current trial.
+    std::string surface_;
+    std::string soundscape_;
+    std::map<std::string, int> ratings_;
+    double lastCommitMs_ = 0;
+};
+
+} // namespace underfoot::gui

@@ -1,0 +1,43 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// underfoot-gui: the experimenter's console.
+#include "app/gui/MainWindow.h"
+
+#include <QApplication>
+#include <QCommandLineParser>
+
+int main(int argc, char** argv) {
+    QApplication app(argc, argv);
+    QApplication::setApplicationName("underfoot");
+    QApplication::setOrganizationName("underfoot");
+    QApplication::setApplicationVersion(UNDERFOOT_VERSION);
+    QCommandLineParser parser;
+    parser.setApplicationDescription("Underfoot — the experimenter's console");
+    parser.addHelpOption();
+    parser.addVersionOption();
+    QCommandLineOption studyOption("study", "Open this study file (.db).", "file");
+    QCommandLineOption dataOption("data-dir",
+                                  "Folder of the demo study and saved presets (default: the "
+                                  "user's application data folder).",
+                                  "dir");
+    QCommandLineOption shotOption("screenshot",
+                                  "Render every main view at 1280x800 into DIR as PNG files and "
+                                  "exit.",
+                                  "dir");
+    parser.addOption(studyOption);
+    parser.addOption(dataOption);
+    parser.addOption(shotOption);
+    parser.process(app);
+
+    underfoot::gui::MainWindow::Options options;
+    options.studyPath = parser.value(studyOption);
+    options.dataDir = parser.value(dataOption);
+    underfoot::gui::MainWindow window(options);
+    if (parser.isSet(shotOption)) {
+        window.resize(1280, 800);
+        window.show();
+        const int failures = window.saveScreenshots(parser.value(shotOption));
+        return failures == 0 ? 0 : 1;
+    }
+    window.show();
+    return QApplication::exec();
+}
