@@ -43,7 +43,7 @@ void VirtualGaitParameters::validate() const {
         throw std::invalid_argument(
             fmt::format("virtual gait: cadence = {} steps/min: expected 0 (standing) or [10, 160]",
                         cadenceStepsPerMin));
-    checkRange("stride", strideM, 0.2, 2.5, "m");
+    if (strideM != 0.0) checkRange("stride", strideM, 0.2, 2.5, "m (or 0: from the cadence)");
     checkRange("leg length", legLengthM, 0.5, 1.2, "m");
     checkRange("variability", variability, 0.0, 0.2, "");
 }
@@ -53,7 +53,7 @@ double VirtualGaitParameters::swingSeconds(double strideSeconds) noexcept {
 }
 
 double VirtualGaitParameters::thighExcursionDeg() const noexcept {
-    return 2.0 * std::atan(strideM / (4.0 * legLengthM)) * 180.0 / kPi;
+    return 2.0 * std::atan(effectiveStrideM() / (4.0 * legLengthM)) * 180.0 / kPi;
 }
 
 std::vector<GaitFrame> virtualGait(const VirtualGaitParameters& p, double seconds,

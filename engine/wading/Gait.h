@@ -11,6 +11,7 @@
 ///    stride runs from its heel strike to its next one; its swing is the last Tsw of the stride,
 ///    Tsw = min(0.4 T, 0.25 s + 0.15 T) for stride time T (swing ~40 % of the cycle at normal
 ///    walking, Perry & Burnfield 2010; proportionally shorter when walking very slowly);
+///  - stride: given, or from the cadence (0.6 m + 0.0075 m per step/min);
 ///  - thigh: forward rotation by the hip excursion Th = 2 atan(stride / (4 legLength)) during the
 ///    swing, backward by the same angle during the stance (no drift); shank: forward rotation of
 ///    1.6 Th in the swing, peaking later (mid-to-late swing, when the knee extends; paper Fig. 3),
@@ -36,7 +37,7 @@ inline constexpr double kGaitFrameRateHz = 100.0;
 
 struct VirtualGaitParameters {
     double cadenceStepsPerMin = 63; ///< 0 (standing) or [10, 160] steps per minute
-    double strideM = 1.2;           ///< stride (two steps), [0.2, 2.5] m
+    double strideM = 0;             ///< stride (two steps), [0.2, 2.5] m; 0 = from the cadence
     double legLengthM = 0.9;        ///< hip to ground, [0.5, 1.2] m
     double variability = 0.03;      ///< relative sd of step durations and amplitudes, [0, 0.2]
     /// Throws std::invalid_argument naming the parameter and its range.
@@ -47,6 +48,11 @@ struct VirtualGaitParameters {
     }
     /// Swing duration for a stride time T: min(0.4 T, 0.25 + 0.15 T) seconds.
     static double swingSeconds(double strideSeconds) noexcept;
+    /// The stride used: strideM, or when 0, 0.6 m + 0.0075 m x cadence (0.80 / 1.07 / 1.49 m at
+    /// 27 / 63 / 118 steps/min: step length grows with cadence, Grieve & Gear 1966).
+    double effectiveStrideM() const noexcept {
+        return strideM > 0 ? strideM : 0.6 + 0.0075 * cadenceStepsPerMin;
+    }
     /// Hip (thigh) excursion over a swing, degrees.
     double thighExcursionDeg() const noexcept;
 };

@@ -42,9 +42,10 @@ void validateWadingOptions(const WadingOptions& o) {
         throw WadingOptionError(
             fmt::format("wading option cadence = {}: expected 0 (standing) or [10, 160] steps/min",
                         o.cadenceStepsPerMin));
-    if (!std::isfinite(o.strideM) || o.strideM < 0.2 || o.strideM > 2.5)
-        throw WadingOptionError(
-            fmt::format("wading option stride = {} m: expected [0.2, 2.5] m", o.strideM));
+    if (!std::isfinite(o.strideM) || (o.strideM != 0 && (o.strideM < 0.2 || o.strideM > 2.5)))
+        throw WadingOptionError(fmt::format(
+            "wading option stride = {} m: expected [0.2, 2.5] m or 0 (from the cadence)",
+            o.strideM));
     if (!std::isfinite(o.sampleRateHz) || o.sampleRateHz < 8000 || o.sampleRateHz > 384000)
         throw WadingOptionError(fmt::format(
             "wading option sample rate = {} Hz: expected [8000, 384000] Hz", o.sampleRateHz));
@@ -84,7 +85,8 @@ WadingOptions wadingOptionsFromParameters(const std::map<std::string, std::strin
                     key, value,
                     "slow (27), normal (63), fast (118), standing (0) or steps per minute");
         } else if (key == "stride_m" || key == "stride") {
-            o.strideM = parseNumber(key, value, "a stride in metres, [0.2, 2.5]");
+            o.strideM =
+                parseNumber(key, value, "a stride in metres, [0.2, 2.5], or 0 (from the cadence)");
         } else if (key == "seed") {
             char* end = nullptr;
             errno = 0;

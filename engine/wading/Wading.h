@@ -21,9 +21,9 @@ struct WadingOptions {
     std::string algorithm = "v2";           ///< "v1" (thigh only) or "v2" (thigh + shank)
     std::string filter = "butterworth_5hz"; ///< butterworth_5hz, butterworth_0_8hz, asymmetric
     double cadenceStepsPerMin = 63;         ///< virtual gait cadence; 0 = standing still
-    double strideM = 1.2;                   ///< virtual gait stride (two steps), metres
-    std::uint64_t seed = 1;                 ///< seeds the gait variability and every layer
-    double sampleRateHz = 48000;            ///< output rate
+    double strideM = 0;          ///< virtual gait stride (two steps), metres; 0 = from the cadence
+    std::uint64_t seed = 1;      ///< seeds the gait variability and every layer
+    double sampleRateHz = 48000; ///< output rate
 };
 
 /// A wading option or parameter that is not valid; the message names the key and what it accepts.

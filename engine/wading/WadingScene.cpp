@@ -153,6 +153,8 @@ WadingPreset parseWadingPreset(const std::string& text, const std::string& file)
         s.radiusMinMm = r->number("radius_min_mm", s.radiusMinMm, 0.1, 20, "mm", "", true);
         s.radiusMaxMm = r->number("radius_max_mm", s.radiusMaxMm, 0.1, 30, "mm", "", true);
         s.noiseHz = r->number("noise_hz", s.noiseHz, 100, 15000, "Hz", "burst high-pass", true);
+        s.noiseHighHz =
+            r->number("noise_high_hz", s.noiseHighHz, 500, 20000, "Hz", "burst low-pass", true);
         s.noiseDecayMs =
             r->number("noise_decay_ms", s.noiseDecayMs, 2, 1000, "ms", "burst time constant");
         s.noiseDb = r->number("noise_db", s.noiseDb, -120, 12, "dB", "noise part");
@@ -262,6 +264,8 @@ void WadingScene::prepare(const ProcessSpec& spec) {
         v.splashBubbles.prepare(fsr, 4000);
         v.splashHp.setCoefficients(
             BiquadCoefficients::highpass(fsr, std::min(s.noiseHz, nyq), std::sqrt(0.5)));
+        v.splashLp.setCoefficients(
+            BiquadCoefficients::lowpass(fsr, std::min(s.noiseHighHz, nyq), std::sqrt(0.5)));
         for (auto& g : v.gain) g.setRampSamples(static_cast<int>(std::lround(fsr / 100.0)));
         for (auto& r : v.recording) r = Loop{};
     }
@@ -303,6 +307,7 @@ void WadingScene::reset(std::uint64_t seed) noexcept {
         v.flowHp.reset();
         v.flowLp.reset();
         v.splashHp.reset();
+        v.splashLp.reset();
         v.eqLow.reset();
         v.eqHigh.reset();
         v.flowBubbles.reset(Random::deriveSeed(seed, 10 + s));
@@ -433,8 +438,9 @@ void WadingScene::renderChunk(float* left, float* right, int n) noexcept {
                     }
                     v.splashEnv = snapToZero(v.splashEnv * splashDecayG_);
                     splashRates[i] = static_cast<float>(splashBubbleRate * v.splashEnv);
-                    c[i] = static_cast<float>(splashNoiseGain_ * v.splashEnv *
-                                              v.splashHp.processSample(v.random.bipolar()));
+                    c[i] = static_cast<float>(
+                        splashNoiseGain_ * v.splashEnv *
+                        v.splashLp.processSample(v.splashHp.processSample(v.random.bipolar())));
                 }
                 float tmp[kChunk];
                 std::fill(tmp, tmp + n, 0.0f);

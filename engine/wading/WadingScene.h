@@ -58,7 +58,8 @@ struct SplashParameters {
     double rateHz = 8;            ///< splash events per second
     double bubblesPerSplash = 12; ///< mean bubbles per event
     double radiusMinMm = 1.5, radiusMaxMm = 10;
-    double noiseHz = 1500; ///< high-pass of the noise burst
+    double noiseHz = 1500;      ///< high-pass of the noise burst
+    double noiseHighHz = 16000; ///< low-pass of the noise burst
     double noiseDecayMs = 60;
     double noiseDb = 0;
     double bubbleDb = 0;
@@ -133,7 +134,7 @@ class WadingScene {
         BubbleStream bubbles;
         // splash
         BubbleStream splashBubbles;
-        Biquad splashHp;
+        Biquad splashHp, splashLp;
         double splashEnv = 0;
         double splashWait = 0;
         Random random;

@@ -1,0 +1,202 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// `underfoot wade`: the wading simulation (STUDIES.md §4), offline.
+//   wade --depth deep --algo v2 --cadence 63 --seconds 20 -o wade.wav   virtual gait
+//   wade --gait recording.csv -o wade.wav                                recorded gait
+//   wade --write-gait gait.csv --cadence 63 --seconds 20                 virtual gait as CSV
+//   wade --latency [--algo v1] [--filter ...]                            measured latencies
+// Bad arguments exit with status 2 and a message naming the option and what it accepts.
+#include "app/cli/CommandRegistry.h"
+#include "engine/io/AudioFile.h"
+#include "engine/render/AudioFeatures.h"
+#include "engine/render/Renderer.h"
+#include "engine/surfaces/Preset.h"
+#include "engine/wading/Gait.h"
+#include "engine/wading/Wading.h"
+#include "engine/wading/WadingLatency.h"
+
+#include <fmt/core.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+
+namespace underfoot::cli {
+namespace {
+namespace eng = underfoot::engine;
+
+struct WadeArgs {
+    std::string depth = "shallow";
+    std::string algo = "v2";
+    std::string filter = "butterworth_5hz";
+    std::string cadence = "63";
+    std::string stride = "0";
+    std::string seconds = "20";
+    std::string seed = "1";
+    std::string rate = "48000";
+    std::string gait;
+    std::string output;
+    std::string writeGait;
+    std::string format = "pcm24";
+    std::string block = "256";
+    bool latency = false;
+    bool report = false;
+};
+
+WadeArgs& args() {
+    static WadeArgs a;
+    return a;
+}
+
+double number(const std::string& option, const std::string& text, double lo, double hi,
+              const char* expected) {
+    errno = 0;
+    char* end = nullptr;
+    const double v = std::strtod(text.c_str(), &end);
+    if (text.empty() || end != text.c_str() + text.size() || !std::isfinite(v) || errno == ERANGE ||
+        v < lo || v > hi)
+        throw UserError(fmt::format("{} \"{}\": expected {}", option, text, expected));
+    return v;
+}
+
+eng::WadingOptions options(const WadeArgs& a) {
+    std::map<std::string, std::string> p{
+        {"algorithm", a.algo}, {"filter", a.filter}, {"cadence", a.cadence}, {"seed", a.seed}};
+    eng::WadingOptions o;
+    try {
+        o = eng::wadingOptionsFromParameters(p);
+    } catch (const eng::WadingOptionError& e) {
+        throw UserError(
+            fmt::format("wade: {} (options --algo, --filter, --cadence, --seed)", e.what()));
+    }
+    o.depth = a.depth; // a name or a preset path (checked when loaded)
+    o.strideM = number("--stride", a.stride, 0, 2.5, "a stride in metres, [0.2, 2.5] (0: auto)");
+    if (o.strideM > 0 && o.strideM < 0.2)
+        throw UserError("--stride \"" + a.stride + "\": expected [0.2, 2.5] m or 0 (auto)");
+    o.sampleRateHz = number("--rate", a.rate, 8000, 384000, "a sample rate in [8000, 384000] Hz");
+    return o;
+}
+
+eng::SampleFormat format(const std::string& f) {
+    if (f == "pcm16") return eng::SampleFormat::Pcm16;
+    if (f == "pcm24") return eng::SampleFormat::Pcm24;
+    if (f == "float") return eng::SampleFormat::Float32;
+    throw UserError("--format \"" + f + "\": expected pcm16, pcm24 or float");
+}
+
+int runWade(const WadeArgs& a) {
+    const eng::WadingOptions o = options(a);
+    const double seconds =
+        number("--seconds", a.seconds, 0.01, 3600, "a duration in (0, 3600] seconds");
+    try {
+        if (a.latency) {
+            const int block = static_cast<int>(
+                number("--block", a.block, 1, 8192, "an audio block size in [1, 8192] samples"));
+            const auto r = eng::measureWadingLatency(o, block);
+            fmt::print("wade latency: depth {}, algorithm {}, filter {}, {} Hz, block {} "
+                       "samples ({:.2f} ms), sensor frames every {:.0f} ms\n",
+                       o.depth, o.algorithm, o.filter, o.sampleRateHz, block, r.blockMs,
+                       r.framePeriodMs);
+            fmt::print("  plumbing: frame arrival -> first changed sample  {:7.2f} ms\n",
+                       r.firstChangeMs);
+            fmt::print("            frame arrival -> first sample > -60 dBFS {:7.2f} ms\n",
+                       r.firstAudibleMs);
+            fmt::print("  dynamics: frame arrival -> within 6 dB of settled {:7.2f} ms\n",
+                       r.withinSixDbMs);
+            fmt::print("  low-pass group delay: {:.1f} ms at 0 Hz, {:.1f} ms at 1 Hz (left "
+                       "thigh); right thigh {:.1f} ms at 0 Hz\n",
+                       r.groupDelayDcMs, r.groupDelay1HzMs, r.rightGroupDelayDcMs);
+            return 0;
+        }
+        if (!a.writeGait.empty()) {
+            if (!a.gait.empty())
+                throw UserError("wade: --write-gait writes the virtual gait; do not give --gait");
+            eng::VirtualGaitParameters p;
+            p.cadenceStepsPerMin = o.cadenceStepsPerMin;
+            p.strideM = o.strideM;
+            const auto frames = eng::virtualGait(p, seconds, o.seed);
+            eng::writeGaitCsv(a.writeGait, frames);
+            fmt::print("wrote {}: {} frames at 100 Hz ({} s), cadence {} steps/min, stride {:.2f} "
+                       "m, seed {}\n",
+                       a.writeGait, frames.size(), seconds, o.cadenceStepsPerMin,
+                       p.effectiveStrideM(), o.seed);
+            if (a.output.empty()) return 0;
+        }
+        if (a.output.empty())
+            throw UserError("wade: -o FILE.wav is required (or --write-gait FILE.csv, --latency)");
+        const eng::SampleFormat fmtOut = format(a.format);
+        const double cpu0 = eng::threadCpuSeconds();
+        eng::AudioBuffer audio;
+        std::string source;
+        if (!a.gait.empty()) {
+            bool shanks = true;
+            const auto frames = eng::readGaitCsv(a.gait, &shanks);
+            if (!shanks && o.algorithm == "v2")
+                fmt::print(stderr,
+                           "underfoot: warning: {} has no shank columns; algorithm v2 "
+                           "hears only the thighs (bubbling and splash stay silent)\n",
+                           a.gait);
+            audio = eng::renderWading(o, frames);
+            source = a.gait;
+        } else {
+            audio = eng::renderWading(o, seconds);
+            eng::VirtualGaitParameters p;
+            p.cadenceStepsPerMin = o.cadenceStepsPerMin;
+            p.strideM = o.strideM;
+            source = fmt::format("virtual gait, cadence {} steps/min, stride {:.2f} m",
+                                 o.cadenceStepsPerMin, p.effectiveStrideM());
+        }
+        const double cpu = eng::threadCpuSeconds() - cpu0;
+        eng::writeAudioFile(a.output, audio, fmtOut);
+        fmt::print("wrote {}: {:.2f} s stereo at {} Hz; depth {}, algorithm {}, filter {}, seed "
+                   "{}; {}\n",
+                   a.output, audio.durationSeconds(), o.sampleRateHz, o.depth, o.algorithm,
+                   o.filter, o.seed, source);
+        if (a.report) {
+            const auto f = eng::computeFeatures(audio);
+            fmt::print("  peak {:.1f} dBFS, RMS {:.1f} dBFS (active frames), centroid {:.0f} Hz, "
+                       "low share {:.2f}, high share {:.2f}; {:.1f}x real time ({:.3f} s CPU)\n",
+                       f.peakDb, f.rmsDb, f.centroidHz, f.lowShare, f.highShare,
+                       cpu > 0 ? audio.durationSeconds() / cpu : 0.0, cpu);
+        }
+    } catch (const eng::WadingOptionError& e) {
+        throw UserError(e.what());
+    } catch (const eng::PresetError& e) {
+        throw UserError(fmt::format("--depth: {}", e.what()));
+    } catch (const eng::GaitFileError& e) {
+        throw UserError(fmt::format("--gait: {}", e.what()));
+    } catch (const eng::FileError& e) {
+        throw UserError(e.what());
+    } catch (const std::invalid_argument& e) {
+        throw UserError(e.what());
+    }
+    return 0;
+}
+
+const CommandRegistrar registrar{
+    "wade", [](CLI::App& app, int& exitCode) {
+        WadeArgs& a = args();
+        auto* cmd = app.add_subcommand(
+            "wade", "Wading through water driven by leg gyroscopes (virtual or recorded gait)");
+        cmd->add_option("--depth", a.depth, "shallow (ankle), deep (thigh) or a preset .toml");
+        cmd->add_option("--algo,--algorithm", a.algo, "v1 (thigh only) or v2 (thigh + shank)");
+        cmd->add_option("--filter", a.filter,
+                        "gyroscope low-pass: butterworth_5hz, butterworth_0_8hz or asymmetric");
+        cmd->add_option("--cadence", a.cadence,
+                        "virtual gait: slow (27), normal (63), fast (118) or steps/min; 0 stands");
+        cmd->add_option("--stride", a.stride,
+                        "virtual gait stride in metres (default 0: from the cadence)");
+        cmd->add_option("--seconds", a.seconds, "duration of the virtual gait (default 20)");
+        cmd->add_option("--seed", a.seed, "seed of the gait variability and the layers");
+        cmd->add_option("--rate", a.rate, "output sample rate in Hz (default 48000)");
+        cmd->add_option("--gait", a.gait, "recorded gait CSV (time_s, left/right thigh/shank)");
+        cmd->add_option("-o,--output", a.output, "output .wav or .flac");
+        cmd->add_option("--format", a.format, "pcm24 (default), pcm16 or float");
+        cmd->add_option("--write-gait", a.writeGait, "write the virtual gait as CSV");
+        cmd->add_flag("--latency", a.latency, "measure the latency from a gyroscope frame");
+        cmd->add_option("--block", a.block, "audio block size for --latency (default 256)");
+        cmd->add_flag("--report", a.report, "print level, spectral centroid and CPU cost");
+        cmd->callback([&exitCode, &a] { exitCode = runWade(a); });
+    }};
+
+} // namespace
+} // namespace underfoot::cli

@@ -1,0 +1,270 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The wading scene and the rendering API: silence at rest, louder and brighter with faster
+// swing, deep louder and lower than shallow, determinism, no allocation in process(), input
+// rejection, presets, options, recordings.
+#include "engine/render/AudioFeatures.h"
+#include "engine/wading/Gait.h"
+#include "engine/wading/Wading.h"
+#include "engine/wading/WadingScene.h"
+#include "tests/common/AllocationTrap.h"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+
+namespace {
+using namespace underfoot::engine;
+
+WadingOptions opts(const std::string& depth, double cadence, const std::string& algo = "v2") {
+    WadingOptions o;
+    o.depth = depth;
+    o.cadenceStepsPerMin = cadence;
+    o.algorithm = algo;
+    return o;
+}
+
+double peakAbs(const AudioBuffer& a) {
+    double m = 0;
+    for (float v : a.samples) m = std::max(m, double(std::fabs(v)));
+    return m;
+}
+
+TEST(WadingScene, SilentWhenStandingStill) {
+    for (const char* algo : {"v1", "v2"})
+        for (const char* depth : {"shallow", "deep"}) {
+            const auto a = renderWading(opts(depth, 0, algo), 3.0);
+            EXPECT_EQ(peakAbs(a), 0.0) << depth << " " << algo;
+        }
+}
+
+TEST(WadingScene, LouderAndBrighterWithFasterSwing) {
+    for (const char* depth : {"shallow", "deep"}) {
+        AudioFeatures prev;
+        bool first = true;
+        for (double cadence : {27.0, 63.0, 118.0}) {
+            const auto a = renderWading(opts(depth, cadence), 12.0);
+            const auto f = computeFeatures(a);
+            std::printf("[ measured ] %s v2 %.0f steps/min: RMS %.1f dBFS, peak %.1f dBFS, "
+                        "centroid %.0f Hz\n",
+                        depth, cadence, f.rmsDb, f.peakDb, f.centroidHz);
+            EXPECT_LT(f.peakDb, -1.0) << depth << " " << cadence; // headroom
+            if (!first) {
+                EXPECT_GT(f.rmsDb, prev.rmsDb + 1.0) << depth << " " << cadence;
+                EXPECT_GT(f.centroidHz, prev.centroidHz) << depth << " " << cadence;
+            }
+            prev = f;
+            first = false;
+        }
+    }
+}
+
+TEST(WadingScene, DeepIsLouderAndLowerThanShallow) {
+    for (double cadence : {27.0, 63.0, 118.0})
+        for (const char* algo : {"v1", "v2"}) {
+            const auto s = computeFeatures(renderWading(opts("shallow", cadence, algo), 12.0));
+            const auto d = computeFeatures(renderWading(opts("deep", cadence, algo), 12.0));
+            std::printf("[ measured ] %s %.0f steps/min: shallow %.1f dBFS / %.0f Hz, deep %.1f "
+                        "dBFS / %.0f Hz\n",
+                        algo, cadence, s.rmsDb, s.centroidHz, d.rmsDb, d.centroidHz);
+            EXPECT_GT(d.rmsDb, s.rmsDb + 2.0) << algo << " " << cadence;
+            EXPECT_LT(d.centroidHz, 0.8 * s.centroidHz) << algo << " " << cadence;
+        }
+}
+
+TEST(WadingScene, DeterministicPerSeed) {
+    auto o = opts("deep", 63);
+    const auto a = renderWading(o, 4.0), b = renderWading(o, 4.0);
+    ASSERT_EQ(a.samples.size(), b.samples.size());
+    EXPECT_EQ(std::memcmp(a.samples.data(), b.samples.data(), a.samples.size() * sizeof(float)), 0);
+    o.seed = 2;
+    const auto c = renderWading(o, 4.0);
+    EXPECT_NE(std::memcmp(a.samples.data(), c.samples.data(), a.samples.size() * sizeof(float)), 0);
+    // Recorded gait: same frames, same output.
+    VirtualGaitParameters p;
+    const auto g = virtualGait(p, 3.0, 9);
+    const auto r1 = renderWading(opts("shallow", 63, "v1"), g);
+    const auto r2 = renderWading(opts("shallow", 63, "v1"), g);
+    EXPECT_EQ(r1.samples, r2.samples);
+    EXPECT_EQ(r1.frames(), 3u * 48000u);
+}
+
+TEST(WadingScene, V1AndV2BothRunAndDiffer) {
+    for (const char* filter : {"butterworth_5hz", "butterworth_0_8hz", "asymmetric"}) {
+        auto o1 = opts("deep", 63, "v1"), o2 = opts("deep", 63, "v2");
+        o1.filter = o2.filter = filter;
+        const auto a = computeFeatures(renderWading(o1, 6.0));
+        const auto b = computeFeatures(renderWading(o2, 6.0));
+        EXPECT_GT(a.rmsDb, -60.0) << filter;
+        EXPECT_GT(b.rmsDb, -60.0) << filter;
+        EXPECT_GT(std::fabs(a.rmsDb - b.rmsDb) + std::fabs(a.centroidHz - b.centroidHz), 0.5);
+    }
+}
+
+TEST(WadingScene, LimbsArePannedToTheirSide) {
+    // Only the left leg swings: the left channel must be louder than the right one.
+    VirtualGaitParameters p;
+    auto g = virtualGait(p, 6.0, 1);
+    for (auto& f : g) f[Limb::RightThigh] = f[Limb::RightShank] = 0;
+    const auto a = renderWading(opts("deep", 63), g);
+    double l = 0, r = 0;
+    for (std::size_t i = 0; i < a.frames(); ++i)
+        l += a.at(i, 0) * a.at(i, 0), r += a.at(i, 1) * a.at(i, 1);
+    // Pan 50 %: cos(pi/8)^2 / sin(pi/8)^2 = 5.8 (7.7 dB).
+    EXPECT_NEAR(10 * std::log10(l / r), 7.66, 0.3);
+}
+
+TEST(WadingScene, ProcessDoesNotAllocateAndRejectsBadInput) {
+    WadingScene scene;
+    scene.configure(loadWadingPreset("deep"), WadingAlgorithm::V2, GyroFilter::Butterworth5Hz);
+    scene.prepare({48000, 256});
+    scene.reset(3);
+    VirtualGaitParameters p;
+    p.cadenceStepsPerMin = 118;
+    auto gait = virtualGait(p, 4.0, 1);
+    gait[150][Limb::LeftThigh] = NAN;
+    gait[151][Limb::RightShank] = INFINITY;
+    std::vector<float> l(256), r(256);
+    std::vector<TimedGaitFrame> ev(8);
+    long allocations = 0;
+    double maxAbs = 0;
+    std::size_t next = 0;
+    {
+        underfoot::test::AllocationTrap trap;
+        for (std::size_t start = 0; start < 4 * 48000; start += 256) {
+            int count = 0;
+            while (next < gait.size() && next * 480 < start + 256) {
+                ev[static_cast<std::size_t>(count)].offset =
+                    static_cast<int>(next * 480 - std::min(next * 480, start));
+                ev[static_cast<std::size_t>(count++)].frame = gait[next++];
+            }
+            scene.process(ev.data(), count, l.data(), r.data(), 256);
+            for (int i = 0; i < 256; ++i)
+                maxAbs = std::max({maxAbs, double(std::fabs(l[static_cast<std::size_t>(i)])),
+                                   double(std::fabs(r[static_cast<std::size_t>(i)]))});
+        }
+        allocations = trap.count();
+    }
+    EXPECT_EQ(allocations, 0);
+    EXPECT_EQ(scene.rejectedReadings(), 2u);
+    EXPECT_TRUE(std::isfinite(maxAbs));
+    EXPECT_GT(maxAbs, 0.01);
+}
+
+TEST(WadingScene, RealTimeFactor) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const auto a = renderWading(opts("deep", 118), 10.0);
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    std::printf("[ measured ] deep v2 118 steps/min: 10 s rendered in %.3f s wall (%.1fx real "
+                "time)\n",
+                s, 10.0 / s);
+    EXPECT_EQ(a.frames(), 480000u);
+    EXPECT_LT(s, 10.0); // at least real time even under sanitizers on a shared machine
+}
+
+TEST(WadingOptions, ParametersFromProtocols) {
+    auto o = wadingOptionsFromParameters(
+        {{"depth", "deep"}, {"algorithm", "v1"}, {"filter", "asymmetric"}, {"cadence", "fast"}});
+    EXPECT_EQ(o.depth, "deep");
+    EXPECT_EQ(o.algorithm, "v1");
+    EXPECT_EQ(o.filter, "asymmetric");
+    EXPECT_EQ(o.cadenceStepsPerMin, 118);
+    EXPECT_EQ(wadingOptionsFromParameters({{"cadence", "slow"}}).cadenceStepsPerMin, 27);
+    EXPECT_EQ(wadingOptionsFromParameters({{"cadence", "normal"}}).cadenceStepsPerMin, 63);
+    EXPECT_EQ(wadingOptionsFromParameters({{"cadence", "90"}}).cadenceStepsPerMin, 90);
+    auto message = [](const std::map<std::string, std::string>& p) {
+        try {
+            wadingOptionsFromParameters(p);
+        } catch (const WadingOptionError& e) {
+            return std::string(e.what());
+        }
+        return std::string();
+    };
+    EXPECT_EQ(message({{"depth", "knee"}}),
+              "wading parameter depth = \"knee\": expected shallow or deep");
+    EXPECT_EQ(message({{"algorithm", "v3"}}),
+              "wading parameter algorithm = \"v3\": expected v1 or v2");
+    EXPECT_NE(message({{"filter", "bessel"}})
+                  .find("expected butterworth_5hz, butterworth_0_8hz "
+                        "or asymmetric"),
+              std::string::npos);
+    EXPECT_NE(message({{"cadence", "brisk"}}).find("cadence = \"brisk\": expected slow (27)"),
+              std::string::npos);
+    EXPECT_NE(message({{"cadence", "500"}}).find("cadence = 500"), std::string::npos);
+    EXPECT_NE(message({{"colour", "blue"}}).find("unknown wading parameter \"colour\""),
+              std::string::npos);
+    EXPECT_NE(message({{"seed", "-3"}}).find("seed"), std::string::npos);
+    EXPECT_THROW(renderWading(opts("deep", 63), -1.0), WadingOptionError);
+    EXPECT_THROW(renderWading(opts("deep", 63), std::vector<GaitFrame>{}), WadingOptionError);
+}
+
+TEST(WadingPresets, ErrorsNameFileLineAndExpectation) {
+    auto message = [](const std::string& text) {
+        try {
+            parseWadingPreset(text, "p.toml");
+        } catch (const PresetError& e) {
+            return std::string(e.what());
+        }
+        return std::string();
+    };
+    EXPECT_NE(message("id = \"x\"\n[mapping]\nc1_exponent = 9\n")
+                  .find("p.toml:3:15: mapping.c1_exponent: expected a number in [0.35, 6], got 9"),
+              std::string::npos)
+        << message("id = \"x\"\n[mapping]\nc1_exponent = 9\n");
+    EXPECT_NE(message("id = \"x\"\n[flowing]\nlevel_dbb = 1\n").find("level_dbb"),
+              std::string::npos);
+    EXPECT_NE(message("id = \"x\"\n[mapping]\nsplash_min_db = -10\nsplash_max_db = -20\n")
+                  .find("expected splash_max_db above splash_min_db"),
+              std::string::npos);
+    EXPECT_NE(message("id = \n").find("p.toml:1"), std::string::npos);
+    EXPECT_THROW(loadWadingPreset("knee"), PresetError);
+    // The shipped presets load and keep the paper's chain constants.
+    for (const char* depth : {"shallow", "deep"}) {
+        const auto p = loadWadingPreset(depth);
+        EXPECT_EQ(p.mapping.c1ReleaseMs, 890);
+        EXPECT_EQ(p.mapping.c2ReleaseMs, 2230);
+        EXPECT_EQ(p.mapping.c3ReleaseMs, 890);
+        EXPECT_EQ(p.mapping.c1Exponent, 1.93);
+        EXPECT_EQ(p.mapping.c2Exponent, 2.56);
+        EXPECT_EQ(p.mapping.c3Exponent, 1.0);
+        EXPECT_EQ(p.mapping.splashDelayMs, 150);
+        EXPECT_EQ(p.mapping.eqLowHz, 260);
+        EXPECT_EQ(p.mapping.eqHighHz, 9250);
+        EXPECT_EQ(p.mapping.pan, 0.5);
+    }
+    const auto deep = loadWadingPreset("deep");
+    EXPECT_EQ(deep.mapping.flowingMinDb, -33);
+    EXPECT_EQ(deep.mapping.flowingMaxDb, 0);
+    EXPECT_EQ(deep.mapping.bubblingMinDb, -38);
+    EXPECT_EQ(deep.mapping.bubblingMaxDb, -5);
+    EXPECT_EQ(deep.mapping.splashMinDb, -40);
+    EXPECT_EQ(deep.mapping.splashMaxDb, 5);
+}
+
+TEST(WadingPresets, LabRecordingReplacesALayer) {
+    // A preset whose flowing layer loops a recording (a 440 Hz tone stands in for it).
+    const auto dir = std::filesystem::temp_directory_path() / "wading_rec_test";
+    std::filesystem::create_directories(dir);
+    AudioBuffer tone;
+    tone.sampleRateHz = 44100;
+    tone.channels = 1;
+    for (int i = 0; i < 44100; ++i)
+        tone.samples.push_back(static_cast<float>(0.5 * std::sin(2 * M_PI * 440 * i / 44100.0)));
+    writeAudioFile((dir / "flow.wav").string(), tone);
+    std::ifstream in(loadWadingPreset("deep").file);
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    text.replace(text.find("[flowing]\n"), 10, "[flowing]\nrecording = \"flow.wav\"\n");
+    text.replace(text.find("id = \"deep\""), 11, "id = \"deep_rec\"");
+    std::ofstream((dir / "deep_rec.toml").string()) << text;
+    auto o = opts((dir / "deep_rec.toml").string(), 63, "v1");
+    const auto a = renderWading(o, 4.0);
+    const auto f = computeFeatures(a);
+    EXPECT_GT(f.rmsDb, -60.0);
+    EXPECT_LT(std::fabs(f.centroidHz - 440.0), 400.0); // the tone dominates the mix
+    std::filesystem::remove_all(dir);
+}
+
+} // namespace
