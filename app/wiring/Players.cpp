@@ -170,6 +170,7 @@ void LivePlayer::stop() {
     engine_.submit(nullptr);
     // Crossfade plus a margin; a stopped stream hands nothing back (then nothing pushes).
     engine_.waitIdle(engine_.settings().crossfadeMs * 1e-3 + 2.0);
+    engine_.collectRetired();
     if (recorder_) {
         recorder_->finish();
         lastDropped_ = recorder_->droppedFrames();

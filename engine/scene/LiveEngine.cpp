@@ -307,6 +307,13 @@ int LiveEngine::collectRetired() {
     return n;
 }
 
+std::vector<std::unique_ptr<LiveScene>> LiveEngine::takeRetired() {
+    std::vector<std::unique_ptr<LiveScene>> out;
+    LiveScene* s = nullptr;
+    while (queues_->retired.pop(s)) out.emplace_back(s);
+    return out;
+}
+
 bool LiveEngine::idle() const noexcept {
     return taken_.load(std::memory_order_acquire) == submitted_.load(std::memory_order_acquire) &&
            !pub_->busy.load(std::memory_order_acquire);
@@ -319,7 +326,6 @@ bool LiveEngine::waitIdle(double timeoutSeconds) {
         if (std::chrono::steady_clock::now() > end) return false;
         std::this_thread::sleep_for(std::chrono::milliseconds(2));
     }
-    collectRetired();
     return true;
 }
 

@@ -100,10 +100,13 @@ class LiveEngine {
     bool submit(std::unique_ptr<LiveScene> scene);
     /// Releases scenes the audio thread handed back; returns how many.
     int collectRetired();
+    /// Takes the scenes the audio thread handed back (e.g. to read their nodeCosts()).
+    std::vector<std::unique_ptr<LiveScene>> takeRetired();
     /// Whether the audio thread has taken every submitted command and retired every faded
     /// scene (so that a recorder fed by a retired scene can be finished).
     bool idle() const noexcept;
-    /// Waits (sleeping) until idle() or the timeout; returns idle().
+    /// Waits (sleeping) until idle() or the timeout; returns idle(). Retired scenes stay
+    /// queued for collectRetired() / takeRetired().
     bool waitIdle(double timeoutSeconds);
 
     /// Emits one impulse on `outputChannel` and watches `inputChannel` for it (threshold 0.5);
