@@ -89,7 +89,11 @@ MainWindow::MainWindow(const Options& options, QWidget* parent) : QMainWindow(pa
     if (context_->hasStudy() && run_->hasResumable()) showView(1);
 }
 
-MainWindow::~MainWindow() = default;
+MainWindow::~MainWindow() {
+    // The views use the study context: end the session and delete them while it exists.
+    run_->closeSession();
+    delete tabs_;
+}
 
 void MainWindow::showView(int index) {
     tabs_->setCurrentIndex(index);
