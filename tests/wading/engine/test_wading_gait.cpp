@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 
@@ -68,6 +69,10 @@ TEST(VirtualGait, FasterCadenceSwingsFasterAndShankPeaksLater) {
         for (const auto& f : virtualGait(p, 10, 1)) m = std::max(m, f[limb]);
         return m;
     };
+    for (double c : {27.0, 63.0, 118.0})
+        std::printf("[ measured ] virtual gait %.0f steps/min: thigh peak %.0f deg/s, shank peak "
+                    "%.0f deg/s\n",
+                    c, peak(c, Limb::LeftThigh), peak(c, Limb::LeftShank));
     EXPECT_LT(peak(27, Limb::LeftThigh), peak(63, Limb::LeftThigh));
     EXPECT_LT(peak(63, Limb::LeftThigh), peak(118, Limb::LeftThigh));
     EXPECT_GT(peak(63, Limb::LeftShank), peak(63, Limb::LeftThigh));
