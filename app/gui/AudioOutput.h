@@ -39,6 +39,8 @@ class AudioOutput : public QObject {
     void silence();
     /// The meters (zeros when not running).
     engine::LiveMeters meters() const;
+    /// The running engine (nullptr when not running).
+    engine::LiveEngine* engine() const { return running() ? engine_.get() : nullptr; }
     /// "jack / system, 48000 Hz, 64 frames" or "not running".
     QString description() const;
 

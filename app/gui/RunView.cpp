@@ -1,14 +1,20 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "app/gui/RunView.h"
 
+#include "app/gui/AudioOutput.h"
 #include "app/gui/StudyContext.h"
 #include "app/gui/WalkerPlayer.h"
 #include "experiment/Catalogue.h"
+#ifdef UNDERFOOT_HAVE_WIRING
+#include "app/wiring/Players.h"
+#endif
 
 #include <QComboBox>
 #include <QCoreApplication>
+#include <QDir>
 #include <QElapsedTimer>
 #include <QEventLoop>
+#include <QFileInfo>
 #include <QFormLayout>
 #include <QGridLayout>
 #include <QGroupBox>
@@ -54,6 +60,57 @@ QFont bigFont(const QWidget* w, double factor) {
     return f;
 }
 } // namespace
+
+/// The session's player: the live engine (app/wiring's LivePlayer, which also records the GRF
+/// next to the study for replay) while the Setup view's audio output runs, and always the
+/// walker meters of the Run view.
+class ConsolePlayer final : public exp::StimulusPlayer {
+  public:
+    ConsolePlayer(WalkerPlayer& meters, AudioOutput* audio, const QString& studyPath)
+        : meters_(meters) {
+#ifdef UNDERFOOT_HAVE_WIRING
+        if (audio && audio->engine()) {
+            wiring::LivePlayerOptions o;
+            const QDir dir = QFileInfo(studyPath).dir();
+            o.studyFolder = dir.path().toStdString();
+            o.recordingFolder = dir.filePath("grf_recordings").toStdString();
+            QDir().mkpath(QString::fromStdString(o.recordingFolder));
+            live_ = std::make_unique<wiring::LivePlayer>(*audio->engine(), o);
+        }
+#else
+        (void)audio;
+        (void)studyPath;
+#endif
+    }
+    exp::StimulusStart start(const exp::Stimulus& stimulus, std::uint64_t plannedSeed) override {
+        exp::StimulusStart started{plannedSeed, std::nullopt};
+#ifdef UNDERFOOT_HAVE_WIRING
+        if (live_) started = live_->start(stimulus, plannedSeed);
+#endif
+        meters_.start(stimulus, started.renderSeed);
+        return started;
+    }
+    void stop() override {
+#ifdef UNDERFOOT_HAVE_WIRING
+        if (live_) live_->stop();
+#endif
+        meters_.stop();
+    }
+    /// Whether stimuli are heard (live engine) or only shown (meters).
+    bool live() const {
+#ifdef UNDERFOOT_HAVE_WIRING
+        return live_ != nullptr;
+#else
+        return false;
+#endif
+    }
+
+  private:
+    WalkerPlayer& meters_;
+#ifdef UNDERFOOT_HAVE_WIRING
+    std::unique_ptr<wiring::LivePlayer> live_;
+#endif
+};
 
 /// The trial page: receives the trial keys when it (or a child that ignores them) has focus.
 class TrialPanel : public QWidget {
@@ -135,6 +192,7 @@ RunView::RunView(StudyContext& context, QWidget* parent) : QWidget(parent), cont
     pages_->addWidget(finishedPage);
     connect(again, &QPushButton::clicked, this, [this] {
         session_.reset();
+        console_.reset();
         emit context_.sessionActiveChanged(false);
         pages_->setCurrentIndex(StartPage);
         refreshStart();
@@ -263,7 +321,7 @@ void RunView::buildStartPage() {
     }
     const auto resumeSelected = [this] {
         auto* item = resumeList_->currentItem();
-        if (!item) {
+        if (!item || item->data(Qt::UserRole).toString().isEmpty()) {
             startMessage_->setText(tr("Select a participant in the list first (Up/Down)."));
             return;
         }
@@ -426,6 +484,7 @@ void RunView::refreshStart() {
         startMessage_->setText(tr("No study open: create or open one in the Study view (Ctrl+1)."));
         return;
     }
+    startMessage_->clear();
     const auto& store = context_.store();
     const auto people = store.participants();
     try {
@@ -457,6 +516,12 @@ void RunView::refreshStart() {
             interrupted << tr("%1 at trial %2 of %3").arg(q(p.code)).arg(answered + 1).arg(planned);
             if (!resumeList_->currentItem()) resumeList_->setCurrentItem(item);
         }
+    }
+    if (resumeList_->count() == 0) {
+        auto* item = new QListWidgetItem(tr("Every registered participant has finished (or "
+                                            "dropped out). Register the next one on the left."),
+                                         resumeList_);
+        item->setFlags(Qt::NoItemFlags);
     }
     if (!interrupted.isEmpty()) {
         resumeBanner_->setText(tr("Interrupted session: %1. Every answer given so far is stored. "
@@ -513,11 +578,14 @@ bool RunView::startSession(const QString& code) {
     if (!context_.hasStudy() || session_) return false;
     exp::SessionSettings settings;
     settings.experimenter = experimenter_->text().trimmed().toStdString();
-    settings.audioConfig = "underfoot-gui: virtual walker meters (no live audio engine in build)";
+    console_ = std::make_unique<ConsolePlayer>(*player_, audio_, context_.path());
+    settings.audioConfig =
+        console_->live() ? ("underfoot-gui live engine: " + audio_->description()).toStdString()
+                         : std::string("underfoot-gui without audio output (walker meters only)");
     settings.sensorConfig = "none";
     settings.appVersion = UNDERFOOT_VERSION;
     try {
-        session_ = std::make_unique<exp::Session>(context_.store(), code.toStdString(), *player_,
+        session_ = std::make_unique<exp::Session>(context_.store(), code.toStdString(), *console_,
                                                   settings);
     } catch (const std::exception& e) {
         startMessage_->setText(q(e.what()));
@@ -621,9 +689,10 @@ void RunView::showTrial() {
     stepLabel_->setText(tr("steps: 0"));
     playButton_->setEnabled(true);
     playButton_->setText(tr("Start stimulus  (Space)"));
-    engineLabel_->setText(
-        tr("Audio: no live audio engine in this build — meters follow the virtual walker; xruns "
-           "and CPU load appear here when the live engine is wired in."));
+    engineLabel_->setText(console_ && console_->live()
+                              ? tr("Audio: %1").arg(audio_->description())
+                              : tr("Audio output not started (Setup view, Ctrl+5): the stimulus "
+                                   "is not heard; the meters follow the virtual walker."));
     // The session's plan, with answered trials ticked.
     planList_->clear();
     const auto trials = context_.store().trials(session_->participant().code);
@@ -1005,6 +1074,17 @@ void RunView::askExclusion(bool previous) {
 }
 
 void RunView::onMeter(const GrfMeter& m) {
+    if (console_ && console_->live() && audio_ && audio_->running()) {
+        const auto lm = audio_->meters();
+        engineLabel_->setText(tr("Audio: %1 · xruns %2 · callback load %3 % (worst %4 %) · GRF "
+                                 "peak %5 N")
+                                  .arg(audio_->description())
+                                  .arg(lm.xruns)
+                                  .arg(lm.loadPercent, 0, 'f', 1)
+                                  .arg(lm.maxLoadPercent, 0, 'f', 1)
+                                  .arg(static_cast<double>(lm.grfPeakNewtons), 0, 'f', 0));
+        engineLabel_->setStyleSheet(lm.xruns > 0 ? "QLabel { color: #a00; }" : QString());
+    }
     leftMeter_->setValue(static_cast<int>(std::lround(m.leftBw * 100)));
     rightMeter_->setValue(static_cast<int>(std::lround(m.rightBw * 100)));
     QString step = tr("steps: %1").arg(m.steps);
@@ -1027,6 +1107,7 @@ void RunView::closeSession() {
         // The answers are committed already; only the session row's end could not be written.
     }
     session_.reset();
+    console_.reset();
     player_->stop();
     paused_ = false;
     pausedLabel_->hide();

@@ -37,6 +37,8 @@ class StudyContext;
 class WalkerPlayer;
 struct GrfMeter;
 class TrialPanel;
+class AudioOutput;
+class ConsolePlayer;
 
 class RunView : public QWidget {
     Q_OBJECT
@@ -57,6 +59,8 @@ class RunView : public QWidget {
     /// For screenshots: registers a scratch participant and shows a trial with an answer chosen.
     bool startDemoTrialForScreenshot();
 
+    /// Plays stimuli through `output`'s live engine while it runs (the walker meters otherwise).
+    void setAudioOutput(AudioOutput* output) { audio_ = output; }
     /// The running session (nullptr when none).
     experiment::Session* session() const { return session_.get(); }
     /// The widget that receives the trial keys (answer letters, digits, Enter, Space).
@@ -108,6 +112,8 @@ class RunView : public QWidget {
 
     StudyContext& context_;
     WalkerPlayer* player_ = nullptr;
+    AudioOutput* audio_ = nullptr;
+    std::unique_ptr<ConsolePlayer> console_;
     std::unique_ptr<experiment::Session> session_;
     QStackedWidget* pages_ = nullptr;
 
