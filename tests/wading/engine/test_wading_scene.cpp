@@ -7,6 +7,7 @@
 #include "engine/wading/Wading.h"
 #include "engine/wading/WadingScene.h"
 #include "tests/common/AllocationTrap.h"
+#include "tests/wading/engine/WadingReference.h"
 
 #include <gtest/gtest.h>
 
@@ -314,6 +315,76 @@ TEST(WadingScene, LivePathMatchesOfflineFrames) {
         ASSERT_EQ(l1, l2) << "block " << k;
         ASSERT_EQ(r1, r2) << "block " << k;
     }
+}
+
+} // namespace
+
+namespace {
+using namespace underfoot::engine;
+
+TEST(WadingScene, AudioGainsFollowTheChainSampleBySample) {
+    // The audio path reproduces the chain's definition sample by sample: the flowing layer loops
+    // a constant 0.5 "recording", the other layers loop silence, the EQ bands are set to 0 dB, so
+    // each output sample is 0.5 x level x (pan-weighted left/right voice gains), the gains
+    // ramping linearly over the 480 samples after each frame to the reference chain's values
+    // (tests/wading/engine/WadingReference.h, independent of the engine).
+    const auto dir = std::filesystem::temp_directory_path() / "wading_gain_test";
+    std::filesystem::create_directories(dir);
+    AudioBuffer dc, zero;
+    dc.sampleRateHz = zero.sampleRateHz = 48000;
+    dc.channels = zero.channels = 1;
+    dc.samples.assign(48000, 0.5f);
+    zero.samples.assign(48000, 0.0f);
+    writeAudioFile((dir / "dc.wav").string(), dc, SampleFormat::Float32);
+    writeAudioFile((dir / "zero.wav").string(), zero, SampleFormat::Float32);
+    std::ifstream in(loadWadingPreset("deep").file);
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    auto replace = [&text](const std::string& a, const std::string& b) {
+        const auto at = text.find(a);
+        ASSERT_NE(at, std::string::npos) << a;
+        text.replace(at, a.size(), b);
+    };
+    replace("eq_max_db = 9.0", "eq_max_db = 0.0");
+    replace("[flowing]\n", "[flowing]\nrecording = \"dc.wav\"\n");
+    replace("[bubbling]\n", "[bubbling]\nrecording = \"zero.wav\"\n");
+    replace("[splash]\n", "[splash]\nrecording = \"zero.wav\"\n");
+    const auto preset = parseWadingPreset(text, (dir / "gain.toml").string());
+    WadingScene scene;
+    scene.configure(preset, WadingAlgorithm::V2, GyroFilter::Butterworth5Hz);
+    scene.prepare({48000, 480});
+    scene.reset(1);
+    std::filesystem::remove_all(dir);
+
+    const double level = std::pow(10.0, (preset.flowing.levelDb + preset.outputGainDb) / 20.0);
+    const double ll = std::cos(M_PI / 8), lr = std::sin(M_PI / 8); // left voice at -50 %
+    const double rl = std::cos(3 * M_PI / 8), rr = std::sin(3 * M_PI / 8);
+    underfoot::test::wading::RefV2 ref;
+    std::vector<float> l(480), r(480);
+    double prevL = 0, prevR = 0, maxOut = 0;
+    for (int k = 0; k < 500; ++k) {
+        GaitFrame f;
+        const double t = k / 100.0;
+        f[Limb::LeftThigh] = t < 1 ? 0 : (t < 2 ? 150 : 40 * (4 - t));
+        f[Limb::RightThigh] = t < 2.5 ? 0 : 90;
+        f[Limb::LeftShank] = t < 1.2 ? 0 : 200;
+        f[Limb::RightShank] = 0;
+        const TimedGaitFrame ev{0, f};
+        scene.process(&ev, 1, l.data(), r.data(), 480);
+        const auto g = ref.step(f);
+        const double tl = g[3], tr = g[4];
+        for (int i = 0; i < 480; ++i) {
+            const double gl = prevL + (tl - prevL) * (i + 1) / 480.0;
+            const double gr = prevR + (tr - prevR) * (i + 1) / 480.0;
+            const double el = 0.5 * level * (ll * gl + rl * gr);
+            const double er = 0.5 * level * (lr * gl + rr * gr);
+            const auto ui = static_cast<std::size_t>(i);
+            ASSERT_NEAR(l[ui], el, 1e-6 + 1e-5 * std::fabs(el)) << "frame " << k << " sample " << i;
+            ASSERT_NEAR(r[ui], er, 1e-6 + 1e-5 * std::fabs(er)) << "frame " << k << " sample " << i;
+            maxOut = std::max(maxOut, std::fabs(el));
+        }
+        prevL = tl, prevR = tr;
+    }
+    EXPECT_GT(maxOut, 0.05); // the input drives the flowing layer to full level
 }
 
 } // namespace
