@@ -88,6 +88,42 @@ int writeTrialsCsv(const StudyStore& store, std::ostream& out, ExportScope scope
     return rows;
 }
 
+int writeParticipantsCsv(const StudyStore& store, std::ostream& out) {
+    const Protocol& protocol = store.protocol();
+    std::vector<std::string> header{"participant", "group", "status", "age",
+                                    "gender",      "shoes", "hearing"};
+    for (const auto& f : protocol.participantFields) header.push_back(f.id);
+    writeRow(out, header);
+    int rows = 0;
+    for (const auto& p : store.participants()) {
+        std::vector<std::string> row{
+            p.code,   p.groupId, toString(p.status), p.age ? std::to_string(*p.age) : "",
+            p.gender, p.shoes,   p.hearing};
+        for (const auto& f : protocol.participantFields) {
+            const auto it = p.fields.find(f.id);
+            row.push_back(it == p.fields.end() ? "" : it->second);
+        }
+        writeRow(out, row);
+        ++rows;
+    }
+    return rows;
+}
+
+int writeScalesCsv(const StudyStore& store, std::ostream& out) {
+    writeRow(out, {"scale", "prompt", "min", "max", "anchors", "stimuli"});
+    int rows = 0;
+    for (const auto& s : store.protocol().questions.scales) {
+        std::string anchors, stimuli;
+        for (const auto& [v, label] : s.anchors)
+            anchors += (anchors.empty() ? "" : "; ") + std::to_string(v) + "=" + label;
+        for (const auto& id : s.stimuli) stimuli += (stimuli.empty() ? "" : " ") + id;
+        writeRow(out,
+                 {s.id, s.prompt, std::to_string(s.min), std::to_string(s.max), anchors, stimuli});
+        ++rows;
+    }
+    return rows;
+}
+
 int writeRatingsCsv(const StudyStore& store, std::ostream& out, ExportScope scope) {
     const StudyInfo info = store.info();
     const Protocol& protocol = store.protocol();

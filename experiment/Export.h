@@ -57,6 +57,12 @@ int writeTrialsCsv(const StudyStore& store, std::ostream& out,
 /// stimulus_id, practice, excluded, one column per factor, scale, value); returns the rows.
 int writeRatingsCsv(const StudyStore& store, std::ostream& out,
                     ExportScope scope = ExportScope::Answered);
+/// Writes one row per participant: participant, group, status, age, gender, shoes, hearing, then
+/// one column per [[participant_fields]] item of the protocol (in protocol order); returns rows.
+int writeParticipantsCsv(const StudyStore& store, std::ostream& out);
+/// Writes the protocol's scales: scale, prompt, min, max, anchors ("value=label; ..."),
+/// stimuli (space-separated; empty = every stimulus); returns rows.
+int writeScalesCsv(const StudyStore& store, std::ostream& out);
 /// Writes the codebook (Markdown): every column, its type and meaning, and the value labels
 /// (answer options, groups, stimuli, scales) of this study's protocol.
 void writeCodebook(const StudyStore& store, std::ostream& out);

@@ -272,6 +272,23 @@ double SimulatedParticipant::responseTimeS() {
 
 namespace underfoot::experiment {
 
+namespace {
+/// A silent player for simulations that reports each clip's own seed in listening tests (the
+/// seed the clip was rendered with), and the planned seed otherwise.
+class SimulationPlayer final : public StimulusPlayer {
+  public:
+    explicit SimulationPlayer(const Protocol& protocol) : protocol_(protocol) {}
+    StimulusStart start(const Stimulus& stimulus, std::uint64_t plannedSeed) override {
+        return {protocol_.clips.enabled ? clipSeed(protocol_, stimulus) : plannedSeed,
+                std::nullopt};
+    }
+    void stop() override {}
+
+  private:
+    const Protocol& protocol_;
+};
+} // namespace
+
 int runSimulatedSession(StudyStore& store, const std::string& code, const ConfusionMatrix& matrix,
                         std::uint64_t seed, const SimulationSettings& settings,
                         const CommitCallback& onCommitted) {
@@ -293,7 +310,7 @@ int runSimulatedSession(StudyStore& store, const std::string& code, const Confus
     const double replayProbability =
         settings.ratingModel ? settings.ratingModel->replayProbability : 0.2;
     double simulatedTimeS = 0.0;
-    SilentPlayer player;
+    SimulationPlayer player(store.protocol());
     Session session(
         store, code, player,
         SessionSettings{"simulation", "none (simulated)", "none (simulated)", UNDERFOOT_VERSION},

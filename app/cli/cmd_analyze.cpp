@@ -3,7 +3,9 @@
 // long-format trial CSV of `underfoot export` or from published count tables.
 #include "analysis/io/CountTables.h"
 #include "analysis/io/TrialCsv.h"
+#include "analysis/ratings/RatingAnalysis.h"
 #include "analysis/report/Export.h"
+#include "analysis/report/RatingReport.h"
 #include "analysis/tables/Tables.h"
 #include "app/cli/CommandRegistry.h"
 
@@ -21,6 +23,7 @@
 #include <fstream>
 #include <limits>
 #include <memory>
+#include <sstream>
 #include <stdexcept>
 
 namespace {
@@ -40,9 +43,90 @@ struct AnalyzeOptions {
     std::vector<std::string> answers;
     bool poolSoundscapes = false;
     double confLevel = 0.95;
+    std::string form = "auto";
+    std::string ratings;
+    std::string participants;
+    std::string scales;
+    std::vector<std::string> groupFields;
 };
 
+void writeText(const std::string& output, const std::string& text) {
+    if (output.empty() || output == "-") {
+        fmt::print("{}", text);
+        return;
+    }
+    std::ofstream out(output, std::ios::binary);
+    if (!out) throw cli::UserError(fmt::format("{}: cannot open for writing", output));
+    out << text;
+    if (!out.flush()) throw cli::UserError(fmt::format("{}: write failed", output));
+}
+
+/// Rating studies (the wading studies and any protocol of scales): the paper's form.
+int analyzeRatings(const AnalyzeOptions& o, analysis::ReportFormat format) {
+    analysis::RatingData data;
+    try {
+        if (!o.study.empty()) {
+            const auto store = experiment::StudyStore::open(o.study);
+            std::ostringstream ratings, participants, scales;
+            experiment::writeRatingsCsv(store, ratings);
+            experiment::writeParticipantsCsv(store, participants);
+            experiment::writeScalesCsv(store, scales);
+            data = analysis::parseRatingData(ratings.str(), o.study + " (ratings)",
+                                             participants.str(), o.study + " (participants)",
+                                             scales.str(), o.study + " (scales)");
+            data.title = store.protocol().title;
+        } else if (!o.ratings.empty()) {
+            data = analysis::readRatingData(o.ratings, o.participants, o.scales);
+        } else {
+            throw cli::UserError("--form ratings needs --study FILE or --ratings FILE (the "
+                                 "ratings CSV of `underfoot export`)");
+        }
+        if (!o.title.empty()) data.title = o.title;
+        analysis::RatingAnalysisOptions options;
+        options.groupingFields = o.groupFields;
+        for (const auto& f : o.groupFields)
+            if (std::find(data.groupingFields.begin(), data.groupingFields.end(), f) ==
+                data.groupingFields.end())
+                throw cli::UserError(fmt::format("--group-by {}: not a participant field of "
+                                                 "this study (fields: {})",
+                                                 f, fmt::join(data.groupingFields, ", ")));
+        const auto result = analysis::analyzeRatingStudy(data, options);
+        writeText(o.output, analysis::renderRatingReport(result, format));
+    } catch (const std::runtime_error& e) {
+        throw cli::UserError(e.what());
+    } catch (const std::invalid_argument& e) {
+        throw cli::UserError(e.what());
+    }
+    return 0;
+}
+
 int analyze(const AnalyzeOptions& o) {
+    if (o.form != "auto" && o.form != "identification" && o.form != "ratings" && o.form != "wading")
+        throw cli::UserError(fmt::format("--form {}: expected auto, identification, ratings or "
+                                         "wading",
+                                         o.form));
+    bool ratingsForm = o.form == "ratings" || o.form == "wading" || !o.ratings.empty();
+    if (o.form == "auto" && !o.study.empty()) {
+        // A protocol that only rates (no surface question) is analysed in the paper's form.
+        try {
+            const auto store = experiment::StudyStore::open(o.study);
+            const auto& q = store.protocol().questions;
+            ratingsForm = !q.asksSurface() && !q.scales.empty();
+        } catch (const std::runtime_error& e) {
+            throw cli::UserError(e.what());
+        }
+    }
+    if (ratingsForm) {
+        const auto format = analysis::parseReportFormat(o.format);
+        if (!format)
+            throw cli::UserError(
+                fmt::format("--format {}: expected csv, latex, markdown or html", o.format));
+        if (int(!o.study.empty()) + int(!o.ratings.empty()) != 1 || !o.trials.empty() ||
+            !o.counts.empty())
+            throw cli::UserError("a rating analysis takes one source: --study FILE or --ratings "
+                                 "FILE [--participants FILE] [--scales FILE]");
+        return analyzeRatings(o, *format);
+    }
     if (int(!o.study.empty()) + int(!o.trials.empty()) + int(!o.counts.empty()) != 1)
         throw cli::UserError(
             "give one source: --study FILE (a study store), --trials FILE or --counts FILE...");
@@ -166,6 +250,19 @@ const cli::CommandRegistrar registrar("analyze", [](CLI::App& app, int& exitCode
     cmd->add_option("--answers", o->answers,
                     "Answer-list order of the protocol for --trials (comma-separated ids; "
                     "dont_know is put last when missing); default: the TVCG 2011 answer sheet")
+        ->delimiter(',');
+    cmd->add_option("--form", o->form,
+                    "auto (rating analysis for protocols that only rate), identification "
+                    "(confusion matrices), ratings or wading (the gait sonification paper's "
+                    "form: medians/IQRs, Friedman, Holm-corrected Wilcoxon, Kruskal-Wallis, "
+                    "Spearman, box plots)")
+        ->capture_default_str();
+    cmd->add_option("--ratings", o->ratings, "Ratings CSV written by `underfoot export`");
+    cmd->add_option("--participants", o->participants,
+                    "Participants CSV written by `underfoot export` (grouping fields)");
+    cmd->add_option("--scales", o->scales, "Scales CSV written by `underfoot export`");
+    cmd->add_option("--group-by", o->groupFields,
+                    "Participant fields to compare groups on (default: every field)")
         ->delimiter(',');
     cmd->add_flag("--pool-soundscapes", o->poolSoundscapes,
                   "One row per surface instead of one per surface and soundscape");

@@ -3,7 +3,9 @@
 // whole simulated study (--simulate) with synthetic participants answering from confusion
 // matrices.
 #include "app/cli/CommandRegistry.h"
+#include "experiment/Clips.h"
 #include "experiment/Protocol.h"
+#include "experiment/RatingModel.h"
 #include "experiment/Session.h"
 #include "experiment/Simulation.h"
 #include "experiment/Store.h"
@@ -12,6 +14,7 @@
 
 #include <cstdio>
 #include <iostream>
+#include <memory>
 
 namespace {
 
@@ -32,6 +35,8 @@ struct Options {
     int participants = 0;
     double soundscapeAccuracy = 0.85;
     std::string prefix = "S";
+    std::string clips;
+    std::string ratingModel;
 };
 
 Options& opts() {
@@ -71,10 +76,21 @@ std::string askOption(const std::string& prompt, const std::vector<AnswerOption>
     }
 }
 
-int askScale(const Scale& s) {
+std::string anchorsText(const Scale& s) {
+    if (s.anchors.empty()) return fmt::format("{} .. {}", s.min, s.max);
+    std::string out;
+    for (const auto& [value, label] : s.anchors)
+        out += fmt::format("{}{} = {}", out.empty() ? "" : ", ", value, label);
+    return fmt::format("{} .. {}; {}", s.min, s.max, out);
+}
+
+int askScale(const Scale& s, bool replayable = false) {
     while (true) {
-        const std::string line = askLine(
-            fmt::format("{} [{} {} .. {} {}]> ", s.prompt, s.min, s.minLabel, s.max, s.maxLabel));
+        const std::string line =
+            askLine(s.anchors.empty() ? fmt::format("{} [{} {} .. {} {}]> ", s.prompt, s.min,
+                                                    s.minLabel, s.max, s.maxLabel)
+                                      : fmt::format("{} [{}]> ", s.prompt, anchorsText(s)));
+        if (replayable && line == "r") return s.min - 1; // caller replays the clip
         try {
             std::size_t used = 0;
             const int v = std::stoi(line, &used);
@@ -89,9 +105,21 @@ int runInteractive(const Options& o) {
     StudyStore store = StudyStore::open(o.study);
     if (!o.protocol.empty()) store.verifyProtocol(loadProtocol(o.protocol));
     const Protocol& p = store.protocol();
-    SilentPlayer player; // headless: the engine is wired in by the app
+    SilentPlayer silent; // headless: the engine is wired in by the app
+    std::unique_ptr<ClipPlayer> clipPlayer;
+    if (p.clips.enabled) {
+        if (o.clips.empty())
+            throw UserError(fmt::format("session: protocol {} is a listening test; give --clips "
+                                        "FOLDER (made by `underfoot clips --protocol ... -o "
+                                        "FOLDER`)",
+                                        p.id));
+        clipPlayer = std::make_unique<ClipPlayer>(
+            p, o.clips, [](const std::string& path) { fmt::print("  [playing {}]\n", path); });
+    }
+    StimulusPlayer& player = clipPlayer ? static_cast<StimulusPlayer&>(*clipPlayer) : silent;
     Session session(store, o.participant, player,
-                    {o.experimenter, o.audio, o.sensor, UNDERFOOT_VERSION});
+                    {o.experimenter, o.audio, o.clips.empty() ? o.sensor : "clips " + o.clips,
+                     UNDERFOOT_VERSION});
     const Questions& q = p.questions;
     fmt::print("{} — participant {} (group {}), session {}{}\n", p.title, o.participant,
                session.participant().groupId, session.sessionNumber(),
@@ -116,12 +144,44 @@ int runInteractive(const Options& o) {
                 fmt::print("\n{} {} of {}{}\n", t.practice ? "Practice trial" : "Trial",
                            t.index + 1, session.trialCount(),
                            o.showStimulus ? fmt::format(" — stimulus {}", t.stimulus.id) : "");
+                if (p.clips.enabled) {
+                    askLine("Press Enter to play the clip. ");
+                    session.presentClip();
+                    while (true) {
+                        for (const Scale* s : session.askedScales()) {
+                            int v = 0;
+                            while ((v = askScale(*s, p.clips.replay)) < s->min) {
+                                session.presentClip();
+                                fmt::print("  (replay {})\n", session.replayCount());
+                            }
+                            session.rate(s->id, v);
+                        }
+                        const std::string comment =
+                            q.comment ? askLine("comment (Enter for none)> ") : std::string();
+                        try {
+                            session.submitRatings(comment);
+                        } catch (const StoreError& e) {
+                            fmt::print("not stored: {}\n", e.what());
+                            continue;
+                        }
+                        break;
+                    }
+                    if (o.ack) fmt::print("ack {} {}\n", o.participant, t.index);
+                    break;
+                }
                 askLine("Press Enter to start the stimulus. ");
                 session.play();
+                for (int lap = session.lapsDone(); lap < session.lapCount(); ++lap) {
+                    askLine(
+                        fmt::format("Lap {} of {} ({}). Press Enter when it is walked. ", lap + 1,
+                                    session.lapCount(),
+                                    session.currentLapSilent() ? "silent baseline" : "with sound"));
+                    session.completeLap();
+                }
                 while (true) {
                     TrialAnswer a;
                     if (q.asksSurface()) a.answer = askOption(q.surfacePrompt, q.surfaceOptions);
-                    for (const auto& s : q.scales) a.ratings[s.id] = askScale(s);
+                    for (const Scale* s : session.askedScales()) a.ratings[s->id] = askScale(*s);
                     if (q.asksSoundscape(session.participant().groupId))
                         a.soundscapeAnswer = askOption(q.soundscapePrompt, q.soundscapeOptions);
                     if (q.comment) a.comment = askLine("comment (Enter for none)> ");
@@ -189,6 +249,22 @@ int runSimulation(const Options& o) {
     }
     SimulationSettings settings;
     settings.soundscapeAccuracy = o.soundscapeAccuracy;
+    if (!o.ratingModel.empty()) {
+        auto model = std::make_shared<RatingModel>(loadRatingModel(o.ratingModel));
+        if (auto problems = checkRatingModel(*model, store.protocol()); !problems.empty()) {
+            std::string all;
+            for (const auto& s : problems) all += (all.empty() ? "" : "\n") + s;
+            throw UserError(all);
+        }
+        settings.ratingModel = std::move(model);
+    }
+    if (!o.clips.empty() && store.protocol().clips.enabled) {
+        if (auto problems = checkClips(store.protocol(), o.clips); !problems.empty()) {
+            std::string all;
+            for (const auto& s : problems) all += (all.empty() ? "" : "\n") + s;
+            throw UserError(all);
+        }
+    }
     const int answers = simulateStudy(store, matrices, o.participants, settings, o.prefix,
                                       [&](const std::string& code, int index) {
                                           if (!o.ack) return;
@@ -230,6 +306,12 @@ const underfoot::cli::CommandRegistrar registrar{
                         "probability that a synthetic participant names the soundscape")
             ->check(CLI::Range(0.0, 1.0));
         cmd->add_option("--prefix", o.prefix, "code prefix of synthetic participants");
+        cmd->add_option("--clips", o.clips,
+                        "clip folder of a listening test (from `underfoot clips`); checked "
+                        "before anything is stored");
+        cmd->add_option("--rating-model", o.ratingModel,
+                        "rating model (TOML) of synthetic participants: effects per factor "
+                        "level, stimulus and participant field (protocols/simulation/)");
         cmd->callback([&exitCode, &o] {
             try {
                 if (o.simulate) {

@@ -36,6 +36,7 @@ struct Options {
     std::string gender, shoes, hearing, group, reason;
     int trial = -1;
     bool include = false;
+    std::vector<std::string> fields;
 };
 
 Options& opts() {
@@ -108,6 +109,9 @@ const underfoot::cli::CommandRegistrar registrar{
         reg->add_option("--hearing", o.hearing, "self-reported hearing");
         reg->add_option("--group", o.group, "override the balanced group assignment");
         reg->add_option("--reason", o.reason, "reason for the override (journaled)");
+        reg->add_option("--field", o.fields,
+                        "NAME=VALUE answer to a [[participant_fields]] item of the protocol "
+                        "(e.g. listening_device=laptop_speakers); repeat per field");
         reg->callback([&exitCode, &o] {
             guarded([&] {
                 StudyStore store = StudyStore::open(o.study);
@@ -115,7 +119,16 @@ const underfoot::cli::CommandRegistrar registrar{
                                   o.hearing,     std::nullopt, o.reason};
                 if (o.age >= 0) np.age = o.age;
                 if (!o.group.empty()) np.groupOverride = o.group;
-                const ParticipantInfo p = store.registerParticipant(np);
+                std::map<std::string, std::string> fields;
+                for (const auto& spec : o.fields) {
+                    const auto eq = spec.find('=');
+                    if (eq == std::string::npos || eq == 0)
+                        throw StoreError(fmt::format("--field {}: expected NAME=VALUE", spec));
+                    if (!fields.emplace(spec.substr(0, eq), spec.substr(eq + 1)).second)
+                        throw StoreError(fmt::format("--field {}: '{}' is given twice", spec,
+                                                     spec.substr(0, eq)));
+                }
+                const ParticipantInfo p = store.registerParticipant(np, fields);
                 fmt::print("registered {} (index {}) in group {} ({}), {} trials planned\n", p.code,
                            p.index, p.groupId,
                            p.assignment == Assignment::Override ? "override" : "balanced",

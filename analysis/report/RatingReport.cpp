@@ -1,0 +1,395 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "analysis/report/RatingReport.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <sstream>
+
+namespace underfoot::analysis {
+
+const char* significanceStars(double p) {
+    if (std::isnan(p)) return "";
+    if (p < 0.001) return "***";
+    if (p < 0.01) return "**";
+    if (p < 0.05) return "*";
+    return "";
+}
+
+namespace {
+
+std::string num(double v, int digits = 3) {
+    if (std::isnan(v)) return "NA";
+    return fmt::format("{:.{}f}", v, digits);
+}
+
+std::string pText(double p) {
+    if (std::isnan(p)) return "NA";
+    if (p < 0.001) return "< 0.001";
+    return fmt::format("{:.3f}", p);
+}
+
+std::string xmlEscape(const std::string& s) {
+    std::string out;
+    for (char c : s) {
+        switch (c) {
+        case '&':
+            out += "&amp;";
+            break;
+        case '<':
+            out += "&lt;";
+            break;
+        case '>':
+            out += "&gt;";
+            break;
+        case '"':
+            out += "&quot;";
+            break;
+        default:
+            out += c;
+        }
+    }
+    return out;
+}
+
+std::string factorsText(const std::map<std::string, std::string>& factors) {
+    std::string out;
+    for (const auto& [f, l] : factors) out += fmt::format("{}{}={}", out.empty() ? "" : ", ", f, l);
+    return out;
+}
+
+std::string statisticText(const TestResult& t) {
+    if (!t.ok()) return "not computed: " + t.error;
+    std::string df;
+    for (double d : t.df) df += (df.empty() ? "" : ", ") + fmt::format("{:g}", d);
+    const std::string p = pText(t.p);
+    return fmt::format("{}{} = {}, p {}", t.statisticName, df.empty() ? "" : "(" + df + ")",
+                       num(t.statistic), p.front() == '<' ? p : "= " + p);
+}
+
+/// Markdown table helper.
+struct Table {
+    std::vector<std::string> header;
+    std::vector<std::vector<std::string>> rows;
+    std::string markdown() const {
+        std::string out = "|";
+        for (const auto& h : header) out += " " + h + " |";
+        out += "\n|";
+        for (std::size_t i = 0; i < header.size(); ++i) out += " --- |";
+        out += "\n";
+        for (const auto& r : rows) {
+            out += "|";
+            for (const auto& c : r) out += " " + c + " |";
+            out += "\n";
+        }
+        return out;
+    }
+    std::string html() const {
+        std::string out = "<table><thead><tr>";
+        for (const auto& h : header) out += "<th>" + xmlEscape(h) + "</th>";
+        out += "</tr></thead><tbody>";
+        for (const auto& r : rows) {
+            out += "<tr>";
+            for (const auto& c : r) out += "<td>" + xmlEscape(c) + "</td>";
+            out += "</tr>";
+        }
+        return out + "</tbody></table>\n";
+    }
+    std::string latex() const {
+        std::string out = "\\begin{tabular}{" + std::string(header.size(), 'l') + "}\n\\toprule\n";
+        auto esc = [](std::string s) {
+            std::string o;
+            for (char c : s) {
+                if (c == '_' || c == '%' || c == '&' || c == '#') o += '\\';
+                if (c == '<')
+                    o += "$<$";
+                else
+                    o += c;
+            }
+            return o;
+        };
+        for (std::size_t i = 0; i < header.size(); ++i) out += (i ? " & " : "") + esc(header[i]);
+        out += " \\\\\n\\midrule\n";
+        for (const auto& r : rows) {
+            for (std::size_t i = 0; i < r.size(); ++i) out += (i ? " & " : "") + esc(r[i]);
+            out += " \\\\\n";
+        }
+        return out + "\\bottomrule\n\\end{tabular}\n";
+    }
+};
+
+Table cellTable(const ScaleAnalysis& s) {
+    Table t{{"cell", "factors", "n", "median", "IQR (Q1-Q3)", "Shapiro-Wilk p"}, {}};
+    for (const auto& c : s.cells)
+        t.rows.push_back({c.stimulus, factorsText(c.factors), std::to_string(c.box.n),
+                          num(c.box.median, 2),
+                          fmt::format("{}-{}", num(c.box.q1, 2), num(c.box.q3, 2)),
+                          c.shapiro.ok() ? pText(c.shapiro.p) : "NA"});
+    return t;
+}
+
+Table pairTable(const std::vector<PairedComparison>& pairs) {
+    Table t{{"comparison", "context", "medians", "pairs", "Z", "p", "p (Holm)", ""}, {}};
+    for (const auto& p : pairs)
+        t.rows.push_back({p.first + " vs " + p.second, p.context,
+                          num(p.medianFirst, 2) + " / " + num(p.medianSecond, 2),
+                          std::to_string(p.pairs), num(p.test.z), pText(p.test.p), pText(p.pHolm),
+                          significanceStars(p.pHolm)});
+    return t;
+}
+
+struct Section {
+    std::string heading;
+    std::string text;
+    std::vector<Table> tables;
+    std::string svg;
+};
+
+std::vector<Section> sections(const RatingStudyAnalysis& a) {
+    std::vector<Section> out;
+    for (const auto& s : a.scales) {
+        Section sec;
+        sec.heading = fmt::format("Scale {} ({} to {})", s.scale.id, s.scale.min, s.scale.max);
+        sec.text = fmt::format(
+            "{}{}\n\nParticipants: {}. Cell values are each participant's mean rating of the "
+            "stimulus. Levene (Brown-Forsythe) across cells: {}. {} across cells ({} "
+            "participants with every cell): {}.",
+            s.scale.prompt, s.scale.anchors.empty() ? "" : " Anchors: " + s.scale.anchors + ".",
+            s.participants, statisticText(s.levene),
+            s.omnibus.conditions.size() >= 3 ? "Friedman test" : "Wilcoxon signed-rank test",
+            s.omnibus.participants, statisticText(s.omnibus.result));
+        sec.tables.push_back(cellTable(s));
+        if (!s.planned.empty()) sec.tables.push_back(pairTable(s.planned));
+        for (const auto& fe : s.factorEffects) {
+            Table t{{"level of " + fe.factor, "n", "median", "IQR (Q1-Q3)"}, {}};
+            for (std::size_t i = 0; i < fe.levels.size(); ++i)
+                t.rows.push_back({fe.levels[i], std::to_string(fe.levelStats[i].n),
+                                  num(fe.levelStats[i].median, 2),
+                                  fmt::format("{}-{}", num(fe.levelStats[i].q1, 2),
+                                              num(fe.levelStats[i].q3, 2))});
+            sec.text +=
+                fmt::format("\n\nMain effect of {} (each participant's median over the "
+                            "other factors; {} participants): {}.",
+                            fe.factor, fe.omnibus.participants, statisticText(fe.omnibus.result));
+            sec.tables.push_back(t);
+            sec.tables.push_back(pairTable(fe.pairs));
+        }
+        for (const auto& g : s.groups) {
+            Table t{{g.field, "n", "median", "IQR (Q1-Q3)"}, {}};
+            for (const auto& grp : g.groups)
+                t.rows.push_back({grp.level, std::to_string(grp.n), num(grp.median, 2),
+                                  fmt::format("{}-{}", num(grp.q1, 2), num(grp.q3, 2))});
+            sec.text += fmt::format("\n\nBetween participants by {} (each participant's median "
+                                    "rating): Kruskal-Wallis {}.",
+                                    g.field, statisticText(g.kruskal));
+            sec.tables.push_back(t);
+            if (!g.pairs.empty()) {
+                Table mw{{"comparison", "W", "p", "p (Holm)", ""}, {}};
+                for (const auto& p : g.pairs)
+                    mw.rows.push_back({p.first + " vs " + p.second, num(p.test.statistic),
+                                       pText(p.test.p), pText(p.pHolm),
+                                       significanceStars(p.pHolm)});
+                sec.tables.push_back(mw);
+            }
+        }
+        sec.svg = ratingBoxPlotSvg(s);
+        out.push_back(std::move(sec));
+    }
+    if (!a.correlations.empty()) {
+        Section sec;
+        sec.heading = "Spearman correlations between scales";
+        sec.text = "Over (participant, stimulus) cells rated on both scales; R's cor.test(method "
+                   "= \"spearman\") p-values, Holm-corrected across all pairs in the last column.";
+        Table t{{"scales", "n", "rho", "p", "p (Holm)", ""}, {}};
+        for (const auto& c : a.correlations)
+            t.rows.push_back({c.first + " ~ " + c.second, std::to_string(c.n),
+                              c.test.estimate.empty() ? "NA" : num(c.test.estimate[0].value),
+                              pText(c.test.p), pText(c.pHolm), significanceStars(c.test.p)});
+        sec.tables.push_back(t);
+        out.push_back(std::move(sec));
+    }
+    return out;
+}
+
+constexpr const char* kMethods =
+    "Medians and quartiles: R's quantile(type = 7). Friedman: friedman.test; Wilcoxon "
+    "signed-rank: Z from the normal approximation with tie correction and without continuity "
+    "correction, zero differences dropped, as SPSS reports it (R: wilcox.test(paired = TRUE, "
+    "exact = FALSE, correct = FALSE) gives the same p); Holm: p.adjust(method = \"holm\") within "
+    "each family (the planned comparisons of a scale; the pairs of a main effect); "
+    "Kruskal-Wallis: kruskal.test; Mann-Whitney: wilcox.test(exact = FALSE, correct = FALSE) with "
+    "Holm, only after a significant Kruskal-Wallis test. Significance: * p < 0.05, ** p < 0.01, "
+    "*** p < 0.001 (corrected p where given).";
+
+} // namespace
+
+std::string ratingBoxPlotSvg(const ScaleAnalysis& s) {
+    const double cellW = 64, left = 52, right = 16, top = 34, plotH = 220, bottom = 96;
+    const double width =
+        left + right + cellW * static_cast<double>(std::max<std::size_t>(1, s.cells.size()));
+    const double height = top + plotH + bottom;
+    const double lo = s.scale.min, hi = s.scale.max > s.scale.min ? s.scale.max : s.scale.min + 1;
+    auto y = [&](double v) { return top + plotH * (1 - (v - lo) / (hi - lo)); };
+    // Colour by the first factor's level (the paper: dark / light blue by depth).
+    static const char* kPalette[] = {"#1f4e79", "#8fb8de", "#4a90c2",
+                                     "#c6dbef", "#2c7fb8", "#a6bddb"};
+    std::map<std::string, std::size_t> colourOf;
+    std::string firstFactor = s.cells.empty() || s.cells.front().factors.empty()
+                                  ? std::string()
+                                  : s.cells.front().factors.begin()->first;
+    std::ostringstream o;
+    o << fmt::format("<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{:.0f}\" height=\"{:.0f}\" "
+                     "viewBox=\"0 0 {:.0f} {:.0f}\" font-family=\"sans-serif\" font-size=\"11\">\n",
+                     width, height, width, height);
+    o << fmt::format("<title>{}</title>\n", xmlEscape(s.scale.id + ": " + s.scale.prompt));
+    o << fmt::format("<text x=\"{:.0f}\" y=\"16\" font-size=\"13\">{}</text>\n", left,
+                     xmlEscape(s.scale.id));
+    // Axis and grid.
+    const double step = (hi - lo) > 12 ? std::ceil((hi - lo) / 10) : 1;
+    for (double v = lo; v <= hi + 1e-9; v += step) {
+        o << fmt::format("<line x1=\"{:.1f}\" x2=\"{:.1f}\" y1=\"{:.1f}\" y2=\"{:.1f}\" "
+                         "stroke=\"#e0e0e0\"/>\n",
+                         left, width - right, y(v), y(v));
+        o << fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\" text-anchor=\"end\">{:g}</text>\n",
+                         left - 6, y(v) + 4, v);
+    }
+    o << fmt::format("<line x1=\"{:.1f}\" x2=\"{:.1f}\" y1=\"{:.1f}\" y2=\"{:.1f}\" "
+                     "stroke=\"black\"/>\n",
+                     left, left, top, top + plotH);
+    for (std::size_t i = 0; i < s.cells.size(); ++i) {
+        const auto& c = s.cells[i];
+        const auto& b = c.box;
+        const double cx = left + cellW * (static_cast<double>(i) + 0.5);
+        std::string level;
+        if (!firstFactor.empty() && c.factors.count(firstFactor)) level = c.factors.at(firstFactor);
+        const std::size_t colour = colourOf.try_emplace(level, colourOf.size()).first->second;
+        const char* fill = kPalette[colour % 6];
+        if (b.n > 0) {
+            o << fmt::format("<line x1=\"{0:.1f}\" x2=\"{0:.1f}\" y1=\"{1:.1f}\" y2=\"{2:.1f}\" "
+                             "stroke=\"black\"/>\n",
+                             cx, y(b.whiskerHigh), y(b.q3));
+            o << fmt::format("<line x1=\"{0:.1f}\" x2=\"{0:.1f}\" y1=\"{1:.1f}\" y2=\"{2:.1f}\" "
+                             "stroke=\"black\"/>\n",
+                             cx, y(b.q1), y(b.whiskerLow));
+            for (double w : {b.whiskerLow, b.whiskerHigh})
+                o << fmt::format("<line x1=\"{:.1f}\" x2=\"{:.1f}\" y1=\"{:.1f}\" y2=\"{:.1f}\" "
+                                 "stroke=\"black\"/>\n",
+                                 cx - 8, cx + 8, y(w), y(w));
+            o << fmt::format("<rect x=\"{:.1f}\" y=\"{:.1f}\" width=\"{:.1f}\" height=\"{:.1f}\" "
+                             "fill=\"{}\" stroke=\"black\"><title>{}: median {:g}, IQR {:g}-{:g}, "
+                             "n {}</title></rect>\n",
+                             cx - 16, y(b.q3), 32.0, std::max(1.0, y(b.q1) - y(b.q3)), fill,
+                             xmlEscape(c.stimulus), b.median, b.q1, b.q3, b.n);
+            o << fmt::format("<line x1=\"{:.1f}\" x2=\"{:.1f}\" y1=\"{:.1f}\" y2=\"{:.1f}\" "
+                             "stroke=\"#d62728\" stroke-width=\"2\"/>\n",
+                             cx - 16, cx + 16, y(b.median), y(b.median));
+            for (double v : b.outliers)
+                o << fmt::format("<circle cx=\"{:.1f}\" cy=\"{:.1f}\" r=\"3\" fill=\"none\" "
+                                 "stroke=\"black\"/>\n",
+                                 cx, y(v));
+            for (double v : b.extremes)
+                o << fmt::format("<circle cx=\"{:.1f}\" cy=\"{:.1f}\" r=\"2.5\" fill=\"black\"/>\n",
+                                 cx, y(v));
+        }
+        o << fmt::format("<text transform=\"translate({:.1f},{:.1f}) rotate(-40)\" "
+                         "text-anchor=\"end\">{}</text>\n",
+                         cx + 4, top + plotH + 14, xmlEscape(c.stimulus));
+    }
+    o << "</svg>\n";
+    return o.str();
+}
+
+std::string renderRatingReport(const RatingStudyAnalysis& a, ReportFormat format) {
+    const auto secs = sections(a);
+    const std::string title = a.title.empty() ? "Rating study" : a.title;
+    std::string out;
+    switch (format) {
+    case ReportFormat::Markdown: {
+        out += fmt::format("# {}\n\n{} participants. {}\n", title, a.participants, kMethods);
+        for (const auto& s : secs) {
+            out += fmt::format("\n## {}\n\n{}\n\n", s.heading, s.text);
+            for (const auto& t : s.tables) out += t.markdown() + "\n";
+            if (!s.svg.empty()) out += s.svg + "\n";
+        }
+        break;
+    }
+    case ReportFormat::Html: {
+        out += fmt::format("<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>{}</title>"
+                           "<style>body{{font-family:sans-serif;max-width:70em;margin:auto}}"
+                           "table{{border-collapse:collapse;margin:0.6em 0}}td,th{{border:1px "
+                           "solid #ccc;padding:2px 6px}}</style></head><body>\n<h1>{}</h1>\n"
+                           "<p>{} participants. {}</p>\n",
+                           xmlEscape(title), xmlEscape(title), a.participants, xmlEscape(kMethods));
+        for (const auto& s : secs) {
+            out += fmt::format("<h2>{}</h2>\n", xmlEscape(s.heading));
+            std::string text = xmlEscape(s.text);
+            for (std::size_t at; (at = text.find("\n\n")) != std::string::npos;)
+                text.replace(at, 2, "</p><p>");
+            out += "<p>" + text + "</p>\n";
+            if (!s.svg.empty()) out += s.svg;
+            for (const auto& t : s.tables) out += t.html();
+        }
+        out += "</body></html>\n";
+        break;
+    }
+    case ReportFormat::Latex: {
+        out += fmt::format("% {}\n", title);
+        for (const auto& s : secs) {
+            out += fmt::format("% {}\n", s.heading);
+            for (const auto& t : s.tables) out += t.latex() + "\n";
+        }
+        break;
+    }
+    case ReportFormat::Csv: {
+        out += std::string(kRatingTidyCsvHeader) + "\n";
+        auto row = [&](const std::string& section, const std::string& scale,
+                       const std::string& subject, const std::string& comparison,
+                       const std::string& statistic, double value) {
+            out += fmt::format("{},{},{},{},{},{}\n", section, scale, subject, comparison,
+                               statistic, std::isnan(value) ? "" : fmt::format("{:.6g}", value));
+        };
+        for (const auto& s : a.scales) {
+            for (const auto& c : s.cells) {
+                row("cell", s.scale.id, c.stimulus, "", "n", static_cast<double>(c.box.n));
+                row("cell", s.scale.id, c.stimulus, "", "median", c.box.median);
+                row("cell", s.scale.id, c.stimulus, "", "q1", c.box.q1);
+                row("cell", s.scale.id, c.stimulus, "", "q3", c.box.q3);
+            }
+            row("omnibus", s.scale.id, "cells", "", s.omnibus.result.statisticName,
+                s.omnibus.result.statistic);
+            row("omnibus", s.scale.id, "cells", "", "p", s.omnibus.result.p);
+            for (const auto& p : s.planned) {
+                const std::string cmp = p.first + " vs " + p.second;
+                row("planned", s.scale.id, p.context, cmp, "z", p.test.z);
+                row("planned", s.scale.id, p.context, cmp, "p", p.test.p);
+                row("planned", s.scale.id, p.context, cmp, "p_holm", p.pHolm);
+            }
+            for (const auto& fe : s.factorEffects) {
+                row("factor", s.scale.id, fe.factor, "", fe.omnibus.result.statisticName,
+                    fe.omnibus.result.statistic);
+                row("factor", s.scale.id, fe.factor, "", "p", fe.omnibus.result.p);
+                for (const auto& p : fe.pairs) {
+                    const std::string cmp = p.first + " vs " + p.second;
+                    row("factor_pair", s.scale.id, fe.factor, cmp, "z", p.test.z);
+                    row("factor_pair", s.scale.id, fe.factor, cmp, "p_holm", p.pHolm);
+                }
+            }
+            for (const auto& g : s.groups) {
+                row("groups", s.scale.id, g.field, "", "H", g.kruskal.statistic);
+                row("groups", s.scale.id, g.field, "", "p", g.kruskal.p);
+            }
+        }
+        for (const auto& c : a.correlations) {
+            row("spearman", c.first, c.second, "", "rho",
+                c.test.estimate.empty() ? std::nan("") : c.test.estimate[0].value);
+            row("spearman", c.first, c.second, "", "p", c.test.p);
+        }
+        break;
+    }
+    }
+    return out;
+}
+
+} // namespace underfoot::analysis
