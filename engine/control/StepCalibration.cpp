@@ -111,7 +111,7 @@ StepCalibrationResult calibrateSteps(const std::vector<ShoeFrame>& recording,
         const double fromStrikes = 0.35 * st.strikePeakP10PerS;
         const double fromNoise = 2 * st.noiseDerivativePerS;
         th.onsetDerivativePerS = std::max({fromStrikes, fromNoise, 1.0});
-        if (fromNoise >= fromStrikes)
+        if (fromNoise > 0.5 * st.strikePeakP10PerS)
             result.warnings.push_back(fmt::format(
                 "{}: strikes barely above the noise (10th percentile strike derivative {:.0f}/s, "
                 "noise {:.0f}/s); soft strikes may be missed",

@@ -13,6 +13,8 @@
 ///             away from their ends, so that no rise or fall counts as noise))
 ///   contact = rest + 0.08 range, release = rest + 0.25 range,
 ///   reference_derivative = median strike peak (strength 1).
+/// A warning is given when the noise term exceeds half the 10th-percentile strike peak (soft
+/// strikes may then be missed).
 /// Thresholds are saved and loaded as TOML, one file per participant.
 #include "engine/control/StepDetector.h"
 

@@ -2,12 +2,13 @@
 #pragma once
 /// The line protocol of the FSR shoes (docs/sensors.md, "Line protocol"), version 1:
 ///
-///     # underfoot-shoes 1 rate_hz=1000 adc_bits=10 columns=t_ms,lh,lt,rh,rt
+///     # underfoot-shoes 1 rate_hz=1000 adc_bits=10
 ///     123456,12,8,640,702
 ///
 /// ASCII, one frame per '\n'-terminated line ('\r' before it is ignored): the sketch's sample
 /// clock in milliseconds and the raw ADC readings of left heel, left toe, right heel, right toe.
-/// Lines starting with '#' are the header (sent at start-up and every second) or comments.
+/// Lines starting with '#' are the header (the sketch sends it at start-up; it may come at any
+/// time, `columns=` is optional and must read t_ms,lh,lt,rh,rt when present) or comments.
 /// The parser never throws: a bad line is rejected with a reason naming its number and what was
 /// expected, and the stream goes on.
 #include "engine/io/sensors/ShoeFrame.h"
