@@ -2,20 +2,26 @@
 #include "app/gui/SetupView.h"
 
 #include "app/gui/AudioOutput.h"
+#include "engine/control/StepDetector.h"
+#include "engine/dsp/Random.h"
+#include "engine/io/sensors/ShoeSimulator.h"
 #include "engine/render/Renderer.h"
 
 #include <QChart>
 #include <QChartView>
 #include <QComboBox>
+#include <QDir>
 #include <QDoubleSpinBox>
 #include <QFormLayout>
 #include <QGridLayout>
 #include <QGroupBox>
 #include <QHBoxLayout>
 #include <QLabel>
+#include <QLineEdit>
 #include <QLineSeries>
 #include <QProgressBar>
 #include <QPushButton>
+#include <QRegularExpression>
 #include <QShortcut>
 #include <QSpinBox>
 #include <QTimer>
@@ -65,7 +71,8 @@ void setSeries(QChart* chart, const std::vector<std::pair<QString, QList<QPointF
 }
 } // namespace
 
-SetupView::SetupView(AudioOutput& audio, QWidget* parent) : QWidget(parent), audio_(audio) {
+SetupView::SetupView(AudioOutput& audio, const QString& dataDir, QWidget* parent)
+    : QWidget(parent), audio_(audio), dataDir_(dataDir) {
     auto* audioBox = new QGroupBox(tr("Audio output"), this);
     auto* al = new QFormLayout(audioBox);
     api_ = new QComboBox(audioBox);
@@ -144,52 +151,85 @@ SetupView::SetupView(AudioOutput& audio, QWidget* parent) : QWidget(parent), aud
     message_->setTextInteractionFlags(Qt::TextSelectableByMouse);
     al->addRow(message_);
 
-    auto* calBox = new QGroupBox(tr("Step calibration (virtual walker while no shoes are "
-                                    "connected)"),
-                                 this);
+    auto* calBox = new QGroupBox(tr("FSR shoes and step calibration"), this);
     auto* cl = new QVBoxLayout(calBox);
-    auto* form = new QHBoxLayout;
-    massKg_ = new QDoubleSpinBox(calBox);
-    massKg_->setRange(eng::WalkerParameters::kMinMassKg, eng::WalkerParameters::kMaxMassKg);
-    massKg_->setValue(70);
-    massKg_->setSuffix(" kg");
-    massKg_->setAccessibleName(tr("Participant body mass"));
-    cadence_ = new QDoubleSpinBox(calBox);
-    cadence_->setRange(eng::WalkerParameters::kMinCadence, eng::WalkerParameters::kMaxCadence);
-    cadence_->setValue(100);
-    cadence_->setSuffix(tr(" steps/min"));
-    cadence_->setAccessibleName(tr("Cadence"));
-    threshold_ = new QDoubleSpinBox(calBox);
-    threshold_->setRange(100, 100000);
-    threshold_->setValue(4000);
-    threshold_->setSingleStep(250);
-    threshold_->setSuffix(" N/s");
-    threshold_->setAccessibleName(tr("Onset threshold on the force derivative"));
-    stepsLabel_ = new QLabel(calBox);
-    stepsLabel_->setAccessibleName(tr("Steps detected"));
-    auto* ml = new QLabel(tr("M&ass:"), calBox);
-    ml->setBuddy(massKg_);
-    auto* cdl = new QLabel(tr("Ca&dence:"), calBox);
-    cdl->setBuddy(cadence_);
-    auto* tl = new QLabel(tr("Onset t&hreshold:"), calBox);
-    tl->setBuddy(threshold_);
-    for (QWidget* w :
-         std::initializer_list<QWidget*>{ml, massKg_, cdl, cadence_, tl, threshold_, stepsLabel_})
-        form->addWidget(w);
-    form->addStretch();
-    grfChart_ = makeChart(tr("Vertical force under each foot"), tr("N"));
-    derivativeChart_ = makeChart(tr("Force derivative (positive changes fire a step)"), tr("N/s"));
-    auto* grfView = new QChartView(grfChart_, calBox);
-    auto* derView = new QChartView(derivativeChart_, calBox);
-    for (auto* v : {grfView, derView}) {
-        v->setRenderHint(QPainter::Antialiasing);
-        v->setMinimumHeight(180);
+    auto* form = new QGridLayout;
+    port_ = new QComboBox(calBox);
+    port_->setEditable(true);
+    port_->setAccessibleName(tr("Serial port of the shoes"));
+    port_->addItem(tr("simulated shoes (scripted walk)"), QString());
+    try {
+        for (const auto& p : eng::SerialSource::listPorts())
+            port_->addItem(q(p.path + (p.description.empty() ? "" : "  — " + p.description)),
+                           q(p.path));
+    } catch (const std::exception&) {
+        // No serial subsystem: only the simulator and typed paths.
     }
-    grfView->setAccessibleName(tr("Force plot"));
-    derView->setAccessibleName(tr("Force derivative plot"));
+    seconds_ = new QSpinBox(calBox);
+    seconds_->setRange(4, 120);
+    seconds_->setValue(15);
+    seconds_->setSuffix(" s");
+    seconds_->setAccessibleName(tr("Length of the calibration recording"));
+    participant_ = new QLineEdit(calBox);
+    participant_->setPlaceholderText(tr("participant code"));
+    participant_->setAccessibleName(tr("Participant whose thresholds are calibrated"));
+    record_ = new QPushButton(tr("Record and cali&brate  (Ctrl+B)"), calBox);
+    record_->setAccessibleName(tr("Record and calibrate the step thresholds"));
+    auto* saveThr = new QPushButton(tr("Save t&hresholds"), calBox);
+    saveThr->setAccessibleName(tr("Save the participant's step thresholds"));
+    auto* portLabel = new QLabel(tr("Sh&oes:"), calBox);
+    portLabel->setBuddy(port_);
+    auto* secLabel = new QLabel(tr("Recordin&g:"), calBox);
+    secLabel->setBuddy(seconds_);
+    auto* partLabel = new QLabel(tr("Partici&pant:"), calBox);
+    partLabel->setBuddy(participant_);
+    form->addWidget(portLabel, 0, 0);
+    form->addWidget(port_, 0, 1, 1, 3);
+    form->addWidget(secLabel, 1, 0);
+    form->addWidget(seconds_, 1, 1);
+    form->addWidget(partLabel, 1, 2);
+    form->addWidget(participant_, 1, 3);
+    auto* calButtons = new QHBoxLayout;
+    calButtons->addWidget(record_);
+    calButtons->addWidget(saveThr);
+    sensorStatus_ = new QLabel(tr("Shoes: not connected."), calBox);
+    sensorStatus_->setWordWrap(true);
+    sensorStatus_->setAccessibleName(tr("Sensor connection status"));
+    calibration_ = new QLabel(calBox);
+    calibration_->setWordWrap(true);
+    calibration_->setTextInteractionFlags(Qt::TextSelectableByMouse);
+    calibration_->setAccessibleName(tr("Calibration result"));
+    pressureChart_ = makeChart(tr("Pressure per sensor (raw 10-bit)"), tr("units"));
+    derivativeChart_ =
+        makeChart(tr("Pressure derivative and onset thresholds (positive changes fire a step)"),
+                  tr("units/s"));
+    auto* pView = new QChartView(pressureChart_, calBox);
+    auto* dView = new QChartView(derivativeChart_, calBox);
+    for (auto* v : {pView, dView}) {
+        v->setRenderHint(QPainter::Antialiasing);
+        v->setMinimumHeight(170);
+    }
+    pView->setAccessibleName(tr("Pressure plot"));
+    dView->setAccessibleName(tr("Pressure derivative plot"));
     cl->addLayout(form);
-    cl->addWidget(grfView, 1);
-    cl->addWidget(derView, 1);
+    cl->addLayout(calButtons);
+    cl->addWidget(sensorStatus_);
+    cl->addWidget(pView, 1);
+    cl->addWidget(dView, 1);
+    cl->addWidget(calibration_);
+    sensorTimer_ = new QTimer(this);
+    sensorTimer_->setInterval(100);
+    connect(sensorTimer_, &QTimer::timeout, this, &SetupView::pollSerial);
+    connect(record_, &QPushButton::clicked, this, [this] {
+        if (port_->currentData().toString().isEmpty() && port_->currentText() == port_->itemText(0))
+            calibrateSimulated();
+        else
+            toggleSerialRecording();
+    });
+    connect(saveThr, &QPushButton::clicked, this, &SetupView::saveThresholds);
+    auto* scB = new QShortcut(QKeySequence(Qt::CTRL | Qt::Key_B), this);
+    scB->setContext(Qt::WidgetWithChildrenShortcut);
+    connect(scB, &QShortcut::activated, record_, &QPushButton::click);
 
     auto* layout = new QHBoxLayout(this);
     layout->addWidget(audioBox, 2);
@@ -225,12 +265,10 @@ SetupView::SetupView(AudioOutput& audio, QWidget* parent) : QWidget(parent), aud
             meterTimer_->stop();
         updateMeters();
     });
-    for (auto* s : {massKg_, cadence_, threshold_})
-        connect(s, &QDoubleSpinBox::valueChanged, this, &SetupView::updateCalibrationPlot);
     loadForm();
     if (!audio_.loadError().isEmpty()) setMessage(audio_.loadError(), true);
     updateMeters();
-    updateCalibrationPlot();
+    calibrateSimulated();
 }
 
 void SetupView::setMessage(const QString& text, bool error) {
@@ -305,55 +343,176 @@ void SetupView::updateMeters() {
     }
 }
 
-void SetupView::updateCalibrationPlot() {
-    eng::WalkerParameters w;
-    w.massKg = massKg_->value();
-    w.cadenceStepsPerMin = cadence_->value();
-    const double rate = 500.0, seconds = 4.0;
-    eng::GrfSignal grf;
-    try {
-        grf = eng::walkerGrf(w, seconds, rate, 7);
-    } catch (const std::exception& e) {
-        stepsLabel_->setText(q(e.what()));
+QString SetupView::calibrationText() const {
+    return calibration_->text();
+}
+
+bool SetupView::calibrateSimulated() {
+    const auto script = eng::defaultWalkScript(1);
+    eng::Random random(2);
+    std::vector<eng::ShoeFrame> frames;
+    const auto n = static_cast<std::size_t>(script.durationMs());
+    frames.reserve(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        eng::ShoeFrame f;
+        f.index = i;
+        f.deviceMs = static_cast<std::uint32_t>(i);
+        f.timeS = static_cast<double>(i) * 1e-3;
+        f.raw = script.sample(i, random);
+        frames.push_back(f);
+    }
+    sensorStatus_->setText(tr("Shoes: simulated (the engine's scripted walk: standing, 8 steps, "
+                              "weight shifts, 6 steps). Choose a serial port to use real shoes."));
+    calibrate(frames, static_cast<int>(script.strikes().size()));
+    return result_ != nullptr;
+}
+
+void SetupView::toggleSerialRecording() {
+    if (serial_) {
+        sensorTimer_->stop();
+        serial_->stop();
+        serial_.reset();
+        record_->setText(tr("Record and cali&brate  (Ctrl+B)"));
+        if (!recording_.empty()) calibrate(recording_, -1);
         return;
     }
-    const double threshold = threshold_->value();
-    std::vector<std::pair<QString, QList<QPointF>>> force, derivative;
-    const char* names[] = {"left", "right"};
-    double fMax = 1, dMax = threshold * 1.2;
-    detectedSteps_ = 0;
-    for (std::size_t c = 0; c < std::min<std::size_t>(grf.channels.size(), 2); ++c) {
-        QList<QPointF> f, d;
-        bool armed = true;
-        double previous = 0;
-        for (std::size_t i = 0; i < grf.frames(); ++i) {
-            const double t = static_cast<double>(i) / rate;
-            if (t > seconds) break;
-            const double v = grf.channels[c][i];
-            const double dv = i == 0 ? 0 : (v - previous) * rate;
-            previous = v;
-            f.append({t, v});
-            d.append({t, std::max(0.0, dv)});
-            fMax = std::max(fMax, v);
-            dMax = std::max(dMax, dv);
-            // Positive changes only; re-armed once the foot has left the ground.
-            if (armed && dv > threshold) {
-                ++detectedSteps_;
-                armed = false;
-            }
-            if (v <= 1.0) armed = true;
-        }
-        force.push_back({tr("%1 foot").arg(tr(names[c])), f});
-        derivative.push_back({tr("%1 foot").arg(tr(names[c])), d});
+    eng::SerialConfig config;
+    config.path = (port_->currentData().toString().isEmpty() ? port_->currentText().trimmed()
+                                                             : port_->currentData().toString())
+                      .toStdString();
+    try {
+        serial_ = std::make_unique<eng::SerialSource>(config);
+        serial_->start();
+    } catch (const std::exception& e) {
+        serial_.reset();
+        sensorStatus_->setText(tr("%1\nCheck the cable and the port name (ls /dev/ttyACM*), and "
+                                  "that you may open it (group dialout).")
+                                   .arg(q(e.what())));
+        return;
     }
-    derivative.push_back({tr("threshold"), {{0, threshold}, {seconds, threshold}}});
-    setSeries(grfChart_, force, seconds, 0, fMax * 1.1);
-    setSeries(derivativeChart_, derivative, seconds, 0, dMax * 1.1);
-    const double expected = seconds * w.cadenceStepsPerMin / 60.0;
-    stepsLabel_->setText(tr("%1 steps detected in %2 s (the walker took about %3)")
-                             .arg(detectedSteps_)
-                             .arg(seconds)
-                             .arg(expected, 0, 'f', 0));
+    recording_.clear();
+    recordUntilS_ = -1;
+    record_->setText(tr("Stop and cali&brate  (Ctrl+B)"));
+    sensorTimer_->start();
+}
+
+void SetupView::pollSerial() {
+    if (!serial_) return;
+    eng::ShoeFrame f;
+    while (serial_->popFrame(f)) {
+        if (recordUntilS_ < 0) recordUntilS_ = f.timeS + seconds_->value();
+        recording_.push_back(f);
+    }
+    const auto st = serial_->status();
+    sensorStatus_->setText(tr("Shoes on %1 (%2): %3 — %4 · %5 frames/s · %6 accepted, %7 lost, "
+                              "%8 rejected lines%9")
+                               .arg(q(serial_->config().path), q(serial_->backendName()),
+                                    q(std::string(eng::sensorStateName(st.state))), q(st.message))
+                               .arg(st.rateHz, 0, 'f', 0)
+                               .arg(st.framesAccepted)
+                               .arg(st.framesLost)
+                               .arg(st.linesRejected)
+                               .arg(st.lastRejection.empty()
+                                        ? QString()
+                                        : tr(" · last rejected: %1").arg(q(st.lastRejection))));
+    if (recordUntilS_ > 0 && !recording_.empty() && recording_.back().timeS >= recordUntilS_)
+        toggleSerialRecording();
+}
+
+void SetupView::calibrate(const std::vector<eng::ShoeFrame>& frames, int expectedSteps) {
+    result_.reset();
+    expectedSteps_ = expectedSteps;
+    detectedSteps_ = 0;
+    eng::StepCalibrationOptions options;
+    options.participant = participant_->text().trimmed().toStdString();
+    try {
+        result_ =
+            std::make_unique<eng::StepCalibrationResult>(eng::calibrateSteps(frames, options));
+    } catch (const std::exception& e) {
+        calibration_->setText(tr("Not calibrated: %1\nRecord again with the participant standing, "
+                                 "then walking at least four steps on each sensor.")
+                                  .arg(q(e.what())));
+        return;
+    }
+    const auto& thr = result_->thresholds;
+    eng::StepDetector detector(thr);
+    eng::StepDetector::Events events;
+    std::vector<std::pair<QString, QList<QPointF>>> pressure, derivative;
+    for (std::size_t i = 0; i < eng::kShoeSensorCount; ++i) {
+        pressure.push_back({q(std::string(eng::shoeSensorName(i))), {}});
+        derivative.push_back({q(std::string(eng::shoeSensorName(i))), {}});
+    }
+    const double t0 = frames.empty() ? 0 : frames.front().timeS;
+    double dMax = 1, tMax = 1;
+    for (std::size_t k = 0; k < frames.size(); ++k) {
+        detectedSteps_ += static_cast<int>(detector.process(frames[k], events));
+        const double t = frames[k].timeS - t0;
+        tMax = t;
+        if (k % 4 != 0) continue; // every 4th frame is plenty for the eye
+        for (std::size_t i = 0; i < eng::kShoeSensorCount; ++i) {
+            pressure[i].second.append({t, static_cast<double>(frames[k].raw[i])});
+            const double d = detector.derivativePerS(i);
+            derivative[i].second.append({t, d});
+            dMax = std::max(dMax, d);
+        }
+    }
+    for (std::size_t i = 0; i < eng::kShoeSensorCount; ++i) {
+        const double onset = thr.sensors[i].onsetDerivativePerS;
+        derivative.push_back({tr("%1 onset").arg(q(std::string(eng::shoeSensorName(i)))),
+                              {{0, onset}, {tMax, onset}}});
+    }
+    setSeries(pressureChart_, pressure, tMax, 0, 1023);
+    setSeries(derivativeChart_, derivative, tMax, -dMax * 0.1, dMax * 1.05);
+    // Each sensor's threshold dashed, in that sensor's colour.
+    const auto series = derivativeChart_->series();
+    for (qsizetype j = static_cast<qsizetype>(eng::kShoeSensorCount); j < series.size(); ++j) {
+        auto* line = static_cast<QLineSeries*>(series[j]);
+        QPen pen(static_cast<QLineSeries*>(series[j - 4])->color());
+        pen.setStyle(Qt::DashLine);
+        pen.setWidthF(1.5);
+        line->setPen(pen);
+    }
+    QString text = tr("Proposed onset thresholds (units/s): ");
+    for (std::size_t i = 0; i < eng::kShoeSensorCount; ++i)
+        text += tr("%1 %2%3")
+                    .arg(q(std::string(eng::shoeSensorName(i))))
+                    .arg(thr.sensors[i].onsetDerivativePerS, 0, 'f', 0)
+                    .arg(i + 1 < eng::kShoeSensorCount ? ", " : ". ");
+    text +=
+        expectedSteps >= 0
+            ? tr("With them the detector finds %1 of the %2 strikes in the "
+                 "recording.")
+                  .arg(detectedSteps_)
+                  .arg(expectedSteps)
+            : tr("With them the detector finds %1 strikes in the recording.").arg(detectedSteps_);
+    for (const auto& w : result_->warnings) text += "\n" + tr("Warning: %1").arg(q(w));
+    calibration_->setText(text);
+}
+
+QString SetupView::saveThresholds() {
+    if (!result_) {
+        calibration_->setText(tr("Record and calibrate first (Ctrl+B)."));
+        return {};
+    }
+    const QString code = participant_->text().trimmed();
+    if (!QRegularExpression("^[A-Za-z0-9_.-]{1,32}$").match(code).hasMatch()) {
+        calibration_->setText(tr("Type the participant's code first (Alt+P): letters, digits, "
+                                 "dot, dash, underscore."));
+        return {};
+    }
+    auto thresholds = result_->thresholds;
+    thresholds.participant = code.toStdString();
+    const QString dir = QDir(dataDir_).filePath("thresholds");
+    QDir().mkpath(dir);
+    const QString path = QDir(dir).filePath(code + ".toml");
+    try {
+        eng::saveStepThresholds(path.toStdString(), thresholds, result_.get());
+    } catch (const std::exception& e) {
+        calibration_->setText(q(e.what()));
+        return {};
+    }
+    calibration_->setText(calibration_->text() + "\n" + tr("Saved %1").arg(path));
+    return path;
 }
 
 } // namespace underfoot::gui

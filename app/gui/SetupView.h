@@ -2,10 +2,19 @@
 #pragma once
 /// The Setup view: audio API, device, sample rate, block size and channel map (headphones,
 /// haptic actuators per shoe), saved as the engine's audio settings TOML; start/stop the live
-/// engine with its meters (peak per output, xruns, callback load); and the step-calibration
-/// plot: the ground reaction force under each foot and its time derivative against the onset
-/// threshold, from the virtual walker while no shoes are connected.
+/// engine with its meters (peak per output, xruns, callback load); the FSR shoes' serial
+/// connection with its live status; and the step calibration of a participant: a recording
+/// (from the shoes, or from the engine's scripted shoe simulator when none are connected) is
+/// calibrated by engine::calibrateSteps, plotted (pressures, their derivative against each
+/// sensor's onset threshold), checked with the StepDetector and saved as the participant's
+/// thresholds TOML.
+#include "engine/control/StepCalibration.h"
+#include "engine/io/sensors/SerialSource.h"
+
 #include <QWidget>
+
+#include <memory>
+#include <vector>
 
 class QComboBox;
 class QSpinBox;
@@ -16,6 +25,7 @@ class QTimer;
 class QProgressBar;
 class QChartView;
 class QChart;
+class QLineEdit;
 
 namespace underfoot::gui {
 
@@ -24,14 +34,22 @@ class AudioOutput;
 class SetupView : public QWidget {
     Q_OBJECT
   public:
-    SetupView(AudioOutput& audio, QWidget* parent = nullptr);
+    SetupView(AudioOutput& audio, const QString& dataDir, QWidget* parent = nullptr);
 
     /// Applies the form to the audio output; returns "" or the problem.
     QString applyForm();
-    /// Redraws the calibration plot (walker parameters and threshold from the form).
-    void updateCalibrationPlot();
-    /// Steps detected in the plotted window (derivative above threshold, positive changes only).
+    /// Calibrates from the scripted shoe simulator's default walk; false (message shown) when
+    /// the calibration fails.
+    bool calibrateSimulated();
+    /// Starts (or stops) recording from the serial port in the form for `seconds`.
+    void toggleSerialRecording();
+    /// Steps the detector found with the proposed thresholds in the calibration recording.
     int detectedSteps() const { return detectedSteps_; }
+    /// Strikes the recording is known to contain (simulation), or -1.
+    int expectedSteps() const { return expectedSteps_; }
+    /// Saves the proposed thresholds for the participant code in the form; returns the path.
+    QString saveThresholds();
+    QString calibrationText() const;
 
   private:
     void fillDevices();
@@ -52,13 +70,25 @@ class SetupView : public QWidget {
     QProgressBar* outputMeters_[8];
     QLabel* message_;
     QTimer* meterTimer_;
-    QDoubleSpinBox* massKg_;
-    QDoubleSpinBox* cadence_;
-    QDoubleSpinBox* threshold_;
-    QLabel* stepsLabel_;
-    QChart* grfChart_;
+    void calibrate(const std::vector<engine::ShoeFrame>& frames, int expectedSteps);
+    void pollSerial();
+
+    QString dataDir_;
+    QComboBox* port_;
+    QSpinBox* seconds_;
+    QLineEdit* participant_;
+    QPushButton* record_;
+    QLabel* sensorStatus_;
+    QLabel* calibration_;
+    QChart* pressureChart_;
     QChart* derivativeChart_;
+    QTimer* sensorTimer_;
+    std::unique_ptr<engine::SerialSource> serial_;
+    std::vector<engine::ShoeFrame> recording_;
+    double recordUntilS_ = 0;
+    std::unique_ptr<engine::StepCalibrationResult> result_;
     int detectedSteps_ = 0;
+    int expectedSteps_ = -1;
 };
 
 } // namespace underfoot::gui

@@ -7,6 +7,7 @@
 #include "app/gui/PaletteView.h"
 #include "app/gui/ResultsView.h"
 #include "app/gui/RunView.h"
+#include "app/gui/SetupView.h"
 #include "app/gui/StudyContext.h"
 #include "app/gui/StudyView.h"
 #include "engine/surfaces/Surface.h"
@@ -16,6 +17,7 @@
 #include <QComboBox>
 #include <QElapsedTimer>
 #include <QFile>
+#include <QFileInfo>
 #include <QLabel>
 #include <QLineEdit>
 #include <QListWidget>
@@ -405,6 +407,29 @@ lock = "answer"
         QVERIFY2(found,
                  qPrintable(QString::fromStdString(p0.path + " " + std::to_string(changed))));
         QVERIFY(palette->saveAs("Bad Id!", "x").isEmpty());
+    }
+
+    void setupCalibratesStepThresholdsThatFindEveryStrike() {
+        auto w = makeWindow();
+        auto* setup = w->setupView();
+        QVERIFY2(setup->calibrateSimulated(), qPrintable(setup->calibrationText()));
+        // The simulator's script knows every foot strike (engine::ShoeScript::strikes()).
+        QVERIFY(setup->expectedSteps() > 0);
+        QCOMPARE(setup->detectedSteps(), setup->expectedSteps());
+        QVERIFY(setup->saveThresholds().isEmpty()); // no participant code yet
+    }
+
+    void replayRendersAStoredWalkerTrial() {
+        const QString file = home_.filePath("small.db"); // from the practice/breaks test
+        QVERIFY(QFile::exists(file));
+        auto w = makeWindow(file);
+        auto* results = w->resultsView();
+        QSignalSpy done(results, &gui::ResultsView::replayFinished);
+        const QString wav = home_.filePath("q1_trial2.wav");
+        results->startReplay("Q1", 1, wav);
+        QVERIFY(done.wait(120000));
+        QCOMPARE(done.front().front().toString(), QString());
+        QVERIFY(QFileInfo(wav).size() > 48000 * 2 * 4); // more than a second of stereo float
     }
 };
 
