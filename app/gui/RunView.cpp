@@ -409,6 +409,13 @@ void RunView::buildTrialPage() {
     auto* exclude = new QPushButton(tr("Exclude trial…  (Ctrl+E)"), trial_);
     exclude->setFocusPolicy(Qt::NoFocus);
     exclude->setAccessibleName(tr("Exclude this trial"));
+    auto* revise = new QPushButton(tr("Change previous answer  (Ctrl+Z)"), trial_);
+    revise->setFocusPolicy(Qt::NoFocus);
+    revise->setAccessibleName(tr("Change the previous answer"));
+    connect(revise, &QPushButton::clicked, this, [this] {
+        revisePrevious();
+        trial_->setFocus();
+    });
     auto* stop = new QPushButton(tr("End session for now  (Ctrl+W)"), trial_);
     stop->setFocusPolicy(Qt::NoFocus);
     stop->setAccessibleName(tr("End the session; it can be resumed"));
@@ -441,6 +448,7 @@ void RunView::buildTrialPage() {
     buttons->addWidget(nextButton_, 2);
     buttons->addWidget(pauseButton_);
     buttons->addWidget(exclude);
+    buttons->addWidget(revise);
     buttons->addWidget(stop);
     left->addLayout(buttons);
     left->addWidget(message_);
@@ -646,6 +654,7 @@ void RunView::showPhase() {
 }
 
 void RunView::showTrial() {
+    revising_ = -1;
     const auto& t = session_->current();
     const auto& p = context_.store().protocol();
     header_->setText(tr("%1 %2 of %3 · participant %4 · group %5")
@@ -909,6 +918,15 @@ void RunView::adjustRating(int delta) {
 
 bool RunView::handleTrialKey(int key, Qt::KeyboardModifiers modifiers, const QString& text) {
     if (!session_ || pages_->currentIndex() != TrialPage) return false;
+    if (key == Qt::Key_Z && modifiers == Qt::ControlModifier) {
+        revisePrevious();
+        return true;
+    }
+    if (key == Qt::Key_Escape && revising_ >= 0) {
+        showTrial();
+        setMessage(tr("Change cancelled; the stored answer is unchanged."), false);
+        return true;
+    }
     if (modifiers & (Qt::ControlModifier | Qt::AltModifier | Qt::MetaModifier)) return false;
     if (key == Qt::Key_Return || key == Qt::Key_Enter) {
         next();
@@ -919,7 +937,10 @@ bool RunView::handleTrialKey(int key, Qt::KeyboardModifiers modifiers, const QSt
         return true;
     }
     if (key == Qt::Key_Space) {
-        play();
+        if (revising_ >= 0)
+            setMessage(tr("Store the changed answer (Enter) or cancel (Esc) first."));
+        else
+            play();
         return true;
     }
     if (key == Qt::Key_Up || key == Qt::Key_Down) {
@@ -980,6 +1001,25 @@ void RunView::next() {
         setMessage(tr("Paused: press Ctrl+P to resume first."));
         return;
     }
+    if (revising_ >= 0) {
+        exp::TrialAnswer a;
+        a.answer = surface_;
+        a.soundscapeAnswer = soundscape_;
+        a.ratings = ratings_;
+        a.comment = comment_->text().trimmed().toStdString();
+        const int index = revising_;
+        try {
+            context_.store().commitAnswer(session_->participant().code, index, a,
+                                          revisingResponseS_);
+        } catch (const std::exception& e) {
+            setMessage(tr("Not changed: %1").arg(q(e.what())));
+            return;
+        }
+        context_.notifyDataChanged();
+        showTrial();
+        setMessage(tr("The answer of trial %1 was changed.").arg(index + 1), false);
+        return;
+    }
     if (!session_->playing()) {
         setMessage(tr("Start the stimulus first (Space); the answer belongs to what was heard."));
         return;
@@ -1010,6 +1050,44 @@ void RunView::next() {
     showPhase();
     if (pages_->currentIndex() == TrialPage)
         setMessage(tr("Answer stored (%1 ms).").arg(lastCommitMs_, 0, 'f', 1), false);
+}
+
+bool RunView::revisePrevious() {
+    if (!session_ || pages_->currentIndex() != TrialPage || paused_) return false;
+    const auto& p = context_.store().protocol();
+    if (p.lock == exp::LockRule::OnAnswer) {
+        setMessage(tr("Answers are locked once given (protocol rule lock = \"answer\")."));
+        return false;
+    }
+    if (session_->playing()) {
+        setMessage(tr("The previous answer is locked: this trial's stimulus has started "
+                      "(protocol rule lock = \"next_trial\")."));
+        return false;
+    }
+    const std::string code = session_->participant().code;
+    const int current = session_->current().index;
+    std::optional<exp::TrialRecord> previous;
+    for (const auto& t : context_.store().trials(code))
+        if (t.answered && t.index < current && (!previous || t.index > previous->index))
+            previous = t;
+    if (!previous) {
+        setMessage(tr("No earlier answer in this session to change."));
+        return false;
+    }
+    surface_ = previous->answer.answer;
+    soundscape_ = previous->answer.soundscapeAnswer;
+    ratings_ = previous->answer.ratings;
+    comment_->setText(QString::fromStdString(previous->answer.comment));
+    revising_ = previous->index;
+    revisingResponseS_ = previous->responseTimeS;
+    header_->setText(tr("Changing the answer of trial %1 — Enter stores the change, Esc cancels")
+                         .arg(previous->index + 1));
+    playButton_->setEnabled(false);
+    setActive(0);
+    setMessage(tr("Trial %1's stored answer is loaded; change it and press Enter.")
+                   .arg(previous->index + 1),
+               false);
+    return true;
 }
 
 void RunView::togglePause() {

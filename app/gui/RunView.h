@@ -10,6 +10,8 @@
 ///   Enter         Next: commit the answer        Alt+M   comment field (Esc leaves it)
 ///   Ctrl+P        pause / resume                 Ctrl+E  exclude this trial (with a reason)
 ///   Ctrl+Shift+E  exclude the previous trial     Ctrl+W  end the session for now (resumable)
+///   Ctrl+Z        change the previous answer (only under lock = "next_trial", before the next
+///                 stimulus starts; Enter stores the change, Esc cancels)
 /// Every answer is committed to the study file (durably) by Next before anything else happens.
 #include "experiment/Session.h"
 
@@ -17,6 +19,7 @@
 
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -56,6 +59,11 @@ class RunView : public QWidget {
     void closeSession();
     /// Excludes the current (or, with `previous`, the last answered) trial with `reason`.
     bool excludeTrial(const QString& reason, bool previous = false);
+    /// Loads the previous trial's answer for a change (lock rule permitting); false with the
+    /// reason in the message line otherwise.
+    bool revisePrevious();
+    /// The trial whose answer is being changed, or -1.
+    int revising() const { return revising_; }
     /// For screenshots: registers a scratch participant and shows a trial with an answer chosen.
     bool startDemoTrialForScreenshot();
 
@@ -162,6 +170,8 @@ class RunView : public QWidget {
     std::string soundscape_;
     std::map<std::string, int> ratings_;
     double lastCommitMs_ = 0;
+    int revising_ = -1;
+    std::optional<double> revisingResponseS_;
 };
 
 } // namespace underfoot::gui

@@ -275,6 +275,8 @@ lock = "answer"
         QTest::keyClick(run->trialPanel(), Qt::Key_Return);
         QVERIFY2(run->trialMessage().startsWith("Not stored yet"), qPrintable(run->trialMessage()));
         QCOMPARE(run->session()->current().index, 0);
+        // lock = "answer": no change of a committed answer is offered.
+        QVERIFY(!run->revisePrevious());
         // Typed "1" then "0" is 10 on a 0-10 scale.
         QTest::keyClick(run->trialPanel(), '1');
         QTest::keyClick(run->trialPanel(), '0');
@@ -326,8 +328,21 @@ lock = "answer"
                 const int index = run->session()->current().index;
                 typed[index] = answerByKeyboard(*run, protocol, i);
             }
-            // The fourth trial is playing with an answer chosen but not committed.
+            // lock = "next_trial": the third answer can still be changed (Ctrl+Z) ...
+            QTest::keyClick(run->trialPanel(), Qt::Key_Z, Qt::ControlModifier);
+            QCOMPARE(run->revising(), 2);
+            const ue::AnswerOption* other = protocol.questions.surfaceOption("metal");
+            QTest::keyClick(run->trialPanel(), other->letter);
+            QTest::keyClick(run->trialPanel(), Qt::Key_Return);
+            QCOMPARE(run->revising(), -1);
+            QVERIFY2(run->trialMessage().contains("changed"), qPrintable(run->trialMessage()));
+            typed[2].answer = "metal";
+            // ... until the next stimulus starts.
             QTest::keyClick(run->trialPanel(), Qt::Key_Space);
+            QTest::keyClick(run->trialPanel(), Qt::Key_Z, Qt::ControlModifier);
+            QCOMPARE(run->revising(), -1);
+            QVERIFY(run->trialMessage().contains("locked"));
+            // The fourth trial is playing with an answer chosen but not committed.
             QTest::keyClick(run->trialPanel(), 'b');
             QVERIFY(w->close());
         }
