@@ -176,6 +176,9 @@ int Session::replayCount() const {
 
 void Session::rate(const std::string& scaleId, int value) {
     const TrialRecord& t = current();
+    if (!playing_)
+        throw std::logic_error(
+            fmt::format("rate() for trial {} before its clip was presented", t.index));
     for (const Scale* s : askedScales()) {
         if (s->id != scaleId) continue;
         if (value < s->min || value > s->max)
@@ -228,7 +231,8 @@ void Session::completeLap() {
             fmt::format("completeLap(): all {} laps of trial {} are done", laps.total(), t.index));
     store_.recordLap(participant_.code, t.index, t.lapsDone + 1);
     const int done = ++trials_[position_].lapsDone;
-    if (done < laps.total()) player_.setMuted(laps.silent(done + 1));
+    if (done < laps.total() && laps.silent(done) != laps.silent(done + 1))
+        player_.setMuted(laps.silent(done + 1)); // baseline over: the sound comes on
 }
 
 } // namespace underfoot::experiment
