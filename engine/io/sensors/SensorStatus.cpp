@@ -30,7 +30,7 @@ std::string_view sensorStateName(SensorState state) noexcept {
 
 FaultMonitor::FaultMonitor(FaultThresholds thresholds) : thresholds_(thresholds) {
     if (!(thresholds_.windowMs > 0)) thresholds_.windowMs = 500;
-    if (!(thresholds_.silenceMs > 0)) thresholds_.silenceMs = 250;
+    if (!(thresholds_.silenceMs > 0)) thresholds_.silenceMs = 400;
 }
 
 void FaultMonitor::setCallback(Callback callback) {

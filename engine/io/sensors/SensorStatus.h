@@ -44,7 +44,7 @@ constexpr bool isFault(SensorState s) noexcept {
 
 /// When a stream is declared faulty. Counts are over a sliding window of `windowMs`.
 struct FaultThresholds {
-    double silenceMs = 250;       ///< no frame for this long -> Silent
+    double silenceMs = 400;       ///< no frame for this long -> Silent (USB hiccups are shorter)
     double startupGraceMs = 2500; ///< Waiting this long after opening (an Arduino resets on open)
     double windowMs = 500;        ///< sliding window for the rates below
     double garbageRatio = 0.02;   ///< rejected / (accepted + rejected) above this ...

@@ -385,9 +385,9 @@ TEST(FaultMonitor, SilenceGarbageLossAndRecoveryFollowTheWindow) {
     m.framesLost(now, 6, "t_ms 1 -> 8: 6 frames lost");
     m.update(now);
     EXPECT_EQ(m.state(), SensorState::Lossy);
-    m.update(now + 0.3);
+    m.update(now + 0.5);
     EXPECT_EQ(m.state(), SensorState::Silent);
-    m.disconnected(now + 0.3, "gone");
+    m.disconnected(now + 0.5, "gone");
     EXPECT_EQ(m.state(), SensorState::Disconnected);
     EXPECT_FALSE(m.recordable());
     EXPECT_EQ(m.status().faults, 3u); // silent, garbage, lossy (lossy -> silent -> disconnected:
