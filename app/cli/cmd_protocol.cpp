@@ -5,6 +5,7 @@
 #include "experiment/Protocol.h"
 
 #include <fmt/core.h>
+#include <fmt/format.h>
 
 #include <algorithm>
 #include <cmath>
@@ -25,8 +26,28 @@ void printSummary(const Protocol& p, std::uint64_t seed, int participants) {
     fmt::print("design: {}-subject, {} stimuli, {} repetition(s), order {}{}{}\n",
                toString(p.design), p.stimuli.size(), p.ordering.repetitions,
                p.ordering.order == OrderKind::Random ? "random per participant" : "fixed",
-               p.ordering.blocks == BlockKind::Repetition ? ", one block per repetition" : "",
+               p.ordering.blocks == BlockKind::Repetition ? ", one block per repetition"
+               : p.ordering.blocks == BlockKind::Scale    ? ", one block per scale"
+                                                          : "",
                p.ordering.noImmediateRepeat ? ", no immediate repeat" : "");
+    if (p.ordering.counterbalance == Counterbalance::LatinSquare)
+        fmt::print("counterbalanced: Williams Latin square, {} orders (groups order1..order{})\n",
+                   p.groups.size(), p.groups.size());
+    if (p.laps.total() > 0)
+        fmt::print("laps per condition: {} silent baseline, then {} with sound\n", p.laps.baseline,
+                   p.laps.feedback);
+    if (p.clips.enabled) {
+        int lab = 0;
+        for (const auto& s : p.stimuli) lab += s.clip ? 1 : 0;
+        fmt::print("listening test: {} clip(s) rendered by `underfoot clips` ({:g} s, seed {}), {} "
+                   "supplied by the lab; replay {}\n",
+                   static_cast<int>(p.stimuli.size()) - lab, p.clips.seconds, p.clips.seed, lab,
+                   p.clips.replay ? "allowed (counted)" : "not allowed");
+    }
+    for (const auto& f : p.participantFields)
+        fmt::print("participant field: {} ({}){}\n", f.id, f.label,
+                   f.options.empty() ? std::string(" free text")
+                                     : fmt::format(": {}", fmt::join(f.options, ", ")));
     fmt::print("questions: {}{}{}{}\n",
                p.questions.asksSurface()
                    ? fmt::format("surface ({} options)", p.questions.surfaceOptions.size())
