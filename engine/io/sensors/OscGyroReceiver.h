@@ -75,6 +75,8 @@ class OscGyroReceiver {
     bool popSample(GyroSample& sample);
     SensorStatus status() const;
     SensorState state() const noexcept;
+    /// True when a trial may be recorded (state Running); the session pauses otherwise.
+    bool recordable() const noexcept { return state() == SensorState::Running; }
     /// Counters of one limb.
     LimbCounters limbCounters(Limb limb) const;
 

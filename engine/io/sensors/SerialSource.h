@@ -75,6 +75,8 @@ class SerialSource {
     SensorStatus status() const;
     /// The current state only (lock-free).
     SensorState state() const noexcept;
+    /// True when a trial may be recorded (state Running); the session pauses otherwise.
+    bool recordable() const noexcept { return state() == SensorState::Running; }
     /// Which backend opened the port ("libserialport" or "termios"; empty before start).
     std::string backendName() const;
     /// Header settings seen on the stream (rate_hz, protocol version); 0 until a header arrived.

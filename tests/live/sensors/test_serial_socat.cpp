@@ -91,6 +91,7 @@ TEST(SerialSocat, DetectsEveryScriptedStepWithFootPartAndTimingAndNoneWhileStand
 
     const SensorStatus st = source.status();
     EXPECT_EQ(stateMidWalk, SensorState::Running);
+    EXPECT_FALSE(source.recordable()); // stopped
     EXPECT_EQ(st.framesAccepted, ticks);
     EXPECT_EQ(popped, ticks);
     EXPECT_EQ(st.linesRejected, 0u) << st.lastRejection;
