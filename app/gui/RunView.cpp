@@ -348,7 +348,7 @@ void RunView::buildTrialPage() {
     stimulus_->setWordWrap(true);
     stimulus_->setAccessibleName(tr("What is playing"));
     lockRule_ = new QLabel(trial_);
-    lockRule_->setStyleSheet("color: palette(mid);");
+    lockRule_->setStyleSheet("color: #505050;");
 
     auto* meters = new QGroupBox(tr("Walker / sensors"), trial_);
     auto* ml = new QGridLayout(meters);
@@ -357,7 +357,7 @@ void RunView::buildTrialPage() {
     for (auto* m : {leftMeter_, rightMeter_}) {
         m->setRange(0, 150);
         m->setFormat("%v % BW");
-        m->setMinimumWidth(160);
+        m->setMinimumWidth(120);
     }
     leftMeter_->setAccessibleName(tr("Left foot force"));
     rightMeter_->setAccessibleName(tr("Right foot force"));
@@ -371,9 +371,10 @@ void RunView::buildTrialPage() {
     ml->addWidget(leftMeter_, 0, 1);
     ml->addWidget(new QLabel(tr("Right GRF"), meters), 1, 0);
     ml->addWidget(rightMeter_, 1, 1);
-    ml->addWidget(stepLabel_, 0, 2, 2, 1);
-    ml->addWidget(engineLabel_, 2, 0, 1, 3);
+    ml->addWidget(stepLabel_, 2, 0, 1, 2);
+    ml->addWidget(engineLabel_, 3, 0, 1, 2);
     ml->setColumnStretch(1, 1);
+    meters->setMaximumWidth(300);
 
     playButton_ = new QPushButton(tr("Start stimulus  (Space)"), trial_);
     playButton_->setMinimumHeight(44);
@@ -426,19 +427,12 @@ void RunView::buildTrialPage() {
     planList_ = new QListWidget(trial_);
     planList_->setFocusPolicy(Qt::NoFocus);
     planList_->setAccessibleName(tr("Trials of this session"));
-    planList_->setMaximumWidth(230);
+    planList_->setMaximumWidth(300);
 
     auto* left = new QVBoxLayout;
     left->addWidget(header_);
     left->addWidget(stimulus_);
     left->addWidget(lockRule_);
-    auto* topRow = new QHBoxLayout;
-    topRow->addWidget(meters, 1);
-    auto* playCol = new QVBoxLayout;
-    playCol->addWidget(playButton_);
-    playCol->addWidget(pausedLabel_);
-    topRow->addLayout(playCol);
-    left->addLayout(topRow);
     left->addWidget(scroll, 1);
     auto* commentRow = new QHBoxLayout;
     commentRow->addWidget(commentLabel);
@@ -452,9 +446,14 @@ void RunView::buildTrialPage() {
     buttons->addWidget(stop);
     left->addLayout(buttons);
     left->addWidget(message_);
+    auto* right = new QVBoxLayout;
+    right->addWidget(playButton_);
+    right->addWidget(pausedLabel_);
+    right->addWidget(meters);
+    right->addWidget(planList_, 1);
     auto* row = new QHBoxLayout(trial_);
     row->addLayout(left, 1);
-    row->addWidget(planList_);
+    row->addLayout(right);
     pages_->addWidget(trial_);
 
     connect(playButton_, &QPushButton::clicked, this, &RunView::play);
@@ -738,14 +737,16 @@ void RunView::rebuildAnswerSections() {
         s.kind = kind;
         s.box = new QGroupBox(prompt, sectionsHost_);
         auto* grid = new QGridLayout(s.box);
-        const int columns = 4;
+        std::size_t longest = 0;
+        for (const auto& o : options) longest = std::max(longest, o.label.size());
+        const int columns = longest > 26 ? 3 : 4; // long labels stay readable at 1280 px
         for (std::size_t i = 0; i < options.size(); ++i) {
             const auto& o = options[i];
             auto* b =
                 new QPushButton(QString("%1   %2").arg(QChar(o.letter)).arg(q(o.label)), s.box);
             b->setCheckable(true);
             b->setFocusPolicy(Qt::NoFocus);
-            b->setMinimumHeight(40);
+            b->setMinimumHeight(36);
             b->setFont(bigFont(this, 1.1));
             b->setStyleSheet("QPushButton { text-align: left; padding-left: 10px; } "
                              "QPushButton:checked { background: #1f6feb; color: white; "
@@ -784,7 +785,7 @@ void RunView::rebuildAnswerSections() {
             auto* b = new QPushButton(QString::number(v), s.box);
             b->setCheckable(true);
             b->setFocusPolicy(Qt::NoFocus);
-            b->setMinimumSize(48, 40);
+            b->setMinimumSize(48, 36);
             b->setFont(bigFont(this, 1.1));
             b->setStyleSheet("QPushButton:checked { background: #1f6feb; color: white; "
                              "font-weight: bold; }");
