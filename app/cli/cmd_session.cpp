@@ -126,6 +126,7 @@ int runInteractive(const Options& o) {
                session.resumed()
                    ? fmt::format(", resuming at trial {}", session.current().index + 1)
                    : "");
+    int shownBlock = 0;
     try {
         while (session.phase() != SessionPhase::Finished) {
             switch (session.phase()) {
@@ -145,6 +146,12 @@ int runInteractive(const Options& o) {
                            t.index + 1, session.trialCount(),
                            o.showStimulus ? fmt::format(" — stimulus {}", t.stimulus.id) : "");
                 if (p.clips.enabled) {
+                    if (p.ordering.blocks == BlockKind::Scale && !t.practice &&
+                        t.block != shownBlock && !session.askedScales().empty()) {
+                        shownBlock = t.block;
+                        fmt::print("\nPart {} of {}: {}\n", t.block, q.scales.size(),
+                                   session.askedScales().front()->prompt);
+                    }
                     askLine("Press Enter to play the clip. ");
                     session.presentClip();
                     while (true) {
