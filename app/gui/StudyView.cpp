@@ -151,9 +151,13 @@ StudyView::StudyView(StudyContext& context, QWidget* parent) : QWidget(parent), 
     (new QVBoxLayout(gbox))->addWidget(groups_);
     left->addWidget(gbox, 1);
 
+    drop_ = new QPushButton(tr("Mark selected as &dropped out…  (Ctrl+D)"), this);
+    drop_->setAccessibleName(tr("Mark the selected participant as dropped out"));
     auto* right = new QVBoxLayout;
     auto* pbox = new QGroupBox(tr("Participants (double-click or Enter: run / resume)"), this);
-    (new QVBoxLayout(pbox))->addWidget(participants_);
+    auto* pl = new QVBoxLayout(pbox);
+    pl->addWidget(participants_);
+    pl->addWidget(drop_);
     right->addWidget(pbox, 3);
     auto* ebox = new QGroupBox(tr("Excluded trials"), this);
     auto* el = new QVBoxLayout(ebox);
@@ -176,6 +180,9 @@ StudyView::StudyView(StudyContext& context, QWidget* parent) : QWidget(parent), 
         openFile(demoStudyPath(dir));
     });
     connect(reincludeButton, &QPushButton::clicked, this, &StudyView::reinclude);
+    connect(drop_, &QPushButton::clicked, this, &StudyView::askDrop);
+    auto* scDrop = new QShortcut(QKeySequence(Qt::CTRL | Qt::Key_D), this);
+    connect(scDrop, &QShortcut::activated, this, &StudyView::askDrop);
     auto* scNew = new QShortcut(QKeySequence(Qt::CTRL | Qt::Key_N), this);
     connect(scNew, &QShortcut::activated, this, &StudyView::createFromForm);
     auto* scOpen = new QShortcut(QKeySequence(Qt::CTRL | Qt::Key_O), this);
@@ -202,6 +209,41 @@ void StudyView::showMessage(const QString& text, bool error) {
 void StudyView::setStudySwitchingEnabled(bool enabled) {
     create_->setEnabled(enabled);
     open_->setEnabled(enabled);
+    drop_->setEnabled(enabled);
+}
+
+bool StudyView::dropParticipant(const QString& code, const QString& reason) {
+    if (!context_.hasStudy() || !drop_->isEnabled()) return false;
+    if (reason.trimmed().isEmpty()) {
+        showMessage(tr("A dropout needs a reason (it is journaled with the study)."), true);
+        return false;
+    }
+    try {
+        context_.store().dropParticipant(code.toStdString(), reason.trimmed().toStdString());
+    } catch (const std::exception& e) {
+        showMessage(q(e.what()), true);
+        return false;
+    }
+    showMessage(tr("%1 marked as dropped out; the group's slot is free again. Their answers stay "
+                   "in the file.")
+                    .arg(code),
+                false);
+    context_.notifyDataChanged();
+    return true;
+}
+
+void StudyView::askDrop() {
+    const int row = participants_->currentRow();
+    if (!context_.hasStudy() || row < 0) {
+        showMessage(tr("Select a participant in the list first."), true);
+        return;
+    }
+    const QString code = participants_->item(row, 0)->text();
+    bool ok = false;
+    const QString reason = QInputDialog::getText(this, tr("Participant dropped out"),
+                                                 tr("Why did %1 drop out?").arg(code),
+                                                 QLineEdit::Normal, QString(), &ok);
+    if (ok) dropParticipant(code, reason);
 }
 
 bool StudyView::createFromForm() {

@@ -25,6 +25,8 @@ class StudyView : public QWidget {
     bool createFromForm();
     /// Opens a study file; returns false and shows the problem otherwise.
     bool openFile(const QString& path);
+    /// Marks a participant as dropped out (frees the group slot); false with the problem shown.
+    bool dropParticipant(const QString& code, const QString& reason);
     /// Disables create/open while a session runs.
     void setStudySwitchingEnabled(bool enabled);
 
@@ -47,6 +49,7 @@ class StudyView : public QWidget {
     void browseFile();
     void browseOpen();
     void reinclude();
+    void askDrop();
     void showMessage(const QString& text, bool error);
 
     StudyContext& context_;
@@ -57,6 +60,7 @@ class StudyView : public QWidget {
     QSpinBox* seed_;
     QPushButton* create_;
     QPushButton* open_;
+    QPushButton* drop_;
     QPlainTextEdit* messages_;
     QLabel* info_;
     QTableWidget* groups_;

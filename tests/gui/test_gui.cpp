@@ -372,6 +372,12 @@ lock = "answer"
         QVERIFY(run->session()->resumed());
         QCOMPARE(run->pageName(), QString("trial"));
         QCOMPARE(run->session()->current().index, 3);
+        // While the session runs the study cannot be switched or participants dropped.
+        QVERIFY(!w->studyView()->dropParticipant("R7", "left early"));
+        run->closeSession();
+        QVERIFY(!w->studyView()->dropParticipant("R7", ""));
+        QVERIFY(w->studyView()->dropParticipant("R7", "left early"));
+        QCOMPARE(w->context().store().participant("R7").status, ue::ParticipantStatus::Dropped);
     }
 
     void badProtocolShowsFileLineColumnAndWhatToDo() {
