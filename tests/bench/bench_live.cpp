@@ -1,0 +1,252 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Cost of live scenes at 48 kHz / 64 frames, run through LiveEngine's callback body
+// (processBlock, exactly what the device callback runs), as % of one core:
+//   - heaviest reference scene: creaking wood + 2.2 s stereo reverb (hall) + soundscape
+//     (forest) + 4 haptic channels (target < 25 %);
+//   - dry single surface (wood, headphones only; target < 3 %);
+//   - the reverb alone (our zero-latency Convolver) against zita-convolver's own figure for
+//     the same IR (one Convproc, quantum 64, partitions 64..8192, its worker threads, 64
+//     samples of latency; target ours <= 1.5 x zita);
+//   - per node of each scene (clock reads around each node), proving that a dry scene does no
+//     reverb, soundscape or haptic work.
+// The LiveCostSummary benchmark measures all of them in ONE run, interleaved block by block so
+// that the load of a shared machine hits them alike, and reports the ratios as counters.
+// Run: build/tests/bench/bench_live [--benchmark_filter=Summary]
+#include "engine/dsp/Denormals.h"
+#include "engine/io/AudioFile.h"
+#include "engine/reverb/Convolver.h"
+#include "engine/scene/LiveEngine.h"
+#include "soundscapes/Library.h"
+#include "soundscapes/Renderer.h"
+
+#include <benchmark/benchmark.h>
+#include <zita-convolver.h>
+
+#include <ctime>
+#include <memory>
+#include <vector>
+
+using namespace underfoot::engine;
+
+namespace {
+constexpr int kRate = 48000;
+constexpr int kBlock = 64;
+
+double processCpuSeconds() {
+    timespec ts{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
+
+double threadCpu() {
+    timespec ts{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
+
+class Ambience final : public AmbienceSource {
+  public:
+    explicit Ambience(const std::string& id)
+        : r_(underfoot::soundscapes::loadSoundscape(id)), id_(id) {}
+    void prepare(const ProcessSpec& spec) override { r_.prepare(spec); }
+    void reset(std::uint64_t seed) noexcept override { r_.reset(seed); }
+    void process(float* l, float* r, int n) noexcept override { r_.process(l, r, n); }
+    std::string name() const override { return id_; }
+
+  private:
+    underfoot::soundscapes::SoundscapeRenderer r_;
+    std::string id_;
+};
+
+AudioSettings settings() {
+    AudioSettings s;
+    s.sampleRateHz = kRate;
+    s.blockSize = kBlock;
+    s.channels.haptic[0] = {2, 3};
+    s.channels.haptic[1] = {4, 5};
+    return s;
+}
+
+/// An offline engine with one scene, driven block by block.
+struct Rig {
+    explicit Rig(bool heaviest) {
+        engine.openOffline(settings());
+        LiveSceneDescription d;
+        d.seed = 3;
+        if (heaviest) {
+            d.surface = "creaking_wood";
+            d.impulseResponse = "hall";
+            d.ambience = std::make_unique<Ambience>("forest");
+            d.modality = OutputModality::AudioHaptic;
+        } else {
+            d.surface = "wood";
+        }
+        auto s = LiveScene::create(std::move(d), engine.processSpec(), engine.settings().channels);
+        s->setMeasureCost(true);
+        scene = s.get(); // owned by the engine; read only from this (the "audio") thread
+        engine.submit(std::move(s));
+        out.assign(6, std::vector<float>(kBlock));
+        for (auto& c : out) outPtr.push_back(c.data());
+    }
+    void block() { engine.processBlock(nullptr, outPtr.data(), kBlock); }
+    LiveEngine engine;
+    LiveScene* scene = nullptr;
+    std::vector<std::vector<float>> out;
+    std::vector<float*> outPtr;
+};
+
+/// zita-convolver used as its author intends (one instance, non-uniform partitions 64..8192
+/// computed in its own threads, one quantum of latency), mono in, stereo IR out.
+/// One instance for the whole program, never destroyed: after a run faster than real time the
+/// Debian build's stop_process()/cleanup() waits forever for its worker threads (seen with gdb:
+/// workers in Convlevel::main's sem_wait, cleanup() polling), so the program's exit ends them.
+struct Zita {
+    static Zita& hall() {
+        static Zita* instance = new Zita(readAudioFile(findImpulseResponse("hall"), kRate));
+        return *instance;
+    }
+    explicit Zita(const AudioBuffer& ir) {
+        const auto len = static_cast<unsigned>(ir.frames());
+        zita.set_options(Convproc::OPT_VECTOR_MODE); // as our Convolver's stages
+        if (zita.configure(1, 2, len, kBlock, kBlock, 8192, 0.0f) != 0)
+            throw std::runtime_error("zita configure failed");
+        for (int c = 0; c < 2; ++c) {
+            std::vector<float> h(len);
+            for (unsigned i = 0; i < len; ++i) h[i] = ir.at(i, ir.channels > 1 ? c : 0);
+            zita.impdata_create(0, static_cast<unsigned>(c), 1, h.data(), 0, static_cast<int>(len));
+        }
+        if (zita.start_process(0, SCHED_OTHER) != 0) throw std::runtime_error("zita start failed");
+    }
+    void block(const float* in, float* l, float* r) {
+        std::copy(in, in + kBlock, zita.inpdata(0));
+        // Synchronous: each call waits for the worker threads' partitions due in it, so that
+        // running faster than real time measures all of zita's work instead of letting it
+        // fall behind (zita stops itself after 5 late cycles in asynchronous mode).
+        zita.process(true);
+        std::copy(zita.outdata(0), zita.outdata(0) + kBlock, l);
+        std::copy(zita.outdata(1), zita.outdata(1) + kBlock, r);
+    }
+    Convproc zita;
+};
+
+std::vector<float> noiseBlock(int n, std::uint32_t seed) {
+    std::vector<float> x(static_cast<std::size_t>(n));
+    for (auto& v : x) {
+        seed = seed * 1664525u + 1013904223u;
+        v = (static_cast<float>(seed >> 8) / 16777216.0f - 0.5f) * 0.2f;
+    }
+    return x;
+}
+
+void sceneBench(benchmark::State& state, bool heaviest) {
+    Rig rig(heaviest);
+    std::int64_t blocks = 0;
+    for (auto _ : state) {
+        rig.block();
+        benchmark::DoNotOptimize(rig.out[0].data());
+        ++blocks;
+    }
+    const double audio = double(blocks) * kBlock / kRate;
+    state.counters["core_pct"] = benchmark::Counter(audio / 100.0, benchmark::Counter::kIsRate |
+                                                                       benchmark::Counter::kInvert);
+    for (const auto& c : rig.scene->nodeCosts())
+        state.counters[std::string(toString(c.node)) + "_pct"] =
+            c.present ? 100.0 * c.seconds / audio : 0.0;
+}
+
+void reverbOurs(benchmark::State& state) {
+    ScopedFlushDenormals flush;
+    Convolver conv;
+    conv.prepare(readAudioFile(findImpulseResponse("hall")), kRate, kBlock);
+    const auto in = noiseBlock(kBlock, 1);
+    std::vector<float> l(kBlock), r(kBlock);
+    std::int64_t blocks = 0;
+    for (auto _ : state) {
+        conv.process(in.data(), l.data(), r.data(), kBlock);
+        benchmark::DoNotOptimize(l.data());
+        ++blocks;
+    }
+    state.counters["core_pct"] =
+        benchmark::Counter(double(blocks) * kBlock / kRate / 100.0,
+                           benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+
+void reverbZita(benchmark::State& state) {
+    ScopedFlushDenormals flush;
+    Zita& z = Zita::hall();
+    const auto in = noiseBlock(kBlock, 1);
+    std::vector<float> l(kBlock), r(kBlock);
+    std::int64_t blocks = 0;
+    for (auto _ : state) {
+        z.block(in.data(), l.data(), r.data());
+        benchmark::DoNotOptimize(l.data());
+        ++blocks;
+    }
+    state.counters["core_pct"] =
+        benchmark::Counter(double(blocks) * kBlock / kRate / 100.0,
+                           benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+
+/// Everything in one run: 20 s of audio, the two scenes and our reverb interleaved block by
+/// block (thread CPU time, so the load of a shared machine hits them alike), then zita for the
+/// same 20 s (process CPU time over the whole phase, which includes its worker threads).
+void liveCostSummary(benchmark::State& state) {
+    Rig heavy(true), dry(false);
+    Convolver conv;
+    conv.prepare(readAudioFile(findImpulseResponse("hall")), kRate, kBlock);
+    Zita& z = Zita::hall();
+    const auto in = noiseBlock(kBlock, 1);
+    std::vector<float> l(kBlock), r(kBlock);
+    const std::int64_t blocks = std::int64_t(20) * kRate / kBlock;
+    double tHeavy = 0, tDry = 0, tOurs = 0, tZita = 0;
+    for (auto _ : state) {
+        for (std::int64_t b = 0; b < blocks; ++b) {
+            const double t0 = threadCpu();
+            heavy.block();
+            const double t1 = threadCpu();
+            dry.block();
+            const double t2 = threadCpu();
+            {
+                ScopedFlushDenormals flush;
+                conv.process(in.data(), l.data(), r.data(), kBlock);
+            }
+            const double t3 = threadCpu();
+            tHeavy += t1 - t0;
+            tDry += t2 - t1;
+            tOurs += t3 - t2;
+            benchmark::DoNotOptimize(l.data());
+        }
+        const double p0 = processCpuSeconds();
+        {
+            ScopedFlushDenormals flush;
+            for (std::int64_t b = 0; b < blocks; ++b) {
+                z.block(in.data(), l.data(), r.data());
+                benchmark::DoNotOptimize(l.data());
+            }
+        }
+        tZita += processCpuSeconds() - p0;
+    }
+    const double audio = double(blocks) * kBlock / kRate * double(state.iterations());
+    state.counters["heaviest_core_pct"] = 100.0 * tHeavy / audio;
+    state.counters["dry_core_pct"] = 100.0 * tDry / audio;
+    state.counters["reverb_ours_pct"] = 100.0 * tOurs / audio;
+    state.counters["reverb_zita_pct"] = 100.0 * tZita / audio;
+    state.counters["ours_over_zita"] = tOurs / std::max(tZita, 1e-12);
+    auto nodes = [&](const char* prefix, LiveScene* sc) {
+        for (const auto& c : sc->nodeCosts())
+            state.counters[std::string(prefix) + toString(c.node) + "_pct"] =
+                c.present ? 100.0 * c.seconds / audio : -1.0; // -1: the node does not exist
+    };
+    nodes("heavy_", heavy.scene);
+    nodes("dry_", dry.scene);
+}
+
+} // namespace
+
+BENCHMARK_CAPTURE(sceneBench, heaviest, true)->MinTime(2.0);
+BENCHMARK_CAPTURE(sceneBench, dry_single_surface, false)->MinTime(2.0);
+BENCHMARK(reverbOurs)->MinTime(2.0);
+BENCHMARK(reverbZita)->MinTime(2.0)->MeasureProcessCPUTime();
+BENCHMARK(liveCostSummary)->Iterations(1)->Unit(benchmark::kSecond);
+
+BENCHMARK_MAIN();
