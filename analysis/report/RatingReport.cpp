@@ -182,7 +182,7 @@ std::vector<Section> sections(const RatingStudyAnalysis& a) {
                 t.rows.push_back({grp.level, std::to_string(grp.n), num(grp.median, 2),
                                   fmt::format("{}-{}", num(grp.q1, 2), num(grp.q3, 2))});
             sec.text += fmt::format("\n\nBetween participants by {} (each participant's median "
-                                    "rating): Kruskal-Wallis {}.",
+                                    "rating): {}.",
                                     g.field, statisticText(g.kruskal));
             sec.tables.push_back(t);
             if (!g.pairs.empty()) {
