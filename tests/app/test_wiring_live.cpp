@@ -1,0 +1,187 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// app/wiring: a protocol's stimulus becomes a live scene with exactly its nodes; the LivePlayer
+// records the GRF next to the study and returns a path `underfoot replay` resolves; a recorded
+// live trial with a soundscape replays (renderer + soundscape as `underfoot replay` mixes it)
+// to the samples that were played.
+#include "app/wiring/Players.h"
+#include "engine/control/GrfFile.h"
+#include "engine/render/Renderer.h"
+#include "soundscapes/Library.h"
+#include "soundscapes/Renderer.h"
+#include "tests/common/ScratchDir.h"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cmath>
+#include <filesystem>
+#include <thread>
+
+namespace eng = underfoot::engine;
+namespace xp = underfoot::experiment;
+namespace wir = underfoot::wiring;
+namespace fs = std::filesystem;
+
+namespace {
+
+eng::AudioSettings settings() {
+    eng::AudioSettings s;
+    s.sampleRateHz = 48000;
+    s.blockSize = 64;
+    s.channels.haptic[0] = {2, 3};
+    s.channels.haptic[1] = {4, 5};
+    s.channels.microphones = {0, 1};
+    return s;
+}
+
+xp::Stimulus stimulus(const std::string& surface) {
+    xp::Stimulus s;
+    s.id = "t_" + surface;
+    s.surface = surface;
+    s.input.kind = xp::InputKind::Walker;
+    s.input.walker["cadence"] = 105.0;
+    return s;
+}
+
+std::unique_ptr<eng::LiveScene> sceneOf(const xp::Stimulus& st,
+                                        const wir::StimulusSceneOptions& o = {}) {
+    return eng::LiveScene::create(wir::describeStimulus(st, 5, o), {48000, 64},
+                                  settings().channels);
+}
+
+} // namespace
+
+TEST(Wiring, StimulusBecomesASceneWithOnlyItsNodes) {
+    auto plain = stimulus("wood");
+    auto s = sceneOf(plain);
+    EXPECT_EQ(s->control(), eng::ControlKind::Walker);
+    EXPECT_FALSE(s->hasNode(eng::SceneNode::Reverb));
+    EXPECT_FALSE(s->hasNode(eng::SceneNode::Ambience));
+    EXPECT_FALSE(s->hasNode(eng::SceneNode::Haptics));
+
+    auto rich = stimulus("metal");
+    rich.reverb = "small_room";
+    rich.soundscape = "forest";
+    rich.modalities = xp::Modalities::AudioHaptic;
+    s = sceneOf(rich);
+    EXPECT_TRUE(s->hasNode(eng::SceneNode::Reverb));
+    EXPECT_TRUE(s->hasNode(eng::SceneNode::Ambience));
+    EXPECT_TRUE(s->hasNode(eng::SceneNode::Haptics));
+    EXPECT_NE(s->summary().find("soundscape forest"), std::string::npos) << s->summary();
+
+    rich.modalities = xp::Modalities::Haptic; // earplugs: no room, no soundscape
+    s = sceneOf(rich);
+    EXPECT_FALSE(s->hasNode(eng::SceneNode::Reverb));
+    EXPECT_FALSE(s->hasNode(eng::SceneNode::Ambience));
+    EXPECT_TRUE(s->hasNode(eng::SceneNode::Haptics));
+
+    auto mic = stimulus("gravel");
+    mic.input.kind = xp::InputKind::Sensor;
+    mic.input.sensor = xp::SensorKind::Microphones;
+    EXPECT_EQ(sceneOf(mic)->control(), eng::ControlKind::Microphones);
+
+    auto fsr = mic;
+    fsr.input.sensor = xp::SensorKind::Fsr;
+    try {
+        sceneOf(fsr);
+        FAIL() << "an FSR stimulus without a shoe source was accepted";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("FSR shoes"), std::string::npos) << e.what();
+    }
+
+    auto badWalker = stimulus("wood");
+    badWalker.input.walker["speed"] = 1.0;
+    EXPECT_THROW(sceneOf(badWalker), std::invalid_argument);
+}
+
+TEST(Wiring, LivePlayerRecordsTheGrfNextToTheStudy) {
+    eng::LiveEngine engine;
+    engine.openOffline(settings());
+    // A stand-in for the device's callback thread.
+    std::atomic<bool> running{true};
+    std::thread audio([&] {
+        std::vector<std::vector<float>> out(6, std::vector<float>(64));
+        std::vector<float*> op;
+        for (auto& c : out) op.push_back(c.data());
+        while (running) {
+            engine.processBlock(nullptr, op.data(), 64);
+            std::this_thread::sleep_for(std::chrono::microseconds(200));
+        }
+    });
+    const auto study = underfoot::test::scratchDir("wiring_live") / "study";
+    wir::LivePlayerOptions o;
+    o.studyFolder = study.string();
+    o.recordingFolder = (study / "recordings").string();
+    wir::LivePlayer player(engine, o);
+    const auto start = player.start(stimulus("wood"), 77);
+    EXPECT_EQ(start.renderSeed, 77u);
+    ASSERT_TRUE(start.grfRecording.has_value());
+    EXPECT_EQ(fs::path(*start.grfRecording).parent_path(), "recordings") << *start.grfRecording;
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    const auto second = player.start(stimulus("gravel"), 78); // stops the first one
+    ASSERT_TRUE(second.grfRecording.has_value());
+    EXPECT_NE(*second.grfRecording, *start.grfRecording);
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    player.stop();
+    EXPECT_EQ(player.lastDroppedFrames(), 0u);
+    running = false;
+    audio.join();
+    for (const auto* ref : {&*start.grfRecording, &*second.grfRecording}) {
+        const auto grf = eng::loadGrfFile((study / *ref).string());
+        EXPECT_EQ(grf.channels.size(), 2u);
+        EXPECT_GT(grf.frames(), 4800u) << *ref;
+        float peak = 0;
+        for (float v : grf.channels[0]) peak = std::max(peak, v);
+        EXPECT_GT(peak, 100.0f) << "the walker's left foot in " << *ref;
+    }
+}
+
+TEST(Wiring, LiveTrialWithSoundscapeReplaysToThePlayedSamples) {
+    eng::LiveEngine engine;
+    engine.openOffline(settings());
+    auto st = stimulus("dry_leaves");
+    st.soundscape = "forest";
+    const std::uint64_t seed = 31;
+    const auto grfPath = (underfoot::test::scratchDir("wiring_live") / "leaves.wav").string();
+    auto d = wir::describeStimulus(st, seed);
+    d.grfRecorder = eng::makeGrfRecorder(grfPath, 2, 48000);
+    auto recorder = d.grfRecorder;
+    engine.submit(
+        eng::LiveScene::create(std::move(d), engine.processSpec(), engine.settings().channels));
+    std::vector<std::vector<float>> out(6, std::vector<float>(64)), played(2);
+    std::vector<float*> op;
+    for (auto& c : out) op.push_back(c.data());
+    for (int b = 0; b < 2 * 48000 / 64; ++b) {
+        engine.processBlock(nullptr, op.data(), 64);
+        for (std::size_t c = 0; c < 2; ++c)
+            played[c].insert(played[c].end(), out[c].begin(), out[c].end());
+    }
+    engine.close();
+    recorder->finish();
+
+    // What `underfoot replay` does (app/cli/cmd_replay.cpp), at the live block size.
+    const auto grf = eng::loadGrfFile(grfPath);
+    eng::RenderOptions ro;
+    ro.blockSize = 64;
+    ro.seed = seed;
+    auto r = eng::renderSurface(st.surface, grf, ro);
+    underfoot::soundscapes::SoundscapeRenderer ambience(
+        underfoot::soundscapes::loadSoundscape("forest"));
+    ambience.prepare({48000, 1024});
+    ambience.reset(seed);
+    const std::size_t n = r.audio.frames();
+    ASSERT_EQ(n, played[0].size());
+    std::vector<float> l(n), rr(n);
+    ambience.process(l.data(), rr.data(), static_cast<int>(n));
+    std::size_t mismatches = 0;
+    double maxDiff = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        const float g = eng::LiveScene::fadeGain(static_cast<std::int64_t>(i), 480);
+        const float el = g * (r.audio.samples[2 * i] + l[i]);
+        const float er = g * (r.audio.samples[2 * i + 1] + rr[i]);
+        if (el != played[0][i] || er != played[1][i]) ++mismatches;
+        maxDiff = std::max(
+            {maxDiff, double(std::fabs(el - played[0][i])), double(std::fabs(er - played[1][i]))});
+    }
+    EXPECT_EQ(mismatches, 0u) << "largest difference " << maxDiff;
+}
