@@ -9,6 +9,7 @@
 
 #include <atomic>
 #include <cmath>
+#include <cstring>
 #include <mutex>
 #include <thread>
 
@@ -48,6 +49,15 @@ std::string printable(std::string_view s) {
             out += fmt::format("\\x{:02x}", u);
     }
     return out;
+}
+
+/// liblo's argument pointers point into the packet, 4-byte aligned, while lo_arg (a union with
+/// doubles) needs 8: read the bytes instead of the union member.
+template <typename T>
+T argumentAs(const lo_arg* arg) {
+    T value;
+    std::memcpy(&value, reinterpret_cast<const unsigned char*>(arg), sizeof value);
+    return value;
 }
 
 } // namespace
@@ -116,16 +126,16 @@ struct OscGyroReceiver::Impl {
         bool sequenced = false;
         std::uint32_t sequence = 0;
         if ((types == "f" || types == "fi") && argc >= 1)
-            value = argv[0]->f;
+            value = argumentAs<float>(argv[0]);
         else if ((types == "d" || types == "di") && argc >= 1)
-            value = argv[0]->d;
+            value = argumentAs<double>(argv[0]);
         else {
             reject(nowS, path, types, "type tags ,f or ,fi (deg/s [, sequence])");
             return;
         }
         if (types.size() == 2 && argc >= 2) {
             sequenced = true;
-            sequence = static_cast<std::uint32_t>(argv[1]->i);
+            sequence = static_cast<std::uint32_t>(argumentAs<std::int32_t>(argv[1]));
         }
         if (!std::isfinite(value)) {
             reject(nowS, path, types, fmt::format("a finite angular velocity, got {}", value));

@@ -221,6 +221,32 @@ TEST(OscGyro, OneLimbGoingSilentIsAFaultThatNamesIt) {
     EXPECT_LT(faultS - shankStoppedS, 1.0);
 }
 
+TEST(OscGyro, DoublesAndSequencesAreReadFromUnalignedArguments) {
+    OscGyroConfig config;
+    config.port = 0;
+    OscGyroReceiver receiver(config);
+    receiver.start();
+    const std::string portText = std::to_string(receiver.port());
+    lo_address to = lo_address_new("127.0.0.1", portText.c_str());
+    lo_send(to, "/underfoot/gyro/left_shank", "di", -123.456789, 41);
+    lo_send(to, "/underfoot/gyro/right_thigh", "d", 99.5);
+    std::vector<GyroSample> got;
+    const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(2);
+    while (got.size() < 2 && std::chrono::steady_clock::now() < until) {
+        GyroSample g;
+        while (receiver.popSample(g)) got.push_back(g);
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    receiver.stop();
+    lo_address_free(to);
+    ASSERT_EQ(got.size(), 2u);
+    EXPECT_EQ(got[0].limb, Limb::LeftShank);
+    EXPECT_DOUBLE_EQ(got[0].angularVelocityDps, -123.456789);
+    EXPECT_EQ(got[0].sequence, 41u);
+    EXPECT_EQ(got[1].limb, Limb::RightThigh);
+    EXPECT_DOUBLE_EQ(got[1].angularVelocityDps, 99.5);
+}
+
 TEST(OscGyro, ABusyPortIsAClearError) {
     OscGyroConfig config;
     config.port = 0;
