@@ -203,7 +203,9 @@ struct SerialSource::Impl {
         case ShoeLineKind::Comment:
             break;
         case ShoeLineKind::Rejected:
-            monitor.lineRejected(nowS, parser.error());
+            // The first line after opening is usually the tail of a line the device sent before
+            // the port was opened: skip it without counting it as garbage.
+            if (parser.lineNumber() > 1) monitor.lineRejected(nowS, parser.error());
             break;
         }
     }

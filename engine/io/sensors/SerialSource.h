@@ -8,8 +8,10 @@
 /// configured with POSIX termios; so is any path libserialport fails on. Either way a reader
 /// thread polls the descriptor (20 ms timeout), splits lines, parses them (ShoeProtocol.h),
 /// stamps each frame with the sensor clock, runs the frame callback (step detection) and pushes
-/// the frame to a lock-free SPSC queue for one consumer (logging, GUI). Faults are tracked by a
-/// FaultMonitor (SensorStatus.h); after a disconnect the port is reopened every 500 ms.
+/// the frame to a lock-free SPSC queue for one consumer (logging, GUI). A bad first line after
+/// opening is skipped uncounted (the tail of a line sent before the port was opened). Faults are
+/// tracked by a FaultMonitor (SensorStatus.h); after a disconnect the port is reopened every 500
+/// ms.
 #include "engine/io/sensors/SensorStatus.h"
 #include "engine/io/sensors/ShoeFrame.h"
 

@@ -2,6 +2,7 @@
 // The FSR shoes over a real serial path: socat makes a pseudo-terminal pair, a writer thread
 // emulates the sketch at 1 kHz on one end (scripted steps, garbage, gaps, silence), a
 // SerialSource reads the other end. Skipped only when socat is not installed.
+#include "engine/control/StepCalibration.h"
 #include "engine/control/StepDetector.h"
 #include "engine/io/sensors/SerialSource.h"
 #include "engine/io/sensors/ShoeProtocol.h"
@@ -274,6 +275,66 @@ TEST(SerialSocat, UnplugIsDetectedWithinASecond) {
     EXPECT_LT(goneAt - killedAt, 1.0);
     EXPECT_FALSE(source.status().message.empty());
     source.stop();
+}
+
+TEST(SerialSocat, CalibratesFromAWalkRecordedThroughThePort) {
+    SocatPair pair("calibrate");
+    REQUIRE_SOCAT(pair);
+    ShoeWalkOptions light; // a light participant (the defaults would count a weight shift)
+    light.heelPeak = 260;
+    light.toePeak = 220;
+    light.standHeel = 170;
+    light.standToe = 140;
+    light.riseMs = 45;
+    ShoeScript walk(light, 12);
+    walk.stand(1000);
+    walk.walk(12);
+    walk.stand(800);
+    const auto ticks = static_cast<std::size_t>(walk.durationMs());
+    SerialConfig config;
+    config.path = pair.app;
+    SerialSource source(config);
+    source.start();
+    const int fd = openWriter(pair.shoes);
+    ASSERT_GE(fd, 0);
+    // A partial line first, as when the port is opened in the middle of the device's stream:
+    // skipped, not counted as garbage.
+    writeAll(fd, "23,1\n");
+    Random noise(12);
+    std::thread writer([&] {
+        paced(fd, ticks, [&](std::size_t i) {
+            return formatShoeLine(static_cast<std::uint32_t>(i), walk.sample(i, noise));
+        });
+    });
+    std::vector<ShoeFrame> frames;
+    frames.reserve(ticks);
+    const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(ticks + 300);
+    while (std::chrono::steady_clock::now() < until) {
+        ShoeFrame f;
+        while (source.popFrame(f)) frames.push_back(f);
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    writer.join();
+    source.stop();
+    ::close(fd);
+    ShoeFrame f;
+    while (source.popFrame(f)) frames.push_back(f);
+    ASSERT_EQ(frames.size(), ticks);
+    EXPECT_EQ(source.status().linesRejected, 0u) << source.status().lastRejection;
+    StepCalibrationOptions options;
+    options.participant = "P12";
+    const StepCalibrationResult result = calibrateSteps(frames, options);
+    for (std::size_t s = 0; s < kShoeSensorCount; ++s)
+        EXPECT_EQ(result.stats[s].strikes, 6u) << shoeSensorName(s);
+    // The recording itself, replayed through a detector with the proposed thresholds: every
+    // strike once.
+    StepDetector detector(result.thresholds);
+    std::size_t events = 0;
+    for (const ShoeFrame& frame : frames) {
+        StepDetector::Events out;
+        events += detector.process(frame, out);
+    }
+    EXPECT_EQ(events, walk.strikes().size());
 }
 
 TEST(SerialSocat, OpeningErrorsNameThePortAndTheReason) {
