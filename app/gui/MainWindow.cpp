@@ -35,7 +35,7 @@ MainWindow::MainWindow(const Options& options, QWidget* parent) : QMainWindow(pa
     audio_ = new AudioOutput(QDir(dataDir_).filePath("audio.toml"), this);
     palette_ = new PaletteView(dataDir_, this);
     palette_->setAudioOutput(audio_);
-    run_->setAudioOutput(audio_);
+    run_->setAudioOutput(audio_, options.startAudio);
     setup_ = new SetupView(*audio_, dataDir_, this);
     tabs_->addTab(study_, tr("&Study"));
     tabs_->addTab(run_, tr("&Run"));

@@ -28,6 +28,9 @@ class MainWindow : public QMainWindow {
         QString dataDir;
         /// Create the demo study when no study is given (off in tests that bring their own).
         bool createDemo = true;
+        /// Start the live audio output when a session starts (so trials are heard); off in
+        /// tests and screenshots.
+        bool startAudio = true;
     };
     explicit MainWindow(const Options& options, QWidget* parent = nullptr);
     ~MainWindow() override;

@@ -585,6 +585,8 @@ bool RunView::startSession(const QString& code) {
     if (!context_.hasStudy() || session_) return false;
     exp::SessionSettings settings;
     settings.experimenter = experimenter_->text().trimmed().toStdString();
+    audioError_.clear();
+    if (audio_ && autoStartAudio_ && !audio_->running()) audioError_ = audio_->start();
     console_ = std::make_unique<ConsolePlayer>(*player_, audio_, context_.path());
     settings.audioConfig =
         console_->live() ? ("underfoot-gui live engine: " + audio_->description()).toStdString()
@@ -697,10 +699,12 @@ void RunView::showTrial() {
     stepLabel_->setText(tr("steps: 0"));
     playButton_->setEnabled(true);
     playButton_->setText(tr("Start stimulus  (Space)"));
-    engineLabel_->setText(console_ && console_->live()
-                              ? tr("Audio: %1").arg(audio_->description())
-                              : tr("Audio output not started (Setup view, Ctrl+5): the stimulus "
-                                   "is not heard; the meters follow the virtual walker."));
+    engineLabel_->setText(
+        console_ && console_->live() ? tr("Audio: %1").arg(audio_->description())
+        : !audioError_.isEmpty()
+            ? tr("Audio output failed to start, the stimulus is not heard: %1").arg(audioError_)
+            : tr("Audio output not started (Setup view, Ctrl+5): the stimulus "
+                 "is not heard; the meters follow the virtual walker."));
     // The session's plan, with answered trials ticked.
     planList_->clear();
     const auto trials = context_.store().trials(session_->participant().code);

@@ -68,7 +68,12 @@ class RunView : public QWidget {
     bool startDemoTrialForScreenshot();
 
     /// Plays stimuli through `output`'s live engine while it runs (the walker meters otherwise).
-    void setAudioOutput(AudioOutput* output) { audio_ = output; }
+    /// With `autoStart`, a session start also starts the output (a failure is shown, the
+    /// session runs without sound).
+    void setAudioOutput(AudioOutput* output, bool autoStart) {
+        audio_ = output;
+        autoStartAudio_ = autoStart;
+    }
     /// The running session (nullptr when none).
     experiment::Session* session() const { return session_.get(); }
     /// The widget that receives the trial keys (answer letters, digits, Enter, Space).
@@ -121,6 +126,8 @@ class RunView : public QWidget {
     StudyContext& context_;
     WalkerPlayer* player_ = nullptr;
     AudioOutput* audio_ = nullptr;
+    bool autoStartAudio_ = false;
+    QString audioError_;
     std::unique_ptr<ConsolePlayer> console_;
     std::unique_ptr<experiment::Session> session_;
     QStackedWidget* pages_ = nullptr;

@@ -31,6 +31,7 @@ int main(int argc, char** argv) {
     underfoot::gui::MainWindow::Options options;
     options.studyPath = parser.value(studyOption);
     options.dataDir = parser.value(dataOption);
+    options.startAudio = !parser.isSet(shotOption);
     underfoot::gui::MainWindow window(options);
     if (parser.isSet(shotOption)) {
         window.resize(1280, 800);

@@ -39,6 +39,7 @@ int runChild(const QString& study, const QString& dataDir) {
     o.studyPath = study;
     o.dataDir = dataDir;
     o.createDemo = false;
+    o.startAudio = false;
     gui::MainWindow w(o);
     w.show();
     w.showView(1);
@@ -106,6 +107,7 @@ class CrashTest : public QObject {
         o.studyPath = study;
         o.dataDir = dir.filePath("data");
         o.createDemo = false;
+        o.startAudio = false;
         gui::MainWindow w(o);
         w.show();
         QCOMPARE(w.tabs()->currentIndex(), 1);

@@ -101,6 +101,7 @@ class GuiTest : public QObject {
         o.studyPath = study;
         o.dataDir = home_.filePath("data");
         o.createDemo = false;
+        o.startAudio = false;
         auto w = std::make_unique<gui::MainWindow>(o);
         w->show();
         return w;
@@ -378,6 +379,28 @@ lock = "answer"
         QVERIFY(!w->studyView()->dropParticipant("R7", ""));
         QVERIFY(w->studyView()->dropParticipant("R7", "left early"));
         QCOMPARE(w->context().store().participant("R7").status, ue::ParticipantStatus::Dropped);
+    }
+
+    void sessionRunsWhetherOrNotTheAudioOutputStarts() {
+        gui::MainWindow::Options o;
+        o.dataDir = home_.filePath("data");
+        o.createDemo = false;
+        o.startAudio = true; // this machine may have no sound card: the session still runs
+        gui::MainWindow w(o);
+        w.show();
+        QVERIFY(createStudy(w, QString(UNDERFOOT_SOURCE_DIR) + "/protocols/tvcg2011_exp1.toml",
+                            home_.filePath("audio.db")));
+        QElapsedTimer t;
+        t.start();
+        registerParticipant(w, "A1");
+        qInfo("session start with an audio output attempt: %lld ms",
+              static_cast<long long>(t.elapsed()));
+        auto* run = w.runView();
+        QVERIFY(run->session());
+        QTest::mouseClick(button(run, "Start the trials"), Qt::LeftButton);
+        QCOMPARE(run->pageName(), QString("trial"));
+        QTest::keyClick(run->trialPanel(), Qt::Key_Space);
+        QVERIFY(run->session()->playing());
     }
 
     void badProtocolShowsFileLineColumnAndWhatToDo() {
