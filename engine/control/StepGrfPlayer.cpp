@@ -42,6 +42,7 @@ std::vector<std::vector<float>> monoChannels(const std::vector<GrfSignal>& signa
 StepGrfPlayer::StepGrfPlayer(GrfBank bank, const StepGrfPlayerConfig& config)
     : config_(config), random_(config.seed), steps_(std::max<std::size_t>(config.stepCapacity, 2)),
       playbacks_(std::max<std::size_t>(config.playbackCapacity, 2)) {
+    seed_.store(config.seed, std::memory_order_relaxed);
     if (!(config_.sampleRateHz > 0) || !std::isfinite(config_.sampleRateHz))
         throw std::invalid_argument("StepGrfPlayer: sample rate must be a finite number > 0");
     if (config_.maxVoices == 0) throw std::invalid_argument("StepGrfPlayer: maxVoices is 0");
@@ -145,18 +146,15 @@ bool StepGrfPlayer::popPlayback(StepPlayback& playback) noexcept {
     return playbacks_.pop(playback);
 }
 
-void StepGrfPlayer::reset(std::uint64_t seed) {
+void StepGrfPlayer::reset(std::uint64_t seed) noexcept {
     for (Voice& v : voices_) v = Voice{};
     StepEvent e;
     while (steps_.pop(e)) {
     }
-    StepPlayback p;
-    while (playbacks_.pop(p)) {
-    }
     random_.setSeed(seed);
-    config_.seed = seed;
+    seed_.store(seed, std::memory_order_relaxed);
     sample_ = 0;
-    activeVoices_ = 0;
+    activeVoices_.store(0, std::memory_order_relaxed);
 }
 
 } // namespace underfoot::engine

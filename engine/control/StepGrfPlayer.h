@@ -73,7 +73,10 @@ class StepGrfPlayer {
     /// Audio thread: writes `n` samples of each of channels() outputs (newtons; overwrites).
     void process(float* const* grf, std::size_t n) noexcept;
     std::size_t channels() const noexcept;
+    /// The construction settings (config().seed is the first seed; see seed()).
     const StepGrfPlayerConfig& config() const noexcept { return config_; }
+    /// The seed in use (the last reset()'s, or config().seed).
+    std::uint64_t seed() const noexcept { return seed_.load(std::memory_order_relaxed); }
 
     /// Consumer side (main thread): the next playback record. False when none is waiting.
     bool popPlayback(StepPlayback& playback) noexcept;
@@ -87,9 +90,11 @@ class StepGrfPlayer {
     /// Voices sounding after the last block.
     std::size_t activeVoices() const noexcept { return activeVoices_.load(); }
 
-    /// Off the audio thread, while process() and pushStep() are not running: silences all
-    /// voices, empties the queues, reseeds.
-    void reset(std::uint64_t seed);
+    /// Silences all voices, drops queued steps, restarts the sample counter and reseeds. Call it
+    /// from the thread that calls process() (e.g. at a trial start inside the callback) or while
+    /// process() is not running; noexcept and allocation-free. Playback records already queued
+    /// for the main thread are left to it.
+    void reset(std::uint64_t seed) noexcept;
 
   private:
     struct Voice {
@@ -112,6 +117,7 @@ class StepGrfPlayer {
     boost::lockfree::spsc_queue<StepPlayback> playbacks_;
     std::atomic<std::uint64_t> stepsDropped_{0}, voicesStolen_{0}, playbacksDropped_{0};
     std::atomic<std::size_t> activeVoices_{0};
+    std::atomic<std::uint64_t> seed_{0};
 };
 
 } // namespace underfoot::engine

@@ -330,6 +330,42 @@ TEST(StepGrfPlayer, SameSeedSameGrfsAndNoAllocationOnTheAudioThread) {
     EXPECT_LT(peak, 2.0f * 820);
 }
 
+TEST(StepGrfPlayer, ResetOnTheAudioThreadReseedsWithoutAllocating) {
+    const GrfBank bank = StepGrfPlayer::loadDefaultBank(48000);
+    auto render = [&](StepGrfPlayer& player) {
+        std::vector<float> l(64), r(64), all;
+        float* out[] = {l.data(), r.data()};
+        for (int b = 0; b < 200; ++b) {
+            if (b % 20 == 0) {
+                StepEvent e;
+                e.foot = b % 40 == 0 ? Foot::Left : Foot::Right;
+                e.strength = 0.8f;
+                player.pushStep(e);
+            }
+            player.process(out, 64);
+            all.insert(all.end(), l.begin(), l.end());
+        }
+        return all;
+    };
+    StepGrfPlayerConfig c;
+    c.seed = 5;
+    StepGrfPlayer fresh(bank, c);
+    const auto expected = render(fresh);
+    c.seed = 6;
+    StepGrfPlayer reused(bank, c);
+    render(reused);
+    StepEvent pending;
+    reused.pushStep(pending); // dropped by reset
+    {
+        underfoot::test::AllocationTrap trap;
+        reused.reset(5);
+        EXPECT_EQ(trap.count(), 0);
+    }
+    EXPECT_EQ(reused.seed(), 5u);
+    EXPECT_EQ(reused.activeVoices(), 0u);
+    EXPECT_EQ(render(reused), expected);
+}
+
 TEST(StepGrfPlayer, PerFootPartLayoutPutsEachSensorOnItsChannel) {
     StepGrfPlayerConfig c;
     c.layout = GrfChannelLayout::PerFootPart;
