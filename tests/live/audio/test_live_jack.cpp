@@ -255,7 +255,9 @@ TEST_F(JackServer, LoopbackLatencyIsOneBlock) {
 
 namespace {
 std::atomic<bool> trapArmed{false};
+std::atomic<std::uint64_t> armedCallbacks{0};
 void armTrap() {
+    if (trapArmed.load(std::memory_order_relaxed)) armedCallbacks.fetch_add(1);
     if (trapArmed.load(std::memory_order_relaxed))
         underfoot::test::countAllocations.store(true, std::memory_order_relaxed);
 }
@@ -268,6 +270,17 @@ TEST_F(JackServer, CallbackDoesNotAllocateAcrossSwapsAndMeterReads) {
     eng::LiveEngine engine;
     engine.open(settings("uf_alloc"));
     engine.setCallbackHooks({&armTrap, &disarmTrap});
+    // The hooks really arm the counter: an allocation between them is counted (checked before
+    // the stream runs, so that no callback disarms it meanwhile).
+    underfoot::test::allocationCount = 0;
+    trapArmed = true;
+    armTrap();
+    auto probe = std::make_unique<int>(1);
+    disarmTrap();
+    volatile int sink = *probe; // keep the allocation observable
+    (void)sink;
+    trapArmed = false;
+    ASSERT_EQ(underfoot::test::allocationCount.load(), 1) << "the trap must see an allocation";
     engine.start();
     std::vector<std::unique_ptr<eng::LiveScene>> scenes;
     for (int k = 0; k < 8; ++k) {
@@ -285,6 +298,7 @@ TEST_F(JackServer, CallbackDoesNotAllocateAcrossSwapsAndMeterReads) {
     // Counts only while the callback runs (the hooks arm and disarm the counter); the main
     // thread meanwhile only submits pre-built scenes, reads meters and frees retired scenes.
     underfoot::test::allocationCount = 0;
+    armedCallbacks = 0;
     trapArmed = true;
     const auto blocksBefore = engine.meters().blocks;
     for (auto& s : scenes) {
@@ -300,6 +314,7 @@ TEST_F(JackServer, CallbackDoesNotAllocateAcrossSwapsAndMeterReads) {
     EXPECT_TRUE(engine.waitIdle(2.0));
     trapArmed = false;
     const auto m = engine.meters();
+    const auto armed = armedCallbacks.load();
     engine.close();
     const long allocations = underfoot::test::allocationCount.load();
     const auto blocks = m.blocks - blocksBefore;
@@ -307,6 +322,7 @@ TEST_F(JackServer, CallbackDoesNotAllocateAcrossSwapsAndMeterReads) {
                 static_cast<unsigned long long>(blocks), allocations,
                 static_cast<unsigned long long>(m.xruns));
     EXPECT_GT(blocks, 1000u);
+    EXPECT_GT(armed, blocks * 9 / 10) << "the callbacks ran inside the armed hooks";
     EXPECT_EQ(m.scenesSwapped, 8u);
     EXPECT_EQ(m.scenesRetired, 8u);
     EXPECT_EQ(allocations, 0);
