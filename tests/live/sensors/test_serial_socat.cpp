@@ -274,7 +274,24 @@ TEST(SerialSocat, UnplugIsDetectedWithinASecond) {
                 (goneAt - killedAt) * 1000, source.status().message.c_str());
     EXPECT_LT(goneAt - killedAt, 1.0);
     EXPECT_FALSE(source.status().message.empty());
+
+    // Plugged in again (a new pty pair behind the same link names): reopened within ~0.5 s.
+    SocatPair again("unplug");
+    ASSERT_TRUE(again.ready());
+    const int fd2 = openWriter(again.shoes);
+    ASSERT_GE(fd2, 0);
+    const double replugS = sensorClockSeconds();
+    paced(fd2, 1500, [](std::size_t i) {
+        return formatShoeLine(static_cast<std::uint32_t>(i), {10, 10, 10, 10});
+    });
+    EXPECT_EQ(source.state(), SensorState::Running) << source.status().message;
+    EXPECT_EQ(source.status().reconnects, 1u);
+    const double backAt = transitions.first(SensorState::Running, replugS);
+    ASSERT_GT(backAt, 0);
+    std::printf("[ measured ] replugged: running again %.0f ms after the port reappeared\n",
+                (backAt - replugS) * 1000);
     source.stop();
+    ::close(fd2);
 }
 
 TEST(SerialSocat, CalibratesFromAWalkRecordedThroughThePort) {
