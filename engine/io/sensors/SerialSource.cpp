@@ -317,6 +317,9 @@ void SerialSource::start() {
         impl_->backend = impl_->port.backend;
     }
     impl_->stopRequested = false;
+    impl_->parser = ShoeLineParser{}; // a restart begins a new stream (line numbers, clock)
+    impl_->line.clear();
+    impl_->discarding = false;
     impl_->monitor.opened(sensorClockSeconds());
     impl_->thread = std::thread([this] { impl_->run(); });
 }
