@@ -2,12 +2,15 @@
 // `underfoot study ...`: create a study file, register / drop participants, exclude trials,
 // inspect a study, its journal and what replay needs for a trial.
 #include "app/cli/CommandRegistry.h"
+#include "experiment/Export.h"
 #include "experiment/Protocol.h"
 #include "experiment/Store.h"
 
 #include <fmt/core.h>
 
+#include <fstream>
 #include <functional>
+#include <iostream>
 
 namespace {
 
@@ -37,6 +40,7 @@ struct Options {
     int trial = -1;
     bool include = false;
     std::vector<std::string> fields;
+    std::string output;
 };
 
 Options& opts() {
@@ -183,6 +187,33 @@ const underfoot::cli::CommandRegistrar registrar{
                            r.grfRecording.value_or("(none)"), r.audioConfig, r.sensorConfig,
                            stimulusToToml(r.stimulus));
                 fmt::print("\n");
+            });
+            exitCode = 0;
+        });
+
+        auto* table = cmd->add_subcommand(
+            "participants", "Write the participants CSV (code, group, status, age, gender, shoes, "
+                            "hearing, one column per [[participant_fields]] item) and, with "
+                            "--scales, the scales CSV, for `underfoot analyze --ratings`");
+        table->add_option("--study", o.study, "study file")->required();
+        table->add_option("-o,--output", o.output, "participants CSV (default: standard output)");
+        table->add_option("--scales", o.reason, "also write the scales CSV to this file");
+        table->callback([&exitCode, &o] {
+            guarded([&] {
+                StudyStore store = StudyStore::open(o.study);
+                auto write = [&](const std::string& path, auto&& writer) {
+                    if (path.empty() || path == "-") {
+                        writer(std::cout);
+                        return;
+                    }
+                    std::ofstream out(path, std::ios::binary);
+                    if (!out) throw StoreError(fmt::format("{}: cannot write the file", path));
+                    writer(out);
+                    if (!out.flush()) throw StoreError(fmt::format("{}: write failed", path));
+                };
+                write(o.output, [&](std::ostream& out) { writeParticipantsCsv(store, out); });
+                if (!o.reason.empty())
+                    write(o.reason, [&](std::ostream& out) { writeScalesCsv(store, out); });
             });
             exitCode = 0;
         });
