@@ -418,6 +418,22 @@ lock = "answer"
         QVERIFY(!QFile::exists(home_.filePath("never.db")));
     }
 
+    void aFileThatIsNotAStudyIsRefusedWithWhatToDo() {
+        const QString junk = home_.filePath("junk.db");
+        QFile f(junk);
+        QVERIFY(f.open(QIODevice::WriteOnly));
+        f.write("this is not an SQLite database, just text that happens to end in .db\n");
+        f.close();
+        auto w = makeWindow(); // reopens the last study of the earlier tests, if any
+        const QString before = w->context().path();
+        QVERIFY(!w->studyView()->openFile(junk));
+        QCOMPARE(w->context().path(), before); // a failed open leaves the open study as it was
+        const QString text = w->studyView()->messages()->toPlainText();
+        QVERIFY2(text.contains("not opened") && text.contains("Underfoot study"), qPrintable(text));
+        QVERIFY(!w->studyView()->openFile(home_.filePath("missing.db")));
+        QVERIFY(w->studyView()->messages()->toPlainText().contains("no such study file"));
+    }
+
     void paletteMeasuresCostAndSavesAPresetThatLoads() {
         auto w = makeWindow();
         auto* palette = w->paletteView();
