@@ -171,8 +171,8 @@ StepThresholds loadStepThresholds(const std::string& path) {
     } catch (const toml::parse_error& e) {
         const auto& b = e.source().begin;
         if (b.line == 0)
-            throw std::runtime_error(fmt::format(
-                "{}: expected a readable step-thresholds file: {}", path, e.description()));
+            throw std::runtime_error(fmt::format("{}: expected a readable step-thresholds file: {}",
+                                                 path, e.description()));
         throw std::runtime_error(
             fmt::format("{}:{}:{}: {}", path, b.line, b.column, e.description()));
     }
