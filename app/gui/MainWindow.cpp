@@ -36,6 +36,7 @@ MainWindow::MainWindow(const Options& options, QWidget* parent) : QMainWindow(pa
     palette_ = new PaletteView(dataDir_, this);
     palette_->setAudioOutput(audio_);
     run_->setAudioOutput(audio_, options.startAudio);
+    results_->setAudioOutput(audio_);
     setup_ = new SetupView(*audio_, dataDir_, this);
     tabs_->addTab(study_, tr("&Study"));
     tabs_->addTab(run_, tr("&Run"));

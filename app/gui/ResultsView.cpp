@@ -3,15 +3,21 @@
 
 #include "analysis/io/TrialCsv.h"
 #include "analysis/report/Export.h"
+#include "app/gui/AudioOutput.h"
 #include "app/gui/HeatMap.h"
 #include "app/gui/Replay.h"
 #include "app/gui/StudyContext.h"
+#include "engine/control/GrfFile.h"
 #include "experiment/Export.h"
+#ifdef UNDERFOOT_HAVE_WIRING
+#include "app/wiring/Players.h"
+#endif
 
 #include <QComboBox>
 #include <QDir>
 #include <QFile>
 #include <QFileDialog>
+#include <QFileInfo>
 #include <QGroupBox>
 #include <QHBoxLayout>
 #include <QHeaderView>
@@ -168,7 +174,22 @@ ResultsView::ResultsView(StudyContext& context, QWidget* parent)
     rl->addWidget(tl);
     rl->addWidget(replayTrial_);
     rl->addWidget(replayButton_);
+    auto* live = new QPushButton(tr("Play through the live engine  (Ctrl+Shift+P)"), replay);
+    live->setAccessibleName(tr("Play the trial through the live engine"));
+    rl->addWidget(live);
     rl->addStretch();
+    const auto playSelected = [this] {
+        if (replayParticipant_->currentText().isEmpty()) {
+            workLabel_->setText(tr("Choose a participant and a trial in the Replay tab first."));
+            return;
+        }
+        const QString e = playLive(replayParticipant_->currentText(), replayTrial_->value() - 1);
+        if (!e.isEmpty()) workLabel_->setText(e);
+    };
+    connect(live, &QPushButton::clicked, this, playSelected);
+    auto* scLive = new QShortcut(QKeySequence(Qt::CTRL | Qt::SHIFT | Qt::Key_P), this);
+    scLive->setContext(Qt::WidgetWithChildrenShortcut);
+    connect(scLive, &QShortcut::activated, this, playSelected);
 
     auto* lower = new QTabWidget(this);
     lower->addTab(summary_, tr("Summary"));
@@ -355,6 +376,46 @@ void ResultsView::startReplay(const QString& participant, int trialIndex, const 
                                     .arg(r.seconds, 0, 'f', 1)
                                     .arg(QDir::toNativeSeparators(wavPath));
     }));
+}
+
+QString ResultsView::playLive(const QString& participant, int trialIndex) {
+#ifdef UNDERFOOT_HAVE_WIRING
+    if (!context_.hasStudy()) return tr("No study open.");
+    if (!audio_) return tr("No audio output.");
+    try {
+        const auto info = context_.store().trialForReplay(participant.toStdString(), trialIndex);
+        auto d = wiring::describeStimulus(info.stimulus, info.renderSeed);
+        if (info.grfRecording) {
+            QString path = QString::fromStdString(*info.grfRecording);
+            if (QFileInfo(path).isRelative())
+                path = QFileInfo(context_.path()).dir().filePath(path);
+            d.control = engine::ControlKind::GrfReplay;
+            engine::GrfLoadOptions options;
+            options.targetRateHz = audio_->settings().sampleRateHz;
+            d.grf = engine::loadGrfFile(path.toStdString(), options);
+        } else if (info.stimulus.input.kind != experiment::InputKind::Walker) {
+            return tr("Trial %1 of %2 was driven by a live sensor and no GRF recording is "
+                      "stored for it: it cannot be replayed exactly.")
+                .arg(trialIndex + 1)
+                .arg(participant);
+        }
+        if (const QString e = audio_->start(); !e.isEmpty()) return e;
+        auto scene = engine::LiveScene::create(std::move(d), audio_->engine()->processSpec(),
+                                               audio_->engine()->settings().channels);
+        if (!audio_->engine()->submit(std::move(scene)))
+            return tr("The audio engine is busy; try again in a moment.");
+    } catch (const std::exception& e) {
+        return q(e.what());
+    }
+    workLabel_->setText(tr("Playing trial %1 of %2 through %3; stop it in the Setup view.")
+                            .arg(trialIndex + 1)
+                            .arg(participant, audio_->description()));
+    return {};
+#else
+    (void)participant;
+    (void)trialIndex;
+    return tr("This build has no live audio wiring; render the trial to WAV instead.");
+#endif
 }
 
 void ResultsView::chooseReplay() {

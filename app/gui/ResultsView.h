@@ -21,6 +21,7 @@ namespace underfoot::gui {
 
 class StudyContext;
 class HeatMap;
+class AudioOutput;
 
 /// The analysis of a study's answered trials (the protocol's answer order; by group for
 /// between-subject designs), as `underfoot analyze --study` computes it.
@@ -44,6 +45,10 @@ class ResultsView : public QWidget {
     /// replayFinished.
     void startReplay(const QString& participant, int trialIndex, const QString& wavPath);
     bool busy() const;
+    /// Plays a stored trial through the live engine (what the participant heard, from its
+    /// render seed and GRF recording or walker); returns "" or what went wrong.
+    QString playLive(const QString& participant, int trialIndex);
+    void setAudioOutput(AudioOutput* output) { audio_ = output; }
 
     HeatMap* heatMap() const { return heatMap_; }
     QTableWidget* summaryTable() const { return summary_; }
@@ -78,6 +83,7 @@ class ResultsView : public QWidget {
     QLabel* workLabel_;
     QFutureWatcher<QString>* exportWatcher_;
     QFutureWatcher<QString>* replayWatcher_;
+    AudioOutput* audio_ = nullptr;
 };
 
 } // namespace underfoot::gui

@@ -490,6 +490,10 @@ lock = "answer"
         QVERIFY(done.wait(120000));
         QCOMPARE(done.front().front().toString(), QString());
         QVERIFY(QFileInfo(wav).size() > 48000 * 2 * 4); // more than a second of stereo float
+        // Live replay: plays, or (no sound card here) says why not; an unplayed trial is refused.
+        const QString live = results->playLive("Q1", 1);
+        qInfo("live replay: %s", live.isEmpty() ? "playing" : qPrintable(live));
+        QVERIFY(!results->playLive("Q1", 99).isEmpty());
     }
 };
 
