@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include <filesystem>
+#include <fstream>
 #include <stdexcept>
 
 namespace underfoot::wiring {
@@ -153,6 +154,8 @@ exp::StimulusStart LivePlayer::start(const exp::Stimulus& stimulus, std::uint64_
     recorder_ = recorder;
     recordingPath_ = path;
     playing_ = true;
+    engine_.resetPeaks();
+    startMeters_ = engine_.meters();
     if (!path.empty()) {
         std::string ref = path;
         if (!options_.studyFolder.empty()) {
@@ -171,9 +174,28 @@ void LivePlayer::stop() {
     // Crossfade plus a margin; a stopped stream hands nothing back (then nothing pushes).
     engine_.waitIdle(engine_.settings().crossfadeMs * 1e-3 + 2.0);
     engine_.collectRetired();
+    const auto m = engine_.meters();
+    stats_ = {};
+    stats_.frames = m.frames - startMeters_.frames;
+    stats_.xruns = m.xruns - startMeters_.xruns;
+    const double rate = engine_.settings().sampleRateHz;
+    const double busyBefore = startMeters_.averageLoadPercent * double(startMeters_.frames) / rate;
+    const double busyNow = m.averageLoadPercent * double(m.frames) / rate;
+    stats_.averageLoadPercent =
+        stats_.frames > 0 ? (busyNow - busyBefore) / (double(stats_.frames) / rate) : 0.0;
+    stats_.maxLoadPercent = m.maxLoadPercent;
+    stats_.maxBlockSeconds = m.maxBlockSeconds;
     if (recorder_) {
         recorder_->finish();
         lastDropped_ = recorder_->droppedFrames();
+        stats_.droppedGrfFrames = lastDropped_;
+        std::ofstream side(recorder_->path() + ".meters.toml");
+        side << fmt::format(
+            "# Measured by the live engine while this trial played (docs/live.md)\n"
+            "scene = \"{}\"\nframes = {}\nxruns = {}\naverage_load_percent = {:.3f}\n"
+            "max_load_percent = {:.3f}\nmax_block_ms = {:.4f}\ndropped_grf_frames = {}\n",
+            summary_, stats_.frames, stats_.xruns, stats_.averageLoadPercent, stats_.maxLoadPercent,
+            stats_.maxBlockSeconds * 1e3, stats_.droppedGrfFrames);
         const std::string error = recorder_->error();
         recorder_.reset();
         if (!error.empty()) throw std::runtime_error("live player: GRF recording: " + error);

@@ -53,6 +53,16 @@ struct LivePlayerOptions {
     StimulusSceneOptions scene;
 };
 
+/// What the engine measured while one stimulus played (from start() to stop()).
+struct LiveTrialStats {
+    std::uint64_t frames = 0;           ///< audio frames the device ran
+    std::uint64_t xruns = 0;            ///< device over/underflows
+    double averageLoadPercent = 0;      ///< callback time / audio time
+    double maxLoadPercent = 0;          ///< worst callback
+    double maxBlockSeconds = 0;         ///< worst callback time
+    std::uint64_t droppedGrfFrames = 0; ///< GRF frames lost by the recording ring (0 = complete)
+};
+
 /// Plays stimuli live through a LiveEngine that the caller opened and started.
 class LivePlayer final : public experiment::StimulusPlayer {
   public:
@@ -71,6 +81,9 @@ class LivePlayer final : public experiment::StimulusPlayer {
     const std::string& recordingPath() const noexcept { return recordingPath_; }
     /// Frames of the last recording lost to a full ring (0 = complete), after stop().
     std::uint64_t lastDroppedFrames() const noexcept { return lastDropped_; }
+    /// The last stopped trial's figures. They are also written next to its GRF recording as
+    /// `<recording>.meters.toml` (frames, xruns, loads, dropped frames, scene summary).
+    const LiveTrialStats& lastTrialStats() const noexcept { return stats_; }
 
   private:
     engine::LiveEngine& engine_;
@@ -78,6 +91,9 @@ class LivePlayer final : public experiment::StimulusPlayer {
     std::shared_ptr<engine::AudioRecorder> recorder_;
     std::string summary_, recordingPath_;
     std::uint64_t lastDropped_ = 0;
+    engine::LiveMeters startMeters_;
+    double startLoadSeconds_ = 0;
+    LiveTrialStats stats_;
     int counter_ = 0;
     bool playing_ = false;
 };

@@ -124,6 +124,10 @@ TEST(Wiring, LivePlayerRecordsTheGrfNextToTheStudy) {
     std::this_thread::sleep_for(std::chrono::milliseconds(300));
     player.stop();
     EXPECT_EQ(player.lastDroppedFrames(), 0u);
+    const auto& stats = player.lastTrialStats();
+    EXPECT_GT(stats.frames, 4800u);
+    EXPECT_GT(stats.averageLoadPercent, 0.0);
+    EXPECT_TRUE(fs::exists(study / (*second.grfRecording + ".meters.toml")));
     running = false;
     audio.join();
     for (const auto* ref : {&*start.grfRecording, &*second.grfRecording}) {
