@@ -128,46 +128,59 @@ std::unique_ptr<LiveScene> LiveScene::create(LiveSceneDescription d, const Proce
 
     // --- control
     int voices = 2;
-    switch (d.control) {
-    case ControlKind::Walker:
-        s->walker_ = std::make_unique<VirtualWalker>(d.walker);
-        s->walker_->prepare(spec);
-        voices = 2;
-        break;
-    case ControlKind::Microphones:
-        if (channels.microphones.empty())
-            throw std::invalid_argument(
-                "LiveScene: microphone control needs microphone input channels in the audio "
-                "settings ([channels] microphones = [1, 2, 3, 4])");
-        s->cook_ = std::make_unique<CookEnvelope>();
-        s->cook_->prepare(spec, static_cast<int>(channels.microphones.size()));
-        s->cook_->setSettings(d.microphones);
-        s->micChannels_ = channels.microphones;
-        s->micPtr_.assign(channels.microphones.size(), nullptr);
-        voices = 1;
-        break;
-    case ControlKind::GrfReplay:
-        if (d.grf.channels.empty() || d.grf.frames() == 0)
-            throw std::invalid_argument("LiveScene: the GRF to replay has no samples");
-        if (d.grf.channels.size() > 16)
-            throw std::invalid_argument("LiveScene: the GRF to replay has more than 16 channels");
-        if (std::fabs(d.grf.sampleRateHz - spec.sampleRateHz) > 1e-6)
-            throw std::invalid_argument(fmt::format(
-                "LiveScene: the GRF is at {} Hz, the device at {} Hz; load it with targetRateHz",
-                d.grf.sampleRateHz, spec.sampleRateHz));
-        s->replay_ = std::move(d.grf);
-        voices = static_cast<int>(s->replay_.channels.size());
-        break;
-    case ControlKind::External:
-        if (!d.external) throw std::invalid_argument("LiveScene: external control without source");
-        voices = d.external->channelCount();
-        if (voices < 1 || voices > 16)
-            throw std::invalid_argument(fmt::format(
-                "LiveScene: the external GRF source has {} channels; expected 1 to 16", voices));
-        s->external_ = std::move(d.external);
-        s->external_->prepare(spec);
-        break;
-    }
+    if (d.wading) {
+        if (d.grfRecorder)
+            throw std::invalid_argument("LiveScene: a water scene has no GRF to record (the "
+                                        "wading node records its gait frames)");
+        s->wading_ = std::move(d.wading);
+        s->wading_->prepare(spec);
+        s->surfaceId_ = "water";
+        voices = 0;
+    } else
+        switch (d.control) {
+        case ControlKind::Walker:
+            s->walker_ = std::make_unique<VirtualWalker>(d.walker);
+            s->walker_->prepare(spec);
+            voices = 2;
+            break;
+        case ControlKind::Microphones:
+            if (channels.microphones.empty())
+                throw std::invalid_argument(
+                    "LiveScene: microphone control needs microphone input channels in the audio "
+                    "settings ([channels] microphones = [1, 2, 3, 4])");
+            s->cook_ = std::make_unique<CookEnvelope>();
+            s->cook_->prepare(spec, static_cast<int>(channels.microphones.size()));
+            s->cook_->setSettings(d.microphones);
+            s->micChannels_ = channels.microphones;
+            s->micPtr_.assign(channels.microphones.size(), nullptr);
+            voices = 1;
+            break;
+        case ControlKind::GrfReplay:
+            if (d.grf.channels.empty() || d.grf.frames() == 0)
+                throw std::invalid_argument("LiveScene: the GRF to replay has no samples");
+            if (d.grf.channels.size() > 16)
+                throw std::invalid_argument(
+                    "LiveScene: the GRF to replay has more than 16 channels");
+            if (std::fabs(d.grf.sampleRateHz - spec.sampleRateHz) > 1e-6)
+                throw std::invalid_argument(
+                    fmt::format("LiveScene: the GRF is at {} Hz, the device at {} Hz; load it with "
+                                "targetRateHz",
+                                d.grf.sampleRateHz, spec.sampleRateHz));
+            s->replay_ = std::move(d.grf);
+            voices = static_cast<int>(s->replay_.channels.size());
+            break;
+        case ControlKind::External:
+            if (!d.external)
+                throw std::invalid_argument("LiveScene: external control without source");
+            voices = d.external->channelCount();
+            if (voices < 1 || voices > 16)
+                throw std::invalid_argument(fmt::format(
+                    "LiveScene: the external GRF source has {} channels; expected 1 to 16",
+                    voices));
+            s->external_ = std::move(d.external);
+            s->external_->prepare(spec);
+            break;
+        }
     const auto nv = static_cast<std::size_t>(voices);
     s->grf_.assign(nv, std::vector<float>(block, 0.0f));
     s->grfScaled_.assign(nv, std::vector<float>(block, 0.0f));
@@ -194,14 +207,15 @@ std::unique_ptr<LiveScene> LiveScene::create(LiveSceneDescription d, const Proce
 
     // --- reverb: only what the headphones will let the participant hear
     if (s->headphones_) {
-        const auto& info = s->voices_.front()->info();
         AudioBuffer impulse;
         if (!d.impulseResponse.empty()) {
             impulse = readAudioFile(findImpulseResponse(d.impulseResponse));
             s->wet_ = dbToGain(d.impulseWetDb);
             s->dry_ = 1.0;
             s->reverbName_ = d.impulseResponse;
-        } else if (info.reverb && !d.dryEvenIfPresetHasReverb) {
+        } else if (!s->voices_.empty() && s->voices_.front()->info().reverb &&
+                   !d.dryEvenIfPresetHasReverb) {
+            const auto& info = s->voices_.front()->info();
             impulse = readAudioFile(findImpulseResponse(info.reverb->impulseResponse));
             s->wet_ = dbToGain(info.reverb->wetDb);
             s->dry_ = dbToGain(info.reverb->dryDb);
@@ -255,6 +269,10 @@ std::unique_ptr<LiveScene> LiveScene::create(LiveSceneDescription d, const Proce
         s->recR_.assign(block, 0.0f);
     }
     s->gain_.assign(block, 1.0f);
+    if (s->wading_ && s->mixL_.empty()) { // the node renders into the mix buffers
+        s->mixL_.assign(block, 0.0f);
+        s->mixR_.assign(block, 0.0f);
+    }
 
     // --- deterministic start (FootstepScene::reset, walkerGrf, soundscape replay)
     for (std::size_t v = 0; v < s->voices_.size(); ++v)
@@ -262,6 +280,7 @@ std::unique_ptr<LiveScene> LiveScene::create(LiveSceneDescription d, const Proce
     if (s->walker_) s->walker_->reset(d.seed);
     if (s->cook_) s->cook_->reset();
     if (s->external_) s->external_->reset(d.seed);
+    if (s->wading_) s->wading_->reset(d.seed);
     if (s->ambience_) s->ambience_->reset(d.seed);
 
     for (int i = 0; i < static_cast<int>(SceneNode::Count); ++i)
@@ -281,8 +300,9 @@ bool LiveScene::hasNode(SceneNode node) const noexcept {
 }
 
 std::string LiveScene::summary() const {
-    std::string s = fmt::format("{}, {}, {} voice{}", surfaceId_, toString(control_),
-                                voices_.size(), voices_.size() == 1 ? "" : "s");
+    std::string s = wading_ ? wading_->summary()
+                            : fmt::format("{}, {}, {} voice{}", surfaceId_, toString(control_),
+                                          voices_.size(), voices_.size() == 1 ? "" : "s");
     if (!headphones_) s += ", headphones off";
     if (reverb_)
         s += fmt::format(", reverb {} ({:.2f} s)", reverbName_,
@@ -386,7 +406,7 @@ void LiveScene::process(const float* const* inputs, int numInputs, float* const*
 
     {
         ScopedFlushDenormals noDenormals; // as FootstepScene::process
-        runControl(inputs, numInputs, n);
+        if (!wading_) runControl(inputs, numInputs, n);
         if (grfRecorder_) grfRecorder_->push(grfScaledPtr_.data(), n);
         account(SceneNode::Control);
 
@@ -423,6 +443,17 @@ void LiveScene::process(const float* const* inputs, int numInputs, float* const*
                                 voiceOut_[static_cast<std::size_t>(i)];
                 if (measure_)
                     hapticSeconds += std::chrono::duration<double>(Clock::now() - t0).count();
+            }
+        }
+        if (wading_) { // the water: gait frames -> stereo, in place of the voices
+            wading_->process(mixL_.data(), mixR_.data(), n);
+            for (int i = 0; i < n; ++i) {
+                const auto k = static_cast<std::size_t>(i);
+                if (reverb_) mono_[k] = 0.5f * (mixL_[k] + mixR_[k]);
+                if (haptics_) {
+                    shoe_[0][k] = mixL_[k];
+                    shoe_[1][k] = mixR_[k];
+                }
             }
         }
         if (measure_) {

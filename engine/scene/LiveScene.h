@@ -26,6 +26,7 @@
 #include "engine/dsp/ProcessSpec.h"
 #include "engine/io/AudioDevice.h"
 #include "engine/io/AudioRecorder.h"
+#include "engine/scene/WadingNode.h"
 #include "engine/surfaces/Layer.h"
 
 #include <array>
@@ -104,6 +105,12 @@ struct LiveSceneDescription {
     CookEnvelopeSettings microphones{1.0, 100.0, 1000.0}; ///< 1000 N per unit of |x| by default
     GrfSignal grf;                       ///< ControlKind::GrfReplay (resampled to the scene rate)
     std::shared_ptr<GrfSource> external; ///< ControlKind::External
+    /// Walking through water (surface "water"): the wading node (a WadingScene fed by its gait
+    /// source) replaces the GRF control and the surface voices; `surface`, `control` and
+    /// `grfRecorder` are then not used (the node records its gait frames itself). Its stereo
+    /// output goes to the headphones (and the reverb, when one is named); with haptics, the
+    /// left / right output drives the left / right shoe through the 50-500 Hz band.
+    std::unique_ptr<WadingNode> wading;
 
     std::uint64_t seed = 1; ///< render seed (voices, walker, ambience)
     /// Recording of the GRF channels from the scene's first sample (made by makeGrfRecorder,
@@ -175,6 +182,9 @@ class LiveScene {
     std::uint64_t seed() const noexcept { return seed_; }
     const std::string& surfaceId() const noexcept { return surfaceId_; }
     ControlKind control() const noexcept { return control_; }
+    /// The wading node of a water scene (null otherwise), e.g. to save its gait recording after
+    /// the scene was retired.
+    const WadingNode* wading() const noexcept { return wading_.get(); }
     OutputModality modality() const noexcept { return modality_; }
     bool hasNode(SceneNode node) const noexcept;
     /// A one-line description: "wood, walker, 2 voices, reverb hall (1.9 s), haptics L:both
@@ -203,6 +213,7 @@ class LiveScene {
     std::vector<int> micChannels_;
     GrfSignal replay_;
     std::shared_ptr<GrfSource> external_;
+    std::unique_ptr<WadingNode> wading_;
     std::vector<std::vector<float>> grf_, grfScaled_;
     std::vector<float*> grfPtr_, grfScaledPtr_;
     std::vector<const float*> micPtr_;
