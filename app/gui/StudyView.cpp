@@ -120,7 +120,7 @@ StudyView::StudyView(StudyContext& context, QWidget* parent) : QWidget(parent), 
 
     messages_ = new QPlainTextEdit(this);
     messages_->setReadOnly(true);
-    messages_->setMaximumHeight(110);
+    messages_->setMaximumHeight(80);
     messages_->setAccessibleName(tr("Messages"));
     messages_->setPlaceholderText(tr("Problems with a protocol or a study file are shown here, "
                                      "with file:line:column."));
@@ -130,8 +130,8 @@ StudyView::StudyView(StudyContext& context, QWidget* parent) : QWidget(parent), 
     info_->setTextInteractionFlags(Qt::TextSelectableByMouse);
     info_->setAccessibleName(tr("Study information"));
 
-    groups_ = makeTable({tr("Group"), tr("Label"), tr("Active"), tr("Completed"), tr("Dropped"),
-                         tr("Target"), tr("Trials"), tr("Duration (min)")},
+    groups_ = makeTable({tr("Group"), tr("Label"), tr("Active"), tr("Done"), tr("Dropped"),
+                         tr("Target"), tr("Trials"), tr("Minutes")},
                         tr("Groups"), this);
     participants_ =
         makeTable({tr("Participant"), tr("Group"), tr("Status"), tr("Answered"), tr("Registered")},
@@ -361,10 +361,8 @@ void StudyView::refresh() {
         QString trials, minutes;
         for (const auto& s : progress.plan.groups)
             if (s.groupId == g.groupId) {
-                trials = tr("%1 + %2 practice, %3 breaks")
-                             .arg(s.mainTrials)
-                             .arg(s.practiceTrials)
-                             .arg(s.breaks);
+                trials =
+                    tr("%1 + %2 pr., %3 br.").arg(s.mainTrials).arg(s.practiceTrials).arg(s.breaks);
                 minutes = QString::number(s.estimatedDurationS / 60.0, 'f', 0);
             }
         setRow(groups_, static_cast<int>(i),
@@ -373,6 +371,11 @@ void StudyView::refresh() {
                 g.target > 0 ? QString::number(g.target) : tr("—"), trials, minutes});
     }
     groups_->resizeColumnsToContents();
+    // The label gives way (elided, full text in its tooltip) so that the counts stay visible.
+    groups_->horizontalHeader()->setSectionResizeMode(QHeaderView::ResizeToContents);
+    groups_->horizontalHeader()->setSectionResizeMode(1, QHeaderView::Stretch);
+    for (int r = 0; r < groups_->rowCount(); ++r)
+        if (auto* item = groups_->item(r, 1)) item->setToolTip(item->text());
     participants_->setRowCount(static_cast<int>(progress.participants.size()));
     const auto people = store.participants();
     for (std::size_t i = 0; i < progress.participants.size(); ++i) {
