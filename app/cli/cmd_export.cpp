@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// `underfoot export`: the long-format trials CSV (one row per trial), the ratings CSV and the
-// codebook of a study.
+// `underfoot export`: the long-format trials CSV (one row per trial), the ratings CSV, the
+// participants and scales tables, and the codebook of a study.
 #include "app/cli/CommandRegistry.h"
 #include "experiment/Export.h"
 #include "experiment/Store.h"
@@ -35,8 +35,9 @@ std::ofstream openOut(const std::filesystem::path& path) {
 const underfoot::cli::CommandRegistrar registrar{
     "export", [](CLI::App& app, int& exitCode) {
         Options& o = opts();
-        auto* cmd = app.add_subcommand(
-            "export", "Write trials.csv (one row per trial), ratings.csv and codebook.md");
+        auto* cmd =
+            app.add_subcommand("export", "Write trials.csv (one row per trial), ratings.csv, "
+                                         "participants.csv, scales.csv and codebook.md");
         cmd->add_option("--study", o.study, "study file")->required();
         cmd->add_option("-o,--out", o.outDir, "output folder (created if needed)");
         cmd->add_flag("--all-trials", o.all, "also write planned trials not answered yet");
@@ -50,15 +51,22 @@ const underfoot::cli::CommandRegistrar registrar{
                 const int rows = writeTrialsCsv(store, trials, scope);
                 auto ratings = openOut(dir / "ratings.csv");
                 const int ratingRows = writeRatingsCsv(store, ratings, scope);
+                auto participants = openOut(dir / "participants.csv");
+                const int participantRows = writeParticipantsCsv(store, participants);
+                auto scales = openOut(dir / "scales.csv");
+                const int scaleRows = writeScalesCsv(store, scales);
                 auto codebook = openOut(dir / "codebook.md");
                 writeCodebook(store, codebook);
                 trials.close();
                 ratings.close();
+                participants.close();
+                scales.close();
                 codebook.close();
-                if (!trials || !ratings || !codebook)
+                if (!trials || !ratings || !participants || !scales || !codebook)
                     throw UserError(fmt::format("{}: writing the export failed", o.outDir));
-                fmt::print("wrote {} trial rows, {} rating rows and the codebook to {}\n", rows,
-                           ratingRows, o.outDir);
+                fmt::print("wrote {} trial rows, {} rating rows, {} participants, {} scales and "
+                           "the codebook to {}\n",
+                           rows, ratingRows, participantRows, scaleRows, o.outDir);
             } catch (const StoreError& e) {
                 throw UserError(e.what());
             } catch (const std::filesystem::filesystem_error& e) {
