@@ -192,9 +192,11 @@ void LivePlayer::stop() {
         std::ofstream side(recorder_->path() + ".meters.toml");
         side << fmt::format(
             "# Measured by the live engine while this trial played (docs/live.md)\n"
-            "scene = \"{}\"\nframes = {}\nxruns = {}\naverage_load_percent = {:.3f}\n"
+            "scene = \"{}\"\nsample_rate = {}\nblock_size = {}\nframes = {}\nxruns = {}\n"
+            "average_load_percent = {:.3f}\n"
             "max_load_percent = {:.3f}\nmax_block_ms = {:.4f}\ndropped_grf_frames = {}\n",
-            summary_, stats_.frames, stats_.xruns, stats_.averageLoadPercent, stats_.maxLoadPercent,
+            summary_, engine_.settings().sampleRateHz, engine_.settings().blockSize, stats_.frames,
+            stats_.xruns, stats_.averageLoadPercent, stats_.maxLoadPercent,
             stats_.maxBlockSeconds * 1e3, stats_.droppedGrfFrames);
         const std::string error = recorder_->error();
         recorder_.reset();
