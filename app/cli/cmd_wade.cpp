@@ -4,11 +4,18 @@
 //   wade --gait recording.csv -o wade.wav                                recorded gait
 //   wade --write-gait gait.csv --cadence 63 --seconds 20                 virtual gait as CSV
 //   wade --latency [--algo v1] [--filter ...]                            measured latencies
+//   wade --live [--osc 9000] [--settings audio.toml] --depth deep --algo v2 --seconds 60
+//        [--record-gait live.csv] [-o live.wav]       live on the audio device: OSC gyroscopes
+//                                                     (--osc) or the virtual gait (--cadence)
 // Bad arguments exit with status 2 and a message naming the option and what it accepts.
 #include "app/cli/CommandRegistry.h"
 #include "engine/io/AudioFile.h"
+#include "engine/io/AudioRecorder.h"
+#include "engine/io/sensors/OscGyroReceiver.h"
 #include "engine/render/AudioFeatures.h"
 #include "engine/render/Renderer.h"
+#include "engine/scene/LiveEngine.h"
+#include "engine/scene/WadingNode.h"
 #include "engine/surfaces/Preset.h"
 #include "engine/wading/Gait.h"
 #include "engine/wading/Wading.h"
@@ -19,6 +26,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <thread>
 
 namespace underfoot::cli {
 namespace {
@@ -40,6 +48,9 @@ struct WadeArgs {
     std::string block = "256";
     bool latency = false;
     bool report = false;
+    bool live = false;
+    std::string osc; ///< UDP port of the gyroscopes ("" = virtual gait)
+    std::string settings, api, device, recordGait;
 };
 
 WadeArgs& args() {
@@ -83,11 +94,134 @@ eng::SampleFormat format(const std::string& f) {
     throw UserError("--format \"" + f + "\": expected pcm16, pcm24 or float");
 }
 
+std::string db(float x) {
+    return x > 0 ? fmt::format("{:.1f} dBFS", 20.0 * std::log10(x)) : std::string("silent");
+}
+
+/// `wade --live`: the wading node on the audio device, fed by OSC gyroscopes or the virtual gait.
+int runLive(const WadeArgs& a, const eng::WadingOptions& o, double seconds) {
+    eng::AudioSettings settings;
+    try {
+        if (!a.settings.empty()) settings = eng::loadAudioSettings(a.settings);
+    } catch (const eng::AudioSettingsError& e) {
+        throw UserError(std::string("wade --settings: ") + e.what());
+    }
+    if (!a.api.empty()) settings.api = a.api;
+    if (!a.device.empty()) settings.device = a.device;
+    std::shared_ptr<eng::OscGyroReceiver> receiver;
+    if (!a.osc.empty()) {
+        eng::OscGyroConfig config;
+        config.port = static_cast<int>(
+            number("--osc", a.osc, 1, 65535, "a UDP port in [1, 65535] for the gyroscopes"));
+        receiver = std::make_shared<eng::OscGyroReceiver>(config);
+    }
+    eng::LiveEngine engine;
+    try {
+        engine.open(settings);
+    } catch (const eng::AudioSettingsError& e) {
+        throw UserError(std::string("wade --live: ") + e.what());
+    }
+    const auto spec = engine.processSpec();
+    eng::WadingOptions live = o;
+    live.sampleRateHz = spec.sampleRateHz;
+    std::unique_ptr<eng::GaitSource> source;
+    if (receiver) {
+        source = std::make_unique<eng::LiveGyroGaitSource>(receiver);
+    } else {
+        eng::VirtualGaitParameters p;
+        p.cadenceStepsPerMin = o.cadenceStepsPerMin;
+        p.strideM = o.strideM;
+        source = std::make_unique<eng::VirtualGaitSource>(p, std::min(600.0, seconds + 1.0));
+    }
+    eng::LiveSceneDescription d;
+    d.seed = o.seed;
+    std::shared_ptr<eng::AudioRecorder> outRecorder;
+    if (!a.output.empty())
+        d.outputRecorder = outRecorder =
+            std::make_shared<eng::AudioRecorder>(a.output, 2, spec.sampleRateHz);
+    // Room for the whole trial's gait at 100 Hz (plus slack for late frames).
+    d.wading = std::make_unique<eng::WadingNode>(live, std::move(source),
+                                                 static_cast<std::size_t>(seconds * 110.0) + 1000);
+    auto scene = eng::LiveScene::create(std::move(d), spec, engine.settings().channels);
+    scene->setMeasureCost(true);
+    fmt::print("device: {} \"{}\", {} Hz, {} frames ({:.2f} ms), {} out / {} in\n",
+               engine.openedApi(), engine.openedDevice(), engine.settings().sampleRateHz,
+               engine.settings().blockSize,
+               1e3 * engine.settings().blockSize / engine.settings().sampleRateHz,
+               engine.outputChannels(), engine.inputChannels());
+    fmt::print("scene: {}\n", scene->summary());
+    if (receiver) {
+        receiver->start();
+        fmt::print("gyroscopes: OSC on UDP port {} (/underfoot/gyro/<left|right>_<thigh|shank> "
+                   ",f deg/s [,i sequence]; docs/sensors.md)\n",
+                   receiver->port());
+    }
+    try {
+        engine.start();
+    } catch (const eng::AudioSettingsError& e) {
+        throw UserError(std::string("wade --live: ") + e.what());
+    }
+    engine.submit(std::move(scene));
+    const auto t0 = std::chrono::steady_clock::now();
+    for (int s = 1; s <= static_cast<int>(std::ceil(seconds)); ++s) {
+        std::this_thread::sleep_until(t0 +
+                                      std::chrono::duration<double>(std::min<double>(s, seconds)));
+        const auto m = engine.meters();
+        std::string sensor;
+        if (receiver) {
+            const auto st = receiver->status();
+            sensor = fmt::format("  gyro {} {:.0f} pkt/s, {} rejected, {} lost",
+                                 eng::sensorStateName(st.state), st.rateHz, st.linesRejected,
+                                 st.framesLost);
+        }
+        fmt::print(
+            "{:5.1f} s  L {:>11}  R {:>11}  load {:4.1f} %  xruns {}{}\n",
+            std::min<double>(s, seconds), db(m.outputPeak[0]),
+            db(m.outputPeak[static_cast<std::size_t>(engine.settings().channels.headphonesRight)]),
+            m.loadPercent, m.xruns, sensor);
+    }
+    engine.submit(nullptr);
+    engine.waitIdle(engine.settings().crossfadeMs * 1e-3 + 2.0);
+    const auto m = engine.meters();
+    const auto retired = engine.takeRetired();
+    engine.close();
+    if (receiver) receiver->stop();
+    if (outRecorder) outRecorder->finish();
+    const double audioSeconds = double(m.frames) / engine.settings().sampleRateHz;
+    fmt::print("{:.2f} s played: {} blocks, {} xruns; callback load avg {:.2f} %, max {:.1f} %\n",
+               audioSeconds, m.blocks, m.xruns, m.averageLoadPercent, m.maxLoadPercent);
+    if (!retired.empty() && retired.front()->wading()) {
+        const eng::WadingNode& node = *retired.front()->wading();
+        fmt::print("gait: {} frames applied, {} recorded, {} beyond the recording's capacity, "
+                   "{} readings rejected\n",
+                   node.framesApplied(), node.recordedFrames(), node.unrecordedFrames(),
+                   node.scene().rejectedReadings());
+        if (!a.recordGait.empty()) {
+            node.writeRecording(a.recordGait);
+            fmt::print("gait recorded: {} (re-render: underfoot wade --gait {} --depth {} --algo "
+                       "{} --seed {} -o FILE.wav)\n",
+                       a.recordGait, a.recordGait, o.depth, o.algorithm, o.seed);
+        }
+    }
+    if (outRecorder)
+        fmt::print("output recorded: {} ({} frames, {} dropped)\n", outRecorder->path(),
+                   outRecorder->writtenFrames(), outRecorder->droppedFrames());
+    return 0;
+}
+
 int runWade(const WadeArgs& a) {
     const eng::WadingOptions o = options(a);
     const double seconds =
         number("--seconds", a.seconds, 0.01, 3600, "a duration in (0, 3600] seconds");
+    if (!a.live && (!a.osc.empty() || !a.settings.empty() || !a.recordGait.empty()))
+        throw UserError("wade: --osc, --settings and --record-gait need --live");
     try {
+        if (a.live) {
+            if (!a.gait.empty() || a.latency || !a.writeGait.empty())
+                throw UserError("wade --live: --gait, --latency and --write-gait are offline "
+                                "options (use --osc PORT for live gyroscopes)");
+            return runLive(a, o, seconds);
+        }
         if (a.latency) {
             const int block = static_cast<int>(
                 number("--block", a.block, 1, 8192, "an audio block size in [1, 8192] samples"));
@@ -166,6 +300,8 @@ int runWade(const WadeArgs& a) {
         throw UserError(fmt::format("--gait: {}", e.what()));
     } catch (const eng::FileError& e) {
         throw UserError(e.what());
+    } catch (const eng::SensorError& e) {
+        throw UserError(fmt::format("wade --osc: {}", e.what()));
     } catch (const std::invalid_argument& e) {
         throw UserError(e.what());
     }
@@ -195,6 +331,15 @@ const CommandRegistrar registrar{
         cmd->add_flag("--latency", a.latency, "measure the latency from a gyroscope frame");
         cmd->add_option("--block", a.block, "audio block size for --latency (default 256)");
         cmd->add_flag("--report", a.report, "print level, spectral centroid and CPU cost");
+        cmd->add_flag("--live", a.live,
+                      "play live on the audio device (virtual gait, or gyroscopes with --osc)");
+        cmd->add_option("--osc", a.osc, "live: UDP port of the OSC gyroscopes (e.g. 9000)");
+        cmd->add_option("--settings", a.settings,
+                        "live: audio settings file (underfoot devices --save)");
+        cmd->add_option("--api", a.api, "live: override the settings' audio API");
+        cmd->add_option("--device", a.device, "live: override the settings' device");
+        cmd->add_option("--record-gait", a.recordGait,
+                        "live: write the trial's gait frames to this CSV (re-render with --gait)");
         cmd->callback([&exitCode, &a] { exitCode = runWade(a); });
     }};
 
