@@ -5,9 +5,15 @@
 #include "app/gui/StudyContext.h"
 #include "app/gui/WalkerPlayer.h"
 #include "experiment/Catalogue.h"
+#include "experiment/Clips.h"
 #ifdef UNDERFOOT_HAVE_WIRING
+#include "app/wiring/ClipPlayer.h"
 #include "app/wiring/Players.h"
 #endif
+
+#include <QFileDialog>
+#include <QFutureWatcher>
+#include <QtConcurrent/QtConcurrentRun>
 
 #include <QComboBox>
 #include <QCoreApplication>
@@ -24,6 +30,7 @@
 #include <QLabel>
 #include <QLineEdit>
 #include <QListWidget>
+#include <QPointer>
 #include <QProgressBar>
 #include <QPushButton>
 #include <QRegularExpressionValidator>
@@ -63,11 +70,27 @@ QFont bigFont(const QWidget* w, double factor) {
 
 /// The session's player: the live engine (app/wiring's LivePlayer, which also records the GRF
 /// next to the study for replay) while the Setup view's audio output runs, and always the
-/// walker meters of the Run view.
+/// walker meters of the Run view. Listening tests present their pre-rendered clips instead
+/// (experiment::ClipPlayer; heard through the live engine when it runs).
 class ConsolePlayer final : public exp::StimulusPlayer {
   public:
-    ConsolePlayer(WalkerPlayer& meters, AudioOutput* audio, const QString& studyPath)
+    /// `clipDir` non-empty: a listening test (throws StoreError when the clips are not ready).
+    ConsolePlayer(WalkerPlayer& meters, AudioOutput* audio, const QString& studyPath,
+                  const exp::Protocol& protocol, const QString& clipDir)
         : meters_(meters) {
+        if (!clipDir.isEmpty()) {
+            exp::ClipPlayer::PlayFunction play;
+            std::function<void()> stop;
+#ifdef UNDERFOOT_HAVE_WIRING
+            if (audio && audio->engine()) {
+                clipAudio_ = std::make_unique<wiring::ClipAudio>(*audio->engine());
+                play = [this](const std::string& path) { clipAudio_->play(path); };
+                stop = [this] { clipAudio_->stop(); };
+            }
+#endif
+            clips_ = std::make_unique<exp::ClipPlayer>(protocol, clipDir.toStdString(), play, stop);
+            return;
+        }
 #ifdef UNDERFOOT_HAVE_WIRING
         if (audio && audio->engine()) {
             wiring::LivePlayerOptions o;
@@ -83,6 +106,7 @@ class ConsolePlayer final : public exp::StimulusPlayer {
 #endif
     }
     exp::StimulusStart start(const exp::Stimulus& stimulus, std::uint64_t plannedSeed) override {
+        if (clips_) return clips_->start(stimulus, plannedSeed);
         exp::StimulusStart started{plannedSeed, std::nullopt};
 #ifdef UNDERFOOT_HAVE_WIRING
         if (live_) started = live_->start(stimulus, plannedSeed);
@@ -91,6 +115,10 @@ class ConsolePlayer final : public exp::StimulusPlayer {
         return started;
     }
     void stop() override {
+        if (clips_) {
+            clips_->stop();
+            return;
+        }
 #ifdef UNDERFOOT_HAVE_WIRING
         if (live_) live_->stop();
 #endif
@@ -99,16 +127,37 @@ class ConsolePlayer final : public exp::StimulusPlayer {
     /// Whether stimuli are heard (live engine) or only shown (meters).
     bool live() const {
 #ifdef UNDERFOOT_HAVE_WIRING
-        return live_ != nullptr;
+        return live_ != nullptr || clipAudio_ != nullptr;
 #else
         return false;
 #endif
     }
 
+    void setMuted(bool muted) override {
+        muted_ = muted;
+    }
+    /// Whether the session asked for silence (baseline laps).
+    bool muted() const {
+        return muted_;
+    }
+    /// The clip presented last ("" before the first or outside listening tests).
+    std::string lastClip() const {
+        return clips_ ? clips_->lastPath() : std::string();
+    }
+#ifdef UNDERFOOT_HAVE_WIRING
+    /// The live player's figures of the last stopped trial (nullptr without the live engine).
+    const wiring::LiveTrialStats* lastTrialStats() const {
+        return live_ ? &live_->lastTrialStats() : nullptr;
+    }
+#endif
+
   private:
     WalkerPlayer& meters_;
+    std::unique_ptr<exp::ClipPlayer> clips_;
+    bool muted_ = false;
 #ifdef UNDERFOOT_HAVE_WIRING
     std::unique_ptr<wiring::LivePlayer> live_;
+    std::unique_ptr<wiring::ClipAudio> clipAudio_;
 #endif
 };
 
@@ -215,6 +264,7 @@ RunView::RunView(StudyContext& context, QWidget* parent) : QWidget(parent), cont
     layout->addWidget(pages_);
     connect(player_, &WalkerPlayer::meter, this, &RunView::onMeter);
     connect(&context_, &StudyContext::studyChanged, this, [this] {
+        clipDir_.clear();
         closeSession();
         pages_->setCurrentIndex(StartPage);
     });
@@ -305,11 +355,40 @@ void RunView::buildStartPage() {
     startMessage_->setAccessibleName(tr("Message"));
     startMessage_->setTextInteractionFlags(Qt::TextSelectableByMouse);
 
+    // Listening tests: the pre-rendered clips every participant hears.
+    clipBox_ = new QGroupBox(tr("Listening-test clips"), page);
+    auto* cl = new QGridLayout(clipBox_);
+    clipStatus_ = new QLabel(clipBox_);
+    clipStatus_->setWordWrap(true);
+    clipStatus_->setTextInteractionFlags(Qt::TextSelectableByMouse);
+    clipStatus_->setAccessibleName(tr("Clip status"));
+    clipProgress_ = new QProgressBar(clipBox_);
+    clipProgress_->setAccessibleName(tr("Clip rendering progress"));
+    clipProgress_->hide();
+    clipRender_ = new QPushButton(tr("Render clips  (Ctrl+Shift+C)"), clipBox_);
+    clipRender_->setAccessibleName(tr("Render the clips of the protocol"));
+    auto* clipPick = new QPushButton(tr("Choose clip folder…"), clipBox_);
+    clipPick->setAccessibleName(tr("Choose the folder holding the clips"));
+    cl->addWidget(clipStatus_, 0, 0, 1, 3);
+    cl->addWidget(clipProgress_, 1, 0);
+    cl->addWidget(clipRender_, 1, 1);
+    cl->addWidget(clipPick, 1, 2);
+    cl->setColumnStretch(0, 1);
+    connect(clipRender_, &QPushButton::clicked, this, [this] { renderClips(); });
+    connect(clipPick, &QPushButton::clicked, this, [this] {
+        const QString dir = QFileDialog::getExistingDirectory(this, tr("Clip folder"), clipDir_);
+        if (!dir.isEmpty()) setClipFolder(dir);
+    });
+    auto* scC = new QShortcut(QKeySequence(Qt::CTRL | Qt::SHIFT | Qt::Key_C), page);
+    scC->setContext(Qt::WidgetWithChildrenShortcut);
+    connect(scC, &QShortcut::activated, this, [this] { renderClips(); });
+
     auto* top = new QHBoxLayout;
     top->addWidget(reg, 1);
     top->addWidget(resume, 1);
     auto* pl = new QVBoxLayout(page);
     pl->addLayout(top, 1);
+    pl->addWidget(clipBox_);
     pl->addWidget(startMessage_);
     pages_->addWidget(page);
 
@@ -384,6 +463,11 @@ void RunView::buildTrialPage() {
     pausedLabel_->setStyleSheet("QLabel { background: #ffd7d7; color: #700; padding: 6px; "
                                 "font-weight: bold; }");
     pausedLabel_->hide();
+    protocolStatus_ = new QLabel(trial_);
+    protocolStatus_->setWordWrap(true);
+    protocolStatus_->setFont(bigFont(this, 1.15));
+    protocolStatus_->setAccessibleName(tr("Clip and lap status"));
+    protocolStatus_->hide();
 
     sectionsHost_ = new QWidget(trial_);
     new QVBoxLayout(sectionsHost_);
@@ -449,6 +533,7 @@ void RunView::buildTrialPage() {
     auto* right = new QVBoxLayout;
     right->addWidget(playButton_);
     right->addWidget(pausedLabel_);
+    right->addWidget(protocolStatus_);
     right->addWidget(meters);
     right->addWidget(planList_, 1);
     auto* row = new QHBoxLayout(trial_);
@@ -456,7 +541,13 @@ void RunView::buildTrialPage() {
     row->addLayout(right);
     pages_->addWidget(trial_);
 
-    connect(playButton_, &QPushButton::clicked, this, &RunView::play);
+    connect(playButton_, &QPushButton::clicked, this, [this] {
+        if (session_ && session_->playing() && context_.store().protocol().clips.enabled)
+            replayClip();
+        else
+            play();
+        trial_->setFocus();
+    });
     connect(nextButton_, &QPushButton::clicked, this, &RunView::next);
     connect(pauseButton_, &QPushButton::clicked, this, &RunView::togglePause);
     connect(exclude, &QPushButton::clicked, this, [this] { askExclusion(false); });
@@ -474,6 +565,7 @@ void RunView::buildTrialPage() {
     shortcut(QKeySequence(Qt::CTRL | Qt::Key_E), [this] { askExclusion(false); });
     shortcut(QKeySequence(Qt::CTRL | Qt::SHIFT | Qt::Key_E), [this] { askExclusion(true); });
     shortcut(QKeySequence(Qt::CTRL | Qt::Key_W), [this] { closeSession(); });
+    shortcut(QKeySequence(Qt::CTRL | Qt::Key_L), [this] { completeLap(); });
 }
 
 bool RunView::hasResumable() const {
@@ -487,6 +579,7 @@ void RunView::refreshStart() {
     resumeList_->clear();
     group_->clear();
     resumeBanner_->hide();
+    refreshClips();
     if (!context_.hasStudy()) {
         startMessage_->setText(tr("No study open: create or open one in the Study view (Ctrl+1)."));
         return;
@@ -587,7 +680,24 @@ bool RunView::startSession(const QString& code) {
     settings.experimenter = experimenter_->text().trimmed().toStdString();
     audioError_.clear();
     if (audio_ && autoStartAudio_ && !audio_->running()) audioError_ = audio_->start();
-    console_ = std::make_unique<ConsolePlayer>(*player_, audio_, context_.path());
+    const auto& protocol = context_.store().protocol();
+    if (protocol.clips.enabled) {
+        const QStringList problems = clipProblems();
+        if (!problems.isEmpty()) {
+            startMessage_->setText(tr("The clips of this listening test are not ready in %1:\n%2\n"
+                                      "Render them (Ctrl+Shift+C) or choose the folder that "
+                                      "holds them, then start again.")
+                                       .arg(clipDir_, problems.mid(0, 6).join("\n")));
+            return false;
+        }
+    }
+    try {
+        console_ = std::make_unique<ConsolePlayer>(*player_, audio_, context_.path(), protocol,
+                                                   protocol.clips.enabled ? clipDir_ : QString());
+    } catch (const std::exception& e) {
+        startMessage_->setText(q(e.what()));
+        return false;
+    }
     settings.audioConfig =
         console_->live() ? ("underfoot-gui live engine: " + audio_->description()).toStdString()
                          : std::string("underfoot-gui without audio output (walker meters only)");
@@ -691,14 +801,17 @@ void RunView::showTrial() {
     ratings_.clear();
     comment_->clear();
     pendingDigits_ = -1;
-    rebuildAnswerSections();
+    rebuildAnswerSections(t);
     setActive(0);
     message_->clear();
     leftMeter_->setValue(0);
     rightMeter_->setValue(0);
     stepLabel_->setText(tr("steps: 0"));
     playButton_->setEnabled(true);
-    playButton_->setText(tr("Start stimulus  (Space)"));
+    playButton_->setText(p.clips.enabled      ? tr("Play clip  (Space)")
+                         : p.laps.total() > 0 ? tr("Start condition, lap 1  (Space)")
+                                              : tr("Start stimulus  (Space)"));
+    refreshProtocolStatus();
     engineLabel_->setText(
         console_ && console_->live() ? tr("Audio: %1").arg(audio_->description())
         : !audioError_.isEmpty()
@@ -728,7 +841,7 @@ void RunView::showTrial() {
     trial_->setFocus();
 }
 
-void RunView::rebuildAnswerSections() {
+void RunView::rebuildAnswerSections(const exp::TrialRecord& trial) {
     auto* layout = static_cast<QVBoxLayout*>(sectionsHost_->layout());
     for (auto& s : sections_) delete s.box;
     sections_.clear();
@@ -773,16 +886,25 @@ void RunView::rebuildAnswerSections() {
                        .arg(q(q_.surfacePrompt))
                        .arg(QChar(q_.surfaceOptions.back().letter)),
                    q_.surfaceOptions);
-    for (std::size_t i = 0; i < q_.scales.size(); ++i) {
-        const auto& sc = q_.scales[i];
+    // Only the scales asked after this stimulus in this block (per-scale blocks, scales
+    // restricted to some stimuli).
+    for (const exp::Scale* asked :
+         exp::askedScales(context_.store().protocol(), trial.stimulus, trial.block)) {
+        const auto& sc = *asked;
         Section s;
         s.kind = SectionKind::Scale;
-        s.scale = static_cast<int>(i);
-        s.box = new QGroupBox(tr("%1  (digits %2–%3; %2 = %4, %3 = %5)")
+        s.scale = static_cast<int>(asked - q_.scales.data());
+        QStringList anchors;
+        for (const auto& [value, wording] : sc.anchors)
+            anchors << QString("%1 = %2").arg(value).arg(q(wording));
+        if (anchors.isEmpty())
+            anchors << QString("%1 = %2").arg(sc.min).arg(q(sc.minLabel))
+                    << QString("%1 = %2").arg(sc.max).arg(q(sc.maxLabel));
+        s.box = new QGroupBox(tr("%1  (digits %2–%3; %4)")
                                   .arg(q(sc.prompt))
                                   .arg(sc.min)
                                   .arg(sc.max)
-                                  .arg(q(sc.minLabel), q(sc.maxLabel)),
+                                  .arg(anchors.join("; ")),
                               sectionsHost_);
         auto* row = new QHBoxLayout(s.box);
         for (int v = sc.min; v <= sc.max; ++v) {
@@ -941,11 +1063,24 @@ bool RunView::handleTrialKey(int key, Qt::KeyboardModifiers modifiers, const QSt
         setMessage(tr("Paused: press Ctrl+P to resume first."));
         return true;
     }
+    const auto& protocol = context_.store().protocol();
     if (key == Qt::Key_Space) {
         if (revising_ >= 0)
             setMessage(tr("Store the changed answer (Enter) or cancel (Esc) first."));
+        else if (protocol.clips.enabled && session_->playing())
+            replayClip();
         else
             play();
+        return true;
+    }
+    if (key == Qt::Key_R && protocol.clips.enabled && !protocol.questions.asksSurface() &&
+        revising_ < 0) {
+        replayClip();
+        return true;
+    }
+    if (key == Qt::Key_L && protocol.laps.total() > 0 &&
+        !protocol.questions.surfaceOptionByLetter('l') && revising_ < 0) {
+        completeLap();
         return true;
     }
     if (key == Qt::Key_Up || key == Qt::Key_Down) {
@@ -992,8 +1127,10 @@ void RunView::play() {
                        .arg(q(e.what())));
         return;
     }
-    playButton_->setEnabled(false);
-    playButton_->setText(tr("Playing…"));
+    const auto& protocol = context_.store().protocol();
+    playButton_->setEnabled(protocol.clips.enabled && protocol.clips.replay);
+    playButton_->setText(protocol.clips.enabled ? tr("Replay clip  (Space / R)") : tr("Playing…"));
+    refreshProtocolStatus();
     if (!player_->hasSource())
         engineLabel_->setText(tr("No sensor stream in this build: the stimulus is recorded as "
                                  "started; enter the participant's answer as usual."));
@@ -1034,7 +1171,16 @@ void RunView::next() {
     a.soundscapeAnswer = soundscape_;
     a.ratings = ratings_;
     a.comment = comment_->text().trimmed().toStdString();
-    const auto problems = context_.store().checkAnswer(session_->participant().groupId, a);
+    if (session_->lapCount() > 0 && session_->lapsDone() < session_->lapCount()) {
+        setMessage(tr("Lap %1 of %2 is being walked: the questions come after the last lap (L "
+                      "completes a lap).")
+                       .arg(session_->lapsDone() + 1)
+                       .arg(session_->lapCount()));
+        return;
+    }
+    const auto& current = session_->current();
+    const auto problems = context_.store().checkAnswer(session_->participant().groupId, a,
+                                                       current.stimulus, current.block);
     if (!problems.empty()) {
         QStringList list;
         for (const auto& p : problems) list << q(p);
@@ -1088,6 +1234,7 @@ bool RunView::revisePrevious() {
     header_->setText(tr("Changing the answer of trial %1 — Enter stores the change, Esc cancels")
                          .arg(previous->index + 1));
     playButton_->setEnabled(false);
+    rebuildAnswerSections(*previous);
     setActive(0);
     setMessage(tr("Trial %1's stored answer is loaded; change it and press Enter.")
                    .arg(previous->index + 1),
@@ -1199,6 +1346,197 @@ void RunView::closeSession() {
     if (context_.hasStudy()) context_.notifyDataChanged();
     pages_->setCurrentIndex(StartPage);
     refreshStart();
+}
+
+void RunView::refreshClips() {
+    const bool clips = context_.hasStudy() && context_.store().protocol().clips.enabled;
+    clipBox_->setVisible(clips);
+    if (!clips) {
+        clipDir_.clear();
+        return;
+    }
+    if (clipDir_.isEmpty())
+        clipDir_ =
+            QFileInfo(context_.path()).dir().filePath("clips/" + q(context_.store().protocol().id));
+    clipRender_->setEnabled(!rendering_);
+    if (rendering_) return;
+    const QStringList problems = clipProblems();
+    clipStatus_->setText(
+        problems.isEmpty()
+            ? tr("%1 clips ready in %2 (manifest checked: every file as rendered).")
+                  .arg(exp::readClipManifest(clipDir_.toStdString()).size())
+                  .arg(clipDir_)
+            : tr("Clips not ready in %1 — %2%3. Render them (Ctrl+Shift+C) or choose the folder "
+                 "that holds them.")
+                  .arg(clipDir_, problems.front())
+                  .arg(problems.size() > 1 ? tr(" (and %1 more)").arg(problems.size() - 1)
+                                           : QString()));
+    clipStatus_->setStyleSheet(problems.isEmpty() ? "color: #0a5c0a;" : "color: #8a1c00;");
+}
+
+void RunView::setClipFolder(const QString& folder) {
+    clipDir_ = folder;
+    refreshClips();
+}
+
+QStringList RunView::clipProblems() const {
+    QStringList out;
+    if (!context_.hasStudy() || !context_.store().protocol().clips.enabled) return out;
+    try {
+        for (const auto& p : exp::checkClips(context_.store().protocol(), clipDir_.toStdString()))
+            out << q(p);
+    } catch (const std::exception& e) {
+        out << q(e.what());
+    }
+    return out;
+}
+
+QString RunView::startMessage() const {
+    return startMessage_->text();
+}
+
+QString RunView::clipStatus() const {
+    return clipStatus_->text();
+}
+
+bool RunView::renderClips() {
+    if (rendering_ || session_ || !context_.hasStudy() ||
+        !context_.store().protocol().clips.enabled)
+        return false;
+#ifdef UNDERFOOT_HAVE_WIRING
+    rendering_ = true;
+    clipRender_->setEnabled(false);
+    clipProgress_->setRange(0, 0);
+    clipProgress_->show();
+    clipStatus_->setText(tr("Rendering the clips into %1…").arg(clipDir_));
+    clipStatus_->setStyleSheet({});
+    // The worker gets its own copy of the protocol: the study may be closed meanwhile.
+    auto protocol = std::make_shared<exp::Protocol>(context_.store().protocol());
+    const std::string dir = clipDir_.toStdString();
+    auto* watcher = new QFutureWatcher<QString>(this);
+    QPointer<QProgressBar> bar(clipProgress_);
+    connect(watcher, &QFutureWatcher<QString>::finished, this, [this, watcher] {
+        const QString error = watcher->result();
+        watcher->deleteLater();
+        rendering_ = false;
+        clipProgress_->hide();
+        refreshClips();
+        if (!error.isEmpty()) {
+            clipStatus_->setText(tr("Rendering failed: %1").arg(error));
+            clipStatus_->setStyleSheet("color: #8a1c00;");
+        }
+    });
+    watcher->setFuture(QtConcurrent::run([protocol, dir, bar]() -> QString {
+        try {
+            wiring::renderClipFolder(*protocol, dir, 48000.0,
+                                     [bar](int done, int total, const std::string&) {
+                                         QMetaObject::invokeMethod(
+                                             bar.data(),
+                                             [bar, done, total] {
+                                                 if (!bar) return;
+                                                 bar->setRange(0, total);
+                                                 bar->setValue(done);
+                                             },
+                                             Qt::QueuedConnection);
+                                         return true;
+                                     });
+        } catch (const std::exception& e) {
+            return QString::fromStdString(e.what());
+        }
+        return {};
+    }));
+    return true;
+#else
+    clipStatus_->setText(tr("This build has no engine wiring: render the clips with `underfoot "
+                            "clips -p PROTOCOL -o %1`, then start.")
+                             .arg(clipDir_));
+    return false;
+#endif
+}
+
+QString RunView::protocolStatus() const {
+    return protocolStatus_->text();
+}
+
+void RunView::refreshProtocolStatus() {
+    if (!session_ || (session_->phase() != exp::SessionPhase::Trial &&
+                      session_->phase() != exp::SessionPhase::Practice)) {
+        protocolStatus_->hide();
+        return;
+    }
+    const auto& p = context_.store().protocol();
+    QStringList lines;
+    if (p.clips.enabled) {
+        if (!session_->playing())
+            lines << tr("Clip not presented yet — Space plays it.");
+        else
+            lines << (p.clips.replay ? tr("Clip presented · replays: %1  (Space or R replays)")
+                                           .arg(session_->replayCount())
+                                     : tr("Clip presented · replay not allowed by the protocol"));
+    }
+    if (session_->lapCount() > 0) {
+        const int done = session_->lapsDone();
+        const int total = session_->lapCount();
+        if (!session_->playing())
+            lines << tr("Laps: 0 of %1 · press Space when the participant sets off").arg(total);
+        else if (done >= total)
+            lines << tr("Laps: %1 of %1 done · ask the questions now").arg(total);
+        else
+            lines << tr("Lap %1 of %2 · %3  (L completes the lap)")
+                         .arg(done + 1)
+                         .arg(total)
+                         .arg(session_->currentLapSilent() ? tr("SILENT baseline")
+                                                           : tr("WITH SOUND"));
+    }
+    protocolStatus_->setText(lines.join("\n"));
+    const bool silent = session_->lapCount() > 0 && session_->playing() &&
+                        session_->lapsDone() < session_->lapCount() && session_->currentLapSilent();
+    protocolStatus_->setStyleSheet(
+        silent
+            ? "QLabel { background: #e8e8e8; color: #303030; padding: 6px; font-weight: bold; }"
+            : "QLabel { background: #dff0ff; color: #0b3d6b; padding: 6px; font-weight: bold; }");
+    protocolStatus_->setVisible(!lines.isEmpty());
+}
+
+void RunView::completeLap() {
+    if (!session_ || session_->lapCount() == 0) return;
+    if (!session_->playing()) {
+        setMessage(tr("Start the condition first (Space), then L after each lap."));
+        return;
+    }
+    if (session_->lapsDone() >= session_->lapCount()) {
+        setMessage(tr("All %1 laps are done; enter the answers and press Enter.")
+                       .arg(session_->lapCount()));
+        return;
+    }
+    try {
+        session_->completeLap();
+    } catch (const std::exception& e) {
+        setMessage(tr("Lap not stored: %1").arg(q(e.what())));
+        return;
+    }
+    refreshProtocolStatus();
+    setMessage(tr("Lap %1 of %2 stored.").arg(session_->lapsDone()).arg(session_->lapCount()),
+               false);
+}
+
+void RunView::replayClip() {
+    if (!session_ || !context_.store().protocol().clips.enabled) return;
+    if (!session_->playing()) {
+        play();
+        return;
+    }
+    if (!context_.store().protocol().clips.replay) {
+        setMessage(tr("This protocol does not allow replaying a clip."));
+        return;
+    }
+    try {
+        session_->presentClip();
+    } catch (const std::exception& e) {
+        setMessage(tr("Not replayed: %1").arg(q(e.what())));
+        return;
+    }
+    refreshProtocolStatus();
 }
 
 bool RunView::startDemoTrialForScreenshot() {

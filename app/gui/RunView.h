@@ -12,6 +12,9 @@
 ///   Ctrl+Shift+E  exclude the previous trial     Ctrl+W  end the session for now (resumable)
 ///   Ctrl+Z        change the previous answer (only under lock = "next_trial", before the next
 ///                 stimulus starts; Enter stores the change, Esc cancels)
+/// Listening tests ([clips]): Space presents the clip, Space or R replays it (counted); only the
+/// scales asked in this block are shown. Lap protocols ([laps]): L (or Ctrl+L when L is an
+/// answer letter) completes the lap being walked; Next is refused until every lap is done.
 /// Every answer is committed to the study file (durably) by Next before anything else happens.
 #include "experiment/Session.h"
 
@@ -64,6 +67,24 @@ class RunView : public QWidget {
     bool revisePrevious();
     /// The trial whose answer is being changed, or -1.
     int revising() const { return revising_; }
+    /// Folder of the listening-test clips of the open study (default: `clips/<protocol id>`
+    /// next to the study file; empty when the protocol has no [clips]).
+    QString clipFolder() const { return clipDir_; }
+    /// Uses `folder` for the clips (checked at the next session start).
+    void setClipFolder(const QString& folder);
+    /// Problems that stop the listening test from starting (empty: the clips are ready).
+    QStringList clipProblems() const;
+    /// Renders the protocol's clips into clipFolder() on a worker thread (progress bar on the
+    /// start page). Returns false when already rendering or the protocol has no [clips].
+    bool renderClips();
+    /// Whether clips are being rendered.
+    bool renderingClips() const { return rendering_; }
+    /// The clip status line of the start page.
+    QString clipStatus() const;
+    /// The message line of the start page.
+    QString startMessage() const;
+    /// The lap / clip line of the trial page.
+    QString protocolStatus() const;
     /// For screenshots: registers a scratch participant and shows a trial with an answer chosen.
     bool startDemoTrialForScreenshot();
 
@@ -108,7 +129,11 @@ class RunView : public QWidget {
     void refreshStart();
     void showPhase();
     void showTrial();
-    void rebuildAnswerSections();
+    void rebuildAnswerSections(const experiment::TrialRecord& trial);
+    void refreshClips();
+    void completeLap();
+    void replayClip();
+    void refreshProtocolStatus();
     void renderDraft();
     bool handleTrialKey(int key, Qt::KeyboardModifiers modifiers, const QString& text);
     void chooseOption(SectionKind kind, char letter);
@@ -144,6 +169,12 @@ class RunView : public QWidget {
     QListWidget* resumeList_ = nullptr;
     QLabel* resumeBanner_ = nullptr;
     QLabel* startMessage_ = nullptr;
+    QGroupBox* clipBox_ = nullptr;
+    QLabel* clipStatus_ = nullptr;
+    QProgressBar* clipProgress_ = nullptr;
+    QPushButton* clipRender_ = nullptr;
+    QString clipDir_;
+    bool rendering_ = false;
 
     // Briefing, break and finished pages.
     QLabel* briefing_ = nullptr;
@@ -159,6 +190,7 @@ class RunView : public QWidget {
     QProgressBar* rightMeter_ = nullptr;
     QLabel* stepLabel_ = nullptr;
     QLabel* engineLabel_ = nullptr;
+    QLabel* protocolStatus_ = nullptr;
     QPushButton* playButton_ = nullptr;
     QPushButton* nextButton_ = nullptr;
     QPushButton* pauseButton_ = nullptr;
