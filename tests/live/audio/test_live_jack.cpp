@@ -21,7 +21,7 @@
 #include <thread>
 
 #include <fcntl.h>
-#include <spawn.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -76,14 +76,22 @@ class JackServer : public ::testing::Test {
         for (auto& a : args) argv.push_back(a.data());
         argv.push_back(nullptr);
         const auto log = underfoot::test::scratchDir("live_jack") / "jackd.log";
-        posix_spawn_file_actions_t actions;
-        posix_spawn_file_actions_init(&actions);
-        posix_spawn_file_actions_addopen(&actions, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
-                                         0644);
-        posix_spawn_file_actions_adddup2(&actions, 1, 2);
-        if (posix_spawn(&pid_, jackd_.c_str(), &actions, nullptr, argv.data(), environ) != 0)
-            pid_ = -1;
-        posix_spawn_file_actions_destroy(&actions);
+        // fork + exec rather than posix_spawn: the server must die with this program even when
+        // a test crashes (PR_SET_PDEATHSIG), so no orphaned server outlives a failed run.
+        const pid_t parent = getpid();
+        pid_ = fork();
+        if (pid_ == 0) {
+            prctl(PR_SET_PDEATHSIG, SIGTERM);
+            if (getppid() != parent) _exit(127); // the parent died before prctl
+            const int fd = open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+            if (fd >= 0) {
+                dup2(fd, 1);
+                dup2(fd, 2);
+                close(fd);
+            }
+            execve(jackd_.c_str(), argv.data(), environ);
+            _exit(127);
+        }
         // Wait (up to 10 s) until the server lists the dummy driver's ports.
         for (int i = 0; i < 100 && pid_ > 0; ++i) {
             std::string out;
