@@ -55,6 +55,10 @@ eng::LiveSceneDescription describeStimulus(const exp::Stimulus& s, std::uint64_t
         d.ambience = makeSoundscapeAmbience(*s.soundscape);
     d.hapticPairs = o.hapticPairs;
     d.hapticGainDb = o.hapticGainDb;
+    if (isWadingStimulus(s)) { // the wading node replaces the GRF control and the voices
+        d.wading = makeWadingNode(s, seed, o.gyroReceiver);
+        return d;
+    }
     if (s.input.kind == exp::InputKind::Walker) {
         d.control = eng::ControlKind::Walker;
         d.walker = walkerFromStimulus(s.input.walker);
@@ -110,7 +114,9 @@ exp::StimulusStart LivePlayer::start(const exp::Stimulus& stimulus, std::uint64_
     if (!engine_.isOpen()) throw std::runtime_error("live player: the audio engine is not open");
     stop();
     auto d = describeStimulus(stimulus, plannedSeed, options_.scene);
-    const int grfChannels = d.control == eng::ControlKind::Walker ? 2
+    const bool wading = d.wading != nullptr;
+    const int grfChannels = wading                                  ? 0
+                            : d.control == eng::ControlKind::Walker ? 2
                             : d.control == eng::ControlKind::Microphones
                                 ? 1
                                 : d.external->channelCount();
@@ -121,12 +127,15 @@ exp::StimulusStart LivePlayer::start(const exp::Stimulus& stimulus, std::uint64_
         fs::create_directories(options_.recordingFolder);
         for (int attempt = 0;; ++attempt) {
             path = (fs::path(options_.recordingFolder) /
-                    fmt::format("grf_{}_{:03d}_seed{}{}.wav", safeName(stimulus.id), ++counter_,
-                                plannedSeed, attempt ? fmt::format("_{}", attempt) : ""))
+                    fmt::format("{}_{}_{:03d}_seed{}{}.{}", wading ? "gait" : "grf",
+                                safeName(stimulus.id), ++counter_, plannedSeed,
+                                attempt ? fmt::format("_{}", attempt) : "", wading ? "csv" : "wav"))
                        .string();
             if (!fs::exists(path)) break;
         }
-        d.grfRecorder = eng::makeGrfRecorder(path, grfChannels, engine_.processSpec().sampleRateHz);
+        if (!wading)
+            d.grfRecorder =
+                eng::makeGrfRecorder(path, grfChannels, engine_.processSpec().sampleRateHz);
     }
     auto recorder = d.grfRecorder;
     std::unique_ptr<eng::LiveScene> scene;
@@ -154,6 +163,7 @@ exp::StimulusStart LivePlayer::start(const exp::Stimulus& stimulus, std::uint64_
     recorder_ = recorder;
     recordingPath_ = path;
     playing_ = true;
+    wading_ = wading;
     engine_.resetPeaks();
     startMeters_ = engine_.meters();
     if (!path.empty()) {
@@ -173,7 +183,29 @@ void LivePlayer::stop() {
     engine_.submit(nullptr);
     // Crossfade plus a margin; a stopped stream hands nothing back (then nothing pushes).
     engine_.waitIdle(engine_.settings().crossfadeMs * 1e-3 + 2.0);
-    engine_.collectRetired();
+    std::string gaitError;
+    if (wading_) {
+        // The retired water scene still holds its gait recording: write it before releasing.
+        bool written = recordingPath_.empty();
+        for (const auto& scene : engine_.takeRetired())
+            if (scene->wading() && !written) {
+                try {
+                    scene->wading()->writeRecording(recordingPath_);
+                    written = true;
+                    if (scene->wading()->unrecordedFrames() > 0)
+                        gaitError = fmt::format("{} gait frames did not fit the recording",
+                                                scene->wading()->unrecordedFrames());
+                } catch (const std::exception& e) {
+                    gaitError = e.what();
+                    written = true;
+                }
+            }
+        if (!written)
+            gaitError = "the water scene was not handed back by the audio thread (stream stopped?)";
+        wading_ = false;
+    } else {
+        engine_.collectRetired();
+    }
     const auto m = engine_.meters();
     stats_ = {};
     stats_.frames = m.frames - startMeters_.frames;
@@ -202,6 +234,9 @@ void LivePlayer::stop() {
         recorder_.reset();
         if (!error.empty()) throw std::runtime_error("live player: GRF recording: " + error);
     }
+    if (!gaitError.empty())
+        throw std::runtime_error(
+            fmt::format("live player: gait recording {}: {}", recordingPath_, gaitError));
 }
 
 eng::AudioBuffer renderStimulus(const exp::Stimulus& stimulus, std::uint64_t seed, double seconds,

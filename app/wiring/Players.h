@@ -11,6 +11,7 @@
 ///  - OfflinePlayer: renders a stimulus to memory (the GUI palette's preview, headless runs):
 ///    the virtual walker for `seconds`, the offline renderer, the soundscape mixed in as
 ///    `underfoot replay` does. Sensor stimuli are previewed with the default walker.
+#include "app/wiring/WadingSource.h"
 #include "engine/io/AudioFile.h"
 #include "engine/scene/LiveEngine.h"
 #include "experiment/Session.h"
@@ -26,6 +27,10 @@ namespace underfoot::wiring {
 struct StimulusSceneOptions {
     /// GRF sources for sensor inputs (null: such stimuli are refused with a clear error).
     std::shared_ptr<engine::GrfSource> fsrSource, gyroSource;
+    /// The gyroscopes of water stimuli (`surface = "water"` with the gyro sensor as input; null:
+    /// such stimuli are refused with a clear error). Water stimuli with a walker input use the
+    /// virtual gait at their `wading.cadence`.
+    std::shared_ptr<engine::OscGyroReceiver> gyroReceiver;
     /// Actuator pairs driven when the stimulus has haptics.
     std::array<engine::HapticPairs, 2> hapticPairs{engine::HapticPairs::Both,
                                                    engine::HapticPairs::Both};
@@ -77,7 +82,9 @@ class LivePlayer final : public experiment::StimulusPlayer {
     bool playing() const noexcept { return playing_; }
     /// The running (or last) scene's one-line summary.
     const std::string& sceneSummary() const noexcept { return summary_; }
-    /// The absolute path of the running (or last) GRF recording ("" when none).
+    /// The absolute path of the running (or last) GRF recording ("" when none). For a water
+    /// stimulus: its gait recording (CSV, written at stop(); `underfoot wade --gait` re-renders
+    /// it), which is also what StimulusStart::grfRecording refers to.
     const std::string& recordingPath() const noexcept { return recordingPath_; }
     /// Frames of the last recording lost to a full ring (0 = complete), after stop().
     std::uint64_t lastDroppedFrames() const noexcept { return lastDropped_; }
@@ -96,6 +103,7 @@ class LivePlayer final : public experiment::StimulusPlayer {
     LiveTrialStats stats_;
     int counter_ = 0;
     bool playing_ = false;
+    bool wading_ = false; ///< the running trial is a water scene (gait recorded at stop)
 };
 
 /// Renders `stimulus` offline: `seconds` of the walker (the stimulus's, or the default walker
