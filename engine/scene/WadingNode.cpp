@@ -2,6 +2,7 @@
 #include "engine/scene/WadingNode.h"
 
 #include "engine/io/sensors/OscGyroReceiver.h"
+#include "engine/io/sensors/SensorClock.h"
 
 #include <fmt/format.h>
 
@@ -19,15 +20,21 @@ LiveGyroGaitSource::LiveGyroGaitSource(std::shared_ptr<OscGyroReceiver> receiver
     if (!receiver_) throw std::invalid_argument("LiveGyroGaitSource: no OSC gyroscope receiver");
 }
 
-void LiveGyroGaitSource::prepare(const ProcessSpec&) {}
+void LiveGyroGaitSource::prepare(const ProcessSpec& spec) {
+    rateHz_ = spec.sampleRateHz;
+}
 
 void LiveGyroGaitSource::reset(std::uint64_t) noexcept {
     assembler_.reset();
+    sinceFrame_ = 0;
+    silentMode_ = false;
+    rejectedBefore_ = 0;
     popped_ = 0;
     rejected_ = 0;
+    silent_ = 0;
 }
 
-int LiveGyroGaitSource::pull(int, TimedGaitFrame* frames, int capacity) noexcept {
+int LiveGyroGaitSource::pull(int n, TimedGaitFrame* frames, int capacity) noexcept {
     int count = 0;
     GyroSample sample;
     GaitFrame frame;
@@ -35,9 +42,37 @@ int LiveGyroGaitSource::pull(int, TimedGaitFrame* frames, int capacity) noexcept
     // first sample. A bounded loop: a flood cannot hold the audio thread (the rest waits).
     for (int k = 0; k < 4096 && receiver_->popSample(sample); ++k) {
         popped_.fetch_add(1, std::memory_order_relaxed);
-        if (assembler_.push(sample, frame) && count < capacity) frames[count++] = {0, frame};
+        if (assembler_.push(sample, frame)) {
+            silentMode_ = false;
+            sinceFrame_ = 0;
+            if (count < capacity) frames[count++] = {0, frame};
+        }
     }
-    rejected_.store(assembler_.rejectedSamples(), std::memory_order_relaxed);
+    rejected_.store(rejectedBefore_ + assembler_.rejectedSamples(), std::memory_order_relaxed);
+    // Silence: after kGyroSilenceSeconds without a frame, stand still (a zero frame every
+    // period, at the sample where it is due, stamped on the sensor clock) and let the next real
+    // sample start afresh.
+    const auto silence = static_cast<std::int64_t>(std::llround(kGyroSilenceSeconds * rateHz_));
+    const auto period = static_cast<std::int64_t>(std::llround(rateHz_ / kGaitFrameRateHz));
+    if (count == 0) {
+        const double nowS = sensorClockSeconds();
+        while (count < capacity) {
+            const std::int64_t limit = silentMode_ ? period : silence;
+            const std::int64_t due = std::max<std::int64_t>(0, limit - sinceFrame_);
+            if (due >= n) break;
+            if (!silentMode_) {
+                rejectedBefore_ += assembler_.rejectedSamples();
+                assembler_.reset(); // the limbs' held readings are stale now
+                silentMode_ = true;
+            }
+            GaitFrame still{};
+            still.timeS = nowS + static_cast<double>(due) / rateHz_;
+            frames[count++] = {static_cast<int>(due), still};
+            silent_.fetch_add(1, std::memory_order_relaxed);
+            sinceFrame_ = -due; // counts from the made-up frame
+        }
+    }
+    sinceFrame_ += n;
     return count;
 }
 

@@ -7,7 +7,10 @@
 /// Gait sources (all pulled once per audio block, allocation-free):
 ///  - LiveGyroGaitSource: GyroSamples popped from an OscGyroReceiver's SPSC queue, folded into
 ///    100 Hz GaitFrames by a GaitFrameAssembler; a frame takes effect at the first sample of the
-///    block in which the audio thread sees it (the paper's live path: no added buffering);
+///    block in which the audio thread sees it (the paper's live path: no added buffering); when
+///    no frame has come for kGyroSilenceSeconds (sensor unplugged, sender stopped) the source
+///    reads as standing still (all-zero frames every 10 ms) so that the water calms down instead
+///    of holding the last swing;
 ///  - VirtualGaitSource: the virtual gait for a cadence, precomputed off the audio thread
 ///    (looped when a trial outlasts it), delivered at the sample where each 100 Hz frame is due.
 /// Every frame the node hands to the scene is also appended to a preallocated gait recording
@@ -43,6 +46,9 @@ class GaitSource {
     virtual std::string name() const = 0;
 };
 
+/// Gyroscope silence after which the live source reads as standing still (10 frame periods).
+inline constexpr double kGyroSilenceSeconds = 0.1;
+
 /// Live gyroscopes: pops the receiver's queue on the audio thread (the single consumer).
 class LiveGyroGaitSource final : public GaitSource {
   public:
@@ -55,11 +61,17 @@ class LiveGyroGaitSource final : public GaitSource {
     /// Samples popped and samples the assembler refused (NaN/Inf/absurd), since reset.
     std::uint64_t samplesPopped() const noexcept { return popped_.load(); }
     std::uint64_t samplesRejected() const noexcept { return rejected_.load(); }
+    /// Standing frames made up because the gyroscopes were silent, since reset.
+    std::uint64_t silentFrames() const noexcept { return silent_.load(); }
 
   private:
     std::shared_ptr<OscGyroReceiver> receiver_;
     GaitFrameAssembler assembler_;
-    std::atomic<std::uint64_t> popped_{0}, rejected_{0};
+    double rateHz_ = 48000;
+    std::int64_t sinceFrame_ = 0; ///< samples since the last frame (real or made up)
+    bool silentMode_ = false;
+    std::uint64_t rejectedBefore_ = 0; ///< rejections counted by earlier assembler runs
+    std::atomic<std::uint64_t> popped_{0}, rejected_{0}, silent_{0};
 };
 
 /// The virtual gait (engine/wading/Gait.h) at the stimulus's cadence.

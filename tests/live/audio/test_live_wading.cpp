@@ -190,11 +190,14 @@ struct Trial {
     std::uint64_t malformed = 0;
     std::uint64_t framesRecorded = 0;
     std::uint64_t callbacks = 0;
+    float quietPeak = -1;           ///< output peak 4.5-5 s after the gyroscopes went silent
+    std::uint64_t silentFrames = 0; ///< standing frames the source made up meanwhile
 };
 
 /// One trial: a fresh receiver and wading scene; 1.5 s standing (malformed packets in the first
 /// half, unarmed because the receiver's error reports allocate on its own thread), then a swing.
-Trial runTrial(const eng::AudioSettings& s, bool armed, const std::string& gaitCsv = {}) {
+Trial runTrial(const eng::AudioSettings& s, bool armed, const std::string& gaitCsv = {},
+               bool thenSilence = false) {
     Trial t;
     eng::LiveEngine engine;
     engine.open(s);
@@ -271,6 +274,12 @@ Trial runTrial(const eng::AudioSettings& s, bool armed, const std::string& gaitC
     }
     if (firstAudibleNs.load() >= 0)
         t.audibleMs = static_cast<double>(firstAudibleNs.load() - sentNs) / 1e6;
+    if (thenSilence) { // the sender stops mid-swing (unplugged): the water must calm down
+        std::this_thread::sleep_for(4500ms);
+        loudest = 0.0f;
+        std::this_thread::sleep_for(500ms);
+        t.quietPeak = loudest.load();
+    }
     engine.submit(nullptr);
     EXPECT_TRUE(engine.waitIdle(2.0));
     watchedEngine = nullptr;
@@ -286,6 +295,8 @@ Trial runTrial(const eng::AudioSettings& s, bool armed, const std::string& gaitC
         const eng::WadingNode& node = *retired.front()->wading();
         t.framesRecorded = node.recordedFrames();
         EXPECT_EQ(node.unrecordedFrames(), 0u);
+        if (const auto* live = dynamic_cast<const eng::LiveGyroGaitSource*>(&node.source()))
+            t.silentFrames = live->silentFrames();
         if (!gaitCsv.empty()) node.writeRecording(gaitCsv);
     }
     return t;
@@ -297,7 +308,8 @@ TEST_F(WadingJack, SwingReachesTheHeadphonesWithinOneBlockOfItsPacket) {
     const auto csv = (underfoot::test::scratchDir("live_wading") / "live_gait.csv").string();
     std::vector<Trial> trials;
     for (int k = 0; k < 3; ++k)
-        trials.push_back(runTrial(settings("uf_wade"), k == 0, k == 0 ? csv : std::string()));
+        trials.push_back(
+            runTrial(settings("uf_wade"), k == 0, k == 0 ? csv : std::string(), k == 1));
     std::vector<double> latencies;
     for (const auto& t : trials) {
         std::printf(
@@ -323,6 +335,17 @@ TEST_F(WadingJack, SwingReachesTheHeadphonesWithinOneBlockOfItsPacket) {
                 static_cast<unsigned long long>(trials[0].callbacks), trials[0].allocations);
     EXPECT_GT(trials[0].callbacks, 500u);
     EXPECT_EQ(trials[0].allocations, 0);
+
+    // Trial 2 stopped sending mid-swing: after 100 ms of silence the source stands still (zero
+    // frames every 10 ms) and the water calms (the v2 releases are 0.89 / 2.23 s); holding the
+    // last swing would keep the swing's level.
+    std::printf("[ wading   ] gyroscopes silent after the swing: %llu standing frames made up, "
+                "output peak 4.5-5 s later %.3g (swing %.3g)\n",
+                static_cast<unsigned long long>(trials[1].silentFrames),
+                static_cast<double>(trials[1].quietPeak), static_cast<double>(trials[1].swingPeak));
+    EXPECT_GE(trials[1].silentFrames, 100u)
+        << "at least 1 s of audio (the dummy driver skips cycles under load)";
+    EXPECT_LT(trials[1].quietPeak, 0.1f * trials[1].swingPeak);
 
     // The trial's gait frames were recorded: ~2 s at 100 Hz (the assembler makes one frame per
     // period), standing then swinging, and the CSV reads back for `underfoot wade --gait`.
