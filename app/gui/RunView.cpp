@@ -107,9 +107,14 @@ class ConsolePlayer final : public exp::StimulusPlayer {
     }
     exp::StimulusStart start(const exp::Stimulus& stimulus, std::uint64_t plannedSeed) override {
         if (clips_) return clips_->start(stimulus, plannedSeed);
-        exp::StimulusStart started{plannedSeed, std::nullopt};
+        exp::StimulusStart started;
+        started.renderSeed = plannedSeed;
 #ifdef UNDERFOOT_HAVE_WIRING
-        if (live_) started = live_->start(stimulus, plannedSeed);
+        // Silent baseline laps: the scene is submitted only when the sound comes on.
+        if (live_ && muted_)
+            deferred_ = {stimulus, plannedSeed};
+        else if (live_)
+            started = live_->start(stimulus, plannedSeed);
 #endif
         meters_.start(stimulus, started.renderSeed);
         return started;
@@ -120,6 +125,7 @@ class ConsolePlayer final : public exp::StimulusPlayer {
             return;
         }
 #ifdef UNDERFOOT_HAVE_WIRING
+        deferred_.reset();
         if (live_) live_->stop();
 #endif
         meters_.stop();
@@ -135,6 +141,22 @@ class ConsolePlayer final : public exp::StimulusPlayer {
 
     void setMuted(bool muted) override {
         muted_ = muted;
+#ifdef UNDERFOOT_HAVE_WIRING
+        if (!muted && deferred_ && live_) {
+            const auto [stimulus, seed] = *deferred_;
+            deferred_.reset();
+            try {
+                live_->start(stimulus, seed);
+                soundError_.clear();
+            } catch (const std::exception& e) {
+                soundError_ = e.what(); // the lap is stored; the view shows why nothing is heard
+            }
+        }
+#endif
+    }
+    /// Why the sound of the feedback laps did not start ("" when it did or was not asked).
+    const std::string& soundError() const {
+        return soundError_;
     }
     /// Whether the session asked for silence (baseline laps).
     bool muted() const {
@@ -155,9 +177,11 @@ class ConsolePlayer final : public exp::StimulusPlayer {
     WalkerPlayer& meters_;
     std::unique_ptr<exp::ClipPlayer> clips_;
     bool muted_ = false;
+    std::string soundError_;
 #ifdef UNDERFOOT_HAVE_WIRING
     std::unique_ptr<wiring::LivePlayer> live_;
     std::unique_ptr<wiring::ClipAudio> clipAudio_;
+    std::optional<std::pair<exp::Stimulus, std::uint64_t>> deferred_;
 #endif
 };
 
@@ -1516,6 +1540,13 @@ void RunView::completeLap() {
         return;
     }
     refreshProtocolStatus();
+    if (console_ && !console_->soundError().empty()) {
+        setMessage(tr("Lap %1 of %2 stored, but the sound did not start: %3")
+                       .arg(session_->lapsDone())
+                       .arg(session_->lapCount())
+                       .arg(q(console_->soundError())));
+        return;
+    }
     setMessage(tr("Lap %1 of %2 stored.").arg(session_->lapsDone()).arg(session_->lapCount()),
                false);
 }
