@@ -18,7 +18,6 @@ namespace underfoot::engine {
 namespace {
 
 constexpr double kClipLevel = 0.9999;       // |x| at or above this is digital full scale
-constexpr double kClipCeiling = 1.0001;     // float files may exceed 1 legitimately
 constexpr int kClipRun = 3;                 // consecutive samples at full scale = clipped
 constexpr double kNegativeTolerance = 0.02; // fraction of the channel's peak
 constexpr double kMaxIrregularity = 0.25;   // allowed deviation of a time step from the median
@@ -109,8 +108,9 @@ GrfSignal loadAudioGrf(const std::string& path, const GrfLoadOptions& o) {
         int run = 0;
         for (std::size_t i = 0; i < n; ++i) {
             const float v = audio.samples[i * ch + c];
-            const double a = std::fabs(v);
-            run = (a >= kClipLevel && a <= kClipCeiling) ? run + 1 : 0;
+            // Only integer files have a full scale to clip at: a float file (what the live
+            // recorder writes) holds 1000 N as 1.0 like any other force.
+            run = (!audio.floatingPoint && std::fabs(v) >= kClipLevel) ? run + 1 : 0;
             if (run == kClipRun && !o.allowClipped)
                 throw FileError(fmt::format(
                     "{}: channel {} (\"{}\") is clipped at t = {:.6f} s (frame {}): {} or more "

@@ -59,6 +59,8 @@ AudioBuffer readAudioFile(const std::string& path) {
     AudioBuffer out;
     out.sampleRateHz = info.samplerate;
     out.channels = info.channels;
+    const int subtype = info.format & SF_FORMAT_SUBMASK;
+    out.floatingPoint = subtype == SF_FORMAT_FLOAT || subtype == SF_FORMAT_DOUBLE;
     out.samples.resize(static_cast<std::size_t>(info.frames) *
                        static_cast<std::size_t>(info.channels));
     const sf_count_t got = sf_readf_float(file.get(), out.samples.data(), info.frames);
@@ -104,6 +106,7 @@ AudioBuffer resample(const AudioBuffer& in, double targetRateHz) {
     AudioBuffer out;
     out.sampleRateHz = targetRateHz;
     out.channels = in.channels;
+    out.floatingPoint = in.floatingPoint;
     const auto ch = static_cast<std::size_t>(in.channels);
     if (inFrames == 0) return out;
     // Room for everything libsamplerate may produce; the result is trimmed/padded to wantFrames.

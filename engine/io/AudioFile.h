@@ -22,6 +22,9 @@ struct AudioBuffer {
     double sampleRateHz = 0;
     int channels = 0;
     std::vector<float> samples; ///< interleaved: frame f, channel c at samples[f * channels + c]
+    /// Read from a floating-point file (values beyond ±1 are legitimate there, so full scale
+    /// means nothing); false for integer PCM and compressed files, and for computed buffers.
+    bool floatingPoint = false;
 
     /// Number of frames (samples per channel).
     std::size_t frames() const {

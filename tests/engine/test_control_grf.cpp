@@ -129,6 +129,21 @@ TEST(GrfFile, ClippedWavIsAnErrorUnlessAllowed) {
     EXPECT_NO_THROW(loadGrfFile(writeWav("once.wav", once, 1000, SF_FORMAT_PCM_16)));
 }
 
+TEST(GrfFile, FloatFilesHaveNoFullScaleToClipAt) {
+    // A live recording (float WAV, 1.0 = 1000 N) of a heavy walker resting near 1000 N for a
+    // while is a force, not a clipped signal; the same plateau in 16-bit PCM is clipping.
+    std::vector<float> x(200, 0.2f);
+    for (int i = 80; i < 120; ++i) x[static_cast<std::size_t>(i)] = 1.0f;
+    for (int i = 120; i < 130; ++i) x[static_cast<std::size_t>(i)] = 1.2f;
+    GrfLoadOptions o;
+    o.targetRateHz = 1000;
+    const GrfSignal g = loadGrfFile(writeWav("plateau_float.wav", x, 1000, SF_FORMAT_FLOAT), o);
+    EXPECT_NEAR(g.channels[0][100], 1000.0f, 1e-3f);
+    EXPECT_NEAR(g.channels[0][125], 1200.0f, 1e-3f);
+    EXPECT_NE(loadError(writeWav("plateau_pcm.wav", x, 1000, SF_FORMAT_PCM_16)).find("clipped"),
+              std::string::npos);
+}
+
 TEST(GrfFile, NegativeForcesBeyondNoiseAreErrorsSmallOnesAreZeroed) {
     auto ref = halfSineStep(1000, 0.8);
     std::vector<float> x(ref.begin(), ref.end());
