@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "app/gui/AudioOutput.h"
 
+#include "engine/scene/TestTone.h"
+
 #include "engine/scene/LiveScene.h"
 
 #include <QFile>
@@ -84,6 +86,25 @@ QString AudioOutput::playWalker(const QString& presetPath, const eng::WalkerPara
         d.seed = 1;
         auto scene = eng::LiveScene::create(std::move(d), engine_->processSpec(),
                                             engine_->settings().channels);
+        if (!engine_->submit(std::move(scene)))
+            return tr("The audio engine is busy; try again in a moment.");
+    } catch (const std::exception& e) {
+        return QString::fromStdString(e.what());
+    }
+    return {};
+}
+
+QString AudioOutput::playTestTone(int outputChannel, double frequencyHz, double levelDbfs) {
+    if (!running())
+        return tr("No audio device runs: start the audio output first (Setup view, Start audio).");
+    if (outputChannel < 0 || outputChannel >= engine_->outputChannels())
+        return tr("Output %1 is not open on this device (%2 outputs open); map it in the channel "
+                  "settings and restart the audio.")
+            .arg(outputChannel + 1)
+            .arg(engine_->outputChannels());
+    try {
+        auto scene =
+            eng::makeTestToneScene(outputChannel, {frequencyHz, levelDbfs}, engine_->processSpec());
         if (!engine_->submit(std::move(scene)))
             return tr("The audio engine is busy; try again in a moment.");
     } catch (const std::exception& e) {

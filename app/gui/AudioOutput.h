@@ -35,6 +35,9 @@ class AudioOutput : public QObject {
     bool running() const;
     /// Plays a surface preset walked on by the virtual walker (starts the stream if needed).
     QString playWalker(const QString& presetPath, const engine::WalkerParameters& walker);
+    /// Plays a test tone on device output `outputChannel` (0-based) alone, replacing the current
+    /// scene. Does not start the stream: returns why not when no device runs, or the problem.
+    QString playTestTone(int outputChannel, double frequencyHz, double levelDbfs);
     /// Fades the current scene out.
     void silence();
     /// The meters (zeros when not running).

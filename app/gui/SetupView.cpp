@@ -6,6 +6,7 @@
 #include "engine/dsp/Random.h"
 #include "engine/io/sensors/ShoeSimulator.h"
 #include "engine/render/Renderer.h"
+#include "engine/scene/TestTone.h"
 
 #include <QChart>
 #include <QChartView>
@@ -133,6 +134,19 @@ SetupView::SetupView(AudioOutput& audio, const QString& dataDir, QWidget* parent
     buttons->addWidget(save);
     buttons->addWidget(startStop_);
     al->addRow(buttons);
+    toneOutput_ = new QComboBox(audioBox);
+    toneOutput_->addItems({tr("headphones left — 1 kHz"), tr("headphones right — 1 kHz"),
+                           tr("left heel — 200 Hz"), tr("left toe — 200 Hz"),
+                           tr("right heel — 200 Hz"), tr("right toe — 200 Hz")});
+    toneOutput_->setAccessibleName(tr("Output for the test tone"));
+    toneButton_ = new QPushButton(audioBox);
+    toneButton_->setAccessibleName(tr("Play or stop the test tone"));
+    auto* toneRow = new QHBoxLayout;
+    toneRow->addWidget(toneOutput_);
+    toneRow->addWidget(toneButton_, 1);
+    auto* toneLabel = new QLabel(tr("Test to&ne (-20 dBFS):"), audioBox);
+    toneLabel->setBuddy(toneOutput_);
+    al->addRow(toneLabel, toneRow);
     meterText_ = new QLabel(audioBox);
     meterText_->setWordWrap(true);
     meterText_->setAccessibleName(tr("Audio engine meters"));
@@ -257,7 +271,23 @@ SetupView::SetupView(AudioOutput& audio, const QString& dataDir, QWidget* parent
         const QString e = audio_.start();
         setMessage(e.isEmpty() ? tr("Running: %1").arg(audio_.description()) : e, !e.isEmpty());
     });
+    connect(toneButton_, &QPushButton::clicked, this, [this] {
+        if (const QString e = toggleTestTone(); !e.isEmpty()) setMessage(e, true);
+    });
+    auto* scT = new QShortcut(QKeySequence(Qt::CTRL | Qt::Key_T), this);
+    scT->setContext(Qt::WidgetWithChildrenShortcut);
+    connect(scT, &QShortcut::activated, this, [this] {
+        if (const QString e = toggleTestTone(); !e.isEmpty()) setMessage(e, true);
+    });
+    connect(toneOutput_, &QComboBox::currentIndexChanged, this, [this] {
+        if (tonePlaying_) {
+            tonePlaying_ = false;
+            if (const QString e = toggleTestTone(); !e.isEmpty()) setMessage(e, true);
+        }
+    });
     connect(&audio_, &AudioOutput::runningChanged, this, [this](bool running) {
+        tonePlaying_ = false;
+        refreshToneButton();
         startStop_->setText(running ? tr("S&top audio") : tr("S&tart audio"));
         if (running)
             meterTimer_->start();
@@ -266,6 +296,7 @@ SetupView::SetupView(AudioOutput& audio, const QString& dataDir, QWidget* parent
         updateMeters();
     });
     loadForm();
+    refreshToneButton();
     if (!audio_.loadError().isEmpty()) setMessage(audio_.loadError(), true);
     updateMeters();
     calibrateSimulated();
@@ -341,6 +372,45 @@ void SetupView::updateMeters() {
         const double db = peak > 0 ? 20 * std::log10(static_cast<double>(peak)) : -60.0;
         outputMeters_[i]->setValue(static_cast<int>(std::clamp(db + 60.0, 0.0, 60.0)));
     }
+}
+
+void SetupView::refreshToneButton() {
+    const bool running = audio_.running();
+    toneButton_->setEnabled(running);
+    toneButton_->setText(!running       ? tr("Test tone: no device runs — start the audio first")
+                         : tonePlaying_ ? tr("Stop test tone  (Ctrl+T)")
+                                        : tr("Play test tone  (Ctrl+T)"));
+}
+
+QString SetupView::toggleTestTone() {
+    if (tonePlaying_) {
+        audio_.silence();
+        tonePlaying_ = false;
+        refreshToneButton();
+        return {};
+    }
+    const auto& ch = audio_.settings().channels;
+    const int item = toneOutput_->currentIndex();
+    const int channel = item == 0   ? ch.headphonesLeft
+                        : item == 1 ? ch.headphonesRight
+                        : item < 4  ? (item == 2 ? ch.haptic[0].heel : ch.haptic[0].toe)
+                                    : (item == 4 ? ch.haptic[1].heel : ch.haptic[1].toe);
+    if (channel < 0)
+        return tr("The %1 actuator has no output channel: map it above, save and restart the "
+                  "audio.")
+            .arg(toneOutput_->currentText().section(QString::fromUtf8(" —"), 0, 0));
+    const auto tone = item < 2 ? eng::kHeadphoneTestTone : eng::kHapticTestTone;
+    const QString e = audio_.playTestTone(channel, tone.frequencyHz, tone.levelDbfs);
+    if (!e.isEmpty()) return e;
+    tonePlaying_ = true;
+    refreshToneButton();
+    setMessage(tr("Test tone %1 Hz, %2 dBFS on output %3 (%4). Ctrl+T stops it.")
+                   .arg(tone.frequencyHz)
+                   .arg(tone.levelDbfs)
+                   .arg(channel + 1)
+                   .arg(toneOutput_->currentText()),
+               false);
+    return {};
 }
 
 QString SetupView::calibrationText() const {

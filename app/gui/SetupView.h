@@ -50,6 +50,12 @@ class SetupView : public QWidget {
     /// Saves the proposed thresholds for the participant code in the form; returns the path.
     QString saveThresholds();
     QString calibrationText() const;
+    /// Plays (or, when one plays, stops) the test tone on the output chosen in the form:
+    /// headphones 1 kHz, actuators 200 Hz, both -20 dBFS. Returns "" or why not.
+    QString toggleTestTone();
+    /// The test tone button (its text says why it is disabled when no device runs).
+    QPushButton* testToneButton() const { return toneButton_; }
+    bool testTonePlaying() const { return tonePlaying_; }
 
   private:
     void fillDevices();
@@ -70,6 +76,10 @@ class SetupView : public QWidget {
     QProgressBar* outputMeters_[8];
     QLabel* message_;
     QTimer* meterTimer_;
+    QComboBox* toneOutput_;
+    QPushButton* toneButton_;
+    bool tonePlaying_ = false;
+    void refreshToneButton();
     void calibrate(const std::vector<engine::ShoeFrame>& frames, int expectedSteps);
     void pollSerial();
 

@@ -4,6 +4,7 @@
 // scale of each block only; laps walked silent then with sound before the questions.
 #include "app/gui/MainWindow.h"
 #include "app/gui/RunView.h"
+#include "app/gui/SetupView.h"
 #include "app/gui/StudyContext.h"
 #include "app/gui/StudyView.h"
 #include "experiment/Clips.h"
@@ -225,6 +226,18 @@ class ProtocolsTest : public QObject {
             // AS is asked three items, the other conditions seven.
             QCOMPARE(t.answer.ratings.size(), std::size_t{t.stimulus.id == "AS" ? 3u : 7u});
         }
+    }
+
+    void testToneSaysWhyWhenNoDeviceRuns() {
+        auto w = makeWindow(); // startAudio = false: no device runs
+        w->showView(4);
+        auto* setup = w->setupView();
+        QVERIFY(!setup->testToneButton()->isEnabled());
+        QVERIFY2(setup->testToneButton()->text().contains("no device runs"),
+                 qPrintable(setup->testToneButton()->text()));
+        const QString why = setup->toggleTestTone();
+        QVERIFY2(why.contains("start the audio output first"), qPrintable(why));
+        QVERIFY(!setup->testTonePlaying());
     }
 };
 
