@@ -228,6 +228,35 @@ SetupView::SetupView(AudioOutput& audio, const QString& dataDir, QWidget* parent
     cl->addLayout(form);
     cl->addLayout(calButtons);
     cl->addWidget(sensorStatus_);
+    // Thigh / shank gyroscopes over OSC (wading studies).
+    auto* gyroRow = new QHBoxLayout;
+    gyroPortBox_ = new QSpinBox(calBox);
+    gyroPortBox_->setRange(0, 65535);
+    gyroPortBox_->setValue(9000);
+    gyroPortBox_->setSpecialValueText(tr("any free port"));
+    gyroPortBox_->setAccessibleName(tr("OSC gyroscope UDP port"));
+    auto* gyroLabel = new QLabel(tr("&Gyroscopes, OSC port:"), calBox);
+    gyroLabel->setBuddy(gyroPortBox_);
+    gyroListen_ = new QPushButton(tr("Listen  (Ctrl+G)"), calBox);
+    gyroListen_->setAccessibleName(tr("Listen for the OSC gyroscopes"));
+    gyroRow->addWidget(gyroLabel);
+    gyroRow->addWidget(gyroPortBox_);
+    gyroRow->addWidget(gyroListen_);
+    gyroRow->addStretch();
+    gyroStatus_ = new QLabel(tr("Gyroscopes: not listening."), calBox);
+    gyroStatus_->setWordWrap(true);
+    gyroStatus_->setAccessibleName(tr("Gyroscope connection status"));
+    cl->addLayout(gyroRow);
+    cl->addWidget(gyroStatus_);
+    gyroTimer_ = new QTimer(this);
+    gyroTimer_->setInterval(200);
+    connect(gyroTimer_, &QTimer::timeout, this, &SetupView::pollGyro);
+    connect(gyroListen_, &QPushButton::clicked, this, [this] {
+        if (const QString e = toggleGyroListening(); !e.isEmpty()) gyroStatus_->setText(e);
+    });
+    auto* scG = new QShortcut(QKeySequence(Qt::CTRL | Qt::Key_G), this);
+    scG->setContext(Qt::WidgetWithChildrenShortcut);
+    connect(scG, &QShortcut::activated, gyroListen_, &QPushButton::click);
     cl->addWidget(pView, 1);
     cl->addWidget(dView, 1);
     cl->addWidget(calibration_);
@@ -411,6 +440,70 @@ QString SetupView::toggleTestTone() {
                    .arg(toneOutput_->currentText()),
                false);
     return {};
+}
+
+QString SetupView::toggleGyroListening() {
+    if (gyro_) {
+        gyroTimer_->stop();
+        gyro_->stop();
+        gyro_.reset();
+        gyroListen_->setText(tr("Listen  (Ctrl+G)"));
+        gyroStatus_->setText(tr("Gyroscopes: not listening."));
+        return {};
+    }
+    eng::OscGyroConfig config;
+    config.port = gyroPortBox_->value();
+    auto receiver = std::make_unique<eng::OscGyroReceiver>(config);
+    try {
+        receiver->start();
+    } catch (const std::exception& e) {
+        return tr("Gyroscopes: %1\nChoose another port (or 0 for any free one) and listen "
+                  "again.")
+            .arg(q(e.what()));
+    }
+    gyro_ = std::move(receiver);
+    gyroListen_->setText(tr("Stop listening  (Ctrl+G)"));
+    gyroTimer_->start();
+    pollGyro();
+    return {};
+}
+
+int SetupView::gyroPort() const {
+    return gyro_ ? gyro_->port() : 0;
+}
+
+QString SetupView::gyroStatusText() const {
+    return gyroStatus_->text();
+}
+
+void SetupView::pollGyro() {
+    if (!gyro_) return;
+    // Status only here: the samples are drained so that the queue never reports drops.
+    eng::GyroSample sample;
+    while (gyro_->popSample(sample)) {
+    }
+    const auto st = gyro_->status();
+    QStringList limbs;
+    for (std::size_t i = 0; i < eng::kLimbCount; ++i) {
+        const auto limb = static_cast<eng::Limb>(i);
+        const auto c = gyro_->limbCounters(limb);
+        limbs << tr("%1 %2%3")
+                     .arg(q(std::string(eng::limbName(limb))))
+                     .arg(c.samples)
+                     .arg(c.lost ? tr(" (%1 lost)").arg(c.lost) : QString());
+    }
+    gyroStatus_->setText(tr("Gyroscopes on UDP %1: %2 — %3 · %4 samples/s · %5 accepted, %6 "
+                            "lost, %7 rejected packets · %8%9")
+                             .arg(gyro_->port())
+                             .arg(q(std::string(eng::sensorStateName(st.state))), q(st.message))
+                             .arg(st.rateHz, 0, 'f', 0)
+                             .arg(st.framesAccepted)
+                             .arg(st.framesLost)
+                             .arg(st.linesRejected)
+                             .arg(limbs.join(", "))
+                             .arg(st.lastRejection.empty()
+                                      ? QString()
+                                      : tr(" · last rejected: %1").arg(q(st.lastRejection))));
 }
 
 QString SetupView::calibrationText() const {

@@ -9,6 +9,7 @@
 /// sensor's onset threshold), checked with the StepDetector and saved as the participant's
 /// thresholds TOML.
 #include "engine/control/StepCalibration.h"
+#include "engine/io/sensors/OscGyroReceiver.h"
 #include "engine/io/sensors/SerialSource.h"
 
 #include <QWidget>
@@ -56,6 +57,13 @@ class SetupView : public QWidget {
     /// The test tone button (its text says why it is disabled when no device runs).
     QPushButton* testToneButton() const { return toneButton_; }
     bool testTonePlaying() const { return tonePlaying_; }
+    /// Starts (or stops) listening for the OSC gyroscopes on the port in the form (0: any free
+    /// port). Returns "" or why not.
+    QString toggleGyroListening();
+    /// The bound UDP port while listening, else 0.
+    int gyroPort() const;
+    /// The gyroscope status line (state, rate, counters per limb).
+    QString gyroStatusText() const;
 
   private:
     void fillDevices();
@@ -80,6 +88,12 @@ class SetupView : public QWidget {
     QPushButton* toneButton_;
     bool tonePlaying_ = false;
     void refreshToneButton();
+    void pollGyro();
+    QSpinBox* gyroPortBox_;
+    QPushButton* gyroListen_;
+    QLabel* gyroStatus_;
+    QTimer* gyroTimer_;
+    std::unique_ptr<engine::OscGyroReceiver> gyro_;
     void calibrate(const std::vector<engine::ShoeFrame>& frames, int expectedSteps);
     void pollSerial();
 

@@ -21,6 +21,12 @@
 #include <memory>
 #include <set>
 
+#include <arpa/inet.h>
+#include <cstring>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
 using namespace underfoot;
 namespace ue = underfoot::experiment;
 
@@ -39,6 +45,32 @@ void typeValue(QWidget* panel, int value) {
     } else {
         QTest::keyClick(panel, static_cast<char>('0' + value));
     }
+}
+
+/// An OSC message (address, one float) as bytes: strings NUL-padded to 4, big-endian float.
+QByteArray oscFloat(const QByteArray& address, float value) {
+    const auto pad = [](QByteArray b) {
+        b.append('\0');
+        while (b.size() % 4) b.append('\0');
+        return b;
+    };
+    QByteArray out = pad(address) + pad(",f");
+    std::uint32_t bits = 0;
+    std::memcpy(&bits, &value, 4);
+    bits = htonl(bits);
+    out.append(reinterpret_cast<const char*>(&bits), 4);
+    return out;
+}
+
+void sendUdp(int port, const QByteArray& bytes) {
+    const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
+    sockaddr_in to{};
+    to.sin_family = AF_INET;
+    to.sin_port = htons(static_cast<std::uint16_t>(port));
+    to.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    ::sendto(fd, bytes.constData(), static_cast<std::size_t>(bytes.size()), 0,
+             reinterpret_cast<const sockaddr*>(&to), sizeof to);
+    ::close(fd);
 }
 
 } // namespace
@@ -238,6 +270,33 @@ class ProtocolsTest : public QObject {
         const QString why = setup->toggleTestTone();
         QVERIFY2(why.contains("start the audio output first"), qPrintable(why));
         QVERIFY(!setup->testTonePlaying());
+    }
+
+    void setupShowsTheOscGyroscopeStatus() {
+        auto w = makeWindow();
+        w->showView(4);
+        auto* setup = w->setupView();
+        for (auto* box : setup->findChildren<QSpinBox*>())
+            if (box->accessibleName() == "OSC gyroscope UDP port") box->setValue(0);
+        QCOMPARE(setup->toggleGyroListening(), QString());
+        const int port = setup->gyroPort();
+        QVERIFY(port > 0);
+        for (int i = 0; i < 20; ++i) {
+            sendUdp(port, oscFloat("/underfoot/gyro/left_thigh", static_cast<float>(i)));
+            sendUdp(port, oscFloat("/underfoot/gyro/right_thigh", static_cast<float>(-i)));
+            QTest::qWait(10); // 100 Hz, as the sensors send
+        }
+        sendUdp(port, oscFloat("/underfoot/gyro/left_elbow", 1.0f)); // unknown limb
+        QTRY_VERIFY2_WITH_TIMEOUT(setup->gyroStatusText().contains("right_thigh 20"),
+                                  qPrintable(setup->gyroStatusText()), 5000);
+        QTRY_VERIFY_WITH_TIMEOUT(setup->gyroStatusText().contains("1 rejected"), 5000);
+        // Loss is counted from arrival gaps: on a loaded machine some may show; none is rejected.
+        QVERIFY2(setup->gyroStatusText().contains("left_thigh 20"),
+                 qPrintable(setup->gyroStatusText()));
+        QVERIFY2(setup->gyroStatusText().contains("40 accepted"),
+                 qPrintable(setup->gyroStatusText()));
+        QCOMPARE(setup->toggleGyroListening(), QString());
+        QCOMPARE(setup->gyroPort(), 0);
     }
 };
 
