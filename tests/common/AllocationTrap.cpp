@@ -8,13 +8,20 @@
 namespace underfoot::test {
 std::atomic<long> allocationCount{0};
 std::atomic<bool> countAllocations{false};
+namespace {
+thread_local bool threadArmed = false;
+}
+void armThisThread(bool on) noexcept {
+    threadArmed = on;
+}
 } // namespace underfoot::test
 
 // The replacements pair malloc with free; GCC cannot see that once they are inlined here.
 #pragma GCC diagnostic ignored "-Wmismatched-new-delete"
 namespace {
 void* countedAllocation(std::size_t size) {
-    if (underfoot::test::countAllocations.load(std::memory_order_relaxed))
+    if (underfoot::test::countAllocations.load(std::memory_order_relaxed) ||
+        underfoot::test::threadArmed)
         underfoot::test::allocationCount.fetch_add(1, std::memory_order_relaxed);
     if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
     throw std::bad_alloc();

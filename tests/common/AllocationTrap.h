@@ -10,6 +10,11 @@ namespace underfoot::test {
 extern std::atomic<long> allocationCount;  ///< allocations seen while armed
 extern std::atomic<bool> countAllocations; ///< armed?
 
+/// Arms (or disarms) the counter for the calling thread only, independently of
+/// `countAllocations`: audio-callback hooks use it where other threads (a sensor receiver, a
+/// recorder's writer) legitimately allocate while the callback runs.
+void armThisThread(bool on) noexcept;
+
 /// Arms the counter (from zero) for its lifetime.
 struct AllocationTrap {
     AllocationTrap() {
