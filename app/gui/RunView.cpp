@@ -842,6 +842,8 @@ void RunView::showTrial() {
             ? tr("Audio output failed to start, the stimulus is not heard: %1").arg(audioError_)
             : tr("Audio output not started (Setup view, Ctrl+5): the stimulus "
                  "is not heard; the meters follow the virtual walker."));
+    if (!lastTrialStats_.isEmpty())
+        engineLabel_->setText(engineLabel_->text() + "\n" + lastTrialStats_);
     // The session's plan, with answered trials ticked.
     planList_->clear();
     const auto trials = context_.store().trials(session_->participant().code);
@@ -1221,6 +1223,19 @@ void RunView::next() {
         return;
     }
     lastCommitMs_ = static_cast<double>(timer.nsecsElapsed()) * 1e-6;
+    lastTrialStats_.clear();
+#ifdef UNDERFOOT_HAVE_WIRING
+    if (const auto* st = console_ ? console_->lastTrialStats() : nullptr; st && st->frames > 0)
+        lastTrialStats_ =
+            tr("Last trial: %1 s, %2 xruns, callback load %3 % average / %4 % worst, worst "
+               "block %5 ms, %6 GRF frames dropped")
+                .arg(static_cast<double>(st->frames) / audio_->settings().sampleRateHz, 0, 'f', 1)
+                .arg(st->xruns)
+                .arg(st->averageLoadPercent, 0, 'f', 1)
+                .arg(st->maxLoadPercent, 0, 'f', 1)
+                .arg(st->maxBlockSeconds * 1e3, 0, 'f', 2)
+                .arg(st->droppedGrfFrames);
+#endif
     context_.notifyDataChanged();
     showPhase();
     if (pages_->currentIndex() == TrialPage)

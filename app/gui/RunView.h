@@ -209,6 +209,7 @@ class RunView : public QWidget {
     std::string soundscape_;
     std::map<std::string, int> ratings_;
     double lastCommitMs_ = 0;
+    QString lastTrialStats_; ///< the live engine's figures of the trial just answered
     int revising_ = -1;
     std::optional<double> revisingResponseS_;
 };
