@@ -109,6 +109,45 @@ int writeParticipantsCsv(const StudyStore& store, std::ostream& out) {
     return rows;
 }
 
+int writeAudioCsv(const StudyStore& store, std::ostream& out, ExportScope scope) {
+    const StudyInfo info = store.info();
+    writeRow(out, std::vector<std::string>(kAudioColumns.begin(), kAudioColumns.end()));
+    int rows = 0;
+    for (const auto& p : store.participants())
+        for (const auto& t : store.trials(p.code)) {
+            if (t.startedAt.empty()) continue;
+            if (scope == ExportScope::Answered && !t.answered) continue;
+            std::vector<std::string> row{info.code,
+                                         p.code,
+                                         std::to_string(t.index),
+                                         t.stimulus.id,
+                                         t.sessionNumber ? std::to_string(*t.sessionNumber) : "",
+                                         t.answered ? "1" : "0",
+                                         t.excluded ? "1" : "0"};
+            if (t.audio) {
+                const TrialAudioStats& a = *t.audio;
+                for (std::string cell :
+                     {fmt::format("{}", a.sampleRateHz), std::to_string(a.blockSize),
+                      std::to_string(a.frames), std::to_string(a.xruns),
+                      fmt::format("{:.3f}", a.averageLoadPercent),
+                      fmt::format("{:.3f}", a.maxLoadPercent), fmt::format("{:.4f}", a.maxBlockMs),
+                      std::to_string(a.droppedGrfFrames)})
+                    row.push_back(std::move(cell));
+            } else {
+                row.insert(row.end(), 8, "");
+            }
+            row.push_back(t.grfRecording.value_or(""));
+            row.push_back(t.sensorLog.value_or(""));
+            row.push_back(std::to_string(t.interruptions));
+            row.push_back(t.interruptionReason);
+            row.push_back(t.startedAt);
+            row.push_back(t.answeredAt);
+            writeRow(out, row);
+            ++rows;
+        }
+    return rows;
+}
+
 int writeScalesCsv(const StudyStore& store, std::ostream& out) {
     writeRow(out, {"scale", "prompt", "min", "max", "anchors", "stimuli"});
     int rows = 0;

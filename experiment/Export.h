@@ -63,6 +63,34 @@ int writeParticipantsCsv(const StudyStore& store, std::ostream& out);
 /// Writes the protocol's scales: scale, prompt, min, max, anchors ("value=label; ..."),
 /// stimuli (space-separated; empty = every stimulus); returns rows.
 int writeScalesCsv(const StudyStore& store, std::ostream& out);
+/// The columns of the audio CSV (one row per started trial), in order.
+inline constexpr std::array<std::string_view, 21> kAudioColumns = {"study",
+                                                                   "participant",
+                                                                   "trial_index",
+                                                                   "stimulus_id",
+                                                                   "session",
+                                                                   "answered",
+                                                                   "excluded",
+                                                                   "sample_rate_hz",
+                                                                   "block_size",
+                                                                   "frames",
+                                                                   "xruns",
+                                                                   "average_load_percent",
+                                                                   "max_load_percent",
+                                                                   "max_block_ms",
+                                                                   "dropped_grf_frames",
+                                                                   "grf_recording",
+                                                                   "sensor_log",
+                                                                   "interruptions",
+                                                                   "interruption_reason",
+                                                                   "started_at",
+                                                                   "answered_at"};
+/// Writes the audio CSV: per started trial, what the audio engine measured while its stimulus
+/// played last (rate, block size, frames, xruns, loads, worst block, dropped GRF frames; empty
+/// for players without a live output), its recordings and its sensor-fault interruptions.
+/// Kept apart from trials.csv, whose columns are a contract with analysis/. Returns the rows.
+int writeAudioCsv(const StudyStore& store, std::ostream& out,
+                  ExportScope scope = ExportScope::Answered);
 /// Writes the codebook (Markdown): every column, its type and meaning, and the value labels
 /// (answer options, groups, stimuli, scales) of this study's protocol.
 void writeCodebook(const StudyStore& store, std::ostream& out);

@@ -80,6 +80,9 @@ void Session::finishBriefing() {
 void Session::play() {
     const TrialRecord& t = current();
     if (playing_) throw std::logic_error("play() while the stimulus is already playing");
+    if (paused_)
+        throw std::logic_error(
+            fmt::format("play() while paused by a sensor fault ({})", pauseReason_));
     if (closed_) throw std::logic_error("play() on a closed session");
     const Protocol& protocol = store_.protocol();
     if (protocol.laps.total() > 0) player_.setMuted(protocol.laps.silent(t.lapsDone + 1));
@@ -93,6 +96,17 @@ void Session::play() {
         playing_ = false;
         throw;
     }
+    if (started.sensorLog) {
+        try {
+            store_.setSensorLog(participant_.code, t.index, *started.sensorLog);
+        } catch (...) {
+            player_.stop();
+            playing_ = false;
+            throw;
+        }
+    }
+    trials_[position_].sensorLog = started.sensorLog;
+    trials_[position_].audio.reset();
     trials_[position_].renderSeed = started.renderSeed;
     trials_[position_].grfRecording = started.grfRecording;
     trials_[position_].sessionNumber = sessionNumber_;
@@ -105,9 +119,15 @@ void Session::answer(const TrialAnswer& answer) {
         throw std::logic_error(
             fmt::format("answer() for trial {} before its stimulus played", t.index));
     const double rt = clock_() - startedAtS_;
+    // A sensor that failed since the last check makes the presentation broken: pause instead.
+    if (const auto fault = player_.sensorFault()) {
+        sensorFault(*fault);
+        throw StoreError(fmt::format("participant '{}' trial {}: not recorded, the sensor "
+                                     "failed ({}); the session is paused",
+                                     participant_.code, t.index, *fault));
+    }
     store_.commitAnswer(participant_.code, t.index, answer, rt >= 0.0 ? rt : 0.0);
-    player_.stop();
-    playing_ = false;
+    stopPlayer();
     trials_[position_].answered = true;
     trials_[position_].answer = answer;
     trials_[position_].responseTimeS = rt;
@@ -140,10 +160,62 @@ void Session::finishBreak() {
     phase_ = trials_[position_].practice ? SessionPhase::Practice : SessionPhase::Trial;
 }
 
+void Session::stopPlayer() {
+    if (!playing_) return;
+    playing_ = false;
+    player_.stop();
+    if (const auto stats = player_.stoppedTrialStats()) {
+        store_.recordTrialAudio(participant_.code, trials_[position_].index, *stats);
+        trials_[position_].audio = stats;
+    }
+}
+
+void Session::sensorFault(const std::string& reason) {
+    if (paused_ || closed_) return;
+    if (phase_ != SessionPhase::Practice && phase_ != SessionPhase::Trial) return;
+    const TrialRecord& t = trials_[position_];
+    const bool wasPlaying = playing_;
+    try {
+        stopPlayer();
+    } catch (...) {
+        playing_ = false; // a failed recording is part of the broken presentation
+    }
+    paused_ = true;
+    pauseReason_ = reason.empty() ? "sensor fault" : reason;
+    if (wasPlaying) {
+        store_.markTrialInterrupted(participant_.code, t.index, pauseReason_);
+        ++trials_[position_].interruptions;
+        trials_[position_].interruptionReason = pauseReason_;
+    } else {
+        store_.journal("sensor_fault", participant_.code, t.index,
+                       jsonObject({{"reason", pauseReason_}}));
+    }
+    pending_.clear();
+}
+
+bool Session::checkSensors() {
+    if (!paused_ && playing_)
+        if (const auto fault = player_.sensorFault()) sensorFault(*fault);
+    return paused_;
+}
+
+void Session::resumeAfterFault() {
+    if (!paused_) return;
+    if (const auto fault = player_.sensorFault())
+        throw std::logic_error(fmt::format("the sensor still fails: {}", *fault));
+    store_.journal("sensor_restored", participant_.code, trials_[position_].index,
+                   jsonObject({{"fault", pauseReason_}}));
+    paused_ = false;
+    pauseReason_.clear();
+}
+
 void Session::interrupt() {
     if (closed_) return;
-    if (playing_) player_.stop();
-    playing_ = false;
+    try {
+        stopPlayer();
+    } catch (...) {
+        playing_ = false;
+    }
     store_.endSession(participant_.code, sessionNumber_, false);
     closed_ = true;
     phase_ = SessionPhase::Finished;

@@ -22,6 +22,8 @@ struct StimulusStart {
     std::uint64_t renderSeed = 0;
     /// Reference of the recorded ground-reaction-force stream, when the input is recorded.
     std::optional<std::string> grfRecording;
+    /// Reference of the trial's sensor log (frames, step events, GRFs), when one is written.
+    std::optional<std::string> sensorLog = std::nullopt;
 };
 
 /// Plays stimuli described as data. Implementations: the engine (app), a fake (tests), a
@@ -36,6 +38,13 @@ class StimulusPlayer {
     /// Mutes or unmutes the running stimulus (silent baseline laps keep the simulation running
     /// without sound). The default does nothing (players without a live output).
     virtual void setMuted(bool muted) { (void)muted; }
+    /// The audio figures of the stimulus stopped last (valid after stop()); players without a
+    /// live output report none (the default).
+    virtual std::optional<TrialAudioStats> stoppedTrialStats() const { return std::nullopt; }
+    /// Why the sensors driving the running stimulus cannot be recorded now (unplugged, silent,
+    /// garbage...), or nullopt when they can or the stimulus uses no sensor (the default). Any
+    /// thread may call it.
+    virtual std::optional<std::string> sensorFault() const { return std::nullopt; }
 };
 
 /// A player that renders nothing and reports the planned seed (headless runs, simulation).
@@ -87,6 +96,23 @@ class Session {
     /// Stops the stimulus and closes the session as interrupted (resume later).
     void interrupt();
 
+    // Sensor faults: the session pauses instead of recording a broken trial.
+
+    /// A sensor driving the current trial failed: the stimulus stops, its presentation is stored
+    /// as interrupted with `reason` (the trial stays unanswered) and the session pauses. No-op
+    /// when not in a trial or already paused.
+    void sensorFault(const std::string& reason);
+    /// Asks the player whether its sensors failed (StimulusPlayer::sensorFault) and pauses if so;
+    /// returns paused(). Call it periodically (the GUI's timer) while a trial plays.
+    bool checkSensors();
+    /// Whether the session is paused by a sensor fault (play() and answers are refused).
+    bool paused() const { return paused_; }
+    /// The fault that paused the session ("" when not paused).
+    const std::string& pauseReason() const { return pauseReason_; }
+    /// The sensor is back: unpauses (journaled); the participant restarts the same trial with
+    /// play(). Throws std::logic_error when the player still reports a fault.
+    void resumeAfterFault();
+
     // Listening-test mode: clips played on demand and rated scale by scale.
 
     /// The scales asked after the current trial (one per block with per-scale blocks).
@@ -120,6 +146,7 @@ class Session {
 
   private:
     void advance();
+    void stopPlayer();
 
     StudyStore& store_;
     StimulusPlayer& player_;
@@ -132,6 +159,8 @@ class Session {
     bool resumed_ = false;
     bool playing_ = false;
     bool closed_ = false;
+    bool paused_ = false;
+    std::string pauseReason_;
     double startedAtS_ = 0.0;
     std::map<std::string, int> pending_;
 };

@@ -121,6 +121,20 @@ CREATE TABLE participant_fields (
   PRIMARY KEY (participant_id, name)
 );
 )sql",
+    // 2 -> 3: live trials: audio figures, sensor log, sensor-fault interruptions.
+    R"sql(
+ALTER TABLE trials ADD COLUMN audio_sample_rate_hz REAL;
+ALTER TABLE trials ADD COLUMN audio_block_size INTEGER;
+ALTER TABLE trials ADD COLUMN audio_frames INTEGER;
+ALTER TABLE trials ADD COLUMN audio_xruns INTEGER;
+ALTER TABLE trials ADD COLUMN audio_average_load_percent REAL;
+ALTER TABLE trials ADD COLUMN audio_max_load_percent REAL;
+ALTER TABLE trials ADD COLUMN audio_max_block_ms REAL;
+ALTER TABLE trials ADD COLUMN audio_dropped_grf_frames INTEGER;
+ALTER TABLE trials ADD COLUMN sensor_log TEXT;
+ALTER TABLE trials ADD COLUMN interruptions INTEGER NOT NULL DEFAULT 0;
+ALTER TABLE trials ADD COLUMN interruption_reason TEXT NOT NULL DEFAULT '';
+)sql",
 };
 constexpr int kMigrationCount = static_cast<int>(sizeof(kMigrations) / sizeof(kMigrations[0]));
 static_assert(kMigrationCount == kSchemaVersion);
@@ -773,7 +787,10 @@ constexpr const char* kTrialColumns =
     "t.id, p.code, t.trial_index, t.block, t.practice, t.stimulus, t.repetition, t.planned_seed, "
     "t.render_seed, t.grf_recording, t.session_number, t.started_at, t.answered_at, "
     "t.response_time_s, t.answer, t.soundscape_answer, t.comment, t.excluded, "
-    "t.exclusion_reason, t.break_after, t.replays, t.laps_done";
+    "t.exclusion_reason, t.break_after, t.replays, t.laps_done, t.audio_sample_rate_hz, "
+    "t.audio_block_size, t.audio_frames, t.audio_xruns, t.audio_average_load_percent, "
+    "t.audio_max_load_percent, t.audio_max_block_ms, t.audio_dropped_grf_frames, t.sensor_log, "
+    "t.interruptions, t.interruption_reason";
 
 TrialRecord readTrial(SQLite::Database& db, SQLite::Statement& q) {
     TrialRecord r;
@@ -800,6 +817,21 @@ TrialRecord readTrial(SQLite::Database& db, SQLite::Statement& q) {
     r.breakAfter = q.getColumn(19).getInt() != 0;
     r.replays = q.getColumn(20).getInt();
     r.lapsDone = q.getColumn(21).getInt();
+    if (!q.getColumn(22).isNull()) {
+        TrialAudioStats a;
+        a.sampleRateHz = q.getColumn(22).getDouble();
+        a.blockSize = q.getColumn(23).getInt();
+        a.frames = fromDb(q.getColumn(24).getInt64());
+        a.xruns = fromDb(q.getColumn(25).getInt64());
+        a.averageLoadPercent = q.getColumn(26).getDouble();
+        a.maxLoadPercent = q.getColumn(27).getDouble();
+        a.maxBlockMs = q.getColumn(28).getDouble();
+        a.droppedGrfFrames = fromDb(q.getColumn(29).getInt64());
+        r.audio = a;
+    }
+    if (!q.getColumn(30).isNull()) r.sensorLog = q.getColumn(30).getString();
+    r.interruptions = q.getColumn(31).getInt();
+    r.interruptionReason = q.getColumn(32).getString();
     if (r.answered) {
         SQLite::Statement rq(db, "SELECT scale, value FROM ratings WHERE trial_id = ?");
         rq.bind(1, trialId);
@@ -862,8 +894,13 @@ void StudyStore::markTrialStarted(const std::string& code, int trialIndex, int s
         throw StoreError(
             fmt::format("participant '{}' trial {} is already answered", code, trialIndex));
     const bool restarted = !check.getColumn(1).isNull();
+    // A restarted trial's earlier sensor log and audio figures belong to the earlier presentation.
     SQLite::Statement q(*db_, "UPDATE trials SET started_at = ?, render_seed = ?, grf_recording = "
-                              "?, session_number = ? WHERE participant_id = ? AND trial_index = ?");
+                              "?, session_number = ?, sensor_log = NULL, audio_sample_rate_hz = "
+                              "NULL, audio_block_size = NULL, audio_frames = NULL, audio_xruns = "
+                              "NULL, audio_average_load_percent = NULL, audio_max_load_percent = "
+                              "NULL, audio_max_block_ms = NULL, audio_dropped_grf_frames = NULL "
+                              "WHERE participant_id = ? AND trial_index = ?");
     q.bind(1, now());
     q.bind(2, toDb(renderSeed));
     if (grfRecording) q.bind(3, *grfRecording);
@@ -1023,6 +1060,68 @@ void StudyStore::recordLap(const std::string& code, int trialIndex, int lap) {
     appendEvent("lap_completed", pid, trialIndex,
                 jsonObject({{"lap", std::to_string(lap)},
                             {"sound", laps.silent(lap) ? "silent baseline" : "feedback"}}));
+    tx.commit();
+}
+
+void StudyStore::setSensorLog(const std::string& code, int trialIndex,
+                              const std::string& sensorLog) {
+    SQLite::Transaction tx(*db_, SQLite::TransactionBehavior::IMMEDIATE);
+    const std::int64_t pid = participantId(code);
+    SQLite::Statement q(*db_, "UPDATE trials SET sensor_log = ? WHERE participant_id = ? AND "
+                              "trial_index = ? AND started_at IS NOT NULL");
+    q.bind(1, sensorLog);
+    q.bind(2, pid);
+    q.bind(3, trialIndex);
+    if (q.exec() != 1)
+        throw StoreError(
+            fmt::format("{}: participant '{}' has no started trial {}", path_, code, trialIndex));
+    tx.commit();
+}
+
+void StudyStore::recordTrialAudio(const std::string& code, int trialIndex,
+                                  const TrialAudioStats& a) {
+    for (const double v : {a.sampleRateHz, a.averageLoadPercent, a.maxLoadPercent, a.maxBlockMs})
+        if (!std::isfinite(v) || v < 0)
+            throw StoreError(fmt::format("participant '{}' trial {}: audio figures must be finite "
+                                         "numbers >= 0",
+                                         code, trialIndex));
+    SQLite::Transaction tx(*db_, SQLite::TransactionBehavior::IMMEDIATE);
+    const std::int64_t pid = participantId(code);
+    SQLite::Statement q(*db_, "UPDATE trials SET audio_sample_rate_hz = ?, audio_block_size = ?, "
+                              "audio_frames = ?, audio_xruns = ?, audio_average_load_percent = ?, "
+                              "audio_max_load_percent = ?, audio_max_block_ms = ?, "
+                              "audio_dropped_grf_frames = ? WHERE participant_id = ? AND "
+                              "trial_index = ?");
+    q.bind(1, a.sampleRateHz);
+    q.bind(2, a.blockSize);
+    q.bind(3, toDb(a.frames));
+    q.bind(4, toDb(a.xruns));
+    q.bind(5, a.averageLoadPercent);
+    q.bind(6, a.maxLoadPercent);
+    q.bind(7, a.maxBlockMs);
+    q.bind(8, toDb(a.droppedGrfFrames));
+    q.bind(9, pid);
+    q.bind(10, trialIndex);
+    if (q.exec() != 1)
+        throw StoreError(
+            fmt::format("{}: participant '{}' has no trial {}", path_, code, trialIndex));
+    tx.commit();
+}
+
+void StudyStore::markTrialInterrupted(const std::string& code, int trialIndex,
+                                      const std::string& reason) {
+    SQLite::Transaction tx(*db_, SQLite::TransactionBehavior::IMMEDIATE);
+    const std::int64_t pid = participantId(code);
+    SQLite::Statement q(*db_, "UPDATE trials SET interruptions = interruptions + 1, "
+                              "interruption_reason = ? WHERE participant_id = ? AND trial_index = "
+                              "? AND answered_at IS NULL");
+    q.bind(1, reason);
+    q.bind(2, pid);
+    q.bind(3, trialIndex);
+    if (q.exec() != 1)
+        throw StoreError(fmt::format("{}: participant '{}' has no unanswered trial {}", path_, code,
+                                     trialIndex));
+    appendEvent("trial_interrupted", pid, trialIndex, jsonObject({{"reason", reason}}));
     tx.commit();
 }
 

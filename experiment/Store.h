@@ -32,8 +32,10 @@ struct StoreError : std::runtime_error {
 
 /// Current schema version written by this code.
 /// Version 2 adds clip replay counts and laps walked per trial, and participant fields
-/// (expertise, listening device...); version-1 studies are migrated when opened.
-inline constexpr int kSchemaVersion = 2;
+/// (expertise, listening device...); version 3 adds per-trial audio figures (TrialAudioStats),
+/// the sensor log reference and sensor-fault interruptions. Older studies are migrated when
+/// opened.
+inline constexpr int kSchemaVersion = 3;
 
 /// Time source (injectable for tests).
 struct Clock {
@@ -129,6 +131,18 @@ struct TrialAnswer {
     std::string comment;
 };
 
+/// What the audio engine measured while a trial's stimulus played (from start to stop).
+struct TrialAudioStats {
+    double sampleRateHz = 0;            ///< the audio settings' sample rate
+    int blockSize = 0;                  ///< the audio settings' block size (frames)
+    std::uint64_t frames = 0;           ///< audio frames the device ran
+    std::uint64_t xruns = 0;            ///< device over/underflows
+    double averageLoadPercent = 0;      ///< callback time / audio time
+    double maxLoadPercent = 0;          ///< worst callback's load
+    double maxBlockMs = 0;              ///< worst callback time
+    std::uint64_t droppedGrfFrames = 0; ///< GRF frames lost by the recording (0 = complete)
+};
+
 /// A stored trial.
 struct TrialRecord {
     std::string participant;
@@ -153,6 +167,14 @@ struct TrialRecord {
     int replays = 0;
     /// Laps completed (interactive tests with [laps]).
     int lapsDone = 0;
+    /// The audio figures of the trial's last presentation (live players only).
+    std::optional<TrialAudioStats> audio;
+    /// Reference of the trial's sensor log (frames, step events, GRFs), when one was written.
+    std::optional<std::string> sensorLog;
+    /// Times a presentation of this trial was interrupted by a sensor fault.
+    int interruptions = 0;
+    /// The last interruption's fault reason ("" when never interrupted).
+    std::string interruptionReason;
 };
 
 /// Everything needed to re-render a trial exactly.
@@ -235,6 +257,14 @@ class StudyStore {
     /// previous trial's answer under the "next_trial" rule.
     void markTrialStarted(const std::string& code, int trialIndex, int sessionNumber,
                           std::uint64_t renderSeed, const std::optional<std::string>& grfRecording);
+    /// Records the sensor log reference of a started trial (the path like grfRecording).
+    void setSensorLog(const std::string& code, int trialIndex, const std::string& sensorLog);
+    /// Stores the audio figures of a trial's last presentation (replacing earlier ones).
+    void recordTrialAudio(const std::string& code, int trialIndex, const TrialAudioStats& stats);
+    /// Marks the presentation of a started, unanswered trial as interrupted by a sensor fault
+    /// (counted, reason kept, journaled as "trial_interrupted"); the trial stays unanswered so
+    /// the participant resumes at it. Throws StoreError for an answered or unknown trial.
+    void markTrialInterrupted(const std::string& code, int trialIndex, const std::string& reason);
     /// Validates and commits an answer in its own durable transaction.
     void commitAnswer(const std::string& code, int trialIndex, const TrialAnswer& answer,
                       std::optional<double> responseTimeS);

@@ -37,7 +37,7 @@ const underfoot::cli::CommandRegistrar registrar{
         Options& o = opts();
         auto* cmd =
             app.add_subcommand("export", "Write trials.csv (one row per trial), ratings.csv, "
-                                         "participants.csv, scales.csv and codebook.md");
+                                         "participants.csv, scales.csv, audio.csv and codebook.md");
         cmd->add_option("--study", o.study, "study file")->required();
         cmd->add_option("-o,--out", o.outDir, "output folder (created if needed)");
         cmd->add_flag("--all-trials", o.all, "also write planned trials not answered yet");
@@ -55,6 +55,8 @@ const underfoot::cli::CommandRegistrar registrar{
                 const int participantRows = writeParticipantsCsv(store, participants);
                 auto scales = openOut(dir / "scales.csv");
                 const int scaleRows = writeScalesCsv(store, scales);
+                auto audio = openOut(dir / "audio.csv");
+                const int audioRows = writeAudioCsv(store, audio, scope);
                 auto codebook = openOut(dir / "codebook.md");
                 writeCodebook(store, codebook);
                 trials.close();
@@ -62,11 +64,12 @@ const underfoot::cli::CommandRegistrar registrar{
                 participants.close();
                 scales.close();
                 codebook.close();
-                if (!trials || !ratings || !participants || !scales || !codebook)
+                audio.close();
+                if (!trials || !ratings || !participants || !scales || !codebook || !audio)
                     throw UserError(fmt::format("{}: writing the export failed", o.outDir));
-                fmt::print("wrote {} trial rows, {} rating rows, {} participants, {} scales and "
-                           "the codebook to {}\n",
-                           rows, ratingRows, participantRows, scaleRows, o.outDir);
+                fmt::print("wrote {} trial rows, {} rating rows, {} participants, {} scales, {} "
+                           "audio rows and the codebook to {}\n",
+                           rows, ratingRows, participantRows, scaleRows, audioRows, o.outDir);
             } catch (const StoreError& e) {
                 throw UserError(e.what());
             } catch (const std::filesystem::filesystem_error& e) {

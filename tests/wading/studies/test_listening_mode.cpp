@@ -214,6 +214,11 @@ TEST(WadingListeningMode, VersionOneStudyFilesAreMigrated) {
     {
         // Turn the file back into schema version 1 (what Underfoot wrote before this version).
         SQLite::Database db(path, SQLite::OPEN_READWRITE);
+        for (const char* column :
+             {"audio_sample_rate_hz", "audio_block_size", "audio_frames", "audio_xruns",
+              "audio_average_load_percent", "audio_max_load_percent", "audio_max_block_ms",
+              "audio_dropped_grf_frames", "sensor_log", "interruptions", "interruption_reason"})
+            db.exec(std::string("ALTER TABLE trials DROP COLUMN ") + column); // version 3's
         db.exec("DROP TABLE participant_fields");
         db.exec("ALTER TABLE trials DROP COLUMN replays");
         db.exec("ALTER TABLE trials DROP COLUMN laps_done");
@@ -221,7 +226,7 @@ TEST(WadingListeningMode, VersionOneStudyFilesAreMigrated) {
     }
     StudyStore store = StudyStore::open(path);
     EXPECT_EQ(store.info().schemaVersion, kSchemaVersion);
-    EXPECT_EQ(kSchemaVersion, 2);
+    EXPECT_EQ(kSchemaVersion, 3);
     const auto trials = store.trials("P1");
     ASSERT_EQ(trials.size(), 24u);
     EXPECT_EQ(trials[0].replays, 0);
