@@ -2,12 +2,16 @@
 #include "app/wiring/Players.h"
 
 #include "app/wiring/Adapters.h"
+#include "engine/io/sensors/OscGyroReceiver.h"
+#include "engine/io/sensors/SensorClock.h"
+#include "engine/io/sensors/SensorLog.h"
 #include "engine/render/Renderer.h"
 #include "soundscapes/Library.h"
 #include "soundscapes/Renderer.h"
 
 #include <fmt/format.h>
 
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
@@ -166,20 +170,99 @@ exp::StimulusStart LivePlayer::start(const exp::Stimulus& stimulus, std::uint64_
     wading_ = wading;
     engine_.resetPeaks();
     startMeters_ = engine_.meters();
-    if (!path.empty()) {
-        std::string ref = path;
+    const auto reference = [this](const std::string& p) {
+        std::string ref = p;
         if (!options_.studyFolder.empty()) {
-            const auto rel = fs::path(path).lexically_relative(options_.studyFolder);
+            const auto rel = fs::path(p).lexically_relative(options_.studyFolder);
             if (!rel.empty() && *rel.begin() != "..") ref = rel.string();
         }
-        result.grfRecording = ref;
+        return ref;
+    };
+    if (!path.empty()) result.grfRecording = reference(path);
+    TrialSensor sensor = TrialSensor::None;
+    if (stimulus.input.kind == exp::InputKind::Sensor &&
+        stimulus.input.sensor == exp::SensorKind::Fsr && options_.shoes)
+        sensor = TrialSensor::Shoes;
+    else if (stimulus.input.kind == exp::InputKind::Sensor &&
+             stimulus.input.sensor == exp::SensorKind::Gyro && options_.scene.gyroReceiver)
+        sensor = TrialSensor::Gyro;
+    sensorLogPath_.clear();
+    if (sensor == TrialSensor::Shoes && options_.shoeSteps && !path.empty()) {
+        sensorLogPath_ =
+            (fs::path(path).parent_path() / (fs::path(path).stem().string() + ".sensors.csv"))
+                .string();
+        try {
+            startSensorLog(sensorLogPath_);
+        } catch (...) {
+            sensor_ = sensor; // stop() releases the scene and the recording
+            try {
+                stop();
+            } catch (...) {
+            }
+            throw;
+        }
+        result.sensorLog = reference(sensorLogPath_);
     }
+    sensor_ = sensor;
     return result;
+}
+
+void LivePlayer::startSensorLog(const std::string& path) {
+    auto log = std::make_shared<eng::SensorLogWriter>(path, eng::sensorClockSeconds());
+    auto* grfSource = dynamic_cast<StepGrfSource*>(options_.scene.fsrSource.get());
+    eng::StepGrfPlayer* stepPlayer = grfSource ? &grfSource->player() : nullptr;
+    const auto drain = [this, stepPlayer](eng::SensorLogWriter* to) {
+        eng::ShoeFrame f;
+        while (options_.shoes->popFrame(f))
+            if (to) to->write(f);
+        eng::StepEvent e;
+        while (options_.shoeSteps->popEvent(e))
+            if (to) to->write(e);
+        eng::StepPlayback p;
+        if (stepPlayer)
+            while (stepPlayer->popPlayback(p))
+                if (to) to->write(p);
+    };
+    drain(nullptr); // what queued up between trials belongs to no trial
+    sensorLogError_.clear();
+    sensorLogRows_ = 0;
+    sensorLogRunning_ = true;
+    sensorLogThread_ = std::thread([this, log, drain] {
+        try {
+            while (sensorLogRunning_.load()) {
+                drain(log.get());
+                std::this_thread::sleep_for(std::chrono::milliseconds(10));
+            }
+            drain(log.get());
+            log->flush();
+        } catch (const std::exception& e) {
+            sensorLogError_ = e.what();
+        }
+        sensorLogRows_ = static_cast<std::size_t>(log->rows());
+    });
+}
+
+void LivePlayer::stopSensorLog() {
+    if (!sensorLogThread_.joinable()) return;
+    sensorLogRunning_ = false;
+    sensorLogThread_.join();
+}
+
+std::optional<std::string> LivePlayer::sensorFault() const {
+    const TrialSensor sensor = sensor_.load();
+    if (sensor == TrialSensor::None) return std::nullopt;
+    const eng::SensorStatus status = sensor == TrialSensor::Shoes
+                                         ? options_.shoes->status()
+                                         : options_.scene.gyroReceiver->status();
+    if (status.state == eng::SensorState::Running) return std::nullopt;
+    return fmt::format("{} {}{}{}", sensor == TrialSensor::Shoes ? "FSR shoes" : "gyroscopes",
+                       eng::sensorStateName(status.state), status.message.empty() ? "" : ": ",
+                       status.message);
 }
 
 void LivePlayer::stop() {
     if (!playing_) return;
-    playing_ = false;
+    playing_ = false; // sensor_ stays: the session asks whether that sensor came back
     engine_.submit(nullptr);
     // Crossfade plus a margin; a stopped stream hands nothing back (then nothing pushes).
     engine_.waitIdle(engine_.settings().crossfadeMs * 1e-3 + 2.0);
@@ -206,6 +289,7 @@ void LivePlayer::stop() {
     } else {
         engine_.collectRetired();
     }
+    stopSensorLog();
     const auto m = engine_.meters();
     stats_ = {};
     stats_.frames = m.frames - startMeters_.frames;
@@ -217,6 +301,7 @@ void LivePlayer::stop() {
         stats_.frames > 0 ? (busyNow - busyBefore) / (double(stats_.frames) / rate) : 0.0;
     stats_.maxLoadPercent = m.maxLoadPercent;
     stats_.maxBlockSeconds = m.maxBlockSeconds;
+    stopped_ = true;
     if (recorder_) {
         recorder_->finish();
         lastDropped_ = recorder_->droppedFrames();
@@ -237,6 +322,22 @@ void LivePlayer::stop() {
     if (!gaitError.empty())
         throw std::runtime_error(
             fmt::format("live player: gait recording {}: {}", recordingPath_, gaitError));
+    if (!sensorLogError_.empty())
+        throw std::runtime_error(fmt::format("live player: sensor log: {}", sensorLogError_));
+}
+
+std::optional<exp::TrialAudioStats> LivePlayer::stoppedTrialStats() const {
+    if (!stopped_) return std::nullopt;
+    exp::TrialAudioStats a;
+    a.sampleRateHz = engine_.settings().sampleRateHz;
+    a.blockSize = engine_.settings().blockSize;
+    a.frames = stats_.frames;
+    a.xruns = stats_.xruns;
+    a.averageLoadPercent = stats_.averageLoadPercent;
+    a.maxLoadPercent = stats_.maxLoadPercent;
+    a.maxBlockMs = stats_.maxBlockSeconds * 1e3;
+    a.droppedGrfFrames = stats_.droppedGrfFrames;
+    return a;
 }
 
 eng::AudioBuffer renderStimulus(const exp::Stimulus& stimulus, std::uint64_t seed, double seconds,

@@ -12,14 +12,18 @@
 ///    the virtual walker for `seconds`, the offline renderer, the soundscape mixed in as
 ///    `underfoot replay` does. Sensor stimuli are previewed with the default walker.
 #include "app/wiring/WadingSource.h"
+#include "engine/control/StepInput.h"
 #include "engine/io/AudioFile.h"
+#include "engine/io/sensors/SerialSource.h"
 #include "engine/scene/LiveEngine.h"
 #include "experiment/Session.h"
 
 #include <array>
+#include <atomic>
 #include <memory>
 #include <optional>
 #include <string>
+#include <thread>
 
 namespace underfoot::wiring {
 
@@ -56,6 +60,13 @@ struct LivePlayerOptions {
     /// study file's folder, which `underfoot replay` resolves them against).
     std::string studyFolder;
     StimulusSceneOptions scene;
+    /// The FSR shoes behind `scene.fsrSource` (a StepGrfSource): the serial port and the step
+    /// detector attached to it. With them, every FSR trial writes its sensor log (shoe frames,
+    /// step events, the GRFs the player chose; SensorLogWriter) next to its GRF recording as
+    /// `<recording>.sensors.csv`, referenced by StimulusStart::sensorLog, and the port's faults
+    /// are reported by sensorFault(). This player is then the only consumer of their queues.
+    std::shared_ptr<engine::SerialSource> shoes;
+    std::shared_ptr<engine::StepInput> shoeSteps;
 };
 
 /// What the engine measured while one stimulus played (from start() to stop()).
@@ -91,8 +102,23 @@ class LivePlayer final : public experiment::StimulusPlayer {
     /// The last stopped trial's figures. They are also written next to its GRF recording as
     /// `<recording>.meters.toml` (frames, xruns, loads, dropped frames, scene summary).
     const LiveTrialStats& lastTrialStats() const noexcept { return stats_; }
+    /// The last stopped trial's figures with the audio settings' rate and block size, for the
+    /// session to store with the trial (nullopt before the first stop()).
+    std::optional<experiment::TrialAudioStats> stoppedTrialStats() const override;
+    /// Why the sensor of the running (or last stopped) trial cannot be recorded now ("FSR shoes
+    /// silent: no frame for 402 ms ...", "gyroscopes disconnected: ..."; the shoes for FSR
+    /// stimuli, the OSC receiver for gyro stimuli), or nullopt (fine, or no sensor). Any thread.
+    std::optional<std::string> sensorFault() const override;
+    /// The absolute path of the running (or last) trial's sensor log ("" when none).
+    const std::string& sensorLogPath() const noexcept { return sensorLogPath_; }
+    /// Rows written to the last sensor log (after stop()).
+    std::size_t lastSensorLogRows() const noexcept { return sensorLogRows_; }
 
   private:
+    enum class TrialSensor { None, Shoes, Gyro };
+    void startSensorLog(const std::string& path);
+    void stopSensorLog();
+
     engine::LiveEngine& engine_;
     LivePlayerOptions options_;
     std::shared_ptr<engine::AudioRecorder> recorder_;
@@ -103,7 +129,13 @@ class LivePlayer final : public experiment::StimulusPlayer {
     LiveTrialStats stats_;
     int counter_ = 0;
     bool playing_ = false;
-    bool wading_ = false; ///< the running trial is a water scene (gait recorded at stop)
+    bool stopped_ = false; ///< a trial was stopped (stats_ is valid)
+    bool wading_ = false;  ///< the running trial is a water scene (gait recorded at stop)
+    std::atomic<TrialSensor> sensor_{TrialSensor::None}; ///< what the running trial depends on
+    std::string sensorLogPath_, sensorLogError_;
+    std::size_t sensorLogRows_ = 0;
+    std::thread sensorLogThread_;
+    std::atomic<bool> sensorLogRunning_{false};
 };
 
 /// Renders `stimulus` offline: `seconds` of the walker (the stimulus's, or the default walker
