@@ -378,3 +378,61 @@ TEST_F(WadingJack, SwingReachesTheHeadphonesWithinOneBlockOfItsPacket) {
     for (float v : replay.samples) peak = std::max(peak, std::fabs(v));
     EXPECT_GT(peak, 0.0f) << "the recorded gait re-renders the swing";
 }
+
+namespace {
+/// Runs a water scene (virtual gait) offline for `seconds` at 48 kHz / 64 frames; returns the
+/// six device outputs (0/1 headphones, 2-5 actuators).
+std::vector<std::vector<float>> runVirtualWater(double cadence, double seconds,
+                                                eng::OutputModality modality) {
+    eng::ChannelMap map;
+    map.headphonesLeft = 0;
+    map.headphonesRight = 1;
+    map.haptic[0] = {2, 3};
+    map.haptic[1] = {4, 5};
+    eng::WadingOptions o;
+    o.depth = "deep";
+    o.seed = 3;
+    eng::VirtualGaitParameters p;
+    p.cadenceStepsPerMin = cadence;
+    eng::LiveSceneDescription d;
+    d.modality = modality;
+    d.seed = 3;
+    d.wading = std::make_unique<eng::WadingNode>(
+        o, std::make_unique<eng::VirtualGaitSource>(p, seconds + 1.0));
+    auto scene = eng::LiveScene::create(std::move(d), {48000, 64}, map);
+    const auto frames = static_cast<std::size_t>(seconds * 48000);
+    std::vector<std::vector<float>> out(6, std::vector<float>(frames, 0.0f));
+    std::vector<float*> ptr(6);
+    for (std::size_t pos = 0; pos + 64 <= frames; pos += 64) {
+        for (std::size_t c = 0; c < 6; ++c) ptr[c] = out[c].data() + pos;
+        scene->process(nullptr, 0, ptr.data(), 6, 64);
+    }
+    return out;
+}
+double rms(const std::vector<float>& x) {
+    double s = 0;
+    for (float v : x) s += double(v) * v;
+    return std::sqrt(s / double(x.size()));
+}
+} // namespace
+
+TEST(LiveWading, VirtualGaitStandsSilentWalksLouderWhenFasterAndDrivesTheShoes) {
+    // Standing (cadence 0): every output sample exactly 0.
+    const auto still = runVirtualWater(0, 2.0, eng::OutputModality::AudioHaptic);
+    for (const auto& ch : still)
+        for (float v : ch) ASSERT_EQ(v, 0.0f);
+    // The virtual gait is audible, and faster walking (118 steps/min) is louder than slow (27),
+    // as offline (docs/wading.md, measured figures).
+    const auto slow = runVirtualWater(27, 6.0, eng::OutputModality::Audio);
+    const auto fast = runVirtualWater(118, 6.0, eng::OutputModality::Audio);
+    const double slowRms = rms(slow[0]) + rms(slow[1]), fastRms = rms(fast[0]) + rms(fast[1]);
+    std::printf("[ wading   ] live scene, virtual gait: headphone RMS (L+R) slow %.4g, fast %.4g\n",
+                slowRms, fastRms);
+    EXPECT_GT(slowRms, 0.0);
+    EXPECT_GT(fastRms, 1.5 * slowRms);
+    EXPECT_EQ(rms(fast[2]), 0.0) << "audio-only: the actuators stay silent";
+    // With haptics, the left/right outputs drive the left/right shoe (heel and toe).
+    const auto both = runVirtualWater(118, 3.0, eng::OutputModality::AudioHaptic);
+    for (int c = 2; c < 6; ++c) EXPECT_GT(rms(both[static_cast<std::size_t>(c)]), 0.0) << c;
+    EXPECT_EQ(both[2], both[3]) << "heel and toe of one shoe carry the same band";
+}
