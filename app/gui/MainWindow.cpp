@@ -153,6 +153,28 @@ int MainWindow::saveScreenshots(const QString& dir) {
         }
         context_->openStudy(original);
     }
+    // A listening test and a lap protocol (shipped wading protocols) on scratch studies.
+    if (scratch.isValid()) {
+        const QString dirOfProtocols = QString::fromStdString(experiment::shippedProtocolDir());
+        const std::pair<const char*, int> cases[] = {{"wading_listening", 0},
+                                                     {"wading_interactive", 4}};
+        for (const auto& [id, laps] : cases) {
+            experiment::StudySettings settings;
+            settings.code = "SCREENSHOT";
+            const QString file = scratch.filePath(QString("%1.db").arg(id));
+            const bool created =
+                context_->createStudy(file, dirOfProtocols + "/" + id + ".toml", settings)
+                    .isEmpty();
+            showView(1);
+            if (created && run_->startProtocolTrialForScreenshot(laps)) {
+                shoot(laps ? "08_run_laps.png" : "07_run_listening.png");
+                run_->closeSession();
+            } else {
+                ++failures;
+            }
+        }
+        if (!original.isEmpty()) context_->openStudy(original);
+    }
     showView(2);
     shoot("04_results.png");
     showView(3);

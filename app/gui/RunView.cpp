@@ -926,13 +926,16 @@ void RunView::rebuildAnswerSections(const exp::TrialRecord& trial) {
         if (anchors.isEmpty())
             anchors << QString("%1 = %2").arg(sc.min).arg(q(sc.minLabel))
                     << QString("%1 = %2").arg(sc.max).arg(q(sc.maxLabel));
-        s.box = new QGroupBox(tr("%1  (digits %2–%3; %4)")
-                                  .arg(q(sc.prompt))
-                                  .arg(sc.min)
-                                  .arg(sc.max)
-                                  .arg(anchors.join("; ")),
+        s.box = new QGroupBox(tr("%1  (digits %2–%3)").arg(q(sc.prompt)).arg(sc.min).arg(sc.max),
                               sectionsHost_);
-        auto* row = new QHBoxLayout(s.box);
+        auto* column = new QVBoxLayout(s.box);
+        auto* anchorLabel = new QLabel(anchors.join("   ·   "), s.box);
+        anchorLabel->setWordWrap(true);
+        anchorLabel->setStyleSheet("color: #404040;");
+        anchorLabel->setAccessibleName(tr("Anchors of %1").arg(q(sc.id)));
+        column->addWidget(anchorLabel);
+        auto* row = new QHBoxLayout;
+        column->addLayout(row);
         for (int v = sc.min; v <= sc.max; ++v) {
             auto* b = new QPushButton(QString::number(v), s.box);
             b->setCheckable(true);
@@ -1583,6 +1586,25 @@ void RunView::replayClip() {
         return;
     }
     refreshProtocolStatus();
+}
+
+bool RunView::startProtocolTrialForScreenshot(int laps) {
+    if (!context_.hasStudy()) return false;
+    if (context_.store().protocol().clips.enabled && !clipProblems().isEmpty()) {
+        if (!renderClips()) return false;
+        while (rendering_) QCoreApplication::processEvents(QEventLoop::AllEvents, 50);
+    }
+    code_->setText("P001");
+    age_->setValue(24);
+    experimenter_->setText("demo");
+    if (!registerAndStart()) return false;
+    if (session_->phase() == exp::SessionPhase::Briefing) session_->finishBriefing();
+    showPhase();
+    handleTrialKey(Qt::Key_Space, Qt::NoModifier, " ");
+    if (context_.store().protocol().clips.enabled) handleTrialKey(Qt::Key_R, Qt::NoModifier, "r");
+    for (int i = 0; i < laps; ++i) handleTrialKey(Qt::Key_L, Qt::NoModifier, "l");
+    handleTrialKey(Qt::Key_7, Qt::NoModifier, "7");
+    return true;
 }
 
 bool RunView::startDemoTrialForScreenshot() {

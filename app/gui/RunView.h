@@ -87,6 +87,9 @@ class RunView : public QWidget {
     QString protocolStatus() const;
     /// For screenshots: registers a scratch participant and shows a trial with an answer chosen.
     bool startDemoTrialForScreenshot();
+    /// For screenshots of listening / lap protocols: renders the clips when needed (waiting),
+    /// registers a participant, presents the clip (or walks `laps` laps) and types a rating.
+    bool startProtocolTrialForScreenshot(int laps);
 
     /// Plays stimuli through `output`'s live engine while it runs (the walker meters otherwise).
     /// With `autoStart`, a session start also starts the output (a failure is shown, the

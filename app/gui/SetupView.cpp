@@ -406,7 +406,7 @@ void SetupView::updateMeters() {
 void SetupView::refreshToneButton() {
     const bool running = audio_.running();
     toneButton_->setEnabled(running);
-    toneButton_->setText(!running       ? tr("Test tone: no device runs — start the audio first")
+    toneButton_->setText(!running       ? tr("No device runs: Start audio first")
                          : tonePlaying_ ? tr("Stop test tone  (Ctrl+T)")
                                         : tr("Play test tone  (Ctrl+T)"));
 }

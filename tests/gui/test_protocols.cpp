@@ -265,7 +265,7 @@ class ProtocolsTest : public QObject {
         w->showView(4);
         auto* setup = w->setupView();
         QVERIFY(!setup->testToneButton()->isEnabled());
-        QVERIFY2(setup->testToneButton()->text().contains("no device runs"),
+        QVERIFY2(setup->testToneButton()->text().contains("No device runs"),
                  qPrintable(setup->testToneButton()->text()));
         const QString why = setup->toggleTestTone();
         QVERIFY2(why.contains("start the audio output first"), qPrintable(why));
