@@ -30,8 +30,8 @@
 #include <QLabel>
 #include <QLineEdit>
 #include <QListWidget>
-#include <QPointer>
 #include <QProgressBar>
+#include <QPromise>
 #include <QPushButton>
 #include <QRegularExpressionValidator>
 #include <QScrollArea>
@@ -299,6 +299,12 @@ RunView::RunView(StudyContext& context, QWidget* parent) : QWidget(parent), cont
 }
 
 RunView::~RunView() {
+    // A clip render in flight stops before its next clip; wait for it (it holds no view data).
+    for (auto* w : findChildren<QFutureWatcher<QString>*>()) {
+        w->disconnect(this);
+        w->cancel();
+        w->waitForFinished();
+    }
     closeSession();
 }
 
@@ -1456,9 +1462,12 @@ bool RunView::renderClips() {
     auto protocol = std::make_shared<exp::Protocol>(context_.store().protocol());
     const std::string dir = clipDir_.toStdString();
     auto* watcher = new QFutureWatcher<QString>(this);
-    QPointer<QProgressBar> bar(clipProgress_);
+    connect(watcher, &QFutureWatcher<QString>::progressRangeChanged, clipProgress_,
+            &QProgressBar::setRange);
+    connect(watcher, &QFutureWatcher<QString>::progressValueChanged, clipProgress_,
+            &QProgressBar::setValue);
     connect(watcher, &QFutureWatcher<QString>::finished, this, [this, watcher] {
-        const QString error = watcher->result();
+        const QString error = watcher->future().resultCount() > 0 ? watcher->result() : QString();
         watcher->deleteLater();
         rendering_ = false;
         clipProgress_->hide();
@@ -1468,24 +1477,20 @@ bool RunView::renderClips() {
             clipStatus_->setStyleSheet("color: #8a1c00;");
         }
     });
-    watcher->setFuture(QtConcurrent::run([protocol, dir, bar]() -> QString {
+    // Progress goes through the promise (thread-safe); a cancelled future (view closing) stops
+    // before the next clip.
+    watcher->setFuture(QtConcurrent::run([protocol, dir](QPromise<QString>& promise) {
         try {
             wiring::renderClipFolder(*protocol, dir, 48000.0,
-                                     [bar](int done, int total, const std::string&) {
-                                         QMetaObject::invokeMethod(
-                                             bar.data(),
-                                             [bar, done, total] {
-                                                 if (!bar) return;
-                                                 bar->setRange(0, total);
-                                                 bar->setValue(done);
-                                             },
-                                             Qt::QueuedConnection);
-                                         return true;
+                                     [&promise](int done, int total, const std::string&) {
+                                         promise.setProgressRange(0, total);
+                                         promise.setProgressValue(done);
+                                         return !promise.isCanceled();
                                      });
+            promise.addResult(QString());
         } catch (const std::exception& e) {
-            return QString::fromStdString(e.what());
+            promise.addResult(QString::fromStdString(e.what()));
         }
-        return {};
     }));
     return true;
 #else
