@@ -103,6 +103,7 @@ LivePlayer::~LivePlayer() {
         stop();
     } catch (...) {
     }
+    stopSensorLog(); // when stop() failed before it
 }
 
 namespace {

@@ -119,15 +119,15 @@ std::map<std::string, int> countKinds(const std::string& csvPath) {
 
 TEST(SessionSensors, AWriterDyingMidTrialPausesTheSessionAndTheTrialIsPresentedAgain) {
     if (!underfoot::test::socatInstalled()) GTEST_SKIP() << "socat is not installed";
-    SocatPair pair("session");
-    ASSERT_TRUE(pair.ready());
+    auto pair = std::make_unique<SocatPair>("session");
+    ASSERT_TRUE(pair->ready());
     eng::ShoeScript script(eng::ShoeWalkOptions{}, 8);
     script.stand(500);
     script.walk(80); // ~45 s of walking: more than the test writes
 
     // The shoes as the app wires them.
     eng::SerialConfig config;
-    config.path = pair.app;
+    config.path = pair->app;
     auto shoes = std::make_shared<eng::SerialSource>(config);
     eng::StepGrfPlayerConfig playerConfig;
     playerConfig.seed = 77;
@@ -171,7 +171,7 @@ TEST(SessionSensors, AWriterDyingMidTrialPausesTheSessionAndTheTrialIsPresentedA
     xp::Session session(store, "P1", player, {"E", "offline 48000/64", "fsr pty", "t"});
     session.finishBriefing();
 
-    const int fd = underfoot::test::openWriter(pair.shoes);
+    int fd = underfoot::test::openWriter(pair->shoes);
     ASSERT_GE(fd, 0);
     auto writer = std::make_unique<ShoeWriter>(fd, script, 0, true);
     ASSERT_TRUE(waitRunning(*shoes, 5.0)) << shoes->status().message;
@@ -211,6 +211,39 @@ TEST(SessionSensors, AWriterDyingMidTrialPausesTheSessionAndTheTrialIsPresentedA
     xp::TrialAnswer answer;
     answer.answer = "wood";
     session.answer(answer);
+
+    // The second trial: the port goes away (socat dies: an unplugged cable), then comes back at
+    // the same path and the source reopens it.
+    const int second = session.current().index;
+    ASSERT_NE(second, index);
+    session.play();
+    EXPECT_FALSE(pollUntil(session, 0.8, [&] { return session.paused(); }))
+        << session.pauseReason();
+    const double unplugS = pair->kill();
+    ASSERT_TRUE(pollUntil(session, 3.0, [&] { return session.paused(); }));
+    const double unplugDelayS = eng::sensorClockSeconds() - unplugS;
+    std::printf("[ measured ] port gone -> session paused: %.0f ms (%s)\n", unplugDelayS * 1e3,
+                session.pauseReason().c_str());
+    EXPECT_LT(unplugDelayS, 1.0);
+    writer->kill();
+    ::close(fd);
+    EXPECT_FALSE(store.trial("P1", second).answered);
+    EXPECT_EQ(store.trial("P1", second).interruptions, 1);
+    pair = std::make_unique<SocatPair>("session"); // same link paths
+    ASSERT_TRUE(pair->ready());
+    fd = underfoot::test::openWriter(pair->shoes);
+    ASSERT_GE(fd, 0);
+    writer = std::make_unique<ShoeWriter>(fd, script, writer->nextTick(), true);
+    ASSERT_TRUE(waitRunning(*shoes, 6.0)) << shoes->status().message;
+    session.resumeAfterFault();
+    ASSERT_EQ(session.current().index, second);
+    session.play();
+    EXPECT_FALSE(pollUntil(session, 1.0, [&] { return session.paused(); }))
+        << session.pauseReason();
+    session.answer(answer);
+    EXPECT_EQ(session.phase(), xp::SessionPhase::Finished);
+    EXPECT_TRUE(store.trial("P1", second).answered);
+    EXPECT_TRUE(store.trial("P1", second).sensorLog.has_value());
     writer->kill();
     ::close(fd);
     running = false;
@@ -247,6 +280,6 @@ TEST(SessionSensors, AWriterDyingMidTrialPausesTheSessionAndTheTrialIsPresentedA
                 t.audio->maxBlockMs);
 
     std::ostringstream csv;
-    EXPECT_EQ(xp::writeAudioCsv(store, csv), 1);
+    EXPECT_EQ(xp::writeAudioCsv(store, csv), 2);
     EXPECT_NE(csv.str().find(*t.sensorLog), std::string::npos);
 }
