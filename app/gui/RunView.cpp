@@ -1547,6 +1547,10 @@ void RunView::refreshProtocolStatus() {
 
 void RunView::completeLap() {
     if (!session_ || session_->lapCount() == 0) return;
+    if (paused_) {
+        setMessage(tr("Paused: press Ctrl+P to resume first."));
+        return;
+    }
     if (!session_->playing()) {
         setMessage(tr("Start the condition first (Space), then L after each lap."));
         return;
