@@ -7,6 +7,7 @@
 #include "app/wiring/Adapters.h"
 #include "app/wiring/Players.h"
 #include "engine/dsp/Random.h"
+#include "engine/io/sensors/OscGyroReceiver.h"
 #include "engine/io/sensors/ShoeProtocol.h"
 #include "engine/io/sensors/ShoeSimulator.h"
 #include "experiment/Export.h"
@@ -282,4 +283,42 @@ TEST(SessionSensors, AWriterDyingMidTrialPausesTheSessionAndTheTrialIsPresentedA
     std::ostringstream csv;
     EXPECT_EQ(xp::writeAudioCsv(store, csv), 2);
     EXPECT_NE(csv.str().find(*t.sensorLog), std::string::npos);
+}
+
+TEST(SessionSensors, GyroTrialsReportTheReceiversFaults) {
+    // A water stimulus wading with the gyroscopes, a real OSC receiver on a free port and no
+    // sender: the trial's sensor is not recordable, so the session would pause.
+    eng::LiveEngine engine;
+    eng::AudioSettings audioSettings;
+    audioSettings.sampleRateHz = 48000;
+    audioSettings.blockSize = 64;
+    engine.openOffline(audioSettings);
+    eng::OscGyroConfig gyroConfig;
+    gyroConfig.port = 0;
+    auto receiver = std::make_shared<eng::OscGyroReceiver>(gyroConfig);
+    receiver->start();
+    wir::LivePlayerOptions o;
+    o.scene.gyroReceiver = receiver;
+    wir::LivePlayer player(engine, o);
+    xp::Stimulus water;
+    water.id = "wade_gyro";
+    water.surface = "water";
+    water.input.kind = xp::InputKind::Sensor;
+    water.input.sensor = xp::SensorKind::Gyro;
+    water.wading["depth"] = std::string("deep");
+    EXPECT_FALSE(player.sensorFault()); // nothing played yet
+    player.start(water, 9);
+    const auto fault = player.sensorFault();
+    ASSERT_TRUE(fault.has_value());
+    EXPECT_EQ(fault->rfind("gyroscopes ", 0), 0u) << *fault;
+    player.stop();
+    EXPECT_TRUE(player.sensorFault()); // still the last trial's sensor: not back yet
+
+    xp::Stimulus walked = water; // the virtual gait needs no sensor
+    walked.input.kind = xp::InputKind::Walker;
+    walked.input.sensor = xp::SensorKind::None;
+    player.start(walked, 9);
+    EXPECT_FALSE(player.sensorFault());
+    player.stop();
+    receiver->stop();
 }
