@@ -15,7 +15,7 @@ printf 'stimulus,BS,GL,WD,DK\nGL,0,5,0,0\nWR,0,0,5,0\nBS,5,0,0,0\n' > confusion.
 "$underfoot" export --study walk.db -o out > /dev/null
 
 # The gravel trial: participant, trial index and render seed from the export.
-row=$(grep ',GL,gravel,' out/trials.csv | head -1)
+row=$(grep -m1 ',GL,gravel,' out/trials.csv)
 participant=$(echo "$row" | cut -d, -f5)
 trial=$(echo "$row" | cut -d, -f8)
 seed=$(echo "$row" | cut -d, -f17)

@@ -51,7 +51,7 @@ grep -q -i "naturalness" out1/scales.csv
 test "$(tail -n +2 out1/ratings.csv | wc -l)" -gt 0
 # A listening trial replays to exactly what `wade` renders with the trial's stored seed (the
 # clip's seed): protocol wading_listening uses algorithm v1 and the 5 Hz filter, 7 s clips.
-row=$(grep ',wade_deep_' out1/trials.csv | head -1)
+row=$(grep -m1 ',wade_deep_' out1/trials.csv)
 participant=$(echo "$row" | cut -d, -f5)
 trial=$(echo "$row" | cut -d, -f8)
 stimulus=$(echo "$row" | cut -d, -f11)
