@@ -75,9 +75,11 @@ QFont bigFont(const QWidget* w, double factor) {
 class ConsolePlayer final : public exp::StimulusPlayer {
   public:
     /// `clipDir` non-empty: a listening test (throws StoreError when the clips are not ready).
+    /// `injected` non-null: stimuli are presented through it instead of the live engine.
     ConsolePlayer(WalkerPlayer& meters, AudioOutput* audio, const QString& studyPath,
-                  const exp::Protocol& protocol, const QString& clipDir)
-        : meters_(meters) {
+                  const exp::Protocol& protocol, const QString& clipDir,
+                  exp::StimulusPlayer* injected)
+        : meters_(meters), injected_(injected) {
         if (!clipDir.isEmpty()) {
             exp::ClipPlayer::PlayFunction play;
             std::function<void()> stop;
@@ -91,6 +93,7 @@ class ConsolePlayer final : public exp::StimulusPlayer {
             clips_ = std::make_unique<exp::ClipPlayer>(protocol, clipDir.toStdString(), play, stop);
             return;
         }
+        if (injected_) return;
 #ifdef UNDERFOOT_HAVE_WIRING
         if (audio && audio->engine()) {
             wiring::LivePlayerOptions o;
@@ -109,6 +112,7 @@ class ConsolePlayer final : public exp::StimulusPlayer {
         if (clips_) return clips_->start(stimulus, plannedSeed);
         exp::StimulusStart started;
         started.renderSeed = plannedSeed;
+        if (injected_) started = injected_->start(stimulus, plannedSeed);
 #ifdef UNDERFOOT_HAVE_WIRING
         // Silent baseline laps: the scene is submitted only when the sound comes on.
         if (live_ && muted_)
@@ -124,11 +128,20 @@ class ConsolePlayer final : public exp::StimulusPlayer {
             clips_->stop();
             return;
         }
+        if (injected_) injected_->stop();
 #ifdef UNDERFOOT_HAVE_WIRING
         deferred_.reset();
         if (live_) live_->stop();
 #endif
         meters_.stop();
+    }
+    /// The fault of the injected player, else of the live player's sensors (shoes, gyroscopes).
+    std::optional<std::string> sensorFault() const override {
+        if (injected_) return injected_->sensorFault();
+#ifdef UNDERFOOT_HAVE_WIRING
+        if (live_) return live_->sensorFault();
+#endif
+        return std::nullopt;
     }
     /// Whether stimuli are heard (live engine) or only shown (meters).
     bool live() const {
@@ -175,6 +188,7 @@ class ConsolePlayer final : public exp::StimulusPlayer {
 
   private:
     WalkerPlayer& meters_;
+    exp::StimulusPlayer* injected_ = nullptr;
     std::unique_ptr<exp::ClipPlayer> clips_;
     bool muted_ = false;
     std::string soundError_;
@@ -493,6 +507,16 @@ void RunView::buildTrialPage() {
     pausedLabel_->setStyleSheet("QLabel { background: #ffd7d7; color: #700; padding: 6px; "
                                 "font-weight: bold; }");
     pausedLabel_->hide();
+    faultBanner_ = new QLabel(trial_);
+    faultBanner_->setWordWrap(true);
+    faultBanner_->setFont(bigFont(this, 1.3));
+    faultBanner_->setStyleSheet("QLabel { background: #c00; color: white; padding: 10px; "
+                                "font-weight: bold; }");
+    faultBanner_->setAccessibleName(tr("Sensor fault"));
+    faultBanner_->hide();
+    sensorTimer_ = new QTimer(this);
+    sensorTimer_->setInterval(100);
+    connect(sensorTimer_, &QTimer::timeout, this, [this] { pollSensors(); });
     protocolStatus_ = new QLabel(trial_);
     protocolStatus_->setWordWrap(true);
     protocolStatus_->setFont(bigFont(this, 1.15));
@@ -560,6 +584,7 @@ void RunView::buildTrialPage() {
     buttons->addWidget(stop);
     left->addLayout(buttons);
     left->addWidget(message_);
+    left->insertWidget(0, faultBanner_);
     auto* right = new QVBoxLayout;
     right->addWidget(playButton_);
     right->addWidget(pausedLabel_);
@@ -596,6 +621,7 @@ void RunView::buildTrialPage() {
     shortcut(QKeySequence(Qt::CTRL | Qt::SHIFT | Qt::Key_E), [this] { askExclusion(true); });
     shortcut(QKeySequence(Qt::CTRL | Qt::Key_W), [this] { closeSession(); });
     shortcut(QKeySequence(Qt::CTRL | Qt::Key_L), [this] { completeLap(); });
+    shortcut(QKeySequence(Qt::CTRL | Qt::SHIFT | Qt::Key_S), [this] { resumeAfterSensorFault(); });
 }
 
 bool RunView::hasResumable() const {
@@ -723,7 +749,8 @@ bool RunView::startSession(const QString& code) {
     }
     try {
         console_ = std::make_unique<ConsolePlayer>(*player_, audio_, context_.path(), protocol,
-                                                   protocol.clips.enabled ? clipDir_ : QString());
+                                                   protocol.clips.enabled ? clipDir_ : QString(),
+                                                   injected_);
     } catch (const std::exception& e) {
         startMessage_->setText(q(e.what()));
         return false;
@@ -743,6 +770,8 @@ bool RunView::startSession(const QString& code) {
     }
     startMessage_->clear();
     paused_ = false;
+    faultBanner_->hide();
+    sensorTimer_->start();
     emit context_.sessionActiveChanged(true);
     context_.notifyDataChanged();
     showPhase();
@@ -1090,6 +1119,10 @@ bool RunView::handleTrialKey(int key, Qt::KeyboardModifiers modifiers, const QSt
         return true;
     }
     if (modifiers & (Qt::ControlModifier | Qt::AltModifier | Qt::MetaModifier)) return false;
+    if (session_->paused()) {
+        setMessage(tr("Paused by a sensor fault: fix the sensor, then press Ctrl+Shift+S."));
+        return true;
+    }
     if (key == Qt::Key_Return || key == Qt::Key_Enter) {
         next();
         return true;
@@ -1149,7 +1182,7 @@ bool RunView::handleTrialKey(int key, Qt::KeyboardModifiers modifiers, const QSt
 }
 
 void RunView::play() {
-    if (!session_ || paused_) return;
+    if (!session_ || paused_ || session_->paused()) return;
     if (session_->phase() != exp::SessionPhase::Trial &&
         session_->phase() != exp::SessionPhase::Practice)
         return;
@@ -1228,6 +1261,10 @@ void RunView::next() {
     try {
         session_->answer(a);
     } catch (const std::exception& e) {
+        if (session_->paused()) {
+            showSensorFault();
+            return;
+        }
         setMessage(tr("Not stored: %1").arg(q(e.what())));
         return;
     }
@@ -1290,8 +1327,70 @@ bool RunView::revisePrevious() {
     return true;
 }
 
+bool RunView::pollSensors() {
+    if (!session_) return false;
+    const bool wasPaused = session_->paused();
+    bool paused = wasPaused;
+    try {
+        paused = session_->checkSensors();
+    } catch (const std::exception& e) {
+        // Storing the interruption failed; the session is paused all the same.
+        setMessage(tr("The interruption could not be stored: %1").arg(q(e.what())));
+        paused = session_->paused();
+    }
+    if (paused && !wasPaused) {
+        showSensorFault();
+        context_.notifyDataChanged();
+    }
+    return paused;
+}
+
+void RunView::showSensorFault() {
+    faultBanner_->setText(tr("SENSOR FAULT — trial %1 interrupted, nothing recorded:\n%2\n"
+                             "Fix the sensor, then press Ctrl+Shift+S (the trial is presented "
+                             "again).")
+                              .arg(session_->current().index + 1)
+                              .arg(q(session_->pauseReason())));
+    faultBanner_->show();
+    sectionsHost_->setEnabled(false);
+    nextButton_->setEnabled(false);
+    playButton_->setEnabled(false);
+    playButton_->setText(tr("Paused by a sensor fault"));
+    setMessage(tr("Answer keys are disabled until the sensor is back."));
+}
+
+bool RunView::resumeAfterSensorFault() {
+    if (!session_ || !session_->paused()) return false;
+    try {
+        session_->resumeAfterFault();
+    } catch (const std::exception& e) {
+        setMessage(tr("Not resumed: %1. Check the connection, then press Ctrl+Shift+S again.")
+                       .arg(q(e.what())));
+        return false;
+    }
+    faultBanner_->hide();
+    nextButton_->setEnabled(true);
+    sectionsHost_->setEnabled(!paused_);
+    showTrial();
+    play();
+    if (session_->playing())
+        setMessage(
+            tr("Sensor back: trial %1 is presented again.").arg(session_->current().index + 1),
+            false);
+    context_.notifyDataChanged();
+    return true;
+}
+
+QString RunView::sensorFaultText() const {
+    return faultBanner_->isHidden() ? QString() : faultBanner_->text();
+}
+
 void RunView::togglePause() {
     if (!session_ || pages_->currentIndex() != TrialPage) return;
+    if (session_->paused()) {
+        setMessage(tr("Paused by a sensor fault: Ctrl+Shift+S resumes once the sensor is back."));
+        return;
+    }
     paused_ = !paused_;
     player_->setPaused(paused_);
     pausedLabel_->setVisible(paused_);
@@ -1389,6 +1488,8 @@ void RunView::closeSession() {
     player_->stop();
     paused_ = false;
     pausedLabel_->hide();
+    sensorTimer_->stop();
+    faultBanner_->hide();
     sectionsHost_->setEnabled(true);
     emit context_.sessionActiveChanged(false);
     if (context_.hasStudy()) context_.notifyDataChanged();

@@ -10,6 +10,8 @@
 ///   Enter         Next: commit the answer        Alt+M   comment field (Esc leaves it)
 ///   Ctrl+P        pause / resume                 Ctrl+E  exclude this trial (with a reason)
 ///   Ctrl+Shift+E  exclude the previous trial     Ctrl+W  end the session for now (resumable)
+///   Ctrl+Shift+S  resume after a sensor fault (refused while the sensor still fails; the
+///                 interrupted trial is then presented again)
 ///   Ctrl+Z        change the previous answer (only under lock = "next_trial", before the next
 ///                 stimulus starts; Enter stores the change, Esc cancels)
 /// Listening tests ([clips]): Space presents the clip, Space or R replays it (counted); only the
@@ -36,6 +38,7 @@ class QListWidget;
 class QProgressBar;
 class QGroupBox;
 class QPlainTextEdit;
+class QTimer;
 
 namespace underfoot::gui {
 
@@ -98,6 +101,17 @@ class RunView : public QWidget {
         audio_ = output;
         autoStartAudio_ = autoStart;
     }
+    /// Presents the stimuli of the next sessions through `player` instead of the live engine
+    /// (another front end's player, or a test double); null restores the default. Not owned.
+    void setStimulusPlayer(experiment::StimulusPlayer* player) { injected_ = player; }
+    /// Asks the session whether the sensors of the playing trial failed (what the 100 ms timer
+    /// does while a trial plays); on a fault shows the banner. Returns whether it is paused.
+    bool pollSensors();
+    /// Resumes after a sensor fault (Ctrl+Shift+S) and presents the interrupted trial again;
+    /// false with the reason in the message line while the sensor still fails.
+    bool resumeAfterSensorFault();
+    /// The sensor-fault banner's text ("" when hidden).
+    QString sensorFaultText() const;
     /// The running session (nullptr when none).
     experiment::Session* session() const { return session_.get(); }
     /// The widget that receives the trial keys (answer letters, digits, Enter, Space).
@@ -146,6 +160,7 @@ class RunView : public QWidget {
     void play();
     void next();
     void togglePause();
+    void showSensorFault();
     void askExclusion(bool previous);
     void onMeter(const GrfMeter& meter);
     void setMessage(const QString& text, bool error = true);
@@ -198,6 +213,9 @@ class RunView : public QWidget {
     QPushButton* nextButton_ = nullptr;
     QPushButton* pauseButton_ = nullptr;
     QLabel* pausedLabel_ = nullptr;
+    QLabel* faultBanner_ = nullptr;
+    QTimer* sensorTimer_ = nullptr;
+    experiment::StimulusPlayer* injected_ = nullptr;
     QLineEdit* comment_ = nullptr;
     QLabel* message_ = nullptr;
     QListWidget* planList_ = nullptr;
