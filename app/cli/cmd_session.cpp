@@ -1,8 +1,19 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // `underfoot session`: runs a session headless in the terminal (answers read from stdin), or a
 // whole simulated study (--simulate) with synthetic participants answering from confusion
-// matrices.
+// matrices. With --live the stimuli play through the audio device (app/wiring LivePlayer): GRF
+// or gait recordings and the audio figures are stored with each trial, FSR shoes (--serial) and
+// gyroscopes (--osc) drive the sensor stimuli, and a sensor fault pauses the session.
 #include "app/cli/CommandRegistry.h"
+#include "app/wiring/Adapters.h"
+#include "app/wiring/Players.h"
+#include "engine/control/StepCalibration.h"
+#include "engine/control/StepGrfPlayer.h"
+#include "engine/control/StepInput.h"
+#include "engine/io/AudioDevice.h"
+#include "engine/io/sensors/OscGyroReceiver.h"
+#include "engine/io/sensors/SerialSource.h"
+#include "engine/scene/LiveEngine.h"
 #include "experiment/Clips.h"
 #include "experiment/Protocol.h"
 #include "experiment/RatingModel.h"
@@ -13,6 +24,7 @@
 #include <fmt/core.h>
 
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 
@@ -37,7 +49,109 @@ struct Options {
     std::string prefix = "S";
     std::string clips;
     std::string ratingModel;
+    // Live audio and sensors.
+    bool live = false;
+    std::string settings;   ///< audio settings TOML (`underfoot devices --save`)
+    std::string recordings; ///< folder of the trials' recordings (default: next to the study)
+    int oscPort = -1;       ///< gyroscopes (OSC/UDP) for gyro and water stimuli
+    std::string serial;     ///< FSR shoes' port
+    int baud = 500000;
+    std::string thresholds; ///< the participant's step thresholds (underfoot sensors calibrate)
+    std::uint64_t stepSeed = 1;
 };
+
+namespace eng = underfoot::engine;
+namespace wir = underfoot::wiring;
+
+std::string askLine(const std::string& prompt);
+
+/// The audio device, the sensors and the player of a live session (all optional parts stay
+/// null when not asked for). Destroyed in reverse order: player, engine, sensors.
+struct LiveRig {
+    std::shared_ptr<eng::SerialSource> shoes;
+    std::shared_ptr<eng::StepInput> steps;
+    std::shared_ptr<eng::OscGyroReceiver> gyros;
+    std::unique_ptr<eng::LiveEngine> engine;
+    std::unique_ptr<wir::LivePlayer> player;
+    ~LiveRig() {
+        player.reset();
+        if (engine) engine->close();
+        if (shoes) shoes->stop();
+        if (gyros) gyros->stop();
+    }
+};
+
+std::unique_ptr<LiveRig> openLiveRig(const Options& o) {
+    auto rig = std::make_unique<LiveRig>();
+    eng::AudioSettings settings;
+    try {
+        if (!o.settings.empty()) settings = eng::loadAudioSettings(o.settings);
+    } catch (const std::exception& e) {
+        throw UserError(std::string("session --settings: ") + e.what());
+    }
+    const std::filesystem::path studyFolder = std::filesystem::absolute(o.study).parent_path();
+    wir::LivePlayerOptions options;
+    options.studyFolder = studyFolder.string();
+    options.recordingFolder =
+        o.recordings.empty() ? (studyFolder / "recordings").string() : o.recordings;
+    try {
+        if (!o.serial.empty()) {
+            eng::SerialConfig config;
+            config.path = o.serial;
+            config.baud = o.baud;
+            rig->shoes = std::make_shared<eng::SerialSource>(config);
+            eng::StepGrfPlayerConfig playerConfig;
+            playerConfig.seed = o.stepSeed;
+            auto player = std::make_shared<eng::StepGrfPlayer>(
+                eng::StepGrfPlayer::loadDefaultBank(settings.sampleRateHz), playerConfig);
+            rig->steps = std::make_shared<eng::StepInput>(
+                o.thresholds.empty() ? eng::StepThresholds{}
+                                     : eng::loadStepThresholds(o.thresholds));
+            rig->steps->attach(*rig->shoes, player.get());
+            rig->shoes->start();
+            options.scene.fsrSource = std::make_shared<wir::StepGrfSource>(player);
+            options.shoes = rig->shoes;
+            options.shoeSteps = rig->steps;
+        }
+        if (o.oscPort >= 0) {
+            eng::OscGyroConfig config;
+            config.port = o.oscPort;
+            rig->gyros = std::make_shared<eng::OscGyroReceiver>(config);
+            rig->gyros->start();
+            options.scene.gyroReceiver = rig->gyros;
+        }
+        rig->engine = std::make_unique<eng::LiveEngine>();
+        rig->engine->open(settings);
+        rig->engine->start();
+    } catch (const UserError&) {
+        throw;
+    } catch (const std::exception& e) {
+        throw UserError(std::string("session --live: ") + e.what());
+    }
+    rig->player = std::make_unique<wir::LivePlayer>(*rig->engine, std::move(options));
+    fmt::print("live audio: {} / {} at {} Hz, block {}{}{}\n", rig->engine->openedApi(),
+               rig->engine->openedDevice(), rig->engine->settings().sampleRateHz,
+               rig->engine->settings().blockSize,
+               rig->shoes ? fmt::format(", FSR shoes on {}", o.serial) : "",
+               rig->gyros ? fmt::format(", gyroscopes on UDP {}", rig->gyros->port()) : "");
+    return rig;
+}
+
+/// While the session is paused by a sensor fault: says why, and resumes when the experimenter
+/// confirms that the sensor is back (refused, with the reason, while it still fails).
+void waitOutSensorFault(Session& session) {
+    while (session.paused()) {
+        fmt::print("\nPAUSED — {}\nThe trial will be presented again. Fix the sensor, then press "
+                   "Enter to resume. ",
+                   session.pauseReason());
+        askLine("");
+        try {
+            session.resumeAfterFault();
+        } catch (const std::logic_error& e) {
+            fmt::print("not yet: {}\n", e.what());
+        }
+    }
+}
 
 Options& opts() {
     static Options o;
@@ -105,7 +219,9 @@ int runInteractive(const Options& o) {
     StudyStore store = StudyStore::open(o.study);
     if (!o.protocol.empty()) store.verifyProtocol(loadProtocol(o.protocol));
     const Protocol& p = store.protocol();
-    SilentPlayer silent; // headless: the engine is wired in by the app
+    SilentPlayer silent; // headless, unless --live wires the engine in
+    std::unique_ptr<LiveRig> rig;
+    if (o.live && !p.clips.enabled) rig = openLiveRig(o);
     std::unique_ptr<ClipPlayer> clipPlayer;
     if (p.clips.enabled) {
         if (o.clips.empty())
@@ -116,7 +232,9 @@ int runInteractive(const Options& o) {
         clipPlayer = std::make_unique<ClipPlayer>(
             p, o.clips, [](const std::string& path) { fmt::print("  [playing {}]\n", path); });
     }
-    StimulusPlayer& player = clipPlayer ? static_cast<StimulusPlayer&>(*clipPlayer) : silent;
+    StimulusPlayer& player = clipPlayer ? static_cast<StimulusPlayer&>(*clipPlayer)
+                             : rig      ? static_cast<StimulusPlayer&>(*rig->player)
+                                        : silent;
     Session session(store, o.participant, player,
                     {o.experimenter, o.audio, o.clips.empty() ? o.sensor : "clips " + o.clips,
                      UNDERFOOT_VERSION});
@@ -178,12 +296,18 @@ int runInteractive(const Options& o) {
                 }
                 askLine("Press Enter to start the stimulus. ");
                 session.play();
+                bool faulted = false;
                 for (int lap = session.lapsDone(); lap < session.lapCount(); ++lap) {
                     askLine(
                         fmt::format("Lap {} of {} ({}). Press Enter when it is walked. ", lap + 1,
                                     session.lapCount(),
                                     session.currentLapSilent() ? "silent baseline" : "with sound"));
+                    if ((faulted = session.checkSensors())) break;
                     session.completeLap();
+                }
+                if (faulted || session.checkSensors()) {
+                    waitOutSensorFault(session);
+                    break; // the same trial again, from the start
                 }
                 while (true) {
                     TrialAnswer a;
@@ -192,6 +316,7 @@ int runInteractive(const Options& o) {
                     if (q.asksSoundscape(session.participant().groupId))
                         a.soundscapeAnswer = askOption(q.soundscapePrompt, q.soundscapeOptions);
                     if (q.comment) a.comment = askLine("comment (Enter for none)> ");
+                    if (session.checkSensors()) break; // nothing stored: the trial comes again
                     try {
                         session.answer(a);
                     } catch (const StoreError& e) {
@@ -199,6 +324,10 @@ int runInteractive(const Options& o) {
                         continue;
                     }
                     if (o.ack) fmt::print("ack {} {}\n", o.participant, t.index);
+                    break;
+                }
+                if (session.paused()) {
+                    waitOutSensorFault(session);
                     break;
                 }
                 break;
@@ -319,8 +448,28 @@ const underfoot::cli::CommandRegistrar registrar{
         cmd->add_option("--rating-model", o.ratingModel,
                         "rating model (TOML) of synthetic participants: effects per factor "
                         "level, stimulus and participant field (protocols/simulation/)");
+        cmd->add_flag("--live", o.live,
+                      "play the stimuli through the audio device (recordings and audio figures "
+                      "stored with each trial; a sensor fault pauses the session)");
+        cmd->add_option("--settings", o.settings,
+                        "audio settings file for --live (`underfoot devices --save`)");
+        cmd->add_option("--recordings", o.recordings,
+                        "folder of the trials' recordings (default: recordings/ beside the "
+                        "study)");
+        cmd->add_option("--osc", o.oscPort,
+                        "UDP port of the OSC gyroscopes (gyro and water "
+                        "stimuli)")
+            ->check(CLI::Range(0, 65535));
+        cmd->add_option("--serial", o.serial, "serial port of the FSR shoes (FSR stimuli)");
+        cmd->add_option("--baud", o.baud, "baud rate of the FSR shoes")->capture_default_str();
+        cmd->add_option("--thresholds", o.thresholds,
+                        "the participant's step thresholds (`underfoot sensors calibrate`)");
         cmd->callback([&exitCode, &o] {
             try {
+                if (!o.live && (!o.settings.empty() || o.oscPort >= 0 || !o.serial.empty() ||
+                                !o.thresholds.empty() || !o.recordings.empty()))
+                    throw UserError("session: --settings, --recordings, --osc, --serial and "
+                                    "--thresholds belong to --live");
                 if (o.simulate) {
                     exitCode = runSimulation(o);
                 } else {
