@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
-/// Re-rendering a stored trial (what `underfoot replay` does), for the Results view: the
-/// stored stimulus, render seed and GRF recording (or the stimulus's virtual walker), with the
-/// soundscape mixed in. Runs on a worker thread; opens its own connection to the study file.
+/// Re-rendering a stored trial for the Results view: app/wiring renderTrialReplay, the same
+/// render as `underfoot replay` (stored stimulus, render seed, GRF or gait recording at the live
+/// trial's rate and block size, soundscape mixed in). Runs on a worker thread; opens its own
+/// connection to the study file.
 #include <QString>
 
 namespace underfoot::gui {
@@ -16,7 +17,6 @@ struct ReplayResult {
 /// Renders trial `trialIndex` (0-based, as stored) of `participant` in `studyPath` into the WAV
 /// file `output`; a walker-driven trial walks for `walkSeconds`.
 ReplayResult renderTrial(const QString& studyPath, const QString& participant, int trialIndex,
-                         const QString& output, double walkSeconds = 8.0,
-                         double sampleRateHz = 48000.0);
+                         const QString& output, double walkSeconds = 8.0);
 
 } // namespace underfoot::gui

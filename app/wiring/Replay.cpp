@@ -1,0 +1,159 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "app/wiring/Replay.h"
+
+#include "app/wiring/Players.h"
+#include "engine/control/GrfFile.h"
+#include "engine/render/Renderer.h"
+#include "engine/wading/Gait.h"
+#include "engine/wading/Wading.h"
+#include "experiment/Clips.h"
+#include "experiment/Store.h"
+#include "soundscapes/Library.h"
+#include "soundscapes/Renderer.h"
+
+#include <fmt/format.h>
+#include <toml++/toml.h>
+
+#include <filesystem>
+#include <vector>
+
+namespace underfoot::wiring {
+namespace {
+
+namespace eng = underfoot::engine;
+namespace exp = underfoot::experiment;
+namespace fs = std::filesystem;
+
+/// What the live engine wrote next to a trial's recording (LivePlayer).
+struct LiveRun {
+    std::optional<double> rate;
+    std::optional<int> blockSize;
+};
+
+LiveRun readMetersFile(const fs::path& recording) {
+    LiveRun run;
+    const fs::path meters = recording.string() + ".meters.toml";
+    if (!fs::exists(meters)) return run;
+    try {
+        const toml::table t = toml::parse_file(meters.string());
+        if (auto r = t["sample_rate"].value<double>(); r && *r > 0) run.rate = *r;
+        if (auto b = t["block_size"].value<std::int64_t>(); b && *b > 0 && *b <= 65536)
+            run.blockSize = static_cast<int>(*b);
+    } catch (const toml::parse_error& e) {
+        throw ReplayError(fmt::format("{}:{}:{}: {}", meters.string(), e.source().begin.line,
+                                      e.source().begin.column, e.description()));
+    }
+    return run;
+}
+
+} // namespace
+
+ReplayRender renderTrialReplay(const ReplayRequest& q) {
+    exp::ReplayInfo info;
+    try {
+        const auto store = exp::StudyStore::open(q.study);
+        info = store.trialForReplay(q.participant, q.trial);
+    } catch (const std::exception& e) {
+        throw ReplayError(e.what());
+    }
+    const auto& stimulus = info.stimulus;
+    if (stimulus.clip)
+        throw ReplayError(fmt::format(
+            "trial {} of {} played the lab-supplied clip `{}` (in the study's clip folder); that "
+            "file is what was heard, nothing is rendered for it",
+            q.trial, q.participant, *stimulus.clip));
+    std::optional<fs::path> recording;
+    LiveRun live;
+    if (info.grfRecording) {
+        recording = fs::path(*info.grfRecording);
+        if (recording->is_relative()) recording = fs::path(q.study).parent_path() / *recording;
+        live = readMetersFile(*recording);
+    }
+    ReplayRender out;
+    out.seed = info.renderSeed;
+    out.sampleRateHz = q.sampleRateHz.value_or(live.rate.value_or(48000.0));
+    out.blockSize = q.blockSize.value_or(live.blockSize.value_or(256));
+    const double rate = out.sampleRateHz;
+    if (!(rate >= 8000 && rate <= 384000))
+        throw ReplayError(fmt::format("sample rate {} Hz: expected 8000 to 384000", rate));
+    if (out.blockSize < 1 || out.blockSize > 65536)
+        throw ReplayError(fmt::format("block size {}: expected 1 to 65536", out.blockSize));
+
+    try {
+        if (!stimulus.wading.empty() || stimulus.surface == "water") {
+            // Wading: the recorded gait of a live trial, else the virtual gait of the stimulus.
+            eng::WadingOptions options =
+                eng::wadingOptionsFromParameters(exp::parameterStrings(stimulus.wading));
+            options.seed = info.renderSeed;
+            options.sampleRateHz = rate;
+            std::string source;
+            if (recording) {
+                out.audio = eng::renderWading(options, eng::readGaitCsv(recording->string()));
+                source = "recorded gait " + recording->string();
+            } else {
+                out.audio = eng::renderWading(options, q.walkSeconds);
+                source = fmt::format("virtual gait, {} steps/min", options.cadenceStepsPerMin);
+            }
+            out.description =
+                fmt::format("{} trial {} (wading): {:.1f} s from {}, seed {}", info.participant,
+                            info.trialIndex, double(out.audio.frames()) / rate, source, out.seed);
+            return out;
+        }
+
+        eng::GrfSignal grf;
+        std::string source;
+        if (recording) {
+            eng::GrfLoadOptions options;
+            options.targetRateHz = rate;
+            try {
+                grf = eng::loadGrfFile(recording->string(), options);
+            } catch (const std::exception& e) {
+                throw ReplayError(std::string("the trial's GRF recording: ") + e.what());
+            }
+            source = "recorded GRF " + recording->string();
+        } else if (stimulus.input.kind == exp::InputKind::Walker) {
+            const auto walker = walkerFromStimulus(stimulus.input.walker);
+            grf = eng::walkerGrf(walker, q.walkSeconds, rate, info.renderSeed);
+            source = "virtual walker " + walker.toString();
+        } else {
+            throw ReplayError(fmt::format(
+                "trial {} of {} was driven by a live sensor and no GRF recording is stored for "
+                "it, so what was heard cannot be re-rendered exactly",
+                q.trial, q.participant));
+        }
+        eng::RenderOptions options;
+        options.sampleRateHz = rate;
+        options.blockSize = out.blockSize;
+        options.seed = info.renderSeed;
+        options.tailSeconds = 1.0;
+        if (stimulus.reverb) options.scene.impulseResponse = *stimulus.reverb;
+        eng::RenderResult r = eng::renderSurface(stimulus.surface, grf, options);
+        if (stimulus.soundscape) {
+            // The background as the participant heard it: same seed, calibrated level.
+            soundscapes::SoundscapeRenderer ambience(
+                soundscapes::loadSoundscape(*stimulus.soundscape));
+            ambience.prepare({rate, 1024});
+            ambience.reset(info.renderSeed);
+            const std::size_t n = r.audio.frames();
+            std::vector<float> l(n), rr(n);
+            ambience.process(l.data(), rr.data(), static_cast<int>(n));
+            for (std::size_t i = 0; i < n; ++i) {
+                r.audio.samples[2 * i] += l[i];
+                r.audio.samples[2 * i + 1] += rr[i];
+            }
+        }
+        out.audio = std::move(r.audio);
+        out.description =
+            fmt::format("{} trial {} ({}{}{}): {:.1f} s from {}, render seed {}, block {}",
+                        info.participant, info.trialIndex, stimulus.surface,
+                        stimulus.soundscape ? " + " : "", stimulus.soundscape.value_or(""),
+                        double(out.audio.frames()) / rate, source, out.seed, out.blockSize);
+        return out;
+    } catch (const ReplayError&) {
+        throw;
+    } catch (const std::exception& e) {
+        throw ReplayError(e.what());
+    }
+}
+
+} // namespace underfoot::wiring

@@ -1,0 +1,45 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+/// Re-rendering a stored trial: what `underfoot replay` writes and the console's Results view
+/// plays. From the study: the stimulus, the render seed and the trial's recording — a GRF
+/// (footsteps) or a gait (wading) recorded live, else the stimulus's virtual walker or gait —
+/// rendered at the sample rate and block size the live engine ran at (read from the recording's
+/// `.meters.toml`; the surfaces decide per block, so only the live block size reproduces a live
+/// trial exactly), with the soundscape mixed in as the live scene mixed it.
+#include "engine/io/AudioFile.h"
+
+#include <cstdint>
+#include <optional>
+#include <stdexcept>
+#include <string>
+
+namespace underfoot::wiring {
+
+/// A trial that cannot be re-rendered, or a broken file; the message says which and why.
+class ReplayError : public std::runtime_error {
+  public:
+    using std::runtime_error::runtime_error;
+};
+
+struct ReplayRequest {
+    std::string study;       ///< study file (.db)
+    std::string participant; ///< participant code
+    int trial = 0;           ///< trial index as stored (0-based; the export's trial_index)
+    double walkSeconds = 10; ///< length when a virtual walker or gait drove the trial
+    std::optional<double> sampleRateHz; ///< default: the live trial's, else 48 kHz
+    std::optional<int> blockSize;       ///< default: the live trial's, else 256
+};
+
+struct ReplayRender {
+    engine::AudioBuffer audio; ///< stereo
+    std::string description;   ///< "P01 trial 3 (gravel + forest): 8.0 s from ..., seed ..."
+    std::uint64_t seed = 0;
+    double sampleRateHz = 0;
+    int blockSize = 0;
+};
+
+/// Renders one stored trial. Throws ReplayError with a message naming the study, the trial and
+/// what is missing (a live sensor trial without recording, a lab-supplied clip, a bad file).
+ReplayRender renderTrialReplay(const ReplayRequest& request);
+
+} // namespace underfoot::wiring
