@@ -8,6 +8,7 @@
 #include "engine/scene/LiveEngine.h"
 #include "tests/common/AllocationTrap.h"
 #include "tests/common/ScratchDir.h"
+#include "tests/live/audio/JackDummyServer.h"
 
 #include <gtest/gtest.h>
 
@@ -25,8 +26,6 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-extern char** environ;
-
 namespace eng = underfoot::engine;
 using namespace std::chrono_literals;
 
@@ -34,90 +33,26 @@ namespace {
 
 constexpr int kPeriod = 64;
 
-std::string findProgram(const std::string& name) {
-    const char* path = std::getenv("PATH");
-    std::string p = path ? path : "/usr/bin:/bin";
-    std::size_t start = 0;
-    while (start <= p.size()) {
-        const std::size_t colon = std::min(p.find(':', start), p.size());
-        const auto candidate = std::filesystem::path(p.substr(start, colon - start)) / name;
-        if (access(candidate.c_str(), X_OK) == 0) return candidate.string();
-        start = colon + 1;
-    }
-    return {};
-}
+using underfoot::test::findProgram;
 
-/// Runs a command (argv) to completion; returns its exit status and stdout.
 int run(const std::vector<std::string>& args, std::string* output = nullptr) {
-    std::string cmd;
-    for (const auto& a : args) cmd += "'" + a + "' ";
-    cmd += "2>&1";
-    FILE* f = popen(cmd.c_str(), "r");
-    if (!f) return -1;
-    char buf[512];
-    std::string out;
-    while (std::fgets(buf, sizeof buf, f)) out += buf;
-    const int status = pclose(f);
-    if (output) *output = out;
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    return underfoot::test::runProgram(args, output);
 }
 
 class JackServer : public ::testing::Test {
   protected:
     static void SetUpTestSuite() {
-        jackd_ = findProgram("jackd");
-        if (jackd_.empty()) return;
-        serverName_ = "underfoot_test_" + std::to_string(getpid());
-        setenv("JACK_DEFAULT_SERVER", serverName_.c_str(), 1);
-        setenv("JACK_NO_START_SERVER", "1", 1);
-        std::vector<std::string> args{jackd_, "--no-realtime",         "-d", "dummy", "-r", "48000",
-                                      "-p",   std::to_string(kPeriod), "-C", "4",     "-P", "6"};
-        std::vector<char*> argv;
-        for (auto& a : args) argv.push_back(a.data());
-        argv.push_back(nullptr);
-        const auto log = underfoot::test::scratchDir("live_jack") / "jackd.log";
-        // fork + exec rather than posix_spawn: the server must die with this program even when
-        // a test crashes (PR_SET_PDEATHSIG), so no orphaned server outlives a failed run.
-        const pid_t parent = getpid();
-        pid_ = fork();
-        if (pid_ == 0) {
-            prctl(PR_SET_PDEATHSIG, SIGTERM);
-            if (getppid() != parent) _exit(127); // the parent died before prctl
-            const int fd = open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-            if (fd >= 0) {
-                dup2(fd, 1);
-                dup2(fd, 2);
-                close(fd);
-            }
-            execve(jackd_.c_str(), argv.data(), environ);
-            _exit(127);
-        }
-        // Wait (up to 10 s) until the server lists the dummy driver's ports.
-        for (int i = 0; i < 100 && pid_ > 0; ++i) {
-            std::string out;
-            if (run({findProgram("jack_lsp")}, &out) == 0 &&
-                out.find("system:playback_6") != std::string::npos) {
-                ready_ = true;
-                break;
-            }
-            std::this_thread::sleep_for(100ms);
-        }
+        server_ = new underfoot::test::JackDummyServer(
+            "underfoot_test", underfoot::test::scratchDir("live_jack") / "jackd.log", kPeriod);
+        serverName_ = server_->name();
+        ready_ = server_->ready();
     }
     static void TearDownTestSuite() {
-        if (pid_ > 0) {
-            kill(pid_, SIGTERM);
-            int status = 0;
-            for (int i = 0; i < 50 && waitpid(pid_, &status, WNOHANG) == 0; ++i)
-                std::this_thread::sleep_for(100ms);
-            if (waitpid(pid_, &status, WNOHANG) == 0) {
-                kill(pid_, SIGKILL);
-                waitpid(pid_, &status, 0);
-            }
-            pid_ = -1;
-        }
+        delete server_;
+        server_ = nullptr;
     }
     void SetUp() override {
-        if (jackd_.empty()) GTEST_SKIP() << "jackd is not installed (Debian package jackd2)";
+        if (!server_->installed()) GTEST_SKIP() << "jackd is not installed (Debian package jackd2)";
         ASSERT_TRUE(ready_) << "jackd (server " << serverName_
                             << ") did not come up within 10 s; see its log in the scratch dir";
     }
@@ -138,13 +73,13 @@ class JackServer : public ::testing::Test {
         return s;
     }
 
-    static std::string jackd_, serverName_;
-    static pid_t pid_;
+    static underfoot::test::JackDummyServer* server_;
+    static std::string serverName_;
     static bool ready_;
 };
 
-std::string JackServer::jackd_, JackServer::serverName_;
-pid_t JackServer::pid_ = -1;
+underfoot::test::JackDummyServer* JackServer::server_ = nullptr;
+std::string JackServer::serverName_;
 bool JackServer::ready_ = false;
 
 /// Waits until the engine has processed `frames` more frames (the dummy driver drops cycles

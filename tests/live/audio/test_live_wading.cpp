@@ -12,6 +12,7 @@
 #include "engine/scene/WadingNode.h"
 #include "tests/common/AllocationTrap.h"
 #include "tests/common/ScratchDir.h"
+#include "tests/live/audio/JackDummyServer.h"
 
 #include <gtest/gtest.h>
 #include <lo/lo.h>
@@ -31,12 +32,9 @@
 #include <arpa/inet.h>
 #include <fcntl.h>
 #include <netinet/in.h>
-#include <spawn.h>
 #include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
-
-extern char** environ;
 
 namespace eng = underfoot::engine;
 using namespace std::chrono_literals;
@@ -47,75 +45,21 @@ namespace {
 constexpr int kPeriod = 64;
 constexpr double kBlockMs = 1000.0 * kPeriod / 48000.0;
 
-std::string findProgram(const std::string& name) {
-    const char* path = std::getenv("PATH");
-    std::string p = path ? path : "/usr/bin:/bin";
-    std::size_t start = 0;
-    while (start <= p.size()) {
-        const std::size_t colon = std::min(p.find(':', start), p.size());
-        const auto candidate = std::filesystem::path(p.substr(start, colon - start)) / name;
-        if (access(candidate.c_str(), X_OK) == 0) return candidate.string();
-        start = colon + 1;
-    }
-    return {};
-}
-
-bool jackPortsListed() {
-    FILE* f = popen(("'" + findProgram("jack_lsp") + "' 2>&1").c_str(), "r");
-    if (!f) return false;
-    char buf[512];
-    std::string out;
-    while (std::fgets(buf, sizeof buf, f)) out += buf;
-    const int status = pclose(f);
-    return WIFEXITED(status) && WEXITSTATUS(status) == 0 &&
-           out.find("system:playback_6") != std::string::npos;
-}
 
 class WadingJack : public ::testing::Test {
   protected:
     static void SetUpTestSuite() {
-        jackd_ = findProgram("jackd");
-        if (jackd_.empty()) return;
-        serverName_ = "underfoot_wade_" + std::to_string(getpid());
-        setenv("JACK_DEFAULT_SERVER", serverName_.c_str(), 1);
-        setenv("JACK_NO_START_SERVER", "1", 1);
-        std::vector<std::string> args{jackd_, "--no-realtime",         "-d", "dummy", "-r", "48000",
-                                      "-p",   std::to_string(kPeriod), "-C", "4",     "-P", "6"};
-        std::vector<char*> argv;
-        for (auto& a : args) argv.push_back(a.data());
-        argv.push_back(nullptr);
-        const auto log = underfoot::test::scratchDir("live_wading") / "jackd.log";
-        posix_spawn_file_actions_t actions;
-        posix_spawn_file_actions_init(&actions);
-        posix_spawn_file_actions_addopen(&actions, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
-                                         0644);
-        posix_spawn_file_actions_adddup2(&actions, 1, 2);
-        if (posix_spawn(&pid_, jackd_.c_str(), &actions, nullptr, argv.data(), environ) != 0)
-            pid_ = -1;
-        posix_spawn_file_actions_destroy(&actions);
-        for (int i = 0; i < 100 && pid_ > 0; ++i) {
-            if (jackPortsListed()) {
-                ready_ = true;
-                break;
-            }
-            std::this_thread::sleep_for(100ms);
-        }
+        server_ = new underfoot::test::JackDummyServer(
+            "underfoot_wade", underfoot::test::scratchDir("live_wading") / "jackd.log", kPeriod);
+        serverName_ = server_->name();
+        ready_ = server_->ready();
     }
     static void TearDownTestSuite() {
-        if (pid_ > 0) {
-            kill(pid_, SIGTERM);
-            int status = 0;
-            for (int i = 0; i < 50 && waitpid(pid_, &status, WNOHANG) == 0; ++i)
-                std::this_thread::sleep_for(100ms);
-            if (waitpid(pid_, &status, WNOHANG) == 0) {
-                kill(pid_, SIGKILL);
-                waitpid(pid_, &status, 0);
-            }
-            pid_ = -1;
-        }
+        delete server_;
+        server_ = nullptr;
     }
     void SetUp() override {
-        if (jackd_.empty()) GTEST_SKIP() << "jackd is not installed (Debian package jackd2)";
+        if (!server_->installed()) GTEST_SKIP() << "jackd is not installed (Debian package jackd2)";
         ASSERT_TRUE(ready_) << "jackd (server " << serverName_ << ") did not come up within 10 s";
     }
     static eng::AudioSettings settings(const std::string& client) {
@@ -130,13 +74,13 @@ class WadingJack : public ::testing::Test {
         s.portConnection = eng::AudioSettings::PortConnection::Manual;
         return s;
     }
-    static std::string jackd_, serverName_;
-    static pid_t pid_;
+    static underfoot::test::JackDummyServer* server_;
+    static std::string serverName_;
     static bool ready_;
 };
 
-std::string WadingJack::jackd_, WadingJack::serverName_;
-pid_t WadingJack::pid_ = -1;
+underfoot::test::JackDummyServer* WadingJack::server_ = nullptr;
+std::string WadingJack::serverName_;
 bool WadingJack::ready_ = false;
 
 // --- what the callback hooks observe (audio thread; plain atomics, no allocation)
