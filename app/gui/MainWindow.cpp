@@ -38,6 +38,10 @@ MainWindow::MainWindow(const Options& options, QWidget* parent) : QMainWindow(pa
     run_->setAudioOutput(audio_, options.startAudio);
     results_->setAudioOutput(audio_);
     setup_ = new SetupView(*audio_, dataDir_, this);
+    run_->setSensorProvider([this] {
+        return LiveSensors{setup_->connectedShoes(), setup_->gyroReceiver(),
+                           setup_->thresholdsDir()};
+    });
     tabs_->addTab(study_, tr("&Study"));
     tabs_->addTab(run_, tr("&Run"));
     tabs_->addTab(results_, tr("R&esults"));

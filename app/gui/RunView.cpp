@@ -7,8 +7,14 @@
 #include "experiment/Catalogue.h"
 #include "experiment/Clips.h"
 #ifdef UNDERFOOT_HAVE_WIRING
+#include "app/wiring/Adapters.h"
 #include "app/wiring/ClipPlayer.h"
 #include "app/wiring/Players.h"
+#include "engine/control/StepCalibration.h"
+#include "engine/control/StepGrfPlayer.h"
+#include "engine/control/StepInput.h"
+#include "engine/io/sensors/OscGyroReceiver.h"
+#include "engine/io/sensors/SerialSource.h"
 #endif
 
 #include <QFileDialog>
@@ -76,16 +82,21 @@ class ConsolePlayer final : public exp::StimulusPlayer {
   public:
     /// `clipDir` non-empty: a listening test (throws StoreError when the clips are not ready).
     /// `injected` non-null: stimuli are presented through it instead of the live engine.
-    ConsolePlayer(WalkerPlayer& meters, AudioOutput* audio, const QString& studyPath,
+    /// `engine` non-null: stimuli play through it; the `sensors` connected in the Setup view
+    /// then drive FSR stimuli (the shoes' steps, detected with `participant`'s thresholds, choose
+    /// the GRFs) and water stimuli (the gyroscopes). Throws when the thresholds file is broken
+    /// or the shoes cannot be reopened.
+    ConsolePlayer(WalkerPlayer& meters, engine::LiveEngine* engine, const QString& studyPath,
                   const exp::Protocol& protocol, const QString& clipDir,
-                  exp::StimulusPlayer* injected)
+                  exp::StimulusPlayer* injected, const LiveSensors& sensors,
+                  const std::string& participant)
         : meters_(meters), injected_(injected) {
         if (!clipDir.isEmpty()) {
             exp::ClipPlayer::PlayFunction play;
             std::function<void()> stop;
 #ifdef UNDERFOOT_HAVE_WIRING
-            if (audio && audio->engine()) {
-                clipAudio_ = std::make_unique<wiring::ClipAudio>(*audio->engine());
+            if (engine) {
+                clipAudio_ = std::make_unique<wiring::ClipAudio>(*engine);
                 play = [this](const std::string& path) { clipAudio_->play(path); };
                 stop = [this] { clipAudio_->stop(); };
             }
@@ -95,17 +106,38 @@ class ConsolePlayer final : public exp::StimulusPlayer {
         }
         if (injected_) return;
 #ifdef UNDERFOOT_HAVE_WIRING
-        if (audio && audio->engine()) {
+        if (engine) {
             wiring::LivePlayerOptions o;
             const QDir dir = QFileInfo(studyPath).dir();
             o.studyFolder = dir.path().toStdString();
             o.recordingFolder = dir.filePath("grf_recordings").toStdString();
             QDir().mkpath(QString::fromStdString(o.recordingFolder));
-            live_ = std::make_unique<wiring::LivePlayer>(*audio->engine(), o);
+            if (sensors.shoes) attachShoes(*engine, sensors, participant, o);
+            o.scene.gyroReceiver = sensors.gyros;
+            gyros_ = sensors.gyros;
+            live_ = std::make_unique<wiring::LivePlayer>(*engine, o);
         }
 #else
-        (void)audio;
+        (void)engine;
         (void)studyPath;
+        (void)sensors;
+        (void)participant;
+#endif
+    }
+    ConsolePlayer(const ConsolePlayer&) = delete;
+    ConsolePlayer& operator=(const ConsolePlayer&) = delete;
+    /// Hands the shoes back to the Setup view: the step detector is detached (the port is
+    /// reopened without it; a failure shows in the Setup view's status line).
+    ~ConsolePlayer() override {
+#ifdef UNDERFOOT_HAVE_WIRING
+        live_.reset();
+        if (!shoes_) return;
+        shoes_->stop();
+        shoes_->setFrameCallback({});
+        try {
+            shoes_->start();
+        } catch (const std::exception&) {
+        }
 #endif
     }
     exp::StimulusStart start(const exp::Stimulus& stimulus, std::uint64_t plannedSeed) override {
@@ -142,6 +174,17 @@ class ConsolePlayer final : public exp::StimulusPlayer {
         if (live_) return live_->sensorFault();
 #endif
         return std::nullopt;
+    }
+    /// The sensors this session's trials may use, for the session record.
+    std::string sensorConfig() const {
+        std::string text;
+#ifdef UNDERFOOT_HAVE_WIRING
+        if (shoes_) text = "FSR shoes on " + shoes_->config().path;
+        if (live_ && gyros_)
+            text += (text.empty() ? "" : ", ") +
+                    ("OSC gyroscopes on UDP " + std::to_string(gyros_->port()));
+#endif
+        return text.empty() ? std::string("none") : text;
     }
     /// Whether stimuli are heard (live engine) or only shown (meters).
     bool live() const {
@@ -193,6 +236,41 @@ class ConsolePlayer final : public exp::StimulusPlayer {
     bool muted_ = false;
     std::string soundError_;
 #ifdef UNDERFOOT_HAVE_WIRING
+    /// What `underfoot session --live` builds (app/cli/cmd_session.cpp): a StepGrfPlayer with
+    /// the default bank at the engine's rate, a StepInput with the participant's thresholds
+    /// attached to the shoes (reopened, since the callback is set while stopped), the player as
+    /// the scene's FSR source, and the shoes and steps for the sensor log.
+    void attachShoes(engine::LiveEngine& engine, const LiveSensors& sensors,
+                     const std::string& participant, wiring::LivePlayerOptions& o) {
+        namespace eng = underfoot::engine;
+        const QString path =
+            QDir(sensors.thresholdsDir).filePath(QString::fromStdString(participant) + ".toml");
+        const eng::StepThresholds thresholds = QFileInfo::exists(path)
+                                                   ? eng::loadStepThresholds(path.toStdString())
+                                                   : eng::StepThresholds{};
+        auto player = std::make_shared<eng::StepGrfPlayer>(
+            eng::StepGrfPlayer::loadDefaultBank(engine.settings().sampleRateHz),
+            eng::StepGrfPlayerConfig{});
+        auto steps = std::make_shared<eng::StepInput>(thresholds);
+        sensors.shoes->stop();
+        steps->attach(*sensors.shoes, player.get());
+        try {
+            sensors.shoes->start();
+        } catch (...) {
+            sensors.shoes->setFrameCallback({}); // `steps` dies with this exception
+            throw;
+        }
+        shoes_ = sensors.shoes; // from here the destructor detaches the steps again
+        steps_ = steps;
+        stepPlayer_ = player;
+        o.scene.fsrSource = std::make_shared<wiring::StepGrfSource>(player);
+        o.shoes = sensors.shoes;
+        o.shoeSteps = steps;
+    }
+    std::shared_ptr<engine::SerialSource> shoes_;
+    std::shared_ptr<engine::StepInput> steps_;
+    std::shared_ptr<engine::StepGrfPlayer> stepPlayer_;
+    std::shared_ptr<engine::OscGyroReceiver> gyros_;
     std::unique_ptr<wiring::LivePlayer> live_;
     std::unique_ptr<wiring::ClipAudio> clipAudio_;
     std::optional<std::pair<exp::Stimulus, std::uint64_t>> deferred_;
@@ -748,17 +826,23 @@ bool RunView::startSession(const QString& code) {
         }
     }
     try {
-        console_ = std::make_unique<ConsolePlayer>(*player_, audio_, context_.path(), protocol,
+        engine::LiveEngine* liveEngine =
+            engineOverride_ ? engineOverride_ : (audio_ ? audio_->engine() : nullptr);
+        console_ = std::make_unique<ConsolePlayer>(*player_, liveEngine, context_.path(), protocol,
                                                    protocol.clips.enabled ? clipDir_ : QString(),
-                                                   injected_);
+                                                   injected_, sensors_ ? sensors_() : LiveSensors{},
+                                                   code.toStdString());
     } catch (const std::exception& e) {
         startMessage_->setText(q(e.what()));
         return false;
     }
     settings.audioConfig =
-        console_->live() ? ("underfoot-gui live engine: " + audio_->description()).toStdString()
+        console_->live() ? ("underfoot-gui live engine: " + (audio_ && !engineOverride_
+                                                                 ? audio_->description()
+                                                                 : QString("set by setLiveEngine")))
+                               .toStdString()
                          : std::string("underfoot-gui without audio output (walker meters only)");
-    settings.sensorConfig = "none";
+    settings.sensorConfig = console_->sensorConfig();
     settings.appVersion = UNDERFOOT_VERSION;
     try {
         session_ = std::make_unique<exp::Session>(context_.store(), code.toStdString(), *console_,
@@ -872,7 +956,10 @@ void RunView::showTrial() {
                                               : tr("Start stimulus  (Space)"));
     refreshProtocolStatus();
     engineLabel_->setText(
-        console_ && console_->live() ? tr("Audio: %1").arg(audio_->description())
+        console_ && console_->live()
+            ? tr("Audio: %1")
+                  .arg(audio_ && !engineOverride_ ? audio_->description()
+                                                  : QString("set by setLiveEngine"))
         : !audioError_.isEmpty()
             ? tr("Audio output failed to start, the stimulus is not heard: %1").arg(audioError_)
             : tr("Audio output not started (Setup view, Ctrl+5): the stimulus "

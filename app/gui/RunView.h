@@ -22,6 +22,7 @@
 
 #include <QWidget>
 
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -40,7 +41,23 @@ class QGroupBox;
 class QPlainTextEdit;
 class QTimer;
 
+namespace underfoot::engine {
+class SerialSource;
+class OscGyroReceiver;
+class LiveEngine;
+} // namespace underfoot::engine
+
 namespace underfoot::gui {
+
+/// The sensors a session may use (the Setup view's connections; null when not connected).
+struct LiveSensors {
+    /// Connected, started FSR shoes; a session takes their frames while it runs.
+    std::shared_ptr<engine::SerialSource> shoes;
+    /// The listening OSC gyroscope receiver (water stimuli with the gyro input).
+    std::shared_ptr<engine::OscGyroReceiver> gyros;
+    /// Folder of the participants' step thresholds (`<code>.toml`; defaults when absent).
+    QString thresholdsDir;
+};
 
 class StudyContext;
 class WalkerPlayer;
@@ -104,6 +121,13 @@ class RunView : public QWidget {
     /// Presents the stimuli of the next sessions through `player` instead of the live engine
     /// (another front end's player, or a test double); null restores the default. Not owned.
     void setStimulusPlayer(experiment::StimulusPlayer* player) { injected_ = player; }
+    /// Where a session start finds the connected sensors (MainWindow: the Setup view's).
+    void setSensorProvider(std::function<LiveSensors()> provider) {
+        sensors_ = std::move(provider);
+    }
+    /// Plays through `engine` instead of the audio output's (tests: an engine driven offline);
+    /// null restores the default. Not owned.
+    void setLiveEngine(engine::LiveEngine* engine) { engineOverride_ = engine; }
     /// Asks the session whether the sensors of the playing trial failed (what the 100 ms timer
     /// does while a trial plays); on a fault shows the banner. Returns whether it is paused.
     bool pollSensors();
@@ -172,6 +196,8 @@ class RunView : public QWidget {
     bool autoStartAudio_ = false;
     QString audioError_;
     std::unique_ptr<ConsolePlayer> console_;
+    std::function<LiveSensors()> sensors_;
+    engine::LiveEngine* engineOverride_ = nullptr;
     std::unique_ptr<experiment::Session> session_;
     QStackedWidget* pages_ = nullptr;
 

@@ -203,7 +203,12 @@ SetupView::SetupView(AudioOutput& audio, const QString& dataDir, QWidget* parent
     form->addWidget(seconds_, 1, 1);
     form->addWidget(partLabel, 1, 2);
     form->addWidget(participant_, 1, 3);
+    connectShoes_ = new QPushButton(tr("Connect shoes  (Ctrl+Shift+B)"), calBox);
+    connectShoes_->setAccessibleName(tr("Connect the shoes for the sessions"));
+    connectShoes_->setToolTip(tr("Keeps the shoes' port open: the Run view's FSR stimuli then "
+                                 "follow the participant's steps"));
     auto* calButtons = new QHBoxLayout;
+    calButtons->addWidget(connectShoes_);
     calButtons->addWidget(record_);
     calButtons->addWidget(saveThr);
     sensorStatus_ = new QLabel(tr("Shoes: not connected."), calBox);
@@ -263,8 +268,13 @@ SetupView::SetupView(AudioOutput& audio, const QString& dataDir, QWidget* parent
     sensorTimer_ = new QTimer(this);
     sensorTimer_->setInterval(100);
     connect(sensorTimer_, &QTimer::timeout, this, &SetupView::pollSerial);
+    connect(connectShoes_, &QPushButton::clicked, this, [this] { toggleShoes(); });
+    auto* scShoes = new QShortcut(QKeySequence(Qt::CTRL | Qt::SHIFT | Qt::Key_B), this);
+    scShoes->setContext(Qt::WidgetWithChildrenShortcut);
+    connect(scShoes, &QShortcut::activated, connectShoes_, &QPushButton::click);
     connect(record_, &QPushButton::clicked, this, [this] {
-        if (port_->currentData().toString().isEmpty() && port_->currentText() == port_->itemText(0))
+        if (!shoes_ && port_->currentData().toString().isEmpty() &&
+            port_->currentText() == port_->itemText(0))
             calibrateSimulated();
         else
             toggleSerialRecording();
@@ -444,6 +454,9 @@ QString SetupView::toggleTestTone() {
 
 QString SetupView::toggleGyroListening() {
     if (gyro_) {
+        if (gyro_.use_count() > 1)
+            return tr("Gyroscopes: the running session uses them; finish or abandon it in the "
+                      "Run view before you stop listening.");
         gyroTimer_->stop();
         gyro_->stop();
         gyro_.reset();
@@ -453,7 +466,7 @@ QString SetupView::toggleGyroListening() {
     }
     eng::OscGyroConfig config;
     config.port = gyroPortBox_->value();
-    auto receiver = std::make_unique<eng::OscGyroReceiver>(config);
+    auto receiver = std::make_shared<eng::OscGyroReceiver>(config);
     try {
         receiver->start();
     } catch (const std::exception& e) {
@@ -478,10 +491,12 @@ QString SetupView::gyroStatusText() const {
 
 void SetupView::pollGyro() {
     if (!gyro_) return;
-    // Status only here: the samples are drained so that the queue never reports drops.
+    // Status only here: the samples are drained so that the queue never reports drops, except
+    // while a session holds the receiver (its water scenes are then the only reader).
     eng::GyroSample sample;
-    while (gyro_->popSample(sample)) {
-    }
+    if (gyro_.use_count() == 1)
+        while (gyro_->popSample(sample)) {
+        }
     const auto st = gyro_->status();
     QStringList limbs;
     for (std::size_t i = 0; i < eng::kLimbCount; ++i) {
@@ -531,45 +546,117 @@ bool SetupView::calibrateSimulated() {
 }
 
 void SetupView::toggleSerialRecording() {
-    if (serial_) {
-        sensorTimer_->stop();
-        serial_->stop();
-        serial_.reset();
+    if (recordingActive_) {
+        recordingActive_ = false;
         record_->setText(tr("Record and cali&brate  (Ctrl+B)"));
+        if (disconnectAfterRecording_) disconnectShoes();
         if (!recording_.empty()) calibrate(recording_, -1);
         return;
+    }
+    if (shoesInSession()) {
+        sensorStatus_->setText(tr("The shoes are in use by the running session (its trials read "
+                                  "their frames). Finish or abandon the session in the Run view, "
+                                  "then record the calibration."));
+        return;
+    }
+    disconnectAfterRecording_ = !shoes_;
+    if (!shoes_ && !connectShoesNow().isEmpty()) return;
+    eng::ShoeFrame f;
+    while (shoes_->popFrame(f)) {
+    }
+    recording_.clear();
+    recordUntilS_ = -1;
+    recordingActive_ = true;
+    record_->setText(tr("Stop and cali&brate  (Ctrl+B)"));
+}
+
+QString SetupView::connectShoesNow() {
+    const bool simulated =
+        port_->currentData().toString().isEmpty() && port_->currentText() == port_->itemText(0);
+    if (simulated) {
+        const QString e = tr("Choose the shoes' serial port first (Alt+O, e.g. /dev/ttyACM0).");
+        sensorStatus_->setText(e);
+        return e;
     }
     eng::SerialConfig config;
     config.path = (port_->currentData().toString().isEmpty() ? port_->currentText().trimmed()
                                                              : port_->currentData().toString())
                       .toStdString();
+    auto shoes = std::make_shared<eng::SerialSource>(config);
     try {
-        serial_ = std::make_unique<eng::SerialSource>(config);
-        serial_->start();
+        shoes->start();
     } catch (const std::exception& e) {
-        serial_.reset();
-        sensorStatus_->setText(tr("%1\nCheck the cable and the port name (ls /dev/ttyACM*), and "
-                                  "that you may open it (group dialout).")
-                                   .arg(q(e.what())));
-        return;
+        const QString text = tr("%1\nCheck the cable and the port name (ls /dev/ttyACM*), and "
+                                "that you may open it (group dialout).")
+                                 .arg(q(e.what()));
+        sensorStatus_->setText(text);
+        return text;
     }
-    recording_.clear();
-    recordUntilS_ = -1;
-    record_->setText(tr("Stop and cali&brate  (Ctrl+B)"));
+    shoes_ = std::move(shoes);
     sensorTimer_->start();
+    pollSerial();
+    return {};
+}
+
+void SetupView::disconnectShoes() {
+    sensorTimer_->stop();
+    if (shoes_) shoes_->stop();
+    shoes_.reset();
+    disconnectAfterRecording_ = false;
+    connectShoes_->setText(tr("Connect shoes  (Ctrl+Shift+B)"));
+    sensorStatus_->setText(tr("Shoes: not connected."));
+}
+
+QString SetupView::toggleShoes() {
+    if (shoes_ && !disconnectAfterRecording_) {
+        if (shoesInSession()) {
+            const QString e = tr("The running session uses the shoes: finish or abandon it in the "
+                                 "Run view before disconnecting them.");
+            sensorStatus_->setText(e);
+            return e;
+        }
+        if (recordingActive_) toggleSerialRecording();
+        disconnectShoes();
+        return {};
+    }
+    if (!shoes_) {
+        if (const QString e = connectShoesNow(); !e.isEmpty()) return e;
+    }
+    disconnectAfterRecording_ = false; // a recording's port stays open as the connection
+    connectShoes_->setText(tr("Disconnect shoes  (Ctrl+Shift+B)"));
+    return {};
+}
+
+QString SetupView::thresholdsDir() const {
+    return QDir(dataDir_).filePath("thresholds");
+}
+
+QString SetupView::sensorStatusText() const {
+    return sensorStatus_->text();
 }
 
 void SetupView::pollSerial() {
-    if (!serial_) return;
-    eng::ShoeFrame f;
-    while (serial_->popFrame(f)) {
-        if (recordUntilS_ < 0) recordUntilS_ = f.timeS + seconds_->value();
-        recording_.push_back(f);
+    if (!shoes_) return;
+    const bool inSession = shoesInSession();
+    if (inSession && recordingActive_) {
+        recordingActive_ = false;
+        recording_.clear();
+        record_->setText(tr("Record and cali&brate  (Ctrl+B)"));
+        calibration_->setText(tr("Recording abandoned: a session took the shoes. Record again "
+                                 "once it is over."));
     }
-    const auto st = serial_->status();
+    if (!inSession) { // a session's player is then the only reader of the frames
+        eng::ShoeFrame f;
+        while (shoes_->popFrame(f)) {
+            if (!recordingActive_) continue;
+            if (recordUntilS_ < 0) recordUntilS_ = f.timeS + seconds_->value();
+            recording_.push_back(f);
+        }
+    }
+    const auto st = shoes_->status();
     sensorStatus_->setText(tr("Shoes on %1 (%2): %3 — %4 · %5 frames/s · %6 accepted, %7 lost, "
-                              "%8 rejected lines%9")
-                               .arg(q(serial_->config().path), q(serial_->backendName()),
+                              "%8 rejected lines%9%10")
+                               .arg(q(shoes_->config().path), q(shoes_->backendName()),
                                     q(std::string(eng::sensorStateName(st.state))), q(st.message))
                                .arg(st.rateHz, 0, 'f', 0)
                                .arg(st.framesAccepted)
@@ -577,8 +664,12 @@ void SetupView::pollSerial() {
                                .arg(st.linesRejected)
                                .arg(st.lastRejection.empty()
                                         ? QString()
-                                        : tr(" · last rejected: %1").arg(q(st.lastRejection))));
-    if (recordUntilS_ > 0 && !recording_.empty() && recording_.back().timeS >= recordUntilS_)
+                                        : tr(" · last rejected: %1").arg(q(st.lastRejection)))
+                               .arg(inSession          ? tr(" · in use by the running session")
+                                    : recordingActive_ ? tr(" · recording")
+                                                       : QString()));
+    if (recordingActive_ && recordUntilS_ > 0 && !recording_.empty() &&
+        recording_.back().timeS >= recordUntilS_)
         toggleSerialRecording();
 }
 

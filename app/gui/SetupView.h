@@ -42,8 +42,23 @@ class SetupView : public QWidget {
     /// Calibrates from the scripted shoe simulator's default walk; false (message shown) when
     /// the calibration fails.
     bool calibrateSimulated();
-    /// Starts (or stops) recording from the serial port in the form for `seconds`.
+    /// Starts (or stops) recording for `seconds` from the connected shoes, else from the serial
+    /// port in the form (opened for the recording only). Refused while a session uses the shoes.
     void toggleSerialRecording();
+    /// Connects (or disconnects) the FSR shoes on the serial port in the form: they stay open
+    /// for the Run view's sessions (FSR stimuli). Returns "" or why not (also shown).
+    QString toggleShoes();
+    /// The connected shoes (null when not connected). A session that holds them is the only
+    /// reader of their frames; this view then shows their status only.
+    std::shared_ptr<engine::SerialSource> connectedShoes() const { return shoes_; }
+    /// Whether a session holds the connected shoes.
+    bool shoesInSession() const { return shoes_ && shoes_.use_count() > 1; }
+    /// The listening OSC gyroscope receiver (null when not listening).
+    std::shared_ptr<engine::OscGyroReceiver> gyroReceiver() const { return gyro_; }
+    /// The folder of the participants' saved thresholds (`<code>.toml`).
+    QString thresholdsDir() const;
+    /// The shoes' status line.
+    QString sensorStatusText() const;
     /// Steps the detector found with the proposed thresholds in the calibration recording.
     int detectedSteps() const { return detectedSteps_; }
     /// Strikes the recording is known to contain (simulation), or -1.
@@ -93,7 +108,7 @@ class SetupView : public QWidget {
     QPushButton* gyroListen_;
     QLabel* gyroStatus_;
     QTimer* gyroTimer_;
-    std::unique_ptr<engine::OscGyroReceiver> gyro_;
+    std::shared_ptr<engine::OscGyroReceiver> gyro_;
     void calibrate(const std::vector<engine::ShoeFrame>& frames, int expectedSteps);
     void pollSerial();
 
@@ -107,7 +122,12 @@ class SetupView : public QWidget {
     QChart* pressureChart_;
     QChart* derivativeChart_;
     QTimer* sensorTimer_;
-    std::unique_ptr<engine::SerialSource> serial_;
+    QPushButton* connectShoes_;
+    std::shared_ptr<engine::SerialSource> shoes_;
+    bool recordingActive_ = false;
+    bool disconnectAfterRecording_ = false;
+    QString connectShoesNow();
+    void disconnectShoes();
     std::vector<engine::ShoeFrame> recording_;
     double recordUntilS_ = 0;
     std::unique_ptr<engine::StepCalibrationResult> result_;
