@@ -45,7 +45,6 @@ namespace {
 constexpr int kPeriod = 64;
 constexpr double kBlockMs = 1000.0 * kPeriod / 48000.0;
 
-
 class WadingJack : public ::testing::Test {
   protected:
     static void SetUpTestSuite() {
