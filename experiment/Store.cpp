@@ -435,6 +435,20 @@ std::int64_t StudyStore::participantId(const std::string& code) const {
     return q.getColumn(0).getInt64();
 }
 
+SQLite::Statement StudyStore::selectTrial(std::int64_t pid, const std::string& code, int trialIndex,
+                                          const std::string& columns) const {
+    SQLite::Statement q(*db_, "SELECT " + columns +
+                                  " FROM trials WHERE participant_id = ? AND trial_index = ?");
+    q.bind(1, pid);
+    q.bind(2, trialIndex);
+    if (!q.executeStep()) noSuchTrial(code, trialIndex);
+    return q;
+}
+
+void StudyStore::noSuchTrial(const std::string& code, int trialIndex) const {
+    throw StoreError(fmt::format("{}: participant '{}' has no trial {}", path_, code, trialIndex));
+}
+
 namespace {
 void readFields(SQLite::Database& db, ParticipantInfo& p) {
     SQLite::Statement q(db, "SELECT name, value FROM participant_fields WHERE participant_id = ?");
@@ -862,9 +876,7 @@ TrialRecord StudyStore::trial(const std::string& code, int trialIndex) const {
                                           kTrialColumns));
     q.bind(1, pid);
     q.bind(2, trialIndex);
-    if (!q.executeStep())
-        throw StoreError(
-            fmt::format("{}: participant '{}' has no trial {}", path_, code, trialIndex));
+    if (!q.executeStep()) noSuchTrial(code, trialIndex);
     return readTrial(*db_, q);
 }
 
@@ -883,13 +895,7 @@ void StudyStore::markTrialStarted(const std::string& code, int trialIndex, int s
                                   const std::optional<std::string>& grfRecording) {
     SQLite::Transaction tx(*db_, SQLite::TransactionBehavior::IMMEDIATE);
     const std::int64_t pid = participantId(code);
-    SQLite::Statement check(*db_, "SELECT answered_at, started_at FROM trials WHERE "
-                                  "participant_id = ? AND trial_index = ?");
-    check.bind(1, pid);
-    check.bind(2, trialIndex);
-    if (!check.executeStep())
-        throw StoreError(
-            fmt::format("{}: participant '{}' has no trial {}", path_, code, trialIndex));
+    SQLite::Statement check = selectTrial(pid, code, trialIndex, "answered_at, started_at");
     if (!check.getColumn(0).isNull())
         throw StoreError(
             fmt::format("participant '{}' trial {} is already answered", code, trialIndex));
@@ -923,13 +929,8 @@ void StudyStore::commitAnswer(const std::string& code, int trialIndex, const Tri
                                      code, trialIndex));
     SQLite::Transaction tx(*db_, SQLite::TransactionBehavior::IMMEDIATE);
     const ParticipantInfo p = participant(code);
-    SQLite::Statement cur(*db_, "SELECT id, started_at, answered_at, stimulus, block, laps_done "
-                                "FROM trials WHERE participant_id = ? AND trial_index = ?");
-    cur.bind(1, p.id);
-    cur.bind(2, trialIndex);
-    if (!cur.executeStep())
-        throw StoreError(
-            fmt::format("{}: participant '{}' has no trial {}", path_, code, trialIndex));
+    SQLite::Statement cur = selectTrial(p.id, code, trialIndex,
+                                        "id, started_at, answered_at, stimulus, block, laps_done");
     const Stimulus trialStimulus = stimulusFromToml(cur.getColumn(3).getString());
     if (const auto problems =
             checkAnswer(p.groupId, answer, trialStimulus, cur.getColumn(4).getInt());
@@ -1002,13 +1003,7 @@ void StudyStore::recordReplay(const std::string& code, int trialIndex) {
                                      code, trialIndex));
     SQLite::Transaction tx(*db_, SQLite::TransactionBehavior::IMMEDIATE);
     const std::int64_t pid = participantId(code);
-    SQLite::Statement cur(*db_, "SELECT started_at, answered_at, replays FROM trials WHERE "
-                                "participant_id = ? AND trial_index = ?");
-    cur.bind(1, pid);
-    cur.bind(2, trialIndex);
-    if (!cur.executeStep())
-        throw StoreError(
-            fmt::format("{}: participant '{}' has no trial {}", path_, code, trialIndex));
+    SQLite::Statement cur = selectTrial(pid, code, trialIndex, "started_at, answered_at, replays");
     if (cur.getColumn(0).isNull())
         throw StoreError(fmt::format("participant '{}' trial {}: replay before the first "
                                      "presentation; expected play() first",
@@ -1035,13 +1030,8 @@ void StudyStore::recordLap(const std::string& code, int trialIndex, int lap) {
                                      trialIndex, lap, laps.total()));
     SQLite::Transaction tx(*db_, SQLite::TransactionBehavior::IMMEDIATE);
     const std::int64_t pid = participantId(code);
-    SQLite::Statement cur(*db_, "SELECT started_at, answered_at, laps_done FROM trials WHERE "
-                                "participant_id = ? AND trial_index = ?");
-    cur.bind(1, pid);
-    cur.bind(2, trialIndex);
-    if (!cur.executeStep())
-        throw StoreError(
-            fmt::format("{}: participant '{}' has no trial {}", path_, code, trialIndex));
+    SQLite::Statement cur =
+        selectTrial(pid, code, trialIndex, "started_at, answered_at, laps_done");
     if (cur.getColumn(0).isNull() || !cur.getColumn(1).isNull())
         throw StoreError(fmt::format("participant '{}' trial {}: laps are recorded between the "
                                      "start of a condition and its answer",
@@ -1102,9 +1092,7 @@ void StudyStore::recordTrialAudio(const std::string& code, int trialIndex,
     q.bind(8, toDb(a.droppedGrfFrames));
     q.bind(9, pid);
     q.bind(10, trialIndex);
-    if (q.exec() != 1)
-        throw StoreError(
-            fmt::format("{}: participant '{}' has no trial {}", path_, code, trialIndex));
+    if (q.exec() != 1) noSuchTrial(code, trialIndex);
     tx.commit();
 }
 
@@ -1137,9 +1125,7 @@ void StudyStore::setExcluded(const std::string& code, int trialIndex, bool exclu
     q.bind(2, excluded ? reason : std::string());
     q.bind(3, pid);
     q.bind(4, trialIndex);
-    if (q.exec() != 1)
-        throw StoreError(
-            fmt::format("{}: participant '{}' has no trial {}", path_, code, trialIndex));
+    if (q.exec() != 1) noSuchTrial(code, trialIndex);
     appendEvent(excluded ? "trial_excluded" : "trial_included", pid, trialIndex,
                 jsonObject({{"reason", reason}}));
     tx.commit();

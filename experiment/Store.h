@@ -20,7 +20,8 @@
 
 namespace SQLite {
 class Database;
-}
+class Statement;
+} // namespace SQLite
 
 namespace underfoot::experiment {
 
@@ -301,6 +302,11 @@ class StudyStore {
     void configure();
     void loadProtocol(const Catalogue& catalogue);
     std::int64_t participantId(const std::string& code) const;
+    /// `SELECT <columns> FROM trials` for one trial, stepped onto its row; throws
+    /// noSuchTrial() when the participant has no such trial.
+    SQLite::Statement selectTrial(std::int64_t participantId, const std::string& code,
+                                  int trialIndex, const std::string& columns) const;
+    [[noreturn]] void noSuchTrial(const std::string& code, int trialIndex) const;
     std::vector<std::string> checkAnswerScales(const std::string& groupId,
                                                const TrialAnswer& answer,
                                                const std::vector<const Scale*>& asked) const;
