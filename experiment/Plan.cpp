@@ -5,6 +5,7 @@
 
 #include <fmt/format.h>
 
+#include <numeric>
 #include <stdexcept>
 
 namespace underfoot::experiment {
@@ -146,46 +147,13 @@ std::vector<PlannedTrial> generatePlan(const Protocol& protocol, const std::stri
             }
             for (int i : perm) sequence.emplace_back(i, r);
         }
-    } else if (!o.noImmediateRepeat) {
-        std::vector<int> all;
-        for (int r = 0; r < reps; ++r)
-            for (int i = 0; i < k; ++i) all.push_back(i);
-        rng.shuffle(all);
-        for (int i : all) sequence.emplace_back(i, 1);
     } else {
-        // Sequential draw weighted by remaining counts, restricted to choices that keep the
-        // rest feasible: never relaxes the constraint, fails loudly if it cannot hold.
-        std::vector<int> counts(static_cast<std::size_t>(k), reps);
-        int remaining = k * reps;
-        int last = -1;
-        if (!feasible(counts, remaining, last))
-            throw std::invalid_argument("impossible ordering constraint: no_immediate_repeat");
-        while (remaining > 0) {
-            std::vector<int> weights(static_cast<std::size_t>(k), 0);
-            int total = 0;
-            for (int x = 0; x < k; ++x) {
-                auto& c = counts[static_cast<std::size_t>(x)];
-                if (c == 0 || x == last) continue;
-                --c;
-                if (feasible(counts, remaining - 1, x)) {
-                    weights[static_cast<std::size_t>(x)] = c + 1;
-                    total += c + 1;
-                }
-                ++c;
-            }
-            if (total == 0)
-                throw std::invalid_argument("impossible ordering constraint: no_immediate_repeat");
-            auto pick = static_cast<int>(rng.below(static_cast<std::uint64_t>(total)));
-            int chosen = 0;
-            for (; chosen < k; ++chosen) {
-                pick -= weights[static_cast<std::size_t>(chosen)];
-                if (pick < 0) break;
-            }
-            --counts[static_cast<std::size_t>(chosen)];
-            --remaining;
-            last = chosen;
-            sequence.emplace_back(chosen, 1);
-        }
+        // Every stimulus `reps` times in one random sequence (drawSequence: with
+        // no_immediate_repeat, never relaxed, failing loudly if it cannot hold).
+        std::vector<int> items(static_cast<std::size_t>(k));
+        std::iota(items.begin(), items.end(), 0);
+        for (int i : drawSequence(items, reps, o.noImmediateRepeat, -1, rng))
+            sequence.emplace_back(i, 1);
     }
 
     std::vector<PlannedTrial> plan;
