@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "analysis/report/RatingReport.h"
 
+#include "analysis/report/Markup.h"
+
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -31,28 +33,9 @@ std::string pText(double p) {
     return fmt::format("{:.3f}", p);
 }
 
-std::string xmlEscape(const std::string& s) {
-    std::string out;
-    for (char c : s) {
-        switch (c) {
-        case '&':
-            out += "&amp;";
-            break;
-        case '<':
-            out += "&lt;";
-            break;
-        case '>':
-            out += "&gt;";
-            break;
-        case '"':
-            out += "&quot;";
-            break;
-        default:
-            out += c;
-        }
-    }
-    return out;
-}
+using markup::latexEscape;
+using markup::markdownCell;
+using markup::xmlEscape;
 
 std::string factorsText(const std::map<std::string, std::string>& factors) {
     std::string out;
@@ -75,13 +58,13 @@ struct Table {
     std::vector<std::vector<std::string>> rows;
     std::string markdown() const {
         std::string out = "|";
-        for (const auto& h : header) out += " " + h + " |";
+        for (const auto& h : header) out += " " + markdownCell(h) + " |";
         out += "\n|";
         for (std::size_t i = 0; i < header.size(); ++i) out += " --- |";
         out += "\n";
         for (const auto& r : rows) {
             out += "|";
-            for (const auto& c : r) out += " " + c + " |";
+            for (const auto& c : r) out += " " + markdownCell(c) + " |";
             out += "\n";
         }
         return out;
@@ -99,21 +82,11 @@ struct Table {
     }
     std::string latex() const {
         std::string out = "\\begin{tabular}{" + std::string(header.size(), 'l') + "}\n\\toprule\n";
-        auto esc = [](std::string s) {
-            std::string o;
-            for (char c : s) {
-                if (c == '_' || c == '%' || c == '&' || c == '#') o += '\\';
-                if (c == '<')
-                    o += "$<$";
-                else
-                    o += c;
-            }
-            return o;
-        };
-        for (std::size_t i = 0; i < header.size(); ++i) out += (i ? " & " : "") + esc(header[i]);
+        for (std::size_t i = 0; i < header.size(); ++i)
+            out += (i ? " & " : "") + latexEscape(header[i]);
         out += " \\\\\n\\midrule\n";
         for (const auto& r : rows) {
-            for (std::size_t i = 0; i < r.size(); ++i) out += (i ? " & " : "") + esc(r[i]);
+            for (std::size_t i = 0; i < r.size(); ++i) out += (i ? " & " : "") + latexEscape(r[i]);
             out += " \\\\\n";
         }
         return out + "\\bottomrule\n\\end{tabular}\n";
