@@ -341,12 +341,8 @@ std::optional<exp::TrialAudioStats> LivePlayer::stoppedTrialStats() const {
     return a;
 }
 
-eng::AudioBuffer renderStimulus(const exp::Stimulus& stimulus, std::uint64_t seed, double seconds,
-                                double rate, int blockSize) {
-    const auto walker = stimulus.input.kind == exp::InputKind::Walker
-                            ? walkerFromStimulus(stimulus.input.walker)
-                            : eng::WalkerParameters{};
-    const auto grf = eng::walkerGrf(walker, seconds, rate, seed);
+eng::AudioBuffer renderStimulusFromGrf(const exp::Stimulus& stimulus, const eng::GrfSignal& grf,
+                                       std::uint64_t seed, double rate, int blockSize) {
     eng::RenderOptions options;
     options.sampleRateHz = rate;
     options.blockSize = blockSize;
@@ -355,7 +351,7 @@ eng::AudioBuffer renderStimulus(const exp::Stimulus& stimulus, std::uint64_t see
     if (stimulus.reverb) options.scene.impulseResponse = *stimulus.reverb;
     auto r = eng::renderSurface(stimulus.surface, grf, options);
     if (stimulus.soundscape && stimulus.modalities != exp::Modalities::Haptic) {
-        // As `underfoot replay` mixes it: same seed, unity gain.
+        // As the live scene mixes it: same seed, unity gain.
         soundscapes::SoundscapeRenderer ambience(soundscapes::loadSoundscape(*stimulus.soundscape));
         ambience.prepare({rate, 1024});
         ambience.reset(seed);
@@ -368,6 +364,15 @@ eng::AudioBuffer renderStimulus(const exp::Stimulus& stimulus, std::uint64_t see
         }
     }
     return std::move(r.audio);
+}
+
+eng::AudioBuffer renderStimulus(const exp::Stimulus& stimulus, std::uint64_t seed, double seconds,
+                                double rate, int blockSize) {
+    const auto walker = stimulus.input.kind == exp::InputKind::Walker
+                            ? walkerFromStimulus(stimulus.input.walker)
+                            : eng::WalkerParameters{};
+    return renderStimulusFromGrf(stimulus, eng::walkerGrf(walker, seconds, rate, seed), seed, rate,
+                                 blockSize);
 }
 
 exp::StimulusStart OfflinePlayer::start(const exp::Stimulus& stimulus, std::uint64_t plannedSeed) {

@@ -144,6 +144,14 @@ engine::AudioBuffer renderStimulus(const experiment::Stimulus& stimulus, std::ui
                                    double seconds, double sampleRateHz = 48000.0,
                                    int blockSize = 64);
 
+/// The offline twin of a footstep LiveScene: `grf` through the stimulus's surface (the
+/// stimulus's impulse response, or the preset's reverb) plus a 1 s tail, with the soundscape
+/// mixed in at unity gain from the same seed (not for haptic-only stimuli, whose scenes have no
+/// headphone mix). What renderStimulus and the trial replay render.
+engine::AudioBuffer renderStimulusFromGrf(const experiment::Stimulus& stimulus,
+                                          const engine::GrfSignal& grf, std::uint64_t seed,
+                                          double sampleRateHz, int blockSize);
+
 /// A player that renders each started stimulus to memory (lastRender()).
 class OfflinePlayer final : public experiment::StimulusPlayer {
   public:

@@ -8,14 +8,11 @@
 #include "engine/wading/Wading.h"
 #include "experiment/Clips.h"
 #include "experiment/Store.h"
-#include "soundscapes/Library.h"
-#include "soundscapes/Renderer.h"
 
 #include <fmt/format.h>
 #include <toml++/toml.h>
 
 #include <filesystem>
-#include <vector>
 
 namespace underfoot::wiring {
 namespace {
@@ -121,28 +118,7 @@ ReplayRender renderTrialReplay(const ReplayRequest& q) {
                 "it, so what was heard cannot be re-rendered exactly",
                 q.trial, q.participant));
         }
-        eng::RenderOptions options;
-        options.sampleRateHz = rate;
-        options.blockSize = out.blockSize;
-        options.seed = info.renderSeed;
-        options.tailSeconds = 1.0;
-        if (stimulus.reverb) options.scene.impulseResponse = *stimulus.reverb;
-        eng::RenderResult r = eng::renderSurface(stimulus.surface, grf, options);
-        if (stimulus.soundscape) {
-            // The background as the participant heard it: same seed, calibrated level.
-            soundscapes::SoundscapeRenderer ambience(
-                soundscapes::loadSoundscape(*stimulus.soundscape));
-            ambience.prepare({rate, 1024});
-            ambience.reset(info.renderSeed);
-            const std::size_t n = r.audio.frames();
-            std::vector<float> l(n), rr(n);
-            ambience.process(l.data(), rr.data(), static_cast<int>(n));
-            for (std::size_t i = 0; i < n; ++i) {
-                r.audio.samples[2 * i] += l[i];
-                r.audio.samples[2 * i + 1] += rr[i];
-            }
-        }
-        out.audio = std::move(r.audio);
+        out.audio = renderStimulusFromGrf(stimulus, grf, info.renderSeed, rate, out.blockSize);
         out.description =
             fmt::format("{} trial {} ({}{}{}): {:.1f} s from {}, render seed {}, block {}",
                         info.participant, info.trialIndex, stimulus.surface,
