@@ -12,6 +12,7 @@
 #include "engine/io/sensors/ShoeSimulator.h"
 #include "experiment/Export.h"
 #include "experiment/Session.h"
+#include "tests/common/PacedOfflineEngine.h"
 #include "tests/live/sensors/SocatHelpers.h"
 
 #include <gtest/gtest.h>
@@ -139,22 +140,8 @@ TEST(SessionSensors, AWriterDyingMidTrialPausesTheSessionAndTheTrialIsPresentedA
     shoes->start();
 
     // The engine without a device: a thread runs the callback body block by block.
-    eng::LiveEngine engine;
-    eng::AudioSettings audioSettings;
-    audioSettings.sampleRateHz = 48000;
-    audioSettings.blockSize = 64;
-    engine.openOffline(audioSettings);
-    std::atomic<bool> running{true};
-    std::thread audio([&] {
-        std::vector<std::vector<float>> out(2, std::vector<float>(64));
-        std::vector<float*> op;
-        for (auto& c : out) op.push_back(c.data());
-        const auto start = std::chrono::steady_clock::now();
-        for (std::size_t b = 0; running.load(); ++b) { // paced like a device: 64 / 48000 s
-            std::this_thread::sleep_until(start + std::chrono::microseconds(b * 4000 / 3));
-            engine.processBlock(nullptr, op.data(), 64);
-        }
-    });
+    underfoot::test::PacedOfflineEngine offline;
+    eng::LiveEngine& engine = offline.engine;
 
     const fs::path study = underfoot::test::scratchDir("session_sensors") / "study";
     fs::create_directories(study);
@@ -247,8 +234,7 @@ TEST(SessionSensors, AWriterDyingMidTrialPausesTheSessionAndTheTrialIsPresentedA
     EXPECT_TRUE(store.trial("P1", second).sensorLog.has_value());
     writer->kill();
     ::close(fd);
-    running = false;
-    audio.join();
+    offline.stop();
     shoes->stop();
 
     const xp::TrialRecord t = store.trial("P1", index);

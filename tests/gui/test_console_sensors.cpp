@@ -16,6 +16,7 @@
 #include "experiment/Catalogue.h"
 #include "experiment/Protocol.h"
 #include "experiment/Store.h"
+#include "tests/common/PacedOfflineEngine.h"
 #include "tests/live/sensors/SocatHelpers.h"
 
 #include <QApplication>
@@ -63,35 +64,7 @@ QPushButton* button(QWidget* root, const QString& name) {
     return nullptr;
 }
 
-/// Drives the engine's callback block by block, paced like a device (64 frames at 48 kHz).
-class OfflineEngine {
-  public:
-    OfflineEngine() {
-        eng::AudioSettings settings;
-        settings.sampleRateHz = 48000;
-        settings.blockSize = 64;
-        engine.openOffline(settings);
-        thread_ = std::thread([this] {
-            std::vector<std::vector<float>> out(2, std::vector<float>(64));
-            std::vector<float*> op;
-            for (auto& c : out) op.push_back(c.data());
-            const auto start = std::chrono::steady_clock::now();
-            for (std::size_t b = 0; running_.load(); ++b) {
-                std::this_thread::sleep_until(start + std::chrono::microseconds(b * 4000 / 3));
-                engine.processBlock(nullptr, op.data(), 64);
-            }
-        });
-    }
-    ~OfflineEngine() {
-        running_ = false;
-        thread_.join();
-    }
-    eng::LiveEngine engine;
-
-  private:
-    std::atomic<bool> running_{true};
-    std::thread thread_;
-};
+using OfflineEngine = underfoot::test::PacedOfflineEngine;
 
 /// Writes the scripted walk's lines at 1 kHz to `fd` until destroyed.
 class ShoeWriter {

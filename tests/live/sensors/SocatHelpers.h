@@ -145,6 +145,13 @@ struct Transitions {
             if (st == state && t >= afterS) return t;
         return 0;
     }
+    /// Message of the first transition into `state` ("" = never).
+    std::string messageOf(SensorState state) {
+        std::lock_guard lock(mutex);
+        for (std::size_t i = 0; i < seen.size(); ++i)
+            if (seen[i].first == state) return messages[i];
+        return {};
+    }
 };
 
 } // namespace underfoot::test

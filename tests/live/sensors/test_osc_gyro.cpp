@@ -4,6 +4,7 @@
 // reports and stamps them.
 #include "engine/io/sensors/OscGyroReceiver.h"
 #include "engine/io/sensors/SensorClock.h"
+#include "tests/live/sensors/SocatHelpers.h"
 
 #include <gtest/gtest.h>
 #include <lo/lo.h>
@@ -21,6 +22,7 @@
 namespace {
 
 using namespace underfoot::engine;
+using underfoot::test::Transitions;
 
 void sendRawDatagram(int port, const std::string& bytes) {
     const int s = ::socket(AF_INET, SOCK_DGRAM, 0);
@@ -41,29 +43,6 @@ void at100Hz(std::size_t ticks, F&& round) {
         round(i);
     }
 }
-
-struct Transitions {
-    std::mutex mutex;
-    std::vector<std::pair<SensorState, double>> seen;
-    std::vector<std::string> messages;
-    void operator()(const SensorStatus& s) {
-        std::lock_guard lock(mutex);
-        seen.emplace_back(s.state, s.stateSinceS);
-        messages.push_back(s.message);
-    }
-    double first(SensorState state, double afterS = 0) {
-        std::lock_guard lock(mutex);
-        for (const auto& [st, t] : seen)
-            if (st == state && t >= afterS) return t;
-        return 0;
-    }
-    std::string messageOf(SensorState state) {
-        std::lock_guard lock(mutex);
-        for (std::size_t i = 0; i < seen.size(); ++i)
-            if (seen[i].first == state) return messages[i];
-        return {};
-    }
-};
 
 float valueAt(std::size_t limb, std::size_t i) {
     return static_cast<float>(80 *
