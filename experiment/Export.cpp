@@ -32,7 +32,8 @@ void writeRow(std::ostream& out, const std::vector<std::string>& cells) {
 }
 } // namespace
 
-int writeTrialsCsv(const StudyStore& store, std::ostream& out, ExportScope scope) {
+int writeTrialsCsv(const StudyStore& store, std::ostream& out, ExportScope scope,
+                   SimulatedRows simulated) {
     const StudyInfo info = store.info();
     const Protocol& protocol = store.protocol();
     const Questions& q = protocol.questions;
@@ -40,6 +41,7 @@ int writeTrialsCsv(const StudyStore& store, std::ostream& out, ExportScope scope
     writeRow(out, header);
     int rows = 0;
     for (const auto& p : store.participants()) {
+        if (p.simulated && simulated == SimulatedRows::Exclude) continue;
         const std::string group = protocol.design == DesignKind::Between ? p.groupId : "";
         for (const auto& t : store.trials(p.code)) {
             if (scope == ExportScope::Answered && !t.answered) continue;
@@ -81,14 +83,16 @@ int writeTrialsCsv(const StudyStore& store, std::ostream& out, ExportScope scope
                            t.exclusionReason,
                            t.answer.comment,
                            t.startedAt,
-                           t.answeredAt});
+                           t.answeredAt,
+                           std::to_string(t.index + 1),
+                           p.simulated ? "1" : "0"});
             ++rows;
         }
     }
     return rows;
 }
 
-int writeParticipantsCsv(const StudyStore& store, std::ostream& out) {
+int writeParticipantsCsv(const StudyStore& store, std::ostream& out, SimulatedRows simulated) {
     const Protocol& protocol = store.protocol();
     std::vector<std::string> header{"participant", "group", "status", "age",
                                     "gender",      "shoes", "hearing"};
@@ -96,6 +100,7 @@ int writeParticipantsCsv(const StudyStore& store, std::ostream& out) {
     writeRow(out, header);
     int rows = 0;
     for (const auto& p : store.participants()) {
+        if (p.simulated && simulated == SimulatedRows::Exclude) continue;
         std::vector<std::string> row{
             p.code,   p.groupId, toString(p.status), p.age ? std::to_string(*p.age) : "",
             p.gender, p.shoes,   p.hearing};
@@ -163,7 +168,8 @@ int writeScalesCsv(const StudyStore& store, std::ostream& out) {
     return rows;
 }
 
-int writeRatingsCsv(const StudyStore& store, std::ostream& out, ExportScope scope) {
+int writeRatingsCsv(const StudyStore& store, std::ostream& out, ExportScope scope,
+                    SimulatedRows simulated) {
     const StudyInfo info = store.info();
     const Protocol& protocol = store.protocol();
     // One column per factor of [[factorial]] stimuli (sorted), so that factorial designs can be
@@ -179,6 +185,7 @@ int writeRatingsCsv(const StudyStore& store, std::ostream& out, ExportScope scop
     writeRow(out, header);
     int rows = 0;
     for (const auto& p : store.participants()) {
+        if (p.simulated && simulated == SimulatedRows::Exclude) continue;
         const std::string group = protocol.design == DesignKind::Between ? p.groupId : "";
         for (const auto& t : store.trials(p.code)) {
             if (scope == ExportScope::Answered && !t.answered) continue;
@@ -224,7 +231,9 @@ void writeCodebook(const StudyStore& store, std::ostream& out) {
         {"participant", "text", "pseudonymous participant code"},
         {"group", "text", "between-subject group id (empty in within-subject designs)"},
         {"session", "integer", "session number of the participant (1, 2, ... after resumes)"},
-        {"trial_index", "integer", "0-based position in the participant's plan (practice first)"},
+        {"trial_index", "integer",
+         "stored index: 0-based position in the participant's plan (practice first); the "
+         "number people see is `trial`"},
         {"block", "integer", "0 = practice; 1..repetitions for blocked orders; otherwise 1"},
         {"practice", "0/1", "1 for practice trials (normally left out of analyses)"},
         {"stimulus_id", "text", "stimulus id of the protocol"},
@@ -248,7 +257,13 @@ void writeCodebook(const StudyStore& store, std::ostream& out) {
         {"exclusion_reason", "text", "why it was excluded"},
         {"comment", "text", "free comment"},
         {"started_at", "ISO 8601 UTC", "when the stimulus started"},
-        {"answered_at", "ISO 8601 UTC", "when the answer was committed"}};
+        {"answered_at", "ISO 8601 UTC", "when the answer was committed"},
+        {"trial", "integer",
+         "trial number as people read and type it (1-based: trial_index + 1; \"trial 3 of 40\" "
+         "in the session, `underfoot replay --trial 3`)"},
+        {"simulated", "0/1",
+         "1 for a synthetic participant of `underfoot session --simulate` (not a person; left "
+         "out of `underfoot analyze` unless --include-simulated)"}};
     for (const auto& r : rows) out << fmt::format("| `{}` | {} | {} |\n", r[0], r[1], r[2]);
     out << "\n## ratings.csv — one row per rating\n\n"
            "Columns: study, participant, group, trial_index, stimulus_id, practice, excluded, "

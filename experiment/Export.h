@@ -13,7 +13,7 @@
 namespace underfoot::experiment {
 
 /// The columns of the long-format trials CSV, in order.
-inline constexpr std::array<std::string_view, 30> kTrialColumns = {"study",
+inline constexpr std::array<std::string_view, 32> kTrialColumns = {"study",
                                                                    "site",
                                                                    "protocol_id",
                                                                    "protocol_hash",
@@ -42,24 +42,31 @@ inline constexpr std::array<std::string_view, 30> kTrialColumns = {"study",
                                                                    "exclusion_reason",
                                                                    "comment",
                                                                    "started_at",
-                                                                   "answered_at"};
+                                                                   "answered_at",
+                                                                   "trial",
+                                                                   "simulated"};
 
 /// Which trials are written.
 enum class ExportScope { Answered, All };
+/// Whether the rows of simulated participants (`underfoot session --simulate`) are written.
+enum class SimulatedRows { Include, Exclude };
 
 /// RFC 4180 field quoting (quotes when the field has a comma, quote, CR or LF).
 std::string csvField(std::string_view value);
 
 /// Writes the trials CSV; returns the number of rows.
 int writeTrialsCsv(const StudyStore& store, std::ostream& out,
-                   ExportScope scope = ExportScope::Answered);
+                   ExportScope scope = ExportScope::Answered,
+                   SimulatedRows simulated = SimulatedRows::Include);
 /// Writes every rating of every scale in long format (study, participant, group, trial_index,
 /// stimulus_id, practice, excluded, one column per factor, scale, value); returns the rows.
 int writeRatingsCsv(const StudyStore& store, std::ostream& out,
-                    ExportScope scope = ExportScope::Answered);
+                    ExportScope scope = ExportScope::Answered,
+                    SimulatedRows simulated = SimulatedRows::Include);
 /// Writes one row per participant: participant, group, status, age, gender, shoes, hearing, then
 /// one column per [[participant_fields]] item of the protocol (in protocol order); returns rows.
-int writeParticipantsCsv(const StudyStore& store, std::ostream& out);
+int writeParticipantsCsv(const StudyStore& store, std::ostream& out,
+                         SimulatedRows simulated = SimulatedRows::Include);
 /// Writes the protocol's scales: scale, prompt, min, max, anchors ("value=label; ..."),
 /// stimuli (space-separated; empty = every stimulus); returns rows.
 int writeScalesCsv(const StudyStore& store, std::ostream& out);

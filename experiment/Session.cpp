@@ -117,14 +117,14 @@ void Session::answer(const TrialAnswer& answer) {
     const TrialRecord& t = current();
     if (!playing_)
         throw std::logic_error(
-            fmt::format("answer() for trial {} before its stimulus played", t.index));
+            fmt::format("answer() for trial {} before its stimulus played", t.index + 1));
     const double rt = clock_() - startedAtS_;
     // A sensor that failed since the last check makes the presentation broken: pause instead.
     if (const auto fault = player_.sensorFault()) {
         sensorFault(*fault);
         throw StoreError(fmt::format("participant '{}' trial {}: not recorded, the sensor "
                                      "failed ({}); the session is paused",
-                                     participant_.code, t.index, *fault));
+                                     participant_.code, t.index + 1, *fault));
     }
     store_.commitAnswer(participant_.code, t.index, answer, rt >= 0.0 ? rt : 0.0);
     stopPlayer();
@@ -250,20 +250,20 @@ void Session::rate(const std::string& scaleId, int value) {
     const TrialRecord& t = current();
     if (!playing_)
         throw std::logic_error(
-            fmt::format("rate() for trial {} before its clip was presented", t.index));
+            fmt::format("rate() for trial {} before its clip was presented", t.index + 1));
     for (const Scale* s : askedScales()) {
         if (s->id != scaleId) continue;
         if (value < s->min || value > s->max)
             throw StoreError(fmt::format("participant '{}' trial {}: rating '{}' is {}; expected "
                                          "{} to {}",
-                                         participant_.code, t.index, scaleId, value, s->min,
+                                         participant_.code, t.index + 1, scaleId, value, s->min,
                                          s->max));
         pending_[scaleId] = value;
         return;
     }
     throw StoreError(fmt::format("participant '{}' trial {}: scale '{}' is not asked in this "
                                  "trial",
-                                 participant_.code, t.index, scaleId));
+                                 participant_.code, t.index + 1, scaleId));
 }
 
 bool Session::ratingsComplete() const {
@@ -297,10 +297,10 @@ void Session::completeLap() {
     if (laps.total() == 0) throw std::logic_error("completeLap() in a protocol without [laps]");
     if (!playing_)
         throw std::logic_error(
-            fmt::format("completeLap() for trial {} before its condition started", t.index));
+            fmt::format("completeLap() for trial {} before its condition started", t.index + 1));
     if (t.lapsDone >= laps.total())
-        throw std::logic_error(
-            fmt::format("completeLap(): all {} laps of trial {} are done", laps.total(), t.index));
+        throw std::logic_error(fmt::format("completeLap(): all {} laps of trial {} are done",
+                                           laps.total(), t.index + 1));
     store_.recordLap(participant_.code, t.index, t.lapsDone + 1);
     const int done = ++trials_[position_].lapsDone;
     if (done < laps.total() && laps.silent(done) != laps.silent(done + 1))

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -293,6 +294,10 @@ int runSimulatedSession(StudyStore& store, const std::string& code, const Confus
                         std::uint64_t seed, const SimulationSettings& settings,
                         const CommitCallback& onCommitted) {
     const ParticipantInfo info = store.participant(code);
+    if (!info.simulated)
+        throw StoreError(fmt::format("{}: participant '{}' is a real participant; a simulation "
+                                     "only answers for the simulated participants it creates",
+                                     store.path(), code));
     const auto first = store.firstUnanswered(code);
     if (!first) return 0;
     // The answerer's stream depends on where the session resumes, so a resumed participant
@@ -311,10 +316,10 @@ int runSimulatedSession(StudyStore& store, const std::string& code, const Confus
         settings.ratingModel ? settings.ratingModel->replayProbability : 0.2;
     double simulatedTimeS = 0.0;
     SimulationPlayer player(store.protocol());
-    Session session(
-        store, code, player,
-        SessionSettings{"simulation", "none (simulated)", "none (simulated)", UNDERFOOT_VERSION},
-        [&] { return simulatedTimeS; });
+    Session session(store, code, player,
+                    SessionSettings{"simulation", "none (simulated)", "none (simulated)",
+                                    UNDERFOOT_VERSION, false},
+                    [&] { return simulatedTimeS; });
     int committed = 0;
     while (session.phase() != SessionPhase::Finished) {
         switch (session.phase()) {
@@ -342,7 +347,8 @@ int runSimulatedSession(StudyStore& store, const std::string& code, const Confus
                 session.submitRatings(a.comment);
             } else {
                 session.play();
-                for (int lap = 0; lap < session.lapCount(); ++lap) {
+                // A resumed trial continues from the laps already walked.
+                for (int lap = session.lapsDone(); lap < session.lapCount(); ++lap) {
                     simulatedTimeS += 30.0 * std::exp(0.1 * listening.gaussian());
                     session.completeLap();
                 }
@@ -373,7 +379,8 @@ int simulateStudy(StudyStore& store, const MatrixByGroup& matrices, int particip
     int committed = 0;
     int completed = 0;
     for (const auto& p : store.participants()) {
-        if (p.status == ParticipantStatus::Dropped) continue;
+        // Real participants (registered, interrupted or done) are never touched nor counted.
+        if (!p.simulated || p.status == ParticipantStatus::Dropped) continue;
         if (p.status != ParticipantStatus::Completed) {
             if (store.firstUnanswered(p.code))
                 committed += runSimulatedSession(store, p.code, matrixFor(p.groupId), seed,
@@ -405,12 +412,39 @@ int simulateStudy(StudyStore& store, const MatrixByGroup& matrices, int particip
                     ? std::string("simulated")
                     : f.options[static_cast<std::size_t>(fieldRng.below(f.options.size()))];
         const ParticipantInfo p =
-            store.registerParticipant({code, std::nullopt, "", "", "", {}, ""}, fields);
+            store.registerParticipant({code, std::nullopt, "", "", "", {}, "", true}, fields);
         committed +=
             runSimulatedSession(store, p.code, matrixFor(p.groupId), seed, settings, onCommitted);
         ++completed;
     }
     return committed;
+}
+
+std::string findProtocolFile(const Protocol& protocol, const std::string& relative,
+                             const std::string& protocolFile) {
+    namespace fs = std::filesystem;
+    std::vector<fs::path> folders;
+    if (!protocolFile.empty()) folders.push_back(fs::path(protocolFile).parent_path());
+    if (!protocol.sourceName.empty())
+        folders.push_back(fs::path(protocol.sourceName).parent_path());
+    folders.push_back(fs::path(shippedProtocolDir()));
+    std::string looked;
+    for (const auto& folder : folders) {
+        const fs::path candidate = folder / relative;
+        std::error_code ec;
+        if (fs::is_regular_file(candidate, ec)) return candidate.string();
+        looked += (looked.empty() ? "" : ", ") + candidate.string();
+    }
+    throw std::runtime_error(fmt::format("protocol {}: [simulation] names '{}', which is not "
+                                         "found (looked at {})",
+                                         protocol.id, relative, looked));
+}
+
+MatrixByGroup defaultMatrices(const Protocol& protocol, const std::string& protocolFile) {
+    MatrixByGroup out;
+    for (const auto& [group, file] : protocol.simulation.confusion)
+        out[group] = loadConfusionMatrix(findProtocolFile(protocol, file, protocolFile));
+    return out;
 }
 
 } // namespace underfoot::experiment

@@ -89,18 +89,29 @@ namespace underfoot::experiment {
 /// Confusion matrices by group id; the entry "" is used for groups without their own.
 using MatrixByGroup = std::map<std::string, ConfusionMatrix>;
 
+/// Finds a file a protocol names by a relative path ([simulation]): beside `protocolFile` when
+/// given, beside the protocol's source file, then in the shipped protocols folder. Throws
+/// std::runtime_error naming the places looked at.
+std::string findProtocolFile(const Protocol& protocol, const std::string& relative,
+                             const std::string& protocolFile = {});
+/// The confusion matrices the protocol names in [simulation] (empty when it names none).
+/// Throws std::runtime_error naming the file when one cannot be read.
+MatrixByGroup defaultMatrices(const Protocol& protocol, const std::string& protocolFile = {});
+
 /// Called after each answer is durably committed (participant code, trial index).
 using CommitCallback = std::function<void(const std::string&, int)>;
 
-/// Runs (or resumes) one participant's session with a synthetic answerer, from the first
-/// unanswered trial to the end. Returns the number of answers committed.
+/// Runs (or resumes) one simulated participant's session with a synthetic answerer, from the
+/// first unanswered trial (and lap) to the end. Returns the number of answers committed. Throws
+/// StoreError for a real (not simulated) participant.
 int runSimulatedSession(StudyStore& store, const std::string& code, const ConfusionMatrix& matrix,
                         std::uint64_t seed, const SimulationSettings& settings,
                         const CommitCallback& onCommitted = {});
 
-/// Produces a whole study: first finishes every registered, unfinished participant, then
-/// registers new ones (codes `<prefix>001`, ...) with balanced assignment until `participants`
-/// have completed. Deterministic for a given study seed. Returns the number of answers.
+/// Produces simulated participants: first finishes every unfinished simulated participant, then
+/// registers new ones flagged `simulated` (codes `<prefix>001`, ...) with balanced assignment
+/// until `participants` simulated participants have completed. Real participants are never
+/// touched nor counted. Deterministic for a given study seed. Returns the number of answers.
 int simulateStudy(StudyStore& store, const MatrixByGroup& matrices, int participants,
                   const SimulationSettings& settings, const std::string& codePrefix = "S",
                   const CommitCallback& onCommitted = {});

@@ -135,6 +135,14 @@ ALTER TABLE trials ADD COLUMN sensor_log TEXT;
 ALTER TABLE trials ADD COLUMN interruptions INTEGER NOT NULL DEFAULT 0;
 ALTER TABLE trials ADD COLUMN interruption_reason TEXT NOT NULL DEFAULT '';
 )sql",
+    // 3 -> 4 (issue #17, task "honest"): simulated participants are flagged as such (a
+    // simulation never writes into a real participant); each session stores whether sound was
+    // played (1), not (0: data entry without sound), or is unknown (NULL, older sessions).
+    R"sql(
+ALTER TABLE participants ADD COLUMN simulated INTEGER NOT NULL DEFAULT 0
+  CHECK (simulated IN (0, 1));
+ALTER TABLE sessions ADD COLUMN sound_played INTEGER CHECK (sound_played IN (0, 1));
+)sql",
 };
 constexpr int kMigrationCount = static_cast<int>(sizeof(kMigrations) / sizeof(kMigrations[0]));
 static_assert(kMigrationCount == kSchemaVersion);
@@ -159,7 +167,7 @@ ParticipantStatus statusFromText(const std::string& s) {
 
 constexpr const char* kParticipantColumns =
     "id, code, idx, age, gender, shoes, hearing, group_id, assignment, override_reason, status, "
-    "registered_at";
+    "registered_at, simulated";
 
 ParticipantInfo readParticipant(SQLite::Statement& q) {
     ParticipantInfo p;
@@ -176,6 +184,7 @@ ParticipantInfo readParticipant(SQLite::Statement& q) {
     p.overrideReason = q.getColumn(9).getString();
     p.status = statusFromText(q.getColumn(10).getString());
     p.registeredAt = q.getColumn(11).getString();
+    p.simulated = q.getColumn(12).getInt() != 0;
     return p;
 }
 
@@ -446,7 +455,8 @@ SQLite::Statement StudyStore::selectTrial(std::int64_t pid, const std::string& c
 }
 
 void StudyStore::noSuchTrial(const std::string& code, int trialIndex) const {
-    throw StoreError(fmt::format("{}: participant '{}' has no trial {}", path_, code, trialIndex));
+    throw StoreError(
+        fmt::format("{}: participant '{}' has no trial {}", path_, code, trialIndex + 1));
 }
 
 namespace {
@@ -655,8 +665,8 @@ ParticipantInfo StudyStore::registerParticipant(const NewParticipant& np,
     const std::string at = now();
     SQLite::Statement ins(*db_, "INSERT INTO participants (code, idx, age, gender, shoes, hearing, "
                                 "group_id, assignment, override_reason, status, seed, "
-                                "registered_at) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, 'registered', "
-                                "?, ?)");
+                                "registered_at, simulated) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, "
+                                "'registered', ?, ?, ?)");
     ins.bind(1, np.code);
     ins.bind(2, index);
     if (np.age) ins.bind(3, *np.age);
@@ -668,6 +678,7 @@ ParticipantInfo StudyStore::registerParticipant(const NewParticipant& np,
     ins.bind(9, np.overrideReason);
     ins.bind(10, toDb(participantSeed(seed, index)));
     ins.bind(11, at);
+    ins.bind(12, np.simulated ? 1 : 0);
     ins.exec();
     const std::int64_t pid = db_->getLastInsertRowid();
     SQLite::Statement field(*db_, "INSERT INTO participant_fields (participant_id, name, value) "
@@ -705,6 +716,7 @@ ParticipantInfo StudyStore::registerParticipant(const NewParticipant& np,
                     {"assignment", assignment == Assignment::Override ? "override" : "balanced"},
                     {"reason", np.overrideReason},
                     {"fields", fieldsText},
+                    {"simulated", np.simulated ? "1" : "0"},
                     {"trials", std::to_string(plan.size())}}));
     tx.commit();
     return participant(np.code);
@@ -735,7 +747,7 @@ int StudyStore::startSession(const std::string& code, const SessionSettings& set
     const int number = n.getColumn(0).getInt();
     SQLite::Statement ins(*db_, "INSERT INTO sessions (participant_id, number, group_id, seed, "
                                 "app_version, audio_config, sensor_config, experimenter, "
-                                "started_at) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?)");
+                                "started_at, sound_played) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
     ins.bind(1, p.id);
     ins.bind(2, number);
     ins.bind(3, p.groupId);
@@ -745,6 +757,7 @@ int StudyStore::startSession(const std::string& code, const SessionSettings& set
     ins.bind(7, settings.sensorConfig);
     ins.bind(8, settings.experimenter);
     ins.bind(9, now());
+    if (settings.soundPlayed) ins.bind(10, *settings.soundPlayed ? 1 : 0);
     ins.exec();
     SQLite::Statement st(*db_, "UPDATE participants SET status = 'active' WHERE id = ?");
     st.bind(1, p.id);
@@ -754,9 +767,34 @@ int StudyStore::startSession(const std::string& code, const SessionSettings& set
                             {"experimenter", settings.experimenter},
                             {"audio", settings.audioConfig},
                             {"sensor", settings.sensorConfig},
+                            {"sound", !settings.soundPlayed   ? "unknown"
+                                      : *settings.soundPlayed ? "played"
+                                                              : "none (data entry)"},
                             {"app_version", settings.appVersion}}));
     tx.commit();
     return number;
+}
+
+std::vector<SessionRecord> StudyStore::sessions(const std::string& code) const {
+    const std::int64_t pid = participantId(code);
+    SQLite::Statement q(*db_, "SELECT number, experimenter, audio_config, sensor_config, "
+                              "started_at, ended_at, outcome, sound_played FROM sessions WHERE "
+                              "participant_id = ? ORDER BY number");
+    q.bind(1, pid);
+    std::vector<SessionRecord> out;
+    while (q.executeStep()) {
+        SessionRecord r;
+        r.number = q.getColumn(0).getInt();
+        r.experimenter = q.getColumn(1).getString();
+        r.audioConfig = q.getColumn(2).getString();
+        r.sensorConfig = q.getColumn(3).getString();
+        r.startedAt = q.getColumn(4).getString();
+        r.endedAt = columnText(q.getColumn(5));
+        r.outcome = columnText(q.getColumn(6));
+        if (!q.getColumn(7).isNull()) r.soundPlayed = q.getColumn(7).getInt() != 0;
+        out.push_back(std::move(r));
+    }
+    return out;
 }
 
 void StudyStore::endSession(const std::string& code, int sessionNumber, bool completed) {
@@ -898,7 +936,7 @@ void StudyStore::markTrialStarted(const std::string& code, int trialIndex, int s
     SQLite::Statement check = selectTrial(pid, code, trialIndex, "answered_at, started_at");
     if (!check.getColumn(0).isNull())
         throw StoreError(
-            fmt::format("participant '{}' trial {} is already answered", code, trialIndex));
+            fmt::format("participant '{}' trial {} is already answered", code, trialIndex + 1));
     const bool restarted = !check.getColumn(1).isNull();
     // A restarted trial's earlier sensor log and audio figures belong to the earlier presentation.
     SQLite::Statement q(*db_, "UPDATE trials SET started_at = ?, render_seed = ?, grf_recording = "
@@ -926,7 +964,7 @@ void StudyStore::commitAnswer(const std::string& code, int trialIndex, const Tri
     if (responseTimeS && (!std::isfinite(*responseTimeS) || *responseTimeS < 0))
         throw StoreError(fmt::format("participant '{}' trial {}: response time must be a finite "
                                      "number >= 0",
-                                     code, trialIndex));
+                                     code, trialIndex + 1));
     SQLite::Transaction tx(*db_, SQLite::TransactionBehavior::IMMEDIATE);
     const ParticipantInfo p = participant(code);
     SQLite::Statement cur = selectTrial(p.id, code, trialIndex,
@@ -937,24 +975,24 @@ void StudyStore::commitAnswer(const std::string& code, int trialIndex, const Tri
         !problems.empty()) {
         std::string all;
         for (const auto& s : problems) all += (all.empty() ? "" : "; ") + s;
-        throw StoreError(fmt::format("participant '{}' trial {}: {}", code, trialIndex, all));
+        throw StoreError(fmt::format("participant '{}' trial {}: {}", code, trialIndex + 1, all));
     }
     if (const int laps = protocol_->laps.total();
         laps > 0 && !cur.getColumn(1).isNull() && cur.getColumn(5).getInt() < laps)
         throw StoreError(fmt::format("participant '{}' trial {}: {} of {} laps walked; expected "
                                      "every lap (baseline and feedback) before the questions",
-                                     code, trialIndex, cur.getColumn(5).getInt(), laps));
+                                     code, trialIndex + 1, cur.getColumn(5).getInt(), laps));
     const std::int64_t trialId = cur.getColumn(0).getInt64();
     if (cur.getColumn(1).isNull())
         throw StoreError(fmt::format("participant '{}' trial {} has not started; expected its "
                                      "stimulus to be played first",
-                                     code, trialIndex));
+                                     code, trialIndex + 1));
     const bool changing = !cur.getColumn(2).isNull();
     if (changing) {
         if (protocol_->lock == LockRule::OnAnswer)
             throw StoreError(fmt::format("participant '{}' trial {}: answers are locked once "
                                          "given (protocol rule lock = \"answer\")",
-                                         code, trialIndex));
+                                         code, trialIndex + 1));
         SQLite::Statement later(*db_, "SELECT 1 FROM trials WHERE participant_id = ? AND "
                                       "trial_index > ? AND started_at IS NOT NULL");
         later.bind(1, p.id);
@@ -962,7 +1000,7 @@ void StudyStore::commitAnswer(const std::string& code, int trialIndex, const Tri
         if (later.executeStep())
             throw StoreError(fmt::format("participant '{}' trial {}: the answer is locked because "
                                          "the next trial has started",
-                                         code, trialIndex));
+                                         code, trialIndex + 1));
     }
     SQLite::Statement q(*db_, "UPDATE trials SET answered_at = ?, response_time_s = ?, answer = ?, "
                               "soundscape_answer = ?, comment = ? WHERE id = ?");
@@ -1000,17 +1038,17 @@ void StudyStore::recordReplay(const std::string& code, int trialIndex) {
     if (!protocol_->clips.replay)
         throw StoreError(fmt::format("participant '{}' trial {}: the protocol does not allow "
                                      "replays ([clips] replay = false)",
-                                     code, trialIndex));
+                                     code, trialIndex + 1));
     SQLite::Transaction tx(*db_, SQLite::TransactionBehavior::IMMEDIATE);
     const std::int64_t pid = participantId(code);
     SQLite::Statement cur = selectTrial(pid, code, trialIndex, "started_at, answered_at, replays");
     if (cur.getColumn(0).isNull())
         throw StoreError(fmt::format("participant '{}' trial {}: replay before the first "
                                      "presentation; expected play() first",
-                                     code, trialIndex));
+                                     code, trialIndex + 1));
     if (!cur.getColumn(1).isNull())
         throw StoreError(
-            fmt::format("participant '{}' trial {} is already answered", code, trialIndex));
+            fmt::format("participant '{}' trial {} is already answered", code, trialIndex + 1));
     const int replays = cur.getColumn(2).getInt() + 1;
     SQLite::Statement q(*db_, "UPDATE trials SET replays = ? WHERE participant_id = ? AND "
                               "trial_index = ?");
@@ -1027,7 +1065,7 @@ void StudyStore::recordLap(const std::string& code, int trialIndex, int lap) {
     const Laps& laps = protocol_->laps;
     if (lap < 1 || lap > laps.total())
         throw StoreError(fmt::format("participant '{}' trial {}: lap {} is outside 1 to {}", code,
-                                     trialIndex, lap, laps.total()));
+                                     trialIndex + 1, lap, laps.total()));
     SQLite::Transaction tx(*db_, SQLite::TransactionBehavior::IMMEDIATE);
     const std::int64_t pid = participantId(code);
     SQLite::Statement cur =
@@ -1035,11 +1073,11 @@ void StudyStore::recordLap(const std::string& code, int trialIndex, int lap) {
     if (cur.getColumn(0).isNull() || !cur.getColumn(1).isNull())
         throw StoreError(fmt::format("participant '{}' trial {}: laps are recorded between the "
                                      "start of a condition and its answer",
-                                     code, trialIndex));
+                                     code, trialIndex + 1));
     if (cur.getColumn(2).getInt() != lap - 1)
         throw StoreError(fmt::format("participant '{}' trial {}: lap {} completed after {} laps; "
                                      "expected lap {}",
-                                     code, trialIndex, lap, cur.getColumn(2).getInt(),
+                                     code, trialIndex + 1, lap, cur.getColumn(2).getInt(),
                                      cur.getColumn(2).getInt() + 1));
     SQLite::Statement q(*db_, "UPDATE trials SET laps_done = ? WHERE participant_id = ? AND "
                               "trial_index = ?");
@@ -1063,8 +1101,8 @@ void StudyStore::setSensorLog(const std::string& code, int trialIndex,
     q.bind(2, pid);
     q.bind(3, trialIndex);
     if (q.exec() != 1)
-        throw StoreError(
-            fmt::format("{}: participant '{}' has no started trial {}", path_, code, trialIndex));
+        throw StoreError(fmt::format("{}: participant '{}' has no started trial {}", path_, code,
+                                     trialIndex + 1));
     tx.commit();
 }
 
@@ -1074,7 +1112,7 @@ void StudyStore::recordTrialAudio(const std::string& code, int trialIndex,
         if (!std::isfinite(v) || v < 0)
             throw StoreError(fmt::format("participant '{}' trial {}: audio figures must be finite "
                                          "numbers >= 0",
-                                         code, trialIndex));
+                                         code, trialIndex + 1));
     SQLite::Transaction tx(*db_, SQLite::TransactionBehavior::IMMEDIATE);
     const std::int64_t pid = participantId(code);
     SQLite::Statement q(*db_, "UPDATE trials SET audio_sample_rate_hz = ?, audio_block_size = ?, "
@@ -1108,7 +1146,7 @@ void StudyStore::markTrialInterrupted(const std::string& code, int trialIndex,
     q.bind(3, trialIndex);
     if (q.exec() != 1)
         throw StoreError(fmt::format("{}: participant '{}' has no unanswered trial {}", path_, code,
-                                     trialIndex));
+                                     trialIndex + 1));
     appendEvent("trial_interrupted", pid, trialIndex, jsonObject({{"reason", reason}}));
     tx.commit();
 }
@@ -1146,7 +1184,7 @@ ReplayInfo StudyStore::trialForReplay(const std::string& code, int trialIndex) c
     if (!t.renderSeed || !t.sessionNumber)
         throw StoreError(fmt::format("participant '{}' trial {} was never presented; nothing to "
                                      "replay",
-                                     code, trialIndex));
+                                     code, trialIndex + 1));
     ReplayInfo r;
     const StudyInfo i = info();
     r.study = i.code;

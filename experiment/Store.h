@@ -34,9 +34,10 @@ struct StoreError : std::runtime_error {
 /// Current schema version written by this code.
 /// Version 2 adds clip replay counts and laps walked per trial, and participant fields
 /// (expertise, listening device...); version 3 adds per-trial audio figures (TrialAudioStats),
-/// the sensor log reference and sensor-fault interruptions. Older studies are migrated when
-/// opened.
-inline constexpr int kSchemaVersion = 3;
+/// the sensor log reference and sensor-fault interruptions; version 4 flags simulated
+/// participants and stores with each session whether sound was played. Older studies are
+/// migrated when opened.
+inline constexpr int kSchemaVersion = 4;
 
 /// Time source (injectable for tests).
 struct Clock {
@@ -85,6 +86,8 @@ struct NewParticipant {
     /// Experimenter override of the balanced assignment (needs a reason).
     std::optional<std::string> groupOverride;
     std::string overrideReason;
+    /// A synthetic participant of `underfoot session --simulate` (never a real person).
+    bool simulated = false;
 };
 
 struct ParticipantInfo {
@@ -102,6 +105,8 @@ struct ParticipantInfo {
     std::string registeredAt;
     /// Answers to the protocol's [[participant_fields]] (field id -> answer).
     std::map<std::string, std::string> fields;
+    /// A synthetic participant created by a simulation (its answers are not a person's).
+    bool simulated = false;
 };
 
 /// Participants per group (dropouts excluded) against the target.
@@ -119,6 +124,21 @@ struct SessionSettings {
     std::string audioConfig;
     std::string sensorConfig;
     std::string appVersion;
+    /// Whether the stimuli are played as sound (true), not at all (false: data entry, answers
+    /// typed in without sound), or unknown (nullopt).
+    std::optional<bool> soundPlayed;
+};
+
+/// A stored session of a participant.
+struct SessionRecord {
+    int number = 0;
+    std::string experimenter;
+    std::string audioConfig;
+    std::string sensorConfig;
+    std::string startedAt;
+    std::string endedAt;
+    std::string outcome; ///< "completed", "interrupted" or "" while open
+    std::optional<bool> soundPlayed;
 };
 
 /// An answer to one trial.
@@ -242,6 +262,8 @@ class StudyStore {
 
     /// Opens a session for a participant; returns its number (1, 2, ... per participant).
     int startSession(const std::string& code, const SessionSettings& settings);
+    /// The sessions of a participant, in order.
+    std::vector<SessionRecord> sessions(const std::string& code) const;
     /// Closes a session; `completed` also marks the participant completed.
     void endSession(const std::string& code, int sessionNumber, bool completed);
 

@@ -44,7 +44,9 @@ const std::vector<std::string>& trialCsvColumns() {
                                                   "exclusion_reason",
                                                   "comment",
                                                   "started_at",
-                                                  "answered_at"};
+                                                  "answered_at",
+                                                  "trial",
+                                                  "simulated"};
     return columns;
 }
 
@@ -167,6 +169,7 @@ std::vector<TrialRecord> recordsToTrials(const std::vector<csv::Record>& records
         t.responseTimeSeconds = cells.number("response_time_s");
         t.excluded = cells.boolean("excluded").value_or(false);
         t.exclusionReason = cells.text("exclusion_reason");
+        t.simulated = cells.boolean("simulated").value_or(false);
         out.push_back(std::move(t));
     }
     return out;

@@ -32,6 +32,8 @@ struct TrialRecord {
     double responseTimeSeconds = std::numeric_limits<double>::quiet_NaN();
     bool excluded = false; ///< excluded trials never enter the tables
     std::string exclusionReason;
+    /// A synthetic participant's trial (`simulated` column; absent = false).
+    bool simulated = false;
 };
 
 } // namespace underfoot::analysis

@@ -48,7 +48,22 @@ struct AnalyzeOptions {
     std::string participants;
     std::string scales;
     std::vector<std::string> groupFields;
+    bool includeSimulated = false;
 };
+
+/// Issue #17: simulated participants are left out of an analysis unless asked for; says so.
+experiment::SimulatedRows simulatedRows(const AnalyzeOptions& o,
+                                        const experiment::StudyStore& store) {
+    if (o.includeSimulated) return experiment::SimulatedRows::Include;
+    int simulated = 0;
+    for (const auto& p : store.participants()) simulated += p.simulated ? 1 : 0;
+    if (simulated > 0)
+        fmt::print(stderr,
+                   "analyze: {} simulated participant(s) left out (--include-simulated keeps "
+                   "them)\n",
+                   simulated);
+    return experiment::SimulatedRows::Exclude;
+}
 
 void writeText(const std::string& output, const std::string& text) {
     if (output.empty() || output == "-") {
@@ -68,8 +83,9 @@ int analyzeRatings(const AnalyzeOptions& o, analysis::ReportFormat format) {
         if (!o.study.empty()) {
             const auto store = experiment::StudyStore::open(o.study);
             std::ostringstream ratings, participants, scales;
-            experiment::writeRatingsCsv(store, ratings);
-            experiment::writeParticipantsCsv(store, participants);
+            const auto rows = simulatedRows(o, store);
+            experiment::writeRatingsCsv(store, ratings, experiment::ExportScope::Answered, rows);
+            experiment::writeParticipantsCsv(store, participants, rows);
             experiment::writeScalesCsv(store, scales);
             data = analysis::parseRatingData(ratings.str(), o.study + " (ratings)",
                                              participants.str(), o.study + " (participants)",
@@ -179,7 +195,8 @@ int analyze(const AnalyzeOptions& o) {
             const auto csv = (dir / "trials.csv").string();
             {
                 std::ofstream out(csv);
-                experiment::writeTrialsCsv(store, out);
+                experiment::writeTrialsCsv(store, out, experiment::ExportScope::Answered,
+                                           simulatedRows(o, store));
             }
             const auto trials = analysis::readTrialCsv(csv);
             std::filesystem::remove_all(dir);
@@ -194,7 +211,16 @@ int analyze(const AnalyzeOptions& o) {
             report = analysis::analyzeTrials(trials, options);
             report.source = o.study;
         } else if (!o.trials.empty()) {
-            const auto trials = analysis::readTrialCsv(o.trials);
+            auto trials = analysis::readTrialCsv(o.trials);
+            if (!o.includeSimulated) {
+                const auto before = trials.size();
+                std::erase_if(trials, [](const analysis::TrialRecord& t) { return t.simulated; });
+                if (trials.size() != before)
+                    fmt::print(stderr,
+                               "analyze: {} trial(s) of simulated participants left out "
+                               "(--include-simulated keeps them)\n",
+                               before - trials.size());
+            }
             report = analysis::analyzeTrials(trials, options);
             report.source = o.trials;
         } else {
@@ -264,6 +290,9 @@ const cli::CommandRegistrar registrar("analyze", [](CLI::App& app, int& exitCode
     cmd->add_option("--group-by", o->groupFields,
                     "Participant fields to compare groups on (default: every field)")
         ->delimiter(',');
+    cmd->add_flag("--include-simulated", o->includeSimulated,
+                  "Also analyse simulated participants (`session --simulate`), left out by "
+                  "default");
     cmd->add_flag("--pool-soundscapes", o->poolSoundscapes,
                   "One row per surface instead of one per surface and soundscape");
     cmd->callback([&exitCode, o] { exitCode = analyze(*o); });

@@ -219,6 +219,8 @@ TEST(WadingListeningMode, VersionOneStudyFilesAreMigrated) {
               "audio_average_load_percent", "audio_max_load_percent", "audio_max_block_ms",
               "audio_dropped_grf_frames", "sensor_log", "interruptions", "interruption_reason"})
             db.exec(std::string("ALTER TABLE trials DROP COLUMN ") + column); // version 3's
+        db.exec("ALTER TABLE participants DROP COLUMN simulated");            // version 4's
+        db.exec("ALTER TABLE sessions DROP COLUMN sound_played");
         db.exec("DROP TABLE participant_fields");
         db.exec("ALTER TABLE trials DROP COLUMN replays");
         db.exec("ALTER TABLE trials DROP COLUMN laps_done");
@@ -226,7 +228,7 @@ TEST(WadingListeningMode, VersionOneStudyFilesAreMigrated) {
     }
     StudyStore store = StudyStore::open(path);
     EXPECT_EQ(store.info().schemaVersion, kSchemaVersion);
-    EXPECT_EQ(kSchemaVersion, 3);
+    EXPECT_EQ(kSchemaVersion, 4);
     const auto trials = store.trials("P1");
     ASSERT_EQ(trials.size(), 24u);
     EXPECT_EQ(trials[0].replays, 0);
@@ -236,6 +238,8 @@ TEST(WadingListeningMode, VersionOneStudyFilesAreMigrated) {
         journaled =
             journaled || (e.kind == "schema_migrated" && e.detail == R"({"from":"1","to":"2"})");
     EXPECT_TRUE(journaled);
-    // The migrated study runs on: a simulated participant completes it.
-    EXPECT_EQ(simulateStudy(store, {{"", ConfusionMatrix{}}}, 2, {}), 48); // P1 + one more
+    EXPECT_FALSE(store.participant("P1").simulated); // migrated participants are real
+    // The migrated study runs on: two simulated participants complete it; P1 (real) untouched.
+    EXPECT_EQ(simulateStudy(store, {{"", ConfusionMatrix{}}}, 2, {}), 48);
+    EXPECT_EQ(store.trials("P1")[0].answered, false);
 }
