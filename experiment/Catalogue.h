@@ -34,6 +34,13 @@ struct Catalogue {
 /// 5 soundscapes. Used by the CLI and the tests until the app passes the engine's list.
 const Catalogue& defaultCatalogue();
 
+/// The candidate closest to `name` by edit distance (insertions, deletions, substitutions;
+/// case-insensitive), or "" when none is within half the name's length: the "did you mean"
+/// of messages about unknown ids.
+std::string closestName(std::string_view name, const std::vector<std::string>& candidates);
+/// "a, b, c (did you mean b?)": the ids sorted, and the closest one to `name` when there is one.
+std::string sortedIdsWithSuggestion(std::string_view name, std::vector<std::string> ids);
+
 /// The id of the "I don't know" answer option.
 inline constexpr std::string_view kDontKnow = "dont_know";
 /// Suffix of the reverb variants of a surface (wood_reverb is wood with convolution reverb).

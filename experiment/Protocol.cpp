@@ -214,6 +214,12 @@ std::string joinIds(const std::vector<CatalogueEntry>& entries) {
     return out;
 }
 
+std::vector<std::string> ids(const std::vector<CatalogueEntry>& entries) {
+    std::vector<std::string> out;
+    for (const auto& e : entries) out.push_back(e.id);
+    return out;
+}
+
 std::string joinList(const std::vector<std::string>& values) {
     std::string out;
     for (const auto& v : values) out += (out.empty() ? "" : ", ") + v;
@@ -458,14 +464,17 @@ void readStimulusFields(Reader& r, const toml::table& t, std::string_view contex
         if (!catalogue.surface(*surface))
             r.problem(*t.get("surface"),
                       fmt::format("unknown surface '{}' in {}; expected one of: {}", *surface,
-                                  context, joinIds(catalogue.surfaces)));
+                                  context,
+                                  sortedIdsWithSuggestion(*surface, ids(catalogue.surfaces))));
         s.surface = *surface;
     }
     if (auto soundscape = r.string(t, "soundscape", context, false)) {
         if (!catalogue.soundscape(*soundscape))
-            r.problem(*t.get("soundscape"),
-                      fmt::format("unknown soundscape '{}' in {}; expected one of: {}", *soundscape,
-                                  context, joinIds(catalogue.soundscapes)));
+            r.problem(
+                *t.get("soundscape"),
+                fmt::format("unknown soundscape '{}' in {}; expected one of: {}", *soundscape,
+                            context,
+                            sortedIdsWithSuggestion(*soundscape, ids(catalogue.soundscapes))));
         s.soundscape = *soundscape;
     }
     if (auto m = r.choice<Modalities>(t, "modalities", context, kModalityNames)) s.modalities = *m;
@@ -656,7 +665,8 @@ Protocol parseProtocol(const std::string& text, const std::string& sourceName,
 
     r.checkKeys(root,
                 {"protocol", "design", "timing", "input", "stimuli", "factorial", "groups",
-                 "ordering", "questions", "rules", "laps", "clips", "participant_fields"},
+                 "ordering", "questions", "rules", "laps", "clips", "participant_fields",
+                 "simulation"},
                 "the protocol file");
 
     // [protocol]
@@ -1187,6 +1197,46 @@ Protocol parseProtocol(const std::string& text, const std::string& sourceName,
                 *t, "lock", "[rules]",
                 {{"next_trial", LockRule::NextTrialStart}, {"answer", LockRule::OnAnswer}}))
             p.lock = *l;
+    }
+
+    // [simulation]: the published data synthetic participants answer from (issue #17).
+    if (auto t = r.table(root, "simulation", "the protocol file", false)) {
+        r.checkKeys(*t, {"confusion", "rating_model"}, "[simulation]");
+        auto relativePath = [&](const toml::node& node, const std::string& value) {
+            if (value.empty() || value.front() == '/' || value.find("..") != std::string::npos)
+                r.problem(node, fmt::format("'{}' in [simulation]: expected a path relative to "
+                                            "the protocol's folder, without '..'",
+                                            value));
+        };
+        if (const toml::node* c = t->get("confusion")) {
+            if (c->is_string()) {
+                p.simulation.confusion[""] = c->as_string()->get();
+                relativePath(*c, c->as_string()->get());
+            } else if (c->is_table()) {
+                for (auto&& [key, node] : *c->as_table()) {
+                    const std::string group(key.str());
+                    if (!p.group(group))
+                        r.problem(node, fmt::format("[simulation] confusion names group '{}', "
+                                                    "which is not a group of the protocol",
+                                                    group));
+                    if (!node.is_string()) {
+                        r.problem(node, fmt::format("confusion.{} in [simulation] must be a "
+                                                    "string (a CSV file)",
+                                                    group));
+                        continue;
+                    }
+                    p.simulation.confusion[group] = node.as_string()->get();
+                    relativePath(node, node.as_string()->get());
+                }
+            } else {
+                r.problem(*c, "'confusion' in [simulation] must be a file name or a table of "
+                              "group = file");
+            }
+        }
+        if (auto m = r.string(*t, "rating_model", "[simulation]", false)) {
+            relativePath(*t->get("rating_model"), *m);
+            p.simulation.ratingModel = *m;
+        }
     }
 
     if (!r.problems().empty()) {

@@ -167,6 +167,16 @@ struct ClipSettings {
     bool replay = true;
 };
 
+/// What synthetic participants (`underfoot session --simulate`) answer from by default
+/// ([simulation]). Paths are relative to the protocol file's folder (protocols/ for the shipped
+/// protocols); `--confusion` and `--rating-model` override them.
+struct SimulationDefaults {
+    /// Confusion matrix CSV per group id ("" = every group without its own).
+    std::map<std::string, std::string> confusion;
+    /// Rating model TOML (empty: none).
+    std::string ratingModel;
+};
+
 /// A participant field asked at registration (e.g. expertise, listening device).
 struct ParticipantField {
     std::string id;
@@ -201,6 +211,8 @@ struct Protocol {
     Laps laps;
     /// Listening-test clips ([clips]).
     ClipSettings clips;
+    /// Default answer sources of synthetic participants ([simulation]).
+    SimulationDefaults simulation;
     /// Fields asked at registration ([[participant_fields]]).
     std::vector<ParticipantField> participantFields;
     /// Where each `clip = "..."` was written (stimulus id -> line, column), for messages.
