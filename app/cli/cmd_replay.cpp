@@ -14,10 +14,12 @@ namespace {
 
 struct ReplayArgs {
     wiring::ReplayRequest request;
+    int trialNumber = 1; ///< as people read it: 1-based ("trial 3 of 40", the export's `trial`)
     std::string output;
 };
 
-int runReplay(const ReplayArgs& a) {
+int runReplay(ReplayArgs a) {
+    a.request.trial = a.trialNumber - 1; // the stored index is 0-based
     wiring::ReplayRender r;
     try {
         r = wiring::renderTrialReplay(a.request);
@@ -35,9 +37,11 @@ CommandRegistrar reg("replay", [](CLI::App& app, int& exitCode) {
     auto* cmd = app.add_subcommand("replay", "Re-render what a participant heard in one trial");
     cmd->add_option("--study", q.study, "study file (.db)")->required();
     cmd->add_option("--participant", q.participant, "participant code")->required();
-    cmd->add_option("--trial", q.trial, "trial index (as in the export's trial_index)")
+    cmd->add_option("--trial", args->trialNumber,
+                    "trial number, 1-based as shown in the session (\"trial 3 of 40\") and in "
+                    "the export's `trial` column (= trial_index + 1)")
         ->required()
-        ->check(CLI::NonNegativeNumber);
+        ->check(CLI::PositiveNumber);
     cmd->add_option("--seconds", q.walkSeconds,
                     "length when the virtual walker (or gait) drove the trial")
         ->capture_default_str()

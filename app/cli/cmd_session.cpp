@@ -6,6 +6,7 @@
 // gyroscopes (--osc) drive the sensor stimuli, and a sensor fault pauses the session.
 #include "app/cli/CommandRegistry.h"
 #include "app/wiring/Adapters.h"
+#include "app/wiring/ClipPlayer.h"
 #include "app/wiring/Players.h"
 #include "engine/control/StepCalibration.h"
 #include "engine/control/StepGrfPlayer.h"
@@ -68,18 +69,39 @@ std::string askLine(const std::string& prompt);
 /// The audio device, the sensors and the player of a live session (all optional parts stay
 /// null when not asked for). Destroyed in reverse order: player, engine, sensors.
 struct LiveRig {
+    std::unique_ptr<wir::ClipAudio> clipAudio; ///< listening tests: clips through the device
     std::shared_ptr<eng::SerialSource> shoes;
     std::shared_ptr<eng::StepInput> steps;
     std::shared_ptr<eng::OscGyroReceiver> gyros;
     std::unique_ptr<eng::LiveEngine> engine;
     std::unique_ptr<wir::LivePlayer> player;
     ~LiveRig() {
+        clipAudio.reset();
         player.reset();
         if (engine) engine->close();
         if (shoes) shoes->stop();
         if (gyros) gyros->stop();
     }
 };
+
+/// Opens the audio device for a listening test's clips (no sensors, no footstep player).
+std::unique_ptr<LiveRig> openClipRig(const Options& o) {
+    auto rig = std::make_unique<LiveRig>();
+    eng::AudioSettings settings;
+    try {
+        if (!o.settings.empty()) settings = eng::loadAudioSettings(o.settings);
+        rig->engine = std::make_unique<eng::LiveEngine>();
+        rig->engine->open(settings);
+        rig->engine->start();
+    } catch (const std::exception& e) {
+        throw UserError(std::string("session --live: no sound can be played: ") + e.what());
+    }
+    rig->clipAudio = std::make_unique<wir::ClipAudio>(*rig->engine);
+    fmt::print("live audio: clips play through {} / {} at {} Hz, block {}\n",
+               rig->engine->openedApi(), rig->engine->openedDevice(),
+               rig->engine->settings().sampleRateHz, rig->engine->settings().blockSize);
+    return rig;
+}
 
 std::unique_ptr<LiveRig> openLiveRig(const Options& o) {
     auto rig = std::make_unique<LiveRig>();
@@ -126,7 +148,7 @@ std::unique_ptr<LiveRig> openLiveRig(const Options& o) {
     } catch (const UserError&) {
         throw;
     } catch (const std::exception& e) {
-        throw UserError(std::string("session --live: ") + e.what());
+        throw UserError(std::string("session --live: no sound can be played: ") + e.what());
     }
     rig->player = std::make_unique<wir::LivePlayer>(*rig->engine, std::move(options));
     fmt::print("live audio: {} / {} at {} Hz, block {}{}{}\n", rig->engine->openedApi(),
@@ -219,31 +241,55 @@ int runInteractive(const Options& o) {
     StudyStore store = StudyStore::open(o.study);
     if (!o.protocol.empty()) store.verifyProtocol(loadProtocol(o.protocol));
     const Protocol& p = store.protocol();
-    SilentPlayer silent; // headless, unless --live wires the engine in
+    {
+        // Issue #17: a session records only real people's answers, never a simulation's.
+        const ParticipantInfo who = store.participant(o.participant);
+        if (who.simulated)
+            throw UserError(fmt::format("session: participant {} is a simulated participant "
+                                        "(made by --simulate); a person's session needs a "
+                                        "registered participant",
+                                        o.participant));
+    }
+    SilentPlayer silent; // data entry, unless --live wires the engine in
+    if (p.clips.enabled && o.clips.empty())
+        throw UserError(fmt::format("session: protocol {} is a listening test; give --clips "
+                                    "FOLDER (made by `underfoot clips --protocol ... -o "
+                                    "FOLDER`)",
+                                    p.id));
     std::unique_ptr<LiveRig> rig;
-    if (o.live && !p.clips.enabled) rig = openLiveRig(o);
+    if (o.live) rig = p.clips.enabled ? openClipRig(o) : openLiveRig(o);
     std::unique_ptr<ClipPlayer> clipPlayer;
     if (p.clips.enabled) {
-        if (o.clips.empty())
-            throw UserError(fmt::format("session: protocol {} is a listening test; give --clips "
-                                        "FOLDER (made by `underfoot clips --protocol ... -o "
-                                        "FOLDER`)",
-                                        p.id));
-        clipPlayer = std::make_unique<ClipPlayer>(
-            p, o.clips, [](const std::string& path) { fmt::print("  [playing {}]\n", path); });
+        ClipPlayer::PlayFunction play = [](const std::string& path) {
+            fmt::print("  [no sound: clip {}]\n", path);
+        };
+        std::function<void()> stop;
+        if (rig) {
+            wir::ClipAudio* audio = rig->clipAudio.get();
+            play = [audio](const std::string& path) {
+                audio->play(path);
+                fmt::print("  [playing {}]\n", path);
+            };
+            stop = [audio] { audio->stop(); };
+        }
+        clipPlayer = std::make_unique<ClipPlayer>(p, o.clips, play, stop);
     }
+    if (!o.live)
+        fmt::print("NO SOUND: this session plays nothing (data entry: the answers are typed in "
+                   "as given; stored with the session). Add --live [--settings audio.toml] to "
+                   "play the stimuli.\n");
     StimulusPlayer& player = clipPlayer ? static_cast<StimulusPlayer&>(*clipPlayer)
                              : rig      ? static_cast<StimulusPlayer&>(*rig->player)
                                         : silent;
     Session session(store, o.participant, player,
-                    {o.experimenter, o.audio, o.clips.empty() ? o.sensor : "clips " + o.clips,
-                     UNDERFOOT_VERSION});
+                    {o.experimenter, o.live ? o.audio : "none (data entry, no sound)",
+                     o.clips.empty() ? o.sensor : "clips " + o.clips, UNDERFOOT_VERSION, o.live});
     const Questions& q = p.questions;
     fmt::print("{} — participant {} (group {}), session {}{}\n", p.title, o.participant,
                session.participant().groupId, session.sessionNumber(),
-               session.resumed()
-                   ? fmt::format(", resuming at trial {}", session.current().index + 1)
-                   : "");
+               session.resumed() ? fmt::format(", resuming at trial {} of {}",
+                                               session.current().index + 1, session.trialCount())
+                                 : "");
     int shownBlock = 0;
     try {
         while (session.phase() != SessionPhase::Finished) {
@@ -291,7 +337,7 @@ int runInteractive(const Options& o) {
                         }
                         break;
                     }
-                    if (o.ack) fmt::print("ack {} {}\n", o.participant, t.index);
+                    if (o.ack) fmt::print("ack {} {}\n", o.participant, t.index + 1);
                     break;
                 }
                 askLine("Press Enter to start the stimulus. ");
@@ -323,7 +369,7 @@ int runInteractive(const Options& o) {
                         fmt::print("not stored: {}\n", e.what());
                         continue;
                     }
-                    if (o.ack) fmt::print("ack {} {}\n", o.participant, t.index);
+                    if (o.ack) fmt::print("ack {} {}\n", o.participant, t.index + 1);
                     break;
                 }
                 if (session.paused()) {
@@ -351,10 +397,23 @@ int runSimulation(const Options& o) {
     StudyStore store = StudyStore::open(o.study);
     if (!o.protocol.empty()) store.verifyProtocol(loadProtocol(o.protocol));
     const bool needsMatrix = store.protocol().questions.asksSurface();
-    if (o.confusion.empty() && needsMatrix)
-        throw UserError("--simulate needs at least one --confusion [GROUP=]FILE (the protocol "
-                        "asks which surface)");
     MatrixByGroup matrices;
+    if (o.confusion.empty() && needsMatrix) {
+        // The published matrices the protocol names ([simulation], protocols/data/).
+        try {
+            matrices = defaultMatrices(store.protocol(), o.protocol);
+        } catch (const std::runtime_error& e) {
+            throw UserError(e.what());
+        }
+        if (matrices.empty())
+            throw UserError(fmt::format("--simulate: protocol {} asks which surface and names no "
+                                        "confusion matrix in [simulation]; give --confusion "
+                                        "[GROUP=]FILE",
+                                        store.protocol().id));
+        for (const auto& [group, file] : store.protocol().simulation.confusion)
+            fmt::print("confusion matrix{}: {} (named by the protocol)\n",
+                       group.empty() ? "" : " of group " + group, file);
+    }
     for (const auto& spec : o.confusion) {
         const auto eq = spec.find('=');
         const std::string group = eq == std::string::npos ? "" : spec.substr(0, eq);
@@ -385,8 +444,19 @@ int runSimulation(const Options& o) {
     }
     SimulationSettings settings;
     settings.soundscapeAccuracy = o.soundscapeAccuracy;
-    if (!o.ratingModel.empty()) {
-        auto model = std::make_shared<RatingModel>(loadRatingModel(o.ratingModel));
+    std::string ratingModelFile = o.ratingModel;
+    if (ratingModelFile.empty() && !store.protocol().simulation.ratingModel.empty()) {
+        try {
+            ratingModelFile = findProtocolFile(store.protocol(),
+                                               store.protocol().simulation.ratingModel, o.protocol);
+        } catch (const std::runtime_error& e) {
+            throw UserError(e.what());
+        }
+        fmt::print("rating model: {} (named by the protocol)\n",
+                   store.protocol().simulation.ratingModel);
+    }
+    if (!ratingModelFile.empty()) {
+        auto model = std::make_shared<RatingModel>(loadRatingModel(ratingModelFile));
         if (auto problems = checkRatingModel(*model, store.protocol()); !problems.empty()) {
             std::string all;
             for (const auto& s : problems) all += (all.empty() ? "" : "\n") + s;
@@ -401,14 +471,23 @@ int runSimulation(const Options& o) {
             throw UserError(all);
         }
     }
+    int real = 0;
+    for (const auto& p : store.participants()) real += p.simulated ? 0 : 1;
+    if (real > 0)
+        fmt::print("{} real participant(s) left untouched: a simulation answers only for the "
+                   "simulated participants it creates\n",
+                   real);
     const int answers = simulateStudy(store, matrices, o.participants, settings, o.prefix,
                                       [&](const std::string& code, int index) {
                                           if (!o.ack) return;
-                                          fmt::print("ack {} {}\n", code, index);
+                                          fmt::print("ack {} {}\n", code, index + 1);
                                           std::fflush(stdout);
                                       });
-    fmt::print("simulated: {} answers committed; {} participants in the study\n", answers,
-               store.participants().size());
+    int simulated = 0;
+    for (const auto& p : store.participants()) simulated += p.simulated ? 1 : 0;
+    fmt::print("simulated: {} answers committed; {} simulated and {} real participants in the "
+               "study\n",
+               answers, simulated, real);
     return 0;
 }
 
@@ -426,7 +505,9 @@ const underfoot::cli::CommandRegistrar registrar{
         cmd->add_option("--experimenter", o.experimenter, "experimenter (recorded)");
         cmd->add_option("--audio", o.audio, "audio configuration (recorded)");
         cmd->add_option("--sensor", o.sensor, "sensor configuration (recorded)");
-        cmd->add_flag("--ack", o.ack, "print 'ack CODE TRIAL' after each committed answer");
+        cmd->add_flag("--ack", o.ack,
+                      "print 'ack CODE TRIAL' (1-based trial number) after each committed "
+                      "answer");
         cmd->add_flag("--show-stimulus", o.showStimulus,
                       "show the stimulus id to the "
                       "experimenter");
@@ -434,7 +515,8 @@ const underfoot::cli::CommandRegistrar registrar{
                       "synthetic participants answering from "
                       "confusion matrices");
         cmd->add_option("--confusion", o.confusion,
-                        "[GROUP=]FILE confusion matrix CSV (published format); repeat per group");
+                        "[GROUP=]FILE confusion matrix CSV (published format); repeat per group; "
+                        "default: the published matrices the protocol names in [simulation]");
         cmd->add_option("--participants", o.participants,
                         "simulate until this many participants have completed")
             ->check(CLI::Range(0, 100000));
@@ -447,7 +529,8 @@ const underfoot::cli::CommandRegistrar registrar{
                         "before anything is stored");
         cmd->add_option("--rating-model", o.ratingModel,
                         "rating model (TOML) of synthetic participants: effects per factor "
-                        "level, stimulus and participant field (protocols/simulation/)");
+                        "level, stimulus and participant field (protocols/simulation/); default: "
+                        "the one the protocol names in [simulation]");
         cmd->add_flag("--live", o.live,
                       "play the stimuli through the audio device (recordings and audio figures "
                       "stored with each trial; a sensor fault pauses the session)");
@@ -470,6 +553,9 @@ const underfoot::cli::CommandRegistrar registrar{
                                 !o.thresholds.empty() || !o.recordings.empty()))
                     throw UserError("session: --settings, --recordings, --osc, --serial and "
                                     "--thresholds belong to --live");
+                if (o.simulate && o.live)
+                    throw UserError("session: --simulate plays nothing (synthetic participants "
+                                    "answer at once); --live belongs to a person's session");
                 if (o.simulate) {
                     exitCode = runSimulation(o);
                 } else {

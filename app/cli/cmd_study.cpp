@@ -8,6 +8,7 @@
 
 #include <fmt/core.h>
 
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <iostream>
@@ -90,15 +91,22 @@ const underfoot::cli::CommandRegistrar registrar{
                                g.dropped, g.target);
                 fmt::print("\n{:<10} {:>4} {:<12} {:<10} {:>8}  {}\n", "code", "idx", "group",
                            "status", "answered", "assignment");
+                int simulated = 0;
                 const auto counts = store.progressCounts();
                 for (const auto& p : store.participants()) {
                     const auto [answered, planned] = counts.at(p.code);
-                    fmt::print("{:<10} {:>4} {:<12} {:<10} {:>4}/{:<3}  {}\n", p.code, p.index,
+                    fmt::print("{:<10} {:>4} {:<12} {:<10} {:>4}/{:<3}  {}{}\n", p.code, p.index,
                                p.groupId, toString(p.status), answered, planned,
                                p.assignment == Assignment::Override
                                    ? "override: " + p.overrideReason
-                                   : "balanced");
+                                   : "balanced",
+                               p.simulated ? "  SIMULATED" : "");
+                    simulated += p.simulated ? 1 : 0;
                 }
+                if (simulated > 0)
+                    fmt::print("\n{} simulated participant(s) (`session --simulate`): not people; "
+                               "left out of `analyze` unless --include-simulated\n",
+                               simulated);
             });
             exitCode = 0;
         });
@@ -120,7 +128,7 @@ const underfoot::cli::CommandRegistrar registrar{
             guarded([&] {
                 StudyStore store = StudyStore::open(o.study);
                 NewParticipant np{o.participant, std::nullopt, o.gender, o.shoes,
-                                  o.hearing,     std::nullopt, o.reason};
+                                  o.hearing,     std::nullopt, o.reason, false};
                 if (o.age >= 0) np.age = o.age;
                 if (!o.group.empty()) np.groupOverride = o.group;
                 std::map<std::string, std::string> fields;
@@ -159,13 +167,17 @@ const underfoot::cli::CommandRegistrar registrar{
                                                        "--include it again)");
         exclude->add_option("--study", o.study, "study file")->required();
         exclude->add_option("--participant", o.participant, "participant code")->required();
-        exclude->add_option("--trial", o.trial, "trial index")->required();
+        exclude
+            ->add_option("--trial", o.trial,
+                         "trial number (1-based, as in the session and the export's `trial`)")
+            ->required()
+            ->check(CLI::PositiveNumber);
         exclude->add_option("--reason", o.reason, "why (journaled, exported)");
         exclude->add_flag("--include", o.include, "include the trial again");
         exclude->callback([&exitCode, &o] {
             guarded([&] {
                 StudyStore store = StudyStore::open(o.study);
-                store.setExcluded(o.participant, o.trial, !o.include, o.reason);
+                store.setExcluded(o.participant, o.trial - 1, !o.include, o.reason);
                 fmt::print("{} trial {} {}\n", o.participant, o.trial,
                            o.include ? "included" : "excluded");
             });
@@ -176,16 +188,21 @@ const underfoot::cli::CommandRegistrar registrar{
                                                    "(stimulus, render seed, GRF recording)");
         trial->add_option("--study", o.study, "study file")->required();
         trial->add_option("--participant", o.participant, "participant code")->required();
-        trial->add_option("--trial", o.trial, "trial index")->required();
+        trial
+            ->add_option("--trial", o.trial,
+                         "trial number (1-based, as in the session and the export's `trial`)")
+            ->required()
+            ->check(CLI::PositiveNumber);
         trial->callback([&exitCode, &o] {
             guarded([&] {
                 StudyStore store = StudyStore::open(o.study);
-                const ReplayInfo r = store.trialForReplay(o.participant, o.trial);
-                fmt::print("study {} protocol sha256 {}\nparticipant {} trial {}\nrender seed {}\n"
+                const ReplayInfo r = store.trialForReplay(o.participant, o.trial - 1);
+                fmt::print("study {} protocol sha256 {}\nparticipant {} trial {} (stored index "
+                           "{})\nrender seed {}\n"
                            "GRF recording {}\naudio config {}\nsensor config {}\n\n{}",
-                           r.study, r.protocolHash, r.participant, r.trialIndex, r.renderSeed,
-                           r.grfRecording.value_or("(none)"), r.audioConfig, r.sensorConfig,
-                           stimulusToToml(r.stimulus));
+                           r.study, r.protocolHash, r.participant, r.trialIndex + 1, r.trialIndex,
+                           r.renderSeed, r.grfRecording.value_or("(none)"), r.audioConfig,
+                           r.sensorConfig, stimulusToToml(r.stimulus));
                 fmt::print("\n");
             });
             exitCode = 0;
@@ -206,6 +223,15 @@ const underfoot::cli::CommandRegistrar registrar{
                         writer(std::cout);
                         return;
                     }
+                    // A missing folder of the output file is created (issue #17).
+                    if (const auto folder = std::filesystem::path(path).parent_path();
+                        !folder.empty()) {
+                        std::error_code ec;
+                        std::filesystem::create_directories(folder, ec);
+                        if (ec)
+                            throw StoreError(fmt::format("{}: cannot create the folder {} ({})",
+                                                         path, folder.string(), ec.message()));
+                    }
                     std::ofstream out(path, std::ios::binary);
                     if (!out) throw StoreError(fmt::format("{}: cannot write the file", path));
                     writer(out);
@@ -225,7 +251,8 @@ const underfoot::cli::CommandRegistrar registrar{
                 StudyStore store = StudyStore::open(o.study);
                 for (const auto& e : store.events())
                     fmt::print("{} {:>6} {:<24} {:<8} {:>4} {}\n", e.at, e.id, e.kind,
-                               e.participant, e.trialIndex ? std::to_string(*e.trialIndex) : "",
+                               e.participant,
+                               e.trialIndex ? std::to_string(*e.trialIndex + 1) : "", // 1-based
                                e.detail);
             });
             exitCode = 0;

@@ -58,7 +58,7 @@ ReplayRender renderTrialReplay(const ReplayRequest& q) {
         throw ReplayError(fmt::format(
             "trial {} of {} played the lab-supplied clip `{}` (in the study's clip folder); that "
             "file is what was heard, nothing is rendered for it",
-            q.trial, q.participant, *stimulus.clip));
+            q.trial + 1, q.participant, *stimulus.clip));
     std::optional<fs::path> recording;
     LiveRun live;
     if (info.grfRecording) {
@@ -91,9 +91,9 @@ ReplayRender renderTrialReplay(const ReplayRequest& q) {
                 out.audio = eng::renderWading(options, q.walkSeconds);
                 source = fmt::format("virtual gait, {} steps/min", options.cadenceStepsPerMin);
             }
-            out.description =
-                fmt::format("{} trial {} (wading): {:.1f} s from {}, seed {}", info.participant,
-                            info.trialIndex, double(out.audio.frames()) / rate, source, out.seed);
+            out.description = fmt::format("{} trial {} (wading): {:.1f} s from {}, seed {}",
+                                          info.participant, info.trialIndex + 1,
+                                          double(out.audio.frames()) / rate, source, out.seed);
             return out;
         }
 
@@ -116,12 +116,12 @@ ReplayRender renderTrialReplay(const ReplayRequest& q) {
             throw ReplayError(fmt::format(
                 "trial {} of {} was driven by a live sensor and no GRF recording is stored for "
                 "it, so what was heard cannot be re-rendered exactly",
-                q.trial, q.participant));
+                q.trial + 1, q.participant));
         }
         out.audio = renderStimulusFromGrf(stimulus, grf, info.renderSeed, rate, out.blockSize);
         out.description =
             fmt::format("{} trial {} ({}{}{}): {:.1f} s from {}, render seed {}, block {}",
-                        info.participant, info.trialIndex, stimulus.surface,
+                        info.participant, info.trialIndex + 1, stimulus.surface,
                         stimulus.soundscape ? " + " : "", stimulus.soundscape.value_or(""),
                         double(out.audio.frames()) / rate, source, out.seed, out.blockSize);
         return out;

@@ -24,7 +24,8 @@ class ReplayError : public std::runtime_error {
 struct ReplayRequest {
     std::string study;       ///< study file (.db)
     std::string participant; ///< participant code
-    int trial = 0;           ///< trial index as stored (0-based; the export's trial_index)
+    int trial = 0;           ///< trial index as stored (0-based; the export's trial_index);
+                             ///< people read and type trial + 1 (`replay --trial`, messages)
     double walkSeconds = 10; ///< length when a virtual walker or gait drove the trial
     std::optional<double> sampleRateHz; ///< default: the live trial's, else 48 kHz
     std::optional<int> blockSize;       ///< default: the live trial's, else 256

@@ -138,12 +138,37 @@ std::unique_ptr<Surface> Surface::loadById(const std::string& idOrPath,
         return load(idOrPath, options);
     const std::string file = surfacesDirectory() + "/" + idOrPath + ".toml";
     if (!fs::exists(file)) {
-        std::string ids;
+        // Sorted, with the closest id suggested (issue #17).
+        std::vector<std::string> names;
         for (const auto& e : fs::directory_iterator(surfacesDirectory()))
-            if (e.path().extension() == ".toml")
-                ids += (ids.empty() ? "" : ", ") + e.path().stem().string();
+            if (e.path().extension() == ".toml") names.push_back(e.path().stem().string());
+        std::sort(names.begin(), names.end());
+        std::string ids, closest;
+        std::size_t best = std::max<std::size_t>(1, idOrPath.size() / 2) + 1;
+        for (const auto& n : names) {
+            ids += (ids.empty() ? "" : ", ") + n;
+            // Edit distance (two-row Wagner-Fischer); a name containing the id counts as 1.
+            std::vector<std::size_t> prev(n.size() + 1), row(n.size() + 1);
+            for (std::size_t j = 0; j <= n.size(); ++j) prev[j] = j;
+            for (std::size_t i = 1; i <= idOrPath.size(); ++i) {
+                row[0] = i;
+                for (std::size_t j = 1; j <= n.size(); ++j)
+                    row[j] = std::min({prev[j] + 1, row[j - 1] + 1,
+                                       prev[j - 1] + (idOrPath[i - 1] == n[j - 1] ? 0 : 1)});
+                std::swap(row, prev);
+            }
+            std::size_t d = prev[n.size()];
+            if (!idOrPath.empty() && n.find(idOrPath) != std::string::npos)
+                d = std::min<std::size_t>(d, 1);
+            if (d < best) {
+                best = d;
+                closest = n;
+            }
+        }
         throw PresetError(fmt::format(
-            "unknown surface \"{}\": expected one of {} (or a .toml file)", idOrPath, ids));
+            "unknown surface \"{}\": expected one of {} (or a .toml "
+            "file){}",
+            idOrPath, ids, closest.empty() ? "" : fmt::format("; did you mean \"{}\"?", closest)));
     }
     return load(file, options);
 }

@@ -41,7 +41,7 @@ test "$(ls recordings/grf_*.wav.meters.toml | wc -l)" -eq 3
 "$underfoot" export --study walk.db -o out > /dev/null
 # audio.csv: sample_rate_hz (8) = 48000, block_size (9) = 64, frames (10) > 0 on every row.
 test "$(tail -n +2 out/audio.csv | awk -F, '$8 == 48000 && $9 == 64 && $10 > 0' | wc -l)" -eq 3
-"$underfoot" replay --study walk.db --participant P1 --trial 1 -o t1.wav > replay.txt
+"$underfoot" replay --study walk.db --participant P1 --trial 2 -o t1.wav > replay.txt
 grep -q "block 64" replay.txt
 
 # 2. FSR shoes on a pseudo-terminal pair; they stop writing during the trial.

@@ -17,7 +17,7 @@ printf 'stimulus,BS,GL,WD,DK\nGL,0,5,0,0\nWR,0,0,5,0\nBS,5,0,0,0\n' > confusion.
 # The gravel trial: participant, trial index and render seed from the export.
 row=$(grep -m1 ',GL,gravel,' out/trials.csv)
 participant=$(echo "$row" | cut -d, -f5)
-trial=$(echo "$row" | cut -d, -f8)
+trial=$(( $(echo "$row" | cut -d, -f8) + 1 ))   # --trial takes the 1-based number
 seed=$(echo "$row" | cut -d, -f17)
 "$underfoot" replay --study walk.db --participant "$participant" --trial "$trial" -o a.wav > /dev/null
 "$underfoot" replay --study walk.db --participant "$participant" --trial "$trial" -o b.wav > /dev/null
@@ -27,11 +27,13 @@ cmp a.wav b.wav
 cmp a.wav rendered.wav
 
 # The study store analyses directly, columns in the protocol's answer order.
-"$underfoot" analyze --study walk.db --format markdown > analysis.md
+"$underfoot" analyze --study walk.db --format markdown 2> left_out.txt > analysis.md
+grep -q "1 simulated participant(s) left out" left_out.txt
+"$underfoot" analyze --study walk.db --include-simulated --format markdown > analysis.md
 grep -q "| Stimulus | BS | GL | WD | DK | n |" analysis.md
 
 # Every trial replays (reverb and soundscape stimuli included).
-for t in 0 1 2; do
+for t in 1 2 3; do
   "$underfoot" replay --study walk.db --participant "$participant" --trial "$t" -o "t$t.wav" > "t$t.txt"
   test -s "t$t.wav"
 done
@@ -46,7 +48,7 @@ grep -q "beach_summer" t*.txt
 "$underfoot" export --study mic.db -o mic > /dev/null
 mp=$(sed -n 2p mic/trials.csv | cut -d, -f5)
 set +e
-"$underfoot" replay --study mic.db --participant "$mp" --trial 0 -o x.wav 2> refused.txt
+"$underfoot" replay --study mic.db --participant "$mp" --trial 1 -o x.wav 2> refused.txt
 status=$?
 set -e
 test "$status" -eq 2

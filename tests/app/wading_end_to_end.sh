@@ -42,7 +42,7 @@ test ! -e x.wav && test ! -e y.wav && test ! -e z.wav
   --code WAD1 --site ci --seed 16 > /dev/null
 "$underfoot" session --study w1.db --simulate --participants 6 --clips clips1 \
   --rating-model "$src/protocols/simulation/wading_listening_ratings.toml" > /dev/null
-"$underfoot" analyze --study w1.db -o w1.md > /dev/null
+"$underfoot" analyze --study w1.db --include-simulated -o w1.md > /dev/null
 grep -q -i "friedman" w1.md
 grep -q "p (Holm)" w1.md
 "$underfoot" export --study w1.db -o out1 > /dev/null
@@ -53,7 +53,7 @@ test "$(tail -n +2 out1/ratings.csv | wc -l)" -gt 0
 # clip's seed): protocol wading_listening uses algorithm v1 and the 5 Hz filter, 7 s clips.
 row=$(grep -m1 ',wade_deep_' out1/trials.csv)
 participant=$(echo "$row" | cut -d, -f5)
-trial=$(echo "$row" | cut -d, -f8)
+trial=$(( $(echo "$row" | cut -d, -f8) + 1 ))   # --trial takes the 1-based number
 stimulus=$(echo "$row" | cut -d, -f11)
 seed=$(echo "$row" | cut -d, -f17)
 "$underfoot" replay --study w1.db --participant "$participant" --trial "$trial" --seconds 7 \
@@ -67,6 +67,6 @@ cmp replay.wav direct.wav
   --code WAD2 --site ci --seed 9 > /dev/null
 "$underfoot" session --study w2.db --simulate --participants 6 \
   --rating-model "$src/protocols/simulation/wading_interactive_ratings.toml" > /dev/null
-"$underfoot" analyze --study w2.db -o w2.md > /dev/null
+"$underfoot" analyze --study w2.db --include-simulated -o w2.md > /dev/null
 grep -q -i "friedman\|wilcoxon" w2.md
 echo "wading end to end: ok"
