@@ -5,12 +5,15 @@
 // checks before it starts. The rendering is app/wiring renderClipFolder, which the console uses.
 #include "app/cli/CommandRegistry.h"
 #include "app/wiring/ClipPlayer.h"
+#include "engine/io/AudioDevice.h"
+#include "engine/scene/LiveEngine.h"
 #include "experiment/Clips.h"
 
 #include <fmt/core.h>
 
 #include <chrono>
 #include <filesystem>
+#include <thread>
 
 namespace underfoot::cli {
 namespace {
@@ -24,7 +27,42 @@ struct ClipsArgs {
     std::string output;
     double rate = 48000.0;
     bool checkOnly = false;
+    bool live = false;    ///< play every clip through the audio device afterwards
+    std::string settings; ///< audio settings TOML for --live (`underfoot devices --save`)
 };
+
+/// --live: plays the clip folder's clips in protocol order through the configured device, each
+/// to its end; refuses with the reason when the device cannot be opened (issue #17: an option
+/// that promises sound plays it or says why not).
+void playClips(const ClipsArgs& a, const std::vector<exp::ClipJob>& jobs) {
+    eng::AudioSettings settings;
+    eng::LiveEngine engine;
+    try {
+        if (!a.settings.empty()) settings = eng::loadAudioSettings(a.settings);
+        engine.open(settings);
+        engine.start();
+    } catch (const std::exception& e) {
+        throw UserError(std::string("clips --live: no sound can be played: ") + e.what());
+    }
+    fmt::print("live audio: {} / {} at {} Hz, block {}\n", engine.openedApi(),
+               engine.openedDevice(), engine.settings().sampleRateHz, engine.settings().blockSize);
+    wiring::ClipAudio audio(engine);
+    int n = 0;
+    for (const auto& job : jobs) {
+        try {
+            audio.play(job.path);
+        } catch (const std::exception& e) {
+            throw UserError(fmt::format("clips --live: {}: {}", job.path, e.what()));
+        }
+        const double seconds =
+            static_cast<double>(audio.lastFrames()) / engine.settings().sampleRateHz;
+        fmt::print("playing {} of {}: {} ({:.1f} s)\n", ++n, jobs.size(), job.path, seconds);
+        std::fflush(stdout);
+        std::this_thread::sleep_for(std::chrono::duration<double>(seconds + 0.1));
+        audio.stop();
+    }
+    engine.close();
+}
 
 ClipsArgs& args() {
     static ClipsArgs a;
@@ -55,6 +93,7 @@ int runClips(const ClipsArgs& a) {
         const auto problems = exp::checkClips(protocol, a.output);
         for (const auto& p : problems) fmt::print("{}\n", p);
         if (problems.empty()) fmt::print("clips: {} clips ready in {}\n", jobs.size(), a.output);
+        if (problems.empty() && a.live) playClips(a, jobs);
         return problems.empty() ? 0 : 1;
     }
     const auto started = std::chrono::steady_clock::now();
@@ -72,6 +111,7 @@ int runClips(const ClipsArgs& a) {
         std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     fmt::print("clips: {} clips in {} ({:.1f} s); manifest {}/{}\n", records.size(), a.output,
                elapsed, a.output, exp::kClipManifest);
+    if (a.live) playClips(a, jobs);
     return 0;
 }
 
@@ -88,7 +128,16 @@ const CommandRegistrar registrar{
             ->check(CLI::Range(8000.0, 192000.0));
         cmd->add_flag("--check", a.checkOnly,
                       "only check that every clip is present and unchanged (exit 1 otherwise)");
-        cmd->callback([&exitCode, &a] { exitCode = runClips(a); });
+        cmd->add_flag("--live", a.live,
+                      "then play every clip, in order, through the audio device (refused with "
+                      "the reason when it cannot be opened)");
+        cmd->add_option("--settings", a.settings,
+                        "audio settings file for --live (`underfoot devices --save`)");
+        cmd->callback([&exitCode, &a] {
+            if (!a.live && !a.settings.empty())
+                throw UserError("clips: --settings belongs to --live");
+            exitCode = runClips(a);
+        });
     }};
 
 } // namespace
