@@ -280,8 +280,16 @@ class SimulationPlayer final : public StimulusPlayer {
   public:
     explicit SimulationPlayer(const Protocol& protocol) : protocol_(protocol) {}
     StimulusStart start(const Stimulus& stimulus, std::uint64_t plannedSeed) override {
-        return {protocol_.clips.enabled ? clipSeed(protocol_, stimulus) : plannedSeed,
-                std::nullopt};
+        if (protocol_.clips.enabled) return {clipSeed(protocol_, stimulus), std::nullopt};
+        // A sensor stimulus (microphones, shoes, gyroscopes) has no person walking: the
+        // simulated participant walks as the virtual walker, for the protocol's trial time, and
+        // that control stream is what the trial records (replay regenerates it from the seed).
+        // Water stimuli replay from the virtual gait of their wading parameters already.
+        if (stimulus.input.kind == InputKind::Sensor && stimulus.wading.empty() &&
+            stimulus.surface != "water")
+            return {plannedSeed,
+                    fmt::format("{}{}", kSimulatedWalkerPrefix, protocol_.timing.trialS)};
+        return {plannedSeed, std::nullopt};
     }
     void stop() override {}
 

@@ -86,6 +86,12 @@ class SimulatedParticipant {
 
 namespace underfoot::experiment {
 
+/// Prefix of the control-stream reference a simulated participant's sensor trial stores in
+/// place of a GRF recording: "virtual-walker:seconds=S" means that the participant's feet were
+/// the stimulus's virtual walker (the engine's default walker for sensor stimuli) for S seconds
+/// from the trial's render seed, which `underfoot replay` regenerates exactly.
+inline constexpr std::string_view kSimulatedWalkerPrefix = "virtual-walker:seconds=";
+
 /// Confusion matrices by group id; the entry "" is used for groups without their own.
 using MatrixByGroup = std::map<std::string, ConfusionMatrix>;
 

@@ -7,6 +7,7 @@
 #include "engine/wading/Gait.h"
 #include "engine/wading/Wading.h"
 #include "experiment/Clips.h"
+#include "experiment/Simulation.h"
 #include "experiment/Store.h"
 
 #include <fmt/format.h>
@@ -61,6 +62,23 @@ ReplayRender renderTrialReplay(const ReplayRequest& q) {
             q.trial + 1, q.participant, *stimulus.clip));
     std::optional<fs::path> recording;
     LiveRun live;
+    // A simulated participant's sensor trial: its feet were the virtual walker (issue #17).
+    std::optional<double> simulatedWalkerSeconds;
+    if (info.grfRecording && info.grfRecording->rfind(exp::kSimulatedWalkerPrefix, 0) == 0) {
+        const std::string value = info.grfRecording->substr(exp::kSimulatedWalkerPrefix.size());
+        try {
+            std::size_t used = 0;
+            const double seconds = std::stod(value, &used);
+            if (used != value.size() || !(seconds > 0 && seconds <= 3600)) throw 0;
+            simulatedWalkerSeconds = seconds;
+        } catch (...) {
+            throw ReplayError(fmt::format("trial {} of {}: stored control stream '{}': expected "
+                                          "{}SECONDS with 0 < SECONDS <= 3600",
+                                          q.trial + 1, q.participant, *info.grfRecording,
+                                          exp::kSimulatedWalkerPrefix));
+        }
+        info.grfRecording.reset();
+    }
     if (info.grfRecording) {
         recording = fs::path(*info.grfRecording);
         if (recording->is_relative()) recording = fs::path(q.study).parent_path() / *recording;
@@ -108,11 +126,20 @@ ReplayRender renderTrialReplay(const ReplayRequest& q) {
                 throw ReplayError(std::string("the trial's GRF recording: ") + e.what());
             }
             source = "recorded GRF " + recording->string();
+        } else if (simulatedWalkerSeconds) {
+            const auto walker = walkerFromStimulus(stimulus.input.walker);
+            grf = eng::walkerGrf(walker, *simulatedWalkerSeconds, rate, info.renderSeed);
+            source = "the simulated participant's virtual walker " + walker.toString();
         } else if (stimulus.input.kind == exp::InputKind::Walker) {
             const auto walker = walkerFromStimulus(stimulus.input.walker);
             grf = eng::walkerGrf(walker, q.walkSeconds, rate, info.renderSeed);
             source = "virtual walker " + walker.toString();
         } else {
+            if (info.audioConfig.rfind("none (data entry", 0) == 0)
+                throw ReplayError(fmt::format(
+                    "trial {} of {} was answered in a session without sound (data entry, no "
+                    "--live): nothing was heard, so there is nothing to re-render",
+                    q.trial + 1, q.participant));
             throw ReplayError(fmt::format(
                 "trial {} of {} was driven by a live sensor and no GRF recording is stored for "
                 "it, so what was heard cannot be re-rendered exactly",

@@ -3,7 +3,7 @@
 # Replay (and analysis of a study store) end to end through the `underfoot` program: a study whose stimuli are driven by the
 # virtual walker is run (simulated participant), then each trial is re-rendered from the store.
 # A replay must be identical to itself and to `underfoot render` with the stored seed; a trial
-# driven by a live sensor with no GRF recording must be refused with a clear message.
+# answered without sound (data entry) must be refused with a clear message.
 #   replay_end_to_end.sh UNDERFOOT SOURCE_DIR WORK_DIR
 set -euo pipefail
 underfoot="$1"; src="$2"; work="$3"
@@ -39,19 +39,31 @@ for t in 1 2 3; do
 done
 grep -q "beach_summer" t*.txt
 
-# Sensor-driven study without GRF recordings: refused, exit status 2, with the reason.
-"$underfoot" study create --study mic.db --protocol "$src/protocols/tvcg2011_exp2.toml" --code M --site ci --seed 1 > /dev/null
-"$underfoot" session --study mic.db --simulate --participants 1 \
-  --confusion "none=$src/tests/experiment/data/tvcg2011_exp2_cond1_no_soundscape_confusion.csv" \
-  --confusion "coherent=$src/tests/experiment/data/tvcg2011_exp2_cond2_coherent_confusion.csv" \
-  --confusion "incoherent=$src/tests/experiment/data/tvcg2011_exp2_cond3_incoherent_confusion.csv" > /dev/null
+# A microphone-driven protocol (TVCG 2011 exp. 1). A simulated participant's feet are the
+# virtual walker for the protocol's trial time (50 s), recorded as the trial's control stream:
+# its trials replay, identical to `underfoot render` with the stored seed (issue #17).
+"$underfoot" study create --study mic.db --protocol "$src/protocols/tvcg2011_exp1.toml" --code M --site ci --seed 1 > /dev/null
+"$underfoot" study register --study mic.db --participant P1 > /dev/null
+"$underfoot" session --study mic.db --simulate --participants 1 > /dev/null
 "$underfoot" export --study mic.db -o mic > /dev/null
-mp=$(sed -n 2p mic/trials.csv | cut -d, -f5)
+row=$(grep -m1 ',GL,gravel,' mic/trials.csv)
+mp=$(echo "$row" | cut -d, -f5)
+mtrial=$(( $(echo "$row" | cut -d, -f8) + 1 ))
+mseed=$(echo "$row" | cut -d, -f17)
+"$underfoot" replay --study mic.db --participant "$mp" --trial "$mtrial" -o m.wav > m.txt
+grep -q "simulated participant's virtual walker" m.txt
+walker=$(grep -o "virtual walker [^ ]*" m.txt | sed 's/virtual walker //; s/,$//')
+"$underfoot" render --surface gravel --walker "$walker" --seconds 50 --seed "$mseed" \
+  --tail 1 --format float -q -o m_rendered.wav
+cmp m.wav m_rendered.wav
+# A person's trial answered without sound (data entry): refused, exit status 2, with the reason.
+printf '\n\na\n\nquit\n' | "$underfoot" session --study mic.db --participant P1 > p1.txt || true
+grep -q "NO SOUND" p1.txt
 set +e
-"$underfoot" replay --study mic.db --participant "$mp" --trial 1 -o x.wav 2> refused.txt
+"$underfoot" replay --study mic.db --participant P1 --trial 1 -o x.wav 2> refused.txt
 status=$?
 set -e
 test "$status" -eq 2
-grep -q "no GRF recording is stored" refused.txt
+grep -q "without sound (data entry" refused.txt
 test ! -e x.wav
 echo "replay end to end: ok"

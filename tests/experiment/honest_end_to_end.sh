@@ -87,11 +87,14 @@ set +e
 set -e
 grep -q 'did you mean "gravel"' render.txt
 
-# clips --live refuses with the reason when no sound can be played.
+# clips --live refuses with the reason when no sound can be played (here: no settings file).
+printf '[protocol]\nid = "cl"\nversion = 1\ntitle = "c"\n[design]\ntype = "within"\n[input]\ntype = "walker"\n[clips]\nseconds = 0.5\n[[stimuli]]\nid = "GL"\nsurface = "gravel"\n[[questions.scales]]\nid = "realism"\nprompt = "R"\nmin = 1\nmax = 7\n' > cl.toml
+"$underfoot" clips --protocol cl.toml -o clips > /dev/null
 set +e
-"$underfoot" clips --protocol "$src/protocols/wading_listening.toml" -o clips --check --live \
-  --settings missing.toml > clips.txt 2>&1
+"$underfoot" clips --protocol cl.toml -o clips --check --live --settings missing.toml \
+  > clips.txt 2>&1
 status=$?
 set -e
 test "$status" -ne 0
+grep -q "no sound can be played" clips.txt
 echo "honest end to end: ok"
