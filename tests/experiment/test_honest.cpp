@@ -295,3 +295,16 @@ TEST(Honest, UnknownIdsGetASortedListAndTheClosestName) {
         EXPECT_NE(what.find("beach_sand, carpet, concrete"), std::string::npos) << what;
     }
 }
+
+TEST(Honest, ASimulatedSensorTrialRecordsItsControlStream) {
+    TempDir dir;
+    StudyStore store = StudyStore::create(
+        dir.file("s.db"), loadProtocol(shipped("tvcg2011_exp1.toml")), {"H", "ci", 2, "t"});
+    simulateStudy(store, matricesFor(store.protocol()), 1, {});
+    const auto code = store.participants().front().code;
+    for (const auto& t : store.trials(code)) {
+        ASSERT_TRUE(t.grfRecording.has_value()) << t.index;
+        EXPECT_EQ(*t.grfRecording, std::string(kSimulatedWalkerPrefix) + "50") << t.index;
+        EXPECT_EQ(store.trialForReplay(code, t.index).renderSeed, t.plannedSeed);
+    }
+}
