@@ -126,7 +126,7 @@ struct SessionSettings {
     std::string appVersion;
     /// Whether the stimuli are played as sound (true), not at all (false: data entry, answers
     /// typed in without sound), or unknown (nullopt).
-    std::optional<bool> soundPlayed;
+    std::optional<bool> soundPlayed = std::nullopt;
 };
 
 /// A stored session of a participant.
@@ -138,7 +138,7 @@ struct SessionRecord {
     std::string startedAt;
     std::string endedAt;
     std::string outcome; ///< "completed", "interrupted" or "" while open
-    std::optional<bool> soundPlayed;
+    std::optional<bool> soundPlayed = std::nullopt;
 };
 
 /// An answer to one trial.

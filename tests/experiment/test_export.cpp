@@ -49,7 +49,7 @@ TEST(ExperimentExport, HeaderIsTheAnalysisContract) {
         "study,site,protocol_id,protocol_hash,participant,group,session,trial_index,block,"
         "practice,stimulus_id,surface,soundscape,modalities,reverb,repetition,render_seed,answer,"
         "answer_label,correct,realism,quality,soundscape_answer,soundscape_correct,"
-        "response_time_s,excluded,exclusion_reason,comment,started_at,answered_at";
+        "response_time_s,excluded,exclusion_reason,comment,started_at,answered_at,trial,simulated";
     std::string joined;
     for (auto c : kTrialColumns) joined += (joined.empty() ? "" : ",") + std::string(c);
     EXPECT_EQ(joined, expected);
