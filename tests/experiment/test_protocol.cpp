@@ -39,7 +39,7 @@ TEST(ExperimentProtocol, Tvcg2011Exp1HasThirteenStimuliTwiceAndNineteenOptions) 
     EXPECT_EQ(p.questions.surfaceOptions.back().id, "dont_know");
     EXPECT_EQ(p.questions.surfaceOptions.back().letter, 's');
     EXPECT_EQ(p.stimulus("WR")->surface, "wood_reverb");
-    EXPECT_EQ(p.stimulus("WR")->reverb, "indoor");
+    EXPECT_EQ(p.stimulus("WR")->reverb, "wooden_room");
     EXPECT_EQ(p.stimulus("BS")->input.sensor, SensorKind::Microphones);
     EXPECT_EQ(generatePlan(p, "all", 1, 0).size(), 26u);
     EXPECT_EQ(p.hash.size(), 64u);
