@@ -226,7 +226,9 @@ std::string formatTrialCsv(const std::vector<TrialRecord>& records) {
                                               t.exclusionReason,
                                               "",
                                               "",
-                                              ""};
+                                              "",
+                                              std::to_string(t.trialIndex + 1),
+                                              t.simulated ? "1" : "0"};
         out += csv::joinLine(fields) + "\n";
     }
     return out;
