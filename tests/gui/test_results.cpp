@@ -179,8 +179,23 @@ class ResultsTest : public QObject {
             QTest::qWait(20);
             QCOMPARE(w->size(), QSize(1280, 800));
             QWidget* page = w->tabs()->currentWidget();
+            int checked = 0;
             for (QLabel* l : page->findChildren<QLabel*>()) {
-                if (!l->isVisible() || l->text().isEmpty() || l->wordWrap()) continue;
+                if (!l->isVisible() || l->text().isEmpty()) continue;
+                if (l->wordWrap()) {
+                    // Wrapped text needs its height at the width it got.
+                    const int need = l->heightForWidth(l->width());
+                    QVERIFY2(l->height() >= need,
+                             qPrintable(QString("view %1: wrapped label '%2' is %3 px high, "
+                                                "needs %4")
+                                            .arg(view)
+                                            .arg(l->text().left(60))
+                                            .arg(l->height())
+                                            .arg(need)));
+                    ++checked;
+                    continue;
+                }
+                ++checked;
                 if (l->textFormat() == Qt::RichText || Qt::mightBeRichText(l->text())) continue;
                 QString shown = l->text().split('\n').first();
                 shown.remove(QRegularExpression("&(?!&)")); // mnemonic marks are not drawn
@@ -192,6 +207,7 @@ class ResultsTest : public QObject {
                                         .arg(l->contentsRect().width())
                                         .arg(need)));
             }
+            QVERIFY(checked > 3);
             for (QAbstractButton* b : page->findChildren<QAbstractButton*>()) {
                 if (!b->isVisible() || b->text().isEmpty()) continue;
                 QVERIFY2(b->width() >= b->minimumSizeHint().width(),
