@@ -116,10 +116,9 @@ void RatingsPlot::paintEvent(QPaintEvent*) {
 
 QString RatingsPlot::save(const QString& path) const {
     if (series_.conditions.empty()) return tr("%1: no ratings yet, nothing to draw").arg(path);
-    const double width =
-        std::max(600.0, 90.0 + 70.0 * static_cast<double>(series_.conditions.size()));
+    const double height = 90.0 + 26.0 * static_cast<double>(series_.conditions.size());
     return saveFigure([this](QPainter& p, const QSizeF& s) { paintFigure(p, s); },
-                      QSizeF(width, 460), path, series_.title);
+                      QSizeF(900, height), path, series_.title);
 }
 
 void RatingsPlot::paintFigure(QPainter& p, const QSizeF& size) const {
@@ -131,86 +130,78 @@ void RatingsPlot::paintFigure(QPainter& p, const QSizeF& size) const {
                    tr("No ratings yet: the plot fills in as answers are committed."));
         return;
     }
+    // Conditions are rows (their labels, however long, read horizontally on the left); the
+    // scale runs along the x axis.
     const QFontMetrics fm(font());
-    const double left = 70, top = 30, right = 16;
-    // Room for the condition labels, rotated 35 degrees under the axis.
     double longest = 0;
-    for (const auto& c : series_.conditions)
-        longest = std::max(longest, static_cast<double>(fm.horizontalAdvance(c.label)));
-    const double bottom = std::min(200.0, 0.6 * longest + 2 * fm.height() + 10);
-    const QRectF plot(left, top, size.width() - left - right, size.height() - top - bottom);
+    QStringList labels;
+    for (const auto& c : series_.conditions) {
+        labels << QString("%1  (n = %2)").arg(c.label).arg(c.values.size());
+        longest = std::max(longest, static_cast<double>(fm.horizontalAdvance(labels.back())));
+    }
+    const double labelW = std::min(longest + 12, size.width() * 0.5);
+    const double top = 34, bottom = 2.5 * fm.height() + 8, right = 20;
+    const QRectF plot(labelW, top, size.width() - labelW - right, size.height() - top - bottom);
     if (plot.width() <= 10 || plot.height() <= 10) return;
     const double span = std::max(1, series_.max - series_.min);
-    const auto yOf = [&](double v) {
-        return plot.bottom() - (v - series_.min + 0.5) / (span + 1.0) * plot.height();
+    const auto xOf = [&](double v) {
+        return plot.left() + (v - series_.min + 0.5) / (span + 1.0) * plot.width();
     };
-    // Title.
     QFont bold = font();
     bold.setBold(true);
     p.setFont(bold);
     p.drawText(QRectF(0, 0, size.width(), top - 4), Qt::AlignCenter | Qt::TextWordWrap,
                series_.title);
     p.setFont(font());
-    // Y axis with a tick per scale point.
-    p.setPen(QColor(120, 120, 120));
-    p.drawLine(QPointF(plot.left(), plot.top()), QPointF(plot.left(), plot.bottom()));
+    // X axis: a tick per scale point, grid lines, axis title.
     const int step = span > 12 ? 2 : 1;
     for (int v = series_.min; v <= series_.max; v += step) {
-        const double y = yOf(v);
+        const double x = xOf(v);
         p.setPen(QColor(230, 230, 230));
-        p.drawLine(QPointF(plot.left(), y), QPointF(plot.right(), y));
+        p.drawLine(QPointF(x, plot.top()), QPointF(x, plot.bottom()));
         p.setPen(Qt::black);
-        p.drawText(QRectF(plot.left() - 30, y - 10, 24, 20), Qt::AlignRight | Qt::AlignVCenter,
+        p.drawText(QRectF(x - 20, plot.bottom() + 2, 40, fm.height()), Qt::AlignCenter,
                    QString::number(v));
     }
-    p.save();
-    p.translate(14, plot.center().y());
-    p.rotate(-90);
-    p.drawText(QRectF(-plot.height() / 2, -10, plot.height(), 20), Qt::AlignCenter, tr("Rating"));
-    p.restore();
-    const double slot = plot.width() / static_cast<double>(series_.conditions.size());
+    p.setPen(QColor(120, 120, 120));
+    p.drawLine(QPointF(plot.left(), plot.bottom()), QPointF(plot.right(), plot.bottom()));
+    p.setPen(Qt::black);
+    p.drawText(QRectF(plot.left(), plot.bottom() + fm.height() + 2, plot.width(), fm.height()),
+               Qt::AlignLeft | Qt::AlignVCenter, tr("Rating"));
+    p.setPen(QColor(60, 60, 60));
+    p.drawText(QRectF(plot.left(), plot.bottom() + fm.height() + 2, plot.width(), fm.height()),
+               Qt::AlignRight | Qt::AlignVCenter,
+               tr("dots: each answer · square: mean · whiskers: 95 % CI (t)"));
+    const double slot = plot.height() / static_cast<double>(series_.conditions.size());
     for (std::size_t i = 0; i < series_.conditions.size(); ++i) {
         const auto& c = series_.conditions[i];
-        const double x = plot.left() + (static_cast<double>(i) + 0.5) * slot;
-        // Individual answers: grey dots spread by a fixed pattern (same picture every time).
+        const double y = plot.top() + (static_cast<double>(i) + 0.5) * slot;
+        p.setPen(Qt::black);
+        p.drawText(QRectF(0, y - slot / 2, labelW - 10, slot), Qt::AlignRight | Qt::AlignVCenter,
+                   fm.elidedText(labels[static_cast<int>(i)], Qt::ElideMiddle,
+                                 static_cast<int>(labelW - 12)));
+        // Individual answers: grey dots above the mean, spread by a fixed pattern.
         p.setPen(Qt::NoPen);
         p.setBrush(QColor(110, 110, 110, 150));
         std::map<double, int> seen;
         for (double v : c.values) {
             const int k = seen[v]++;
-            const double dx = (k % 2 ? 1 : -1) * ((k + 1) / 2) * 4.0;
-            p.drawEllipse(
-                QPointF(x - slot * 0.18 + std::clamp(dx, -slot * 0.15, slot * 0.15), yOf(v)), 2.5,
-                2.5);
+            const double dx = (k % 2 ? 1 : -1) * ((k + 1) / 2) * 3.0;
+            p.drawEllipse(QPointF(xOf(v) + std::clamp(dx, -9.0, 9.0), y - slot * 0.22), 2.5, 2.5);
         }
-        // Mean and 95 % CI.
+        // Mean and 95 % CI below them.
         p.setPen(QPen(QColor(31, 111, 235), 2));
         p.setBrush(QColor(31, 111, 235));
-        const double mx = x + slot * 0.12;
+        const double my = y + slot * 0.12;
         if (std::isfinite(c.ciLow) && std::isfinite(c.ciHigh)) {
             const double lo = std::max<double>(c.ciLow, series_.min - 0.5);
             const double hi = std::min<double>(c.ciHigh, series_.max + 0.5);
-            p.drawLine(QPointF(mx, yOf(lo)), QPointF(mx, yOf(hi)));
-            p.drawLine(QPointF(mx - 5, yOf(lo)), QPointF(mx + 5, yOf(lo)));
-            p.drawLine(QPointF(mx - 5, yOf(hi)), QPointF(mx + 5, yOf(hi)));
+            p.drawLine(QPointF(xOf(lo), my), QPointF(xOf(hi), my));
+            p.drawLine(QPointF(xOf(lo), my - 4), QPointF(xOf(lo), my + 4));
+            p.drawLine(QPointF(xOf(hi), my - 4), QPointF(xOf(hi), my + 4));
         }
-        p.drawRect(QRectF(mx - 4, yOf(c.mean) - 4, 8, 8));
-        // Condition label and n under the axis.
-        p.setPen(Qt::black);
-        p.save();
-        p.translate(x, plot.bottom() + 8);
-        p.rotate(-35);
-        const QString text = QString("%1  (n = %2)").arg(c.label).arg(c.values.size());
-        p.drawText(QRectF(-fm.horizontalAdvance(text) - 4, -2, fm.horizontalAdvance(text) + 4,
-                          fm.height()),
-                   Qt::AlignRight | Qt::AlignTop, text);
-        p.restore();
+        p.drawRect(QRectF(xOf(c.mean) - 4, my - 4, 8, 8));
     }
-    // Legend.
-    p.setPen(QColor(60, 60, 60));
-    p.drawText(QRectF(0, size.height() - fm.height() - 2, size.width() - right, fm.height()),
-               Qt::AlignRight | Qt::AlignVCenter,
-               tr("dots: each answer · square: mean · whiskers: 95 % CI (t)"));
 }
 
 } // namespace underfoot::gui
