@@ -88,6 +88,10 @@ ParticipantWindow::ParticipantWindow(QWidget* parent) : QWidget(parent, Qt::Wind
     refresh();
 }
 
+void ParticipantWindow::setHeld(bool held) {
+    held_ = held;
+}
+
 void ParticipantWindow::setFlow(exp::TrialFlow* flow) {
     flow_ = flow;
     refresh();
@@ -108,7 +112,11 @@ void ParticipantWindow::refresh() {
         replay_->hide();
         return;
     }
-    const exp::ParticipantScreen s = flow_->participantScreen();
+    exp::ParticipantScreen s = flow_->participantScreen();
+    if (held_ && s.page == exp::ParticipantScreen::Page::Trial) {
+        s.answering = false;
+        s.text = "Please wait a moment.";
+    }
     heading_->setText(q(s.heading));
     text_->setText(q(s.text));
     progress_->setVisible(s.total > 0);
@@ -256,7 +264,7 @@ void ParticipantWindow::keyPressEvent(QKeyEvent* event) {
         return;
     }
     const exp::ParticipantScreen s = flow_->participantScreen();
-    if (s.page != exp::ParticipantScreen::Page::Trial || !s.answering) {
+    if (s.page != exp::ParticipantScreen::Page::Trial || !s.answering || held_) {
         event->accept(); // keys wait until answers are asked
         return;
     }

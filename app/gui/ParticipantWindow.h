@@ -35,6 +35,8 @@ class ParticipantWindow : public QWidget {
     void setFlow(experiment::TrialFlow* flow);
     /// Redraws from the flow.
     void refresh();
+    /// The experimenter paused the session (Ctrl+P): "Please wait", answers disabled.
+    void setHeld(bool held);
     /// Shows the window full screen on a screen other than `experimenterScreen` when there is
     /// one (returns true), else as a window on the same screen (returns false).
     bool showOnParticipantScreen(QScreen* experimenterScreen);
@@ -62,6 +64,7 @@ class ParticipantWindow : public QWidget {
     void renderDraft();
 
     experiment::TrialFlow* flow_ = nullptr;
+    bool held_ = false;
     QLabel* heading_ = nullptr;
     QLabel* text_ = nullptr;
     QProgressBar* progress_ = nullptr;

@@ -1745,7 +1745,9 @@ ParticipantWindow* RunView::openParticipantWindow() {
     if (!participantWindow_) {
         participantWindow_ = new ParticipantWindow(); // a top-level window, deleted below
         connect(this, &RunView::flowChanged, participantWindow_.data(), [this] {
-            if (participantWindow_) participantWindow_->setFlow(flow_.get());
+            if (!participantWindow_) return;
+            participantWindow_->setHeld(paused_);
+            participantWindow_->setFlow(flow_.get());
         });
         connect(participantWindow_.data(), &ParticipantWindow::draftChanged, this, [this] {
             renderDraft();

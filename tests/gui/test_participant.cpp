@@ -150,6 +150,15 @@ class ParticipantTest : public QObject {
             QVERIFY(!b.contains("stimulus", Qt::CaseInsensitive));
             QVERIFY(!b.contains("repetition", Qt::CaseInsensitive));
 
+            // The experimenter's pause (Ctrl+P) holds the participant's answers.
+            if (n == 2) {
+                QTest::mouseClick(button(run, "Pause or resume"), Qt::LeftButton);
+                QVERIFY(pw->visibleTexts().contains("Please wait a moment."));
+                QTest::keyClick(pw, 'a');
+                QVERIFY(run->flow()->draft().answer.empty());
+                QTest::mouseClick(button(run, "Pause or resume"), Qt::LeftButton);
+                QVERIFY(pw->visibleTexts().contains("Please answer."));
+            }
             // Odd trials answered on the participant window, even ones on the Run view.
             QWidget* target = n % 2 ? static_cast<QWidget*>(pw) : run->trialPanel();
             const ue::AnswerOption& surface =
