@@ -20,6 +20,7 @@ PACKAGES=(
   libssl-dev
   # GUI
   qt6-base-dev qt6-charts-dev libqt6opengl6-dev libqt6sql6-sqlite libgl-dev xvfb xauth
+  qt6-svg-dev  # console figures exported as SVG (QSvgGenerator)
   # tests and benchmarks
   googletest libgtest-dev libgmock-dev libbenchmark-dev valgrind
 )

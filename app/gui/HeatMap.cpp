@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "app/gui/HeatMap.h"
 
+#include "app/gui/Figures.h"
+
 #include <QHelpEvent>
 #include <QPainter>
 #include <QToolTip>
@@ -34,54 +36,94 @@ double HeatMap::total() const {
 
 QString HeatMap::rowLabel(std::size_t row) const {
     const auto& k = matrix_.rows[row];
-    QString s = QString::fromStdString(k.surfaceId);
-    if (!k.soundscapeId.empty()) s += " + " + QString::fromStdString(k.soundscapeId);
+    QString s = surfaceLabel(k.surfaceId);
+    if (!k.soundscapeId.empty()) s += " + " + soundscapeLabel(k.soundscapeId);
     return s;
 }
 
-HeatMap::Geometry HeatMap::geometry() const {
+QString HeatMap::columnLabel(std::size_t column) const {
+    const auto& o = matrix_.columns.options[column];
+    return QString::fromStdString(o.label.empty() ? o.id : o.label);
+}
+
+namespace {
+constexpr double kAxisTitle = 22; // room for an axis title
+}
+
+HeatMap::Geometry HeatMap::geometry(const QSizeF& size) const {
     Geometry g;
     const QFontMetrics fm(font());
     double labelW = 0;
     for (std::size_t r = 0; r < matrix_.rows.size(); ++r)
         labelW = std::max(labelW, static_cast<double>(fm.horizontalAdvance(rowLabel(r))));
     double headerH = 0;
-    for (const auto& c : matrix_.columns.options)
-        headerH = std::max(headerH,
-                           static_cast<double>(fm.horizontalAdvance(QString::fromStdString(c.id))));
-    g.left = labelW + 12;
-    g.top = std::min(headerH, 140.0) + 12;
+    for (std::size_t c = 0; c < matrix_.columns.options.size(); ++c)
+        headerH = std::max(headerH, static_cast<double>(fm.horizontalAdvance(columnLabel(c))));
+    g.left = kAxisTitle + labelW + 12;
+    g.top = kAxisTitle + std::min(headerH, 160.0) + 12;
     const double cols = std::max<double>(1, static_cast<double>(matrix_.columns.options.size()));
     const double rows = std::max<double>(1, static_cast<double>(matrix_.rows.size()));
-    g.cellW = std::max(18.0, (width() - g.left - 8) / cols);
-    g.cellH = std::max(16.0, std::min(34.0, (height() - g.top - 8) / rows));
+    g.cellW = std::max(30.0, (size.width() - g.left - 8) / cols);
+    g.cellH = std::max(28.0, std::min(40.0, (size.height() - g.top - 8) / rows));
     return g;
 }
 
 void HeatMap::paintEvent(QPaintEvent*) {
     QPainter p(this);
+    paintFigure(p, QSizeF(size()));
+}
+
+QString HeatMap::save(const QString& path) const {
+    if (matrix_.rows.empty()) return tr("%1: no answers yet, nothing to draw").arg(path);
+    const Geometry g = geometry(QSizeF(900, 420));
+    const QSizeF size(g.left + g.cellW * static_cast<double>(matrix_.columns.options.size()) + 8,
+                      g.top + g.cellH * static_cast<double>(matrix_.rows.size()) + 8);
+    return saveFigure([this](QPainter& p, const QSizeF& s) { paintFigure(p, s); }, size, path,
+                      tr("Confusion matrix, group %1").arg(QString::fromStdString(matrix_.group)));
+}
+
+void HeatMap::paintFigure(QPainter& p, const QSizeF& size) const {
     p.setRenderHint(QPainter::Antialiasing, false);
+    p.setFont(font());
+    p.fillRect(QRectF(QPointF(0, 0), size), Qt::white);
+    p.setPen(Qt::black);
     if (matrix_.rows.empty() || matrix_.columns.options.empty()) {
-        p.drawText(rect(), Qt::AlignCenter,
+        p.drawText(QRectF(QPointF(0, 0), size), Qt::AlignCenter,
                    tr("No answered trials yet: the matrix fills in as answers are committed."));
         return;
     }
-    const Geometry g = geometry();
+    const Geometry g = geometry(size);
     const QFontMetrics fm(font());
+    const double gridW = g.cellW * static_cast<double>(matrix_.columns.options.size());
+    const double gridH = g.cellH * static_cast<double>(matrix_.rows.size());
+    // Axis titles.
+    QFont bold = font();
+    bold.setBold(true);
+    p.setFont(bold);
+    p.drawText(QRectF(g.left, 0, gridW, kAxisTitle), Qt::AlignCenter,
+               tr("Answer given (cell: count and row %)"));
+    p.save();
+    p.translate(0, g.top + gridH / 2);
+    p.rotate(-90);
+    p.drawText(QRectF(-gridH / 2, 0, gridH, kAxisTitle), Qt::AlignCenter, tr("Surface presented"));
+    p.restore();
+    p.setFont(font());
     // Column headers, rotated.
     for (std::size_t c = 0; c < matrix_.columns.options.size(); ++c) {
         p.save();
         p.translate(g.left + (static_cast<double>(c) + 0.5) * g.cellW + fm.ascent() / 2.0,
                     g.top - 6);
         p.rotate(-90);
-        p.drawText(0, 0, QString::fromStdString(matrix_.columns.options[c].id));
+        p.drawText(0, 0, columnLabel(c));
         p.restore();
     }
+    QFont small = font();
+    small.setPointSizeF(small.pointSizeF() * 0.8);
     for (std::size_t r = 0; r < matrix_.rows.size(); ++r) {
         const double y = g.top + static_cast<double>(r) * g.cellH;
-        p.setPen(palette().color(QPalette::Text));
-        p.drawText(QRectF(0, y, g.left - 6, g.cellH), Qt::AlignRight | Qt::AlignVCenter,
-                   rowLabel(r));
+        p.setPen(Qt::black);
+        p.drawText(QRectF(kAxisTitle, y, g.left - kAxisTitle - 6, g.cellH),
+                   Qt::AlignRight | Qt::AlignVCenter, rowLabel(r));
         for (std::size_t c = 0; c < matrix_.columns.options.size(); ++c) {
             const double pct = matrix_.rowPercent(r, c);
             const double v = std::isfinite(pct) ? pct / 100.0 : 0.0;
@@ -96,7 +138,13 @@ void HeatMap::paintEvent(QPaintEvent*) {
             const double count = matrix_.counts[r][c];
             if (count > 0) {
                 p.setPen(v > 0.5 ? Qt::white : Qt::black);
-                p.drawText(cell, Qt::AlignCenter, QString::number(count, 'g', 4));
+                p.setFont(font());
+                p.drawText(cell.adjusted(0, 1, 0, -cell.height() / 2), Qt::AlignCenter,
+                           QString::number(count, 'g', 4));
+                p.setFont(small);
+                p.drawText(cell.adjusted(0, cell.height() / 2, 0, -1), Qt::AlignCenter,
+                           QString("%1 %").arg(pct, 0, 'f', 0));
+                p.setFont(font());
             }
         }
     }
@@ -105,20 +153,19 @@ void HeatMap::paintEvent(QPaintEvent*) {
 bool HeatMap::event(QEvent* e) {
     if (e->type() == QEvent::ToolTip && !matrix_.rows.empty()) {
         auto* help = static_cast<QHelpEvent*>(e);
-        const Geometry g = geometry();
+        const Geometry g = geometry(QSizeF(size()));
         const double x = (help->pos().x() - g.left) / g.cellW;
         const double y = (help->pos().y() - g.top) / g.cellH;
         if (x >= 0 && y >= 0 && x < static_cast<double>(matrix_.columns.options.size()) &&
             y < static_cast<double>(matrix_.rows.size())) {
             const auto r = static_cast<std::size_t>(y), c = static_cast<std::size_t>(x);
-            QToolTip::showText(
-                help->globalPos(),
-                tr("%1 answered %2: %3 of %4 (%5 %)")
-                    .arg(rowLabel(r), QString::fromStdString(matrix_.columns.options[c].label))
-                    .arg(matrix_.counts[r][c])
-                    .arg(matrix_.rowTotal(r))
-                    .arg(matrix_.rowPercent(r, c), 0, 'f', 1),
-                this);
+            QToolTip::showText(help->globalPos(),
+                               tr("%1 answered %2: %3 of %4 (%5 %)")
+                                   .arg(rowLabel(r), columnLabel(c))
+                                   .arg(matrix_.counts[r][c])
+                                   .arg(matrix_.rowTotal(r))
+                                   .arg(matrix_.rowPercent(r, c), 0, 'f', 1),
+                               this);
         } else {
             QToolTip::hideText();
         }

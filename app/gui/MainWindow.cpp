@@ -4,6 +4,7 @@
 #include "app/gui/AudioOutput.h"
 #include "app/gui/DemoStudy.h"
 #include "app/gui/PaletteView.h"
+#include "app/gui/ParticipantWindow.h"
 #include "app/gui/ResultsView.h"
 #include "app/gui/RunView.h"
 #include "app/gui/SetupView.h"
@@ -128,6 +129,7 @@ void MainWindow::closeEvent(QCloseEvent* event) {
     // Every answer is already committed; closing only ends the session as interrupted so that
     // reopening offers to resume it.
     run_->closeSession();
+    run_->closeParticipantWindow();
     event->accept();
 }
 
@@ -151,6 +153,14 @@ int MainWindow::saveScreenshots(const QString& dir) {
         if (QFile::copy(context_->path(), copy) && context_->openStudy(copy).isEmpty() &&
             run_->startDemoTrialForScreenshot()) {
             shoot("03_run_trial.png");
+            // The participant's screen of the same trial (only what the participant may see).
+            if (auto* pw = run_->openParticipantWindow()) {
+                pw->resize(1280, 800);
+                QApplication::processEvents();
+                QApplication::processEvents();
+                if (!pw->grab().save(QDir(dir).filePath("09_participant_window.png"))) ++failures;
+                run_->closeParticipantWindow();
+            }
             run_->closeSession();
         } else {
             ++failures;
@@ -180,7 +190,11 @@ int MainWindow::saveScreenshots(const QString& dir) {
         if (!original.isEmpty()) context_->openStudy(original);
     }
     showView(2);
+    results_->showFigure(0);
     shoot("04_results.png");
+    results_->showFigure(1);
+    shoot("10_results_ratings.png");
+    results_->showFigure(0);
     showView(3);
     shoot("05_sound_palette.png");
     showView(4);

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "app/gui/PaletteView.h"
 
+#include <cstring>
+
 #include "app/gui/AudioOutput.h"
 #include "app/gui/PresetEdit.h"
 #include "engine/render/Renderer.h"
@@ -36,7 +38,50 @@ namespace {
 QString q(const std::string& s) {
     return QString::fromStdString(s);
 }
-enum Column { PathCol, ValueCol, UnitCol, RangeCol, HelpCol };
+enum Column { PathCol, ValueCol, UnitCol, RangeCol };
+
+/// A parameter as people read it, from its declared path: "layer[1].modes[3].freq_hz" ->
+/// "Layer 1 · mode 3 · frequency" (the unit has its own column, the help is the tooltip).
+QString parameterLabel(const std::string& path) {
+    static const std::pair<const char*, const char*> words[] = {
+        {"freq", "frequency"}, {"t60", "T60 decay time"},
+        {"db", "dB"},          {"q", "Q"},
+        {"hp", "high-pass"},   {"lp", "low-pass"},
+        {"bw", "bandwidth"},   {"min", "minimum"},
+        {"max", "maximum"},    {"rms", "RMS"},
+        {"lfo", "LFO"}};
+    static const char* unitSuffixes[] = {"_hz", "_s",  "_ms", "_kg", "_db",    "_m",
+                                         "_n",  "_pa", "_mm", "_cm", "_per_s", "_percent"};
+    QStringList parts;
+    for (const QString& part : QString::fromStdString(path).split('.', Qt::SkipEmptyParts)) {
+        QString name = part;
+        QString index;
+        if (const auto open = part.indexOf('['); open >= 0 && part.endsWith(']')) {
+            name = part.left(open);
+            index = part.mid(open + 1, part.size() - open - 2);
+            if (name.endsWith("s") && name != "layers") name.chop(1); // modes[3] -> mode 3
+            if (name == "layers") name = "layer";
+        }
+        for (const char* suffix : unitSuffixes)
+            if (name.endsWith(suffix) && name.size() > static_cast<int>(std::strlen(suffix))) {
+                name.chop(static_cast<int>(std::strlen(suffix)));
+                break;
+            }
+        QStringList out;
+        for (const QString& w : name.split('_', Qt::SkipEmptyParts)) {
+            QString word = w;
+            for (const auto& [from, to] : words)
+                if (w == from) word = to;
+            out << word;
+        }
+        QString text = out.join(' ');
+        if (!index.isEmpty()) text += ' ' + index;
+        parts << text;
+    }
+    QString label = parts.join(QString::fromUtf8(" \u00b7 "));
+    if (!label.isEmpty()) label[0] = label[0].toUpper();
+    return label;
+}
 
 CostMeasurement measure(const QString& presetPath, eng::WalkerParameters walker) {
     CostMeasurement m;
@@ -73,9 +118,9 @@ PaletteView::PaletteView(const QString& dataDir, QWidget* parent)
     info_ = new QLabel(this);
     info_->setWordWrap(true);
     info_->setAccessibleName(tr("Surface description"));
-    params_ = new QTableWidget(0, 5, this);
+    params_ = new QTableWidget(0, 4, this);
     params_->setHorizontalHeaderLabels(
-        {tr("Parameter"), tr("Value"), tr("Unit"), tr("Documented range"), tr("What it does")});
+        {tr("Parameter"), tr("Value"), tr("Unit"), tr("Documented range")});
     params_->verticalHeader()->setVisible(false);
     params_->horizontalHeader()->setStretchLastSection(true);
     params_->setEditTriggers(QAbstractItemView::NoEditTriggers);
@@ -248,13 +293,16 @@ void PaletteView::showSurface() {
         const auto& p = ps[i];
         const int row = static_cast<int>(i);
         original_[p.path] = p.value;
-        params_->setItem(row, PathCol, new QTableWidgetItem(q(p.path)));
+        auto* name = new QTableWidgetItem(parameterLabel(p.path));
+        name->setData(Qt::UserRole, q(p.path));
+        name->setToolTip(tr("%1\n(preset key %2)").arg(q(p.help), q(p.path)));
+        params_->setItem(row, PathCol, name);
         auto* spin = new QDoubleSpinBox(params_);
         spin->setDecimals(p.maxValue - p.minValue < 10 ? 4 : 2);
         spin->setRange(p.minValue, p.maxValue);
         spin->setStepType(QAbstractSpinBox::AdaptiveDecimalStepType);
         spin->setValue(p.value);
-        spin->setAccessibleName(q(p.path));
+        spin->setAccessibleName(parameterLabel(p.path));
         spin->setAccessibleDescription(q(p.help));
         spin->setToolTip(q(p.help));
         params_->setCellWidget(row, ValueCol, spin);
@@ -264,7 +312,6 @@ void PaletteView::showSurface() {
                                                   .arg(p.minValue, 0, 'g', 6)
                                                   .arg(p.maxValue, 0, 'g', 6)
                                                   .arg(p.logScale ? tr(" (log)") : QString())));
-        params_->setItem(row, HelpCol, new QTableWidgetItem(q(p.help)));
     }
     params_->resizeColumnsToContents();
     cost_->setText(tr("CPU cost: not measured yet (Ctrl+M)"));
@@ -273,7 +320,7 @@ void PaletteView::showSurface() {
 
 bool PaletteView::setParameter(const QString& path, double value) {
     for (int r = 0; r < params_->rowCount(); ++r)
-        if (params_->item(r, PathCol)->text() == path) {
+        if (params_->item(r, PathCol)->data(Qt::UserRole).toString() == path) {
             auto* spin = static_cast<QDoubleSpinBox*>(params_->cellWidget(r, ValueCol));
             if (value < spin->minimum() || value > spin->maximum()) return false;
             spin->setValue(value);
@@ -285,7 +332,8 @@ bool PaletteView::setParameter(const QString& path, double value) {
 QString PaletteView::currentPresetText(const QString& id, const QString& name) const {
     ParamValues values;
     for (int r = 0; r < params_->rowCount(); ++r) {
-        const std::string path = params_->item(r, PathCol)->text().toStdString();
+        const std::string path =
+            params_->item(r, PathCol)->data(Qt::UserRole).toString().toStdString();
         const double v = static_cast<QDoubleSpinBox*>(params_->cellWidget(r, ValueCol))->value();
         const auto it = original_.find(path);
         if (it == original_.end() || std::abs(it->second - v) > 1e-12 * std::abs(v))

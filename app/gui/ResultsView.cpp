@@ -4,7 +4,9 @@
 #include "analysis/io/TrialCsv.h"
 #include "analysis/report/Export.h"
 #include "app/gui/AudioOutput.h"
+#include "app/gui/Figures.h"
 #include "app/gui/HeatMap.h"
+#include "app/gui/RatingsPlot.h"
 #include "app/gui/Replay.h"
 #include "app/gui/StudyContext.h"
 #include "engine/control/GrfFile.h"
@@ -49,6 +51,11 @@ QString q(const std::string& s) {
 }
 QString num(double v, int decimals = 1) {
     return std::isfinite(v) ? QString::number(v, 'f', decimals) : QString("—");
+}
+/// A group's label from the protocol ("footsteps alone"), the id when it has none.
+QString groupLabelOf(const exp::Protocol& p, const std::string& id) {
+    const exp::Group* g = p.group(id);
+    return QString::fromStdString(g && !g->label.empty() ? g->label : id);
 }
 QString pval(double p) {
     if (!std::isfinite(p)) return "—";
@@ -138,16 +145,39 @@ ResultsView::ResultsView(StudyContext& context, QWidget* parent)
     top->addWidget(exportButton_);
 
     heatMap_ = new HeatMap(this);
+    ratings_ = new RatingsPlot(this);
+    scale_ = new QComboBox(this);
+    scale_->setAccessibleName(tr("Scale of the ratings plot"));
+    auto* saveFigureButton = new QPushButton(tr("Save &figure… (SVG, PNG)"), this);
+    saveFigureButton->setAccessibleName(tr("Save the figure shown"));
+    saveFigureButton->setToolTip(
+        tr("The figure on screen as SVG (vector) or PNG at %1 dpi").arg(kPrintDpi));
+    auto* ratingsPage = new QWidget(this);
+    auto* rp = new QVBoxLayout(ratingsPage);
+    rp->setContentsMargins(0, 0, 0, 0);
+    auto* scaleRow = new QHBoxLayout;
+    auto* scaleLabel = new QLabel(tr("Sc&ale:"), ratingsPage);
+    scaleLabel->setBuddy(scale_);
+    scaleRow->addWidget(scaleLabel);
+    scaleRow->addWidget(scale_, 1);
+    rp->addLayout(scaleRow);
+    rp->addWidget(ratings_, 1);
+    figures_ = new QTabWidget(this);
+    figures_->addTab(heatMap_, tr("Confusion matrix"));
+    figures_->addTab(ratingsPage, tr("Ratings per condition"));
+    figures_->setCornerWidget(saveFigureButton);
+    connect(saveFigureButton, &QPushButton::clicked, this, &ResultsView::chooseFigureFile);
+    connect(scale_, &QComboBox::currentIndexChanged, this, &ResultsView::showRatings);
 
     summary_ = new QTableWidget(0, 9, this);
     summary_->setHorizontalHeaderLabels({tr("Group"), tr("Surface"), tr("Soundscape"), tr("n"),
                                          tr("% correct"), tr("% wrong"), tr("% don't know"),
                                          tr("Realism (correct)"), tr("Quality (all but DK)")});
     summary_->setAccessibleName(tr("Summary per stimulus"));
-    tests_ = new QTableWidget(0, 10, this);
+    tests_ = new QTableWidget(0, 11, this);
     tests_->setHorizontalHeaderLabels({tr("Measure"), tr("Surface"), tr("Groups"), tr("Value A"),
-                                       tr("Value B"), tr("Test"), tr("Statistic"), tr("df"),
-                                       tr("p"), tr("p (Holm)")});
+                                       tr("Value B"), tr("Result"), tr("Test"), tr("Statistic"),
+                                       tr("df"), tr("p"), tr("p (Holm)")});
     tests_->setAccessibleName(tr("Between-group tests"));
     for (auto* t : {summary_, tests_}) {
         t->setEditTriggers(QAbstractItemView::NoEditTriggers);
@@ -197,7 +227,7 @@ ResultsView::ResultsView(StudyContext& context, QWidget* parent)
     lower->addTab(replay, tr("Replay"));
 
     auto* split = new QSplitter(Qt::Vertical, this);
-    split->addWidget(heatMap_);
+    split->addWidget(figures_);
     split->addWidget(lower);
     split->setStretchFactor(0, 3);
     split->setStretchFactor(1, 2);
@@ -263,7 +293,8 @@ void ResultsView::refresh() {
         heatMap_->setMatrix({});
         return;
     }
-    for (const auto& c : report_.confusions) group_->addItem(q(c.group));
+    for (const auto& c : report_.confusions)
+        group_->addItem(groupLabelOf(context_.store().protocol(), c.group), q(c.group));
     const int again = group_->findText(previous);
     group_->setCurrentIndex(again >= 0 ? again : 0);
     group_->blockSignals(false);
@@ -271,18 +302,22 @@ void ResultsView::refresh() {
     for (const auto& s : report_.summary) n += s.n;
     status_->setText(
         tr("%1 answered trials analysed (practice and excluded trials left out)").arg(n));
+    const auto groupLabel = [this](const std::string& id) {
+        return groupLabelOf(context_.store().protocol(), id);
+    };
     summary_->setRowCount(static_cast<int>(report_.summary.size()));
     for (std::size_t i = 0; i < report_.summary.size(); ++i) {
         const auto& s = report_.summary[i];
-        const QStringList cells = {q(s.group),
-                                   q(s.stimulus.surfaceId),
-                                   q(s.stimulus.soundscapeId),
-                                   QString::number(s.n),
-                                   num(s.correct.percent),
-                                   num(s.wrong.percent),
-                                   num(s.dontKnow.percent),
-                                   num(s.realism.mean, 2),
-                                   num(s.quality.mean, 2)};
+        const QStringList cells = {
+            groupLabel(s.group),
+            surfaceLabel(s.stimulus.surfaceId),
+            s.stimulus.soundscapeId.empty() ? QString() : soundscapeLabel(s.stimulus.soundscapeId),
+            QString::number(s.n),
+            num(s.correct.percent),
+            num(s.wrong.percent),
+            num(s.dontKnow.percent),
+            num(s.realism.mean, 2),
+            num(s.quality.mean, 2)};
         for (int c = 0; c < cells.size(); ++c)
             summary_->setItem(static_cast<int>(i), c, new QTableWidgetItem(cells[c]));
     }
@@ -293,10 +328,11 @@ void ResultsView::refresh() {
         QString df;
         for (double d : c.test.df) df += (df.isEmpty() ? "" : ", ") + num(d, 2);
         const QStringList cells = {q(an::measureName(c.measure)),
-                                   c.surfaceId.empty() ? tr("(all)") : q(c.surfaceId),
-                                   q(c.groupA) + " vs " + q(c.groupB),
+                                   c.surfaceId.empty() ? tr("(all)") : surfaceLabel(c.surfaceId),
+                                   groupLabel(c.groupA) + " vs " + groupLabel(c.groupB),
                                    num(c.valueA, 2),
                                    num(c.valueB, 2),
+                                   testInWords(c.test),
                                    c.test.ok() ? q(c.test.method) : q(c.test.error),
                                    num(c.test.statistic, 3),
                                    df,
@@ -307,6 +343,15 @@ void ResultsView::refresh() {
     }
     tests_->resizeColumnsToContents();
     showMatrix();
+    const QString previousScale = scale_->currentData().toString();
+    scale_->blockSignals(true);
+    scale_->clear();
+    for (const auto& sc : context_.store().protocol().questions.scales)
+        scale_->addItem(q(sc.prompt), q(sc.id));
+    const int scaleAgain = scale_->findData(previousScale);
+    scale_->setCurrentIndex(scaleAgain >= 0 ? scaleAgain : 0);
+    scale_->blockSignals(false);
+    showRatings();
     fillReplayParticipants();
 }
 
@@ -317,6 +362,48 @@ void ResultsView::showMatrix() {
         return;
     }
     heatMap_->setMatrix(report_.confusions[static_cast<std::size_t>(i)]);
+}
+
+void ResultsView::showRatings() {
+    if (!context_.hasStudy() || scale_->currentIndex() < 0) {
+        ratings_->setSeries({});
+        return;
+    }
+    try {
+        ratings_->setSeries(
+            ratingSeries(context_.store(), scale_->currentData().toString().toStdString()));
+    } catch (const std::exception& e) {
+        ratings_->setSeries({});
+        workLabel_->setText(q(e.what()));
+    }
+}
+
+void ResultsView::showFigure(int index) {
+    figures_->setCurrentIndex(index);
+}
+
+QString ResultsView::saveHeatMap(const QString& path) const {
+    return heatMap_->save(path);
+}
+
+QString ResultsView::saveRatingsPlot(const QString& path) const {
+    return ratings_->save(path);
+}
+
+void ResultsView::chooseFigureFile() {
+    if (!context_.hasStudy()) return;
+    const bool matrix = figures_->currentIndex() == 0;
+    const QString suggested =
+        QFileInfo(context_.path())
+            .dir()
+            .filePath(matrix ? QString("confusion_%1.svg").arg(group_->currentText())
+                             : QString("ratings_%1.svg").arg(scale_->currentData().toString()));
+    const QString file = QFileDialog::getSaveFileName(
+        this, tr("Save figure"), suggested, tr("SVG (*.svg);;PNG, %1 dpi (*.png)").arg(kPrintDpi));
+    if (file.isEmpty()) return;
+    const QString error = matrix ? saveHeatMap(file) : saveRatingsPlot(file);
+    workLabel_->setText(
+        error.isEmpty() ? tr("Figure written to %1.").arg(QDir::toNativeSeparators(file)) : error);
 }
 
 void ResultsView::fillReplayParticipants() {

@@ -16,11 +16,13 @@ class QTableWidget;
 class QSpinBox;
 class QProgressBar;
 class QPushButton;
+class QTabWidget;
 
 namespace underfoot::gui {
 
 class StudyContext;
 class HeatMap;
+class RatingsPlot;
 class AudioOutput;
 
 /// The analysis of a study's answered trials (the protocol's answer order; by group for
@@ -51,6 +53,14 @@ class ResultsView : public QWidget {
     void setAudioOutput(AudioOutput* output) { audio_ = output; }
 
     HeatMap* heatMap() const { return heatMap_; }
+    RatingsPlot* ratingsPlot() const { return ratings_; }
+    /// The scale shown in the ratings plot.
+    QComboBox* scaleBox() const { return scale_; }
+    /// Saves the heat map / the ratings plot as .svg or .png; "" or what went wrong.
+    QString saveHeatMap(const QString& path) const;
+    QString saveRatingsPlot(const QString& path) const;
+    /// Shows figure `index` (0 confusion matrix, 1 ratings per condition).
+    void showFigure(int index);
     QTableWidget* summaryTable() const { return summary_; }
     QTableWidget* testsTable() const { return tests_; }
     QComboBox* groupBox() const { return group_; }
@@ -63,6 +73,8 @@ class ResultsView : public QWidget {
 
   private:
     void showMatrix();
+    void showRatings();
+    void chooseFigureFile();
     void chooseExport();
     void chooseReplay();
     void fillReplayParticipants();
@@ -73,6 +85,9 @@ class ResultsView : public QWidget {
     QComboBox* group_;
     QLabel* status_;
     HeatMap* heatMap_;
+    RatingsPlot* ratings_;
+    QComboBox* scale_;
+    QTabWidget* figures_;
     QTableWidget* summary_;
     QTableWidget* tests_;
     QComboBox* replayParticipant_;

@@ -2,6 +2,7 @@
 #include "app/gui/RunView.h"
 
 #include "app/gui/AudioOutput.h"
+#include "app/gui/ParticipantWindow.h"
 #include "app/gui/StudyContext.h"
 #include "app/gui/WalkerPlayer.h"
 #include "experiment/Catalogue.h"
@@ -356,7 +357,9 @@ RunView::RunView(StudyContext& context, QWidget* parent) : QWidget(parent), cont
     fl->addWidget(again);
     pages_->addWidget(finishedPage);
     connect(again, &QPushButton::clicked, this, [this] {
+        flow_.reset();
         session_.reset();
+        emit flowChanged();
         console_.reset();
         emit context_.sessionActiveChanged(false);
         pages_->setCurrentIndex(StartPage);
@@ -379,6 +382,18 @@ RunView::RunView(StudyContext& context, QWidget* parent) : QWidget(parent), cont
     layout->setContentsMargins(0, 0, 0, 0);
     layout->addWidget(pages_);
     connect(player_, &WalkerPlayer::meter, this, &RunView::onMeter);
+    // F11 opens / closes the participant window; Ctrl+K shows / hides the answer key here.
+    auto* scF11 = new QShortcut(QKeySequence(Qt::Key_F11), this);
+    scF11->setContext(Qt::WidgetWithChildrenShortcut);
+    connect(scF11, &QShortcut::activated, this, [this] {
+        if (participantWindow())
+            closeParticipantWindow();
+        else
+            openParticipantWindow();
+    });
+    auto* scK = new QShortcut(QKeySequence(Qt::CTRL | Qt::Key_K), this);
+    scK->setContext(Qt::WidgetWithChildrenShortcut);
+    connect(scK, &QShortcut::activated, this, [this] { setAnswerKeyShown(!answerKeyShown_); });
     connect(&context_, &StudyContext::studyChanged, this, [this] {
         clipDir_.clear();
         closeSession();
@@ -391,6 +406,7 @@ RunView::RunView(StudyContext& context, QWidget* parent) : QWidget(parent), cont
 }
 
 RunView::~RunView() {
+    closeParticipantWindow();
     // A clip render in flight stops before its next clip; wait for it (it holds no view data).
     for (auto* w : findChildren<QFutureWatcher<QString>*>()) {
         w->disconnect(this);
@@ -511,6 +527,22 @@ void RunView::buildStartPage() {
     auto* pl = new QVBoxLayout(page);
     pl->addLayout(top, 1);
     pl->addWidget(clipBox_);
+    auto* participantButton =
+        new QPushButton(tr("Participant window (second screen when there is one)  (F11)"), page);
+    participantButton->setAccessibleName(tr("Open or close the participant window"));
+    participantButton->setToolTip(
+        tr("Shows the participant only the briefing, the questions, the answers, the scales and "
+           "progress; never the stimulus, the plan or your notes."));
+    connect(participantButton, &QPushButton::clicked, this, [this] {
+        if (participantWindow())
+            closeParticipantWindow();
+        else
+            openParticipantWindow();
+    });
+    auto* participantRow = new QHBoxLayout;
+    participantRow->addWidget(participantButton);
+    participantRow->addStretch();
+    pl->addLayout(participantRow);
     pl->addWidget(startMessage_);
     pages_->addWidget(page);
 
@@ -852,6 +884,7 @@ bool RunView::startSession(const QString& code) {
         context_.notifyDataChanged();
         return false;
     }
+    flow_ = std::make_unique<exp::TrialFlow>(context_.store(), *session_);
     startMessage_->clear();
     paused_ = false;
     faultBanner_->hide();
@@ -870,15 +903,25 @@ void RunView::showPhase() {
         const auto& part = session_->participant();
         int practice = 0;
         for (const auto& t : context_.store().trials(part.code)) practice += t.practice ? 1 : 0;
+        // The experimenter's notes (the protocol's description) only while this screen is not
+        // the participant's; the participant's briefing is what the participant window shows.
+        const QString participantText =
+            flow_ ? q(flow_->participantBriefing()).toHtmlEscaped().replace("\n", "<br>")
+                  : QString();
         briefing_->setText(
             tr("<h2>%1</h2><p>Participant <b>%2</b>, group <b>%3</b>, session "
-               "%4: %5 trials (%6 practice).</p><p>%7</p><p>Press Enter when the "
-               "briefing is done.</p>")
-                .arg(q(p.title).toHtmlEscaped(), q(part.code).toHtmlEscaped(), q(part.groupId))
+               "%4: %5 trials (%6 practice).</p>%7<p><b>The participant reads:</b><br>%8</p>"
+               "<p>Press Enter when the briefing is done.</p>")
+                .arg(answerKeyShown_ ? q(p.title).toHtmlEscaped() : tr("Briefing"),
+                     q(part.code).toHtmlEscaped(),
+                     answerKeyShown_ ? q(part.groupId) : tr("(hidden)"))
                 .arg(session_->sessionNumber())
                 .arg(session_->trialCount())
                 .arg(practice)
-                .arg(q(p.description).toHtmlEscaped().replace("\n", " ")));
+                .arg(answerKeyShown_ ? tr("<p><b>Experimenter's notes:</b> %1</p>")
+                                           .arg(q(p.description).toHtmlEscaped().replace("\n", " "))
+                                     : QString(),
+                     participantText));
         pages_->setCurrentIndex(BriefingPage);
         pages_->currentWidget()->setFocus();
         break;
@@ -905,16 +948,15 @@ void RunView::showPhase() {
         emit context_.sessionActiveChanged(false);
         break;
     }
+    emit flowChanged();
 }
 
 void RunView::showTrial() {
-    revising_ = -1;
+    flow_->reset();
     const auto& t = session_->current();
     const auto& p = context_.store().protocol();
-    header_->setText(tr("%1 %2 of %3 · participant %4 · group %5")
-                         .arg(t.practice ? tr("Practice trial") : tr("Trial"))
-                         .arg(t.index + 1)
-                         .arg(session_->trialCount())
+    header_->setText(tr("%1 · participant %2 · group %3")
+                         .arg(q(exp::trialLabel(t.index, session_->trialCount(), t.practice)))
                          .arg(q(session_->participant().code), q(session_->participant().groupId)));
     const auto& s = t.stimulus;
     QString what = tr("<b>%1</b>").arg(surfaceLabel(s.surface).toHtmlEscaped());
@@ -939,12 +981,8 @@ void RunView::showTrial() {
                            ? tr("Answers are locked once committed (protocol rule).")
                            : tr("The answer can be changed until the next stimulus starts "
                                 "(protocol rule); Next commits it now."));
-    surface_.clear();
-    soundscape_.clear();
-    ratings_.clear();
     comment_->clear();
-    pendingDigits_ = -1;
-    rebuildAnswerSections(t);
+    rebuildAnswerSections();
     setActive(0);
     message_->clear();
     leftMeter_->setValue(0);
@@ -966,7 +1004,7 @@ void RunView::showTrial() {
                  "is not heard; the meters follow the virtual walker."));
     if (!lastTrialStats_.isEmpty())
         engineLabel_->setText(engineLabel_->text() + "\n" + lastTrialStats_);
-    // The session's plan, with answered trials ticked.
+    // The session's plan, with answered trials ticked (1-based numbers, as people read them).
     planList_->clear();
     const auto trials = context_.store().trials(session_->participant().code);
     for (const auto& tr_ : trials) {
@@ -985,222 +1023,163 @@ void RunView::showTrial() {
             item->setFont(f);
         }
     }
+    stimulus_->setVisible(answerKeyShown_);
+    planList_->setVisible(answerKeyShown_);
     pages_->setCurrentIndex(TrialPage);
     trial_->setFocus();
 }
 
-void RunView::rebuildAnswerSections(const exp::TrialRecord& trial) {
+void RunView::rebuildAnswerSections() {
     auto* layout = static_cast<QVBoxLayout*>(sectionsHost_->layout());
     for (auto& s : sections_) delete s.box;
     sections_.clear();
     while (auto* item = layout->takeAt(0)) delete item;
     const auto& q_ = context_.store().protocol().questions;
-    const std::string group = session_->participant().groupId;
-    const auto addOptions = [&](SectionKind kind, const QString& prompt,
-                                const std::vector<exp::AnswerOption>& options) {
+    for (const exp::AnswerSection& sec : flow_->sections()) {
         Section s;
-        s.kind = kind;
-        s.box = new QGroupBox(prompt, sectionsHost_);
-        auto* grid = new QGridLayout(s.box);
-        std::size_t longest = 0;
-        for (const auto& o : options) longest = std::max(longest, o.label.size());
-        const int columns = longest > 26 ? 3 : 4; // long labels stay readable at 1280 px
-        for (std::size_t i = 0; i < options.size(); ++i) {
-            const auto& o = options[i];
-            auto* b =
-                new QPushButton(QString("%1   %2").arg(QChar(o.letter)).arg(q(o.label)), s.box);
-            b->setCheckable(true);
-            b->setFocusPolicy(Qt::NoFocus);
-            b->setMinimumHeight(36);
-            b->setFont(bigFont(this, 1.1));
-            b->setStyleSheet("QPushButton { text-align: left; padding-left: 10px; } "
-                             "QPushButton:checked { background: #1f6feb; color: white; "
-                             "font-weight: bold; }");
-            b->setAccessibleName(tr("Answer %1: %2").arg(QChar(o.letter)).arg(q(o.label)));
-            const char letter = o.letter;
-            connect(b, &QPushButton::clicked, this, [this, kind, letter] {
-                chooseOption(kind, letter);
-                trial_->setFocus();
-            });
-            grid->addWidget(b, static_cast<int>(i) / columns, static_cast<int>(i) % columns);
-            s.buttons.push_back(b);
+        s.kind = sec.kind;
+        s.scale = sec.scale;
+        const int index = static_cast<int>(sections_.size());
+        if (sec.kind != SectionKind::Scale) {
+            const QString keys =
+                sec.kind == SectionKind::Surface
+                    ? tr("%1  (keys a–%2)").arg(q(sec.prompt)).arg(QChar(sec.options.back().letter))
+                    : tr("%1  (keys a–%2 when this section is active; Down moves here)")
+                          .arg(q(sec.prompt))
+                          .arg(QChar(sec.options.back().letter));
+            s.box = new QGroupBox(keys, sectionsHost_);
+            auto* grid = new QGridLayout(s.box);
+            std::size_t longest = 0;
+            for (const auto& o : sec.options) longest = std::max(longest, o.label.size());
+            const int columns = longest > 26 ? 3 : 4; // long labels stay readable at 1280 px
+            for (std::size_t i = 0; i < sec.options.size(); ++i) {
+                const auto& o = sec.options[i];
+                auto* b =
+                    new QPushButton(QString("%1   %2").arg(QChar(o.letter)).arg(q(o.label)), s.box);
+                b->setCheckable(true);
+                b->setFocusPolicy(Qt::NoFocus);
+                b->setMinimumHeight(36);
+                b->setFont(bigFont(this, 1.1));
+                b->setStyleSheet("QPushButton { text-align: left; padding-left: 10px; } "
+                                 "QPushButton:checked { background: #1f6feb; color: white; "
+                                 "font-weight: bold; }");
+                b->setAccessibleName(tr("Answer %1: %2").arg(QChar(o.letter)).arg(q(o.label)));
+                const char letter = o.letter;
+                const SectionKind kind = sec.kind;
+                connect(b, &QPushButton::clicked, this, [this, kind, letter] {
+                    chooseOption(kind, letter);
+                    trial_->setFocus();
+                });
+                grid->addWidget(b, static_cast<int>(i) / columns, static_cast<int>(i) % columns);
+                s.buttons.push_back(b);
+            }
+        } else {
+            const auto& sc = *sec.scale;
+            QStringList anchors;
+            for (const auto& a : exp::anchorTexts(sc)) anchors << q(a);
+            s.box = new QGroupBox(
+                tr("%1  (digits %2–%3)").arg(q(sc.prompt)).arg(sc.min).arg(sc.max), sectionsHost_);
+            auto* column = new QVBoxLayout(s.box);
+            auto* anchorLabel = new QLabel(anchors.join("   ·   "), s.box);
+            anchorLabel->setWordWrap(true);
+            anchorLabel->setStyleSheet("color: #404040;");
+            anchorLabel->setAccessibleName(tr("Anchors of %1").arg(q(sc.id)));
+            column->addWidget(anchorLabel);
+            auto* row = new QHBoxLayout;
+            column->addLayout(row);
+            for (int v = sc.min; v <= sc.max; ++v) {
+                auto* b = new QPushButton(QString::number(v), s.box);
+                b->setCheckable(true);
+                b->setFocusPolicy(Qt::NoFocus);
+                b->setMinimumSize(48, 36);
+                b->setFont(bigFont(this, 1.1));
+                b->setStyleSheet("QPushButton:checked { background: #1f6feb; color: white; "
+                                 "font-weight: bold; }");
+                b->setAccessibleName(tr("%1: %2").arg(q(sc.id)).arg(v));
+                connect(b, &QPushButton::clicked, this, [this, index, v, id = sc.id] {
+                    flow_->setRating(id, v);
+                    setActive(index);
+                    trial_->setFocus();
+                });
+                row->addWidget(b);
+                s.buttons.push_back(b);
+            }
+            row->addStretch();
         }
-        layout->addWidget(s.box);
-        sections_.push_back(std::move(s));
-    };
-    if (q_.asksSurface())
-        addOptions(SectionKind::Surface,
-                   tr("%1  (keys a–%2)")
-                       .arg(q(q_.surfacePrompt))
-                       .arg(QChar(q_.surfaceOptions.back().letter)),
-                   q_.surfaceOptions);
-    // Only the scales asked after this stimulus in this block (per-scale blocks, scales
-    // restricted to some stimuli).
-    for (const exp::Scale* asked :
-         exp::askedScales(context_.store().protocol(), trial.stimulus, trial.block)) {
-        const auto& sc = *asked;
-        Section s;
-        s.kind = SectionKind::Scale;
-        s.scale = static_cast<int>(asked - q_.scales.data());
-        QStringList anchors;
-        for (const auto& [value, wording] : sc.anchors)
-            anchors << QString("%1 = %2").arg(value).arg(q(wording));
-        if (anchors.isEmpty())
-            anchors << QString("%1 = %2").arg(sc.min).arg(q(sc.minLabel))
-                    << QString("%1 = %2").arg(sc.max).arg(q(sc.maxLabel));
-        s.box = new QGroupBox(tr("%1  (digits %2–%3)").arg(q(sc.prompt)).arg(sc.min).arg(sc.max),
-                              sectionsHost_);
-        auto* column = new QVBoxLayout(s.box);
-        auto* anchorLabel = new QLabel(anchors.join("   ·   "), s.box);
-        anchorLabel->setWordWrap(true);
-        anchorLabel->setStyleSheet("color: #404040;");
-        anchorLabel->setAccessibleName(tr("Anchors of %1").arg(q(sc.id)));
-        column->addWidget(anchorLabel);
-        auto* row = new QHBoxLayout;
-        column->addLayout(row);
-        for (int v = sc.min; v <= sc.max; ++v) {
-            auto* b = new QPushButton(QString::number(v), s.box);
-            b->setCheckable(true);
-            b->setFocusPolicy(Qt::NoFocus);
-            b->setMinimumSize(48, 36);
-            b->setFont(bigFont(this, 1.1));
-            b->setStyleSheet("QPushButton:checked { background: #1f6feb; color: white; "
-                             "font-weight: bold; }");
-            b->setAccessibleName(tr("%1: %2").arg(q(sc.id)).arg(v));
-            const int section = static_cast<int>(sections_.size());
-            connect(b, &QPushButton::clicked, this, [this, section, v, id = sc.id] {
-                ratings_[id] = v;
-                setActive(section);
-                renderDraft();
-                trial_->setFocus();
-            });
-            row->addWidget(b);
-            s.buttons.push_back(b);
-        }
-        row->addStretch();
         layout->addWidget(s.box);
         sections_.push_back(std::move(s));
     }
-    if (q_.asksSoundscape(group))
-        addOptions(SectionKind::Soundscape,
-                   tr("%1  (keys a–%2 when this section is active; Down moves here)")
-                       .arg(q(q_.soundscapePrompt))
-                       .arg(QChar(q_.soundscapeOptions.back().letter)),
-                   q_.soundscapeOptions);
     layout->addStretch();
     comment_->setVisible(q_.comment);
 }
 
 void RunView::setActive(int section) {
-    if (sections_.empty()) return;
-    active_ = std::clamp(section, 0, static_cast<int>(sections_.size()) - 1);
-    pendingDigits_ = -1;
-    for (int i = 0; i < static_cast<int>(sections_.size()); ++i)
-        sections_[static_cast<std::size_t>(i)].box->setStyleSheet(
-            i == active_ ? "QGroupBox { border: 2px solid #1f6feb; border-radius: 4px; "
-                           "margin-top: 1.4em; font-weight: bold; } QGroupBox::title { "
-                           "subcontrol-origin: margin; left: 8px; }"
-                         : "QGroupBox { border: 1px solid palette(mid); border-radius: 4px; "
-                           "margin-top: 1.4em; } QGroupBox::title { subcontrol-origin: margin; "
-                           "left: 8px; }");
+    if (!flow_) return;
+    flow_->setActive(section);
     renderDraft();
 }
 
 void RunView::renderDraft() {
-    const auto& q_ = context_.store().protocol().questions;
-    for (auto& s : sections_) {
+    if (!flow_) return;
+    const int active = flow_->activeSection();
+    const auto& draft = flow_->draft();
+    for (int i = 0; i < static_cast<int>(sections_.size()); ++i) {
+        auto& s = sections_[static_cast<std::size_t>(i)];
+        s.box->setStyleSheet(
+            i == active ? "QGroupBox { border: 2px solid #1f6feb; border-radius: 4px; "
+                          "margin-top: 1.4em; font-weight: bold; } QGroupBox::title { "
+                          "subcontrol-origin: margin; left: 8px; }"
+                        : "QGroupBox { border: 1px solid palette(mid); border-radius: 4px; "
+                          "margin-top: 1.4em; } QGroupBox::title { subcontrol-origin: margin; "
+                          "left: 8px; }");
         if (s.kind == SectionKind::Scale) {
-            const auto& sc = q_.scales[static_cast<std::size_t>(s.scale)];
-            const auto it = ratings_.find(sc.id);
-            for (std::size_t i = 0; i < s.buttons.size(); ++i)
-                s.buttons[i]->setChecked(it != ratings_.end() &&
-                                         it->second == sc.min + static_cast<int>(i));
+            const auto it = draft.ratings.find(s.scale->id);
+            for (std::size_t b = 0; b < s.buttons.size(); ++b)
+                s.buttons[b]->setChecked(it != draft.ratings.end() &&
+                                         it->second == s.scale->min + static_cast<int>(b));
         } else {
-            const auto& options =
-                s.kind == SectionKind::Surface ? q_.surfaceOptions : q_.soundscapeOptions;
-            const std::string& chosen = s.kind == SectionKind::Surface ? surface_ : soundscape_;
-            for (std::size_t i = 0; i < s.buttons.size(); ++i)
-                s.buttons[i]->setChecked(options[i].id == chosen);
+            const auto& options = flow_->sections()[static_cast<std::size_t>(i)].options;
+            const std::string& chosen =
+                s.kind == SectionKind::Surface ? draft.answer : draft.soundscapeAnswer;
+            for (std::size_t b = 0; b < s.buttons.size(); ++b)
+                s.buttons[b]->setChecked(options[b].id == chosen);
         }
     }
+    emit flowChanged();
+}
+
+void RunView::showFlowResult(const exp::FlowResult& result) {
+    if (result)
+        message_->clear();
+    else
+        setMessage(q(result.message));
 }
 
 void RunView::chooseOption(SectionKind kind, char letter) {
-    const auto& q_ = context_.store().protocol().questions;
-    const exp::AnswerOption* o = kind == SectionKind::Surface ? q_.surfaceOptionByLetter(letter)
-                                                              : q_.soundscapeOptionByLetter(letter);
-    if (!o) {
-        setMessage(tr("No answer has the letter '%1' here.").arg(QChar(letter)));
-        return;
-    }
-    (kind == SectionKind::Surface ? surface_ : soundscape_) = o->id;
-    message_->clear();
-    // Move on to the next section that still needs an answer.
-    for (int i = 0; i < static_cast<int>(sections_.size()); ++i)
-        if (sections_[static_cast<std::size_t>(i)].kind == kind) {
-            setActive(std::min(i + 1, static_cast<int>(sections_.size()) - 1));
-            break;
-        }
+    showFlowResult(flow_->choose(kind, letter));
+    renderDraft();
 }
 
 void RunView::typeDigit(int digit) {
-    if (sections_.empty()) return;
-    int section = active_;
-    if (sections_[static_cast<std::size_t>(section)].kind != SectionKind::Scale) {
-        section = -1;
-        const auto& q_ = context_.store().protocol().questions;
-        for (int i = 0; i < static_cast<int>(sections_.size()); ++i) {
-            const auto& s = sections_[static_cast<std::size_t>(i)];
-            if (s.kind == SectionKind::Scale &&
-                !ratings_.count(q_.scales[static_cast<std::size_t>(s.scale)].id)) {
-                section = i;
-                break;
-            }
-        }
-        if (section < 0) return;
-        setActive(section);
-    }
-    const auto& sc = context_.store().protocol().questions.scales[static_cast<std::size_t>(
-        sections_[static_cast<std::size_t>(section)].scale)];
-    // Two-digit values (0–10 scales): "1" then "0" gives 10.
-    int value = digit;
-    if (pendingDigits_ >= 0 && pendingDigits_ * 10 + digit <= sc.max)
-        value = pendingDigits_ * 10 + digit;
-    if (value < sc.min || value > sc.max) {
-        setMessage(tr("%1 is outside the scale %2–%3.").arg(value).arg(sc.min).arg(sc.max));
-        pendingDigits_ = -1;
-        return;
-    }
-    ratings_[sc.id] = value;
-    message_->clear();
-    if (value != 0 && value * 10 <= sc.max) {
-        pendingDigits_ = value; // a second digit may follow
-        renderDraft();
-    } else {
-        setActive(section + 1 < static_cast<int>(sections_.size()) ? section + 1 : section);
-    }
+    const auto r = flow_->typeDigit(digit);
+    if (r.refusal != exp::Refusal::NotAllowed && r.refusal != exp::Refusal::NotInTrial)
+        showFlowResult(r);
+    renderDraft();
 }
 
 void RunView::adjustRating(int delta) {
-    if (sections_.empty()) return;
-    const auto& s = sections_[static_cast<std::size_t>(active_)];
-    if (s.kind != SectionKind::Scale) return;
-    const auto& sc =
-        context_.store().protocol().questions.scales[static_cast<std::size_t>(s.scale)];
-    const auto it = ratings_.find(sc.id);
-    const int from = it == ratings_.end() ? (sc.min + sc.max) / 2 - delta : it->second;
-    ratings_[sc.id] = std::clamp(from + delta, sc.min, sc.max);
-    pendingDigits_ = -1;
+    flow_->adjust(delta);
     renderDraft();
 }
 
 bool RunView::handleTrialKey(int key, Qt::KeyboardModifiers modifiers, const QString& text) {
-    if (!session_ || pages_->currentIndex() != TrialPage) return false;
+    if (!session_ || !flow_ || pages_->currentIndex() != TrialPage) return false;
     if (key == Qt::Key_Z && modifiers == Qt::ControlModifier) {
         revisePrevious();
         return true;
     }
-    if (key == Qt::Key_Escape && revising_ >= 0) {
+    if (key == Qt::Key_Escape && flow_->revising()) {
+        flow_->cancelRevision();
         showTrial();
         setMessage(tr("Change cancelled; the stored answer is unchanged."), false);
         return true;
@@ -1219,8 +1198,9 @@ bool RunView::handleTrialKey(int key, Qt::KeyboardModifiers modifiers, const QSt
         return true;
     }
     const auto& protocol = context_.store().protocol();
+    const bool revising = flow_->revising().has_value();
     if (key == Qt::Key_Space) {
-        if (revising_ >= 0)
+        if (revising)
             setMessage(tr("Store the changed answer (Enter) or cancel (Esc) first."));
         else if (protocol.clips.enabled && session_->playing())
             replayClip();
@@ -1229,17 +1209,17 @@ bool RunView::handleTrialKey(int key, Qt::KeyboardModifiers modifiers, const QSt
         return true;
     }
     if (key == Qt::Key_R && protocol.clips.enabled && !protocol.questions.asksSurface() &&
-        revising_ < 0) {
+        !revising) {
         replayClip();
         return true;
     }
     if (key == Qt::Key_L && protocol.laps.total() > 0 &&
-        !protocol.questions.surfaceOptionByLetter('l') && revising_ < 0) {
+        !protocol.questions.surfaceOptionByLetter('l') && !revising) {
         completeLap();
         return true;
     }
     if (key == Qt::Key_Up || key == Qt::Key_Down) {
-        setActive(active_ + (key == Qt::Key_Down ? 1 : -1));
+        setActive(flow_->activeSection() + (key == Qt::Key_Down ? 1 : -1));
         return true;
     }
     if (key == Qt::Key_Left || key == Qt::Key_Right) {
@@ -1249,15 +1229,9 @@ bool RunView::handleTrialKey(int key, Qt::KeyboardModifiers modifiers, const QSt
     if (text.size() == 1) {
         const QChar c = text.at(0).toLower();
         if (c >= 'a' && c <= 'z') {
-            const bool soundscapeActive =
-                !sections_.empty() &&
-                sections_[static_cast<std::size_t>(active_)].kind == SectionKind::Soundscape;
-            const bool hasSurface =
-                !sections_.empty() && sections_.front().kind == SectionKind::Surface;
-            if (soundscapeActive)
-                chooseOption(SectionKind::Soundscape, c.toLatin1());
-            else if (hasSurface)
-                chooseOption(SectionKind::Surface, c.toLatin1());
+            const auto r = flow_->chooseLetter(c.toLatin1());
+            if (r || r.message.rfind("No answer", 0) == 0) showFlowResult(r);
+            renderDraft();
             return true;
         }
         if (c >= '0' && c <= '9') {
@@ -1269,17 +1243,16 @@ bool RunView::handleTrialKey(int key, Qt::KeyboardModifiers modifiers, const QSt
 }
 
 void RunView::play() {
-    if (!session_ || paused_ || session_->paused()) return;
+    if (!session_ || !flow_ || paused_ || session_->paused()) return;
     if (session_->phase() != exp::SessionPhase::Trial &&
         session_->phase() != exp::SessionPhase::Practice)
         return;
     if (session_->playing()) return;
-    try {
-        session_->play();
-    } catch (const std::exception& e) {
+    const exp::FlowResult r = flow_->start();
+    if (!r) {
         setMessage(tr("%1\nThe stimulus did not start; check the Setup view, then press Space "
                       "again.")
-                       .arg(q(e.what())));
+                       .arg(q(r.message)));
         return;
     }
     const auto& protocol = context_.store().protocol();
@@ -1289,70 +1262,55 @@ void RunView::play() {
     if (!player_->hasSource())
         engineLabel_->setText(tr("No sensor stream in this build: the stimulus is recorded as "
                                  "started; enter the participant's answer as usual."));
+    emit flowChanged();
     context_.notifyDataChanged();
 }
 
 void RunView::next() {
-    if (!session_ || pages_->currentIndex() != TrialPage) return;
+    if (!session_ || !flow_ || pages_->currentIndex() != TrialPage) return;
     if (paused_) {
         setMessage(tr("Paused: press Ctrl+P to resume first."));
         return;
     }
-    if (revising_ >= 0) {
-        exp::TrialAnswer a;
-        a.answer = surface_;
-        a.soundscapeAnswer = soundscape_;
-        a.ratings = ratings_;
-        a.comment = comment_->text().trimmed().toStdString();
-        const int index = revising_;
-        try {
-            context_.store().commitAnswer(session_->participant().code, index, a,
-                                          revisingResponseS_);
-        } catch (const std::exception& e) {
-            setMessage(tr("Not changed: %1").arg(q(e.what())));
+    flow_->setComment(comment_->text().trimmed().toStdString());
+    if (const auto index = flow_->revising()) {
+        const exp::FlowResult r = flow_->commitRevision();
+        if (!r) {
+            setMessage(tr("Not changed: %1").arg(q(r.message)));
             return;
         }
         context_.notifyDataChanged();
         showTrial();
-        setMessage(tr("The answer of trial %1 was changed.").arg(index + 1), false);
+        setMessage(tr("The answer of trial %1 was changed.").arg(*index + 1), false);
+        emit flowChanged();
         return;
     }
-    if (!session_->playing()) {
+    QElapsedTimer timer;
+    timer.start();
+    const exp::FlowResult r = flow_->commit();
+    switch (r.refusal) {
+    case exp::Refusal::None:
+        break;
+    case exp::Refusal::NotStarted:
         setMessage(tr("Start the stimulus first (Space); the answer belongs to what was heard."));
         return;
-    }
-    exp::TrialAnswer a;
-    a.answer = surface_;
-    a.soundscapeAnswer = soundscape_;
-    a.ratings = ratings_;
-    a.comment = comment_->text().trimmed().toStdString();
-    if (session_->lapCount() > 0 && session_->lapsDone() < session_->lapCount()) {
+    case exp::Refusal::LapsPending:
         setMessage(tr("Lap %1 of %2 is being walked: the questions come after the last lap (L "
                       "completes a lap).")
                        .arg(session_->lapsDone() + 1)
                        .arg(session_->lapCount()));
         return;
-    }
-    const auto& current = session_->current();
-    const auto problems = context_.store().checkAnswer(session_->participant().groupId, a,
-                                                       current.stimulus, current.block);
-    if (!problems.empty()) {
-        QStringList list;
-        for (const auto& p : problems) list << q(p);
+    case exp::Refusal::Incomplete:
         setMessage(
-            tr("Not stored yet: %1. Complete the answer, then press Enter.").arg(list.join("; ")));
+            tr("Not stored yet: %1. Complete the answer, then press Enter.").arg(q(r.message)));
         return;
-    }
-    QElapsedTimer timer;
-    timer.start();
-    try {
-        session_->answer(a);
-    } catch (const std::exception& e) {
+    default:
         if (session_->paused()) {
             showSensorFault();
+            emit flowChanged();
             return;
         }
-        setMessage(tr("Not stored: %1").arg(q(e.what())));
+        setMessage(tr("Not stored: %1").arg(q(r.message)));
         return;
     }
     lastCommitMs_ = static_cast<double>(timer.nsecsElapsed()) * 1e-6;
@@ -1376,40 +1334,20 @@ void RunView::next() {
 }
 
 bool RunView::revisePrevious() {
-    if (!session_ || pages_->currentIndex() != TrialPage || paused_) return false;
-    const auto& p = context_.store().protocol();
-    if (p.lock == exp::LockRule::OnAnswer) {
-        setMessage(tr("Answers are locked once given (protocol rule lock = \"answer\")."));
+    if (!session_ || !flow_ || pages_->currentIndex() != TrialPage || paused_) return false;
+    const exp::FlowResult r = flow_->revisePrevious();
+    if (!r) {
+        setMessage(q(r.message));
         return false;
     }
-    if (session_->playing()) {
-        setMessage(tr("The previous answer is locked: this trial's stimulus has started "
-                      "(protocol rule lock = \"next_trial\")."));
-        return false;
-    }
-    const std::string code = session_->participant().code;
-    const int current = session_->current().index;
-    std::optional<exp::TrialRecord> previous;
-    for (const auto& t : context_.store().trials(code))
-        if (t.answered && t.index < current && (!previous || t.index > previous->index))
-            previous = t;
-    if (!previous) {
-        setMessage(tr("No earlier answer in this session to change."));
-        return false;
-    }
-    surface_ = previous->answer.answer;
-    soundscape_ = previous->answer.soundscapeAnswer;
-    ratings_ = previous->answer.ratings;
-    comment_->setText(QString::fromStdString(previous->answer.comment));
-    revising_ = previous->index;
-    revisingResponseS_ = previous->responseTimeS;
+    const int index = *flow_->revising();
+    comment_->setText(QString::fromStdString(flow_->draft().comment));
     header_->setText(tr("Changing the answer of trial %1 — Enter stores the change, Esc cancels")
-                         .arg(previous->index + 1));
+                         .arg(index + 1));
     playButton_->setEnabled(false);
-    rebuildAnswerSections(*previous);
-    setActive(0);
-    setMessage(tr("Trial %1's stored answer is loaded; change it and press Enter.")
-                   .arg(previous->index + 1),
+    rebuildAnswerSections();
+    renderDraft();
+    setMessage(tr("Trial %1's stored answer is loaded; change it and press Enter.").arg(index + 1),
                false);
     return true;
 }
@@ -1483,6 +1421,7 @@ void RunView::togglePause() {
     pausedLabel_->setVisible(paused_);
     pauseButton_->setText(paused_ ? tr("Resume  (Ctrl+P)") : tr("Pause  (Ctrl+P)"));
     sectionsHost_->setEnabled(!paused_);
+    emit flowChanged();
     try {
         context_.store().journal(paused_ ? "paused" : "resumed", session_->participant().code,
                                  session_->current().index, "{}");
@@ -1497,21 +1436,14 @@ bool RunView::excludeTrial(const QString& reason, bool previous) {
         setMessage(tr("An exclusion needs a reason (e.g. \"participant stopped walking\")."));
         return false;
     }
-    int index = -1;
     const auto code = session_->participant().code;
-    if (previous) {
-        for (const auto& t : context_.store().trials(code))
-            if (t.answered) index = std::max(index, t.index);
-        if (index < 0) {
-            setMessage(tr("No trial has been answered yet in this session."));
-            return false;
-        }
-    } else {
-        if (session_->phase() != exp::SessionPhase::Trial &&
-            session_->phase() != exp::SessionPhase::Practice)
-            return false;
-        index = session_->current().index;
+    std::string why;
+    const auto target = flow_ ? flow_->exclusionTarget(previous, &why) : std::nullopt;
+    if (!target) {
+        if (previous) setMessage(q(why));
+        return false;
     }
+    const int index = *target;
     try {
         context_.store().setExcluded(code, index, true, reason.trimmed().toStdString());
     } catch (const std::exception& e) {
@@ -1570,6 +1502,7 @@ void RunView::closeSession() {
     } catch (const std::exception&) {
         // The answers are committed already; only the session row's end could not be written.
     }
+    flow_.reset();
     session_.reset();
     console_.reset();
     player_->stop();
@@ -1579,6 +1512,7 @@ void RunView::closeSession() {
     faultBanner_->hide();
     sectionsHost_->setEnabled(true);
     emit context_.sessionActiveChanged(false);
+    emit flowChanged();
     if (context_.hasStudy()) context_.notifyDataChanged();
     pages_->setCurrentIndex(StartPage);
     refreshStart();
@@ -1694,64 +1628,41 @@ QString RunView::protocolStatus() const {
 }
 
 void RunView::refreshProtocolStatus() {
-    if (!session_ || (session_->phase() != exp::SessionPhase::Trial &&
-                      session_->phase() != exp::SessionPhase::Practice)) {
+    if (!session_ || !flow_ ||
+        (session_->phase() != exp::SessionPhase::Trial &&
+         session_->phase() != exp::SessionPhase::Practice)) {
         protocolStatus_->hide();
         return;
     }
-    const auto& p = context_.store().protocol();
     QStringList lines;
-    if (p.clips.enabled) {
-        if (!session_->playing())
-            lines << tr("Clip not presented yet — Space plays it.");
-        else
-            lines << (p.clips.replay ? tr("Clip presented · replays: %1  (Space or R replays)")
-                                           .arg(session_->replayCount())
-                                     : tr("Clip presented · replay not allowed by the protocol"));
-    }
-    if (session_->lapCount() > 0) {
-        const int done = session_->lapsDone();
-        const int total = session_->lapCount();
-        if (!session_->playing())
-            lines << tr("Laps: 0 of %1 · press Space when the participant sets off").arg(total);
-        else if (done >= total)
-            lines << tr("Laps: %1 of %1 done · ask the questions now").arg(total);
-        else
-            lines << tr("Lap %1 of %2 · %3  (L completes the lap)")
-                         .arg(done + 1)
-                         .arg(total)
-                         .arg(session_->currentLapSilent() ? tr("SILENT baseline")
-                                                           : tr("WITH SOUND"));
-    }
+    for (const auto& l : flow_->experimenterStatus()) lines << q(l);
     protocolStatus_->setText(lines.join("\n"));
-    const bool silent = session_->lapCount() > 0 && session_->playing() &&
-                        session_->lapsDone() < session_->lapCount() && session_->currentLapSilent();
     protocolStatus_->setStyleSheet(
-        silent
+        flow_->silentLapNow()
             ? "QLabel { background: #e8e8e8; color: #303030; padding: 6px; font-weight: bold; }"
             : "QLabel { background: #dff0ff; color: #0b3d6b; padding: 6px; font-weight: bold; }");
     protocolStatus_->setVisible(!lines.isEmpty());
+    emit flowChanged();
 }
 
 void RunView::completeLap() {
-    if (!session_ || session_->lapCount() == 0) return;
+    if (!session_ || !flow_ || session_->lapCount() == 0) return;
     if (paused_) {
         setMessage(tr("Paused: press Ctrl+P to resume first."));
         return;
     }
-    if (!session_->playing()) {
+    const exp::FlowResult r = flow_->completeLap();
+    if (r.refusal == exp::Refusal::NotStarted) {
         setMessage(tr("Start the condition first (Space), then L after each lap."));
         return;
     }
-    if (session_->lapsDone() >= session_->lapCount()) {
+    if (r.refusal == exp::Refusal::NotAllowed) {
         setMessage(tr("All %1 laps are done; enter the answers and press Enter.")
                        .arg(session_->lapCount()));
         return;
     }
-    try {
-        session_->completeLap();
-    } catch (const std::exception& e) {
-        setMessage(tr("Lap not stored: %1").arg(q(e.what())));
+    if (!r) {
+        setMessage(tr("Lap not stored: %1").arg(q(r.message)));
         return;
     }
     refreshProtocolStatus();
@@ -1767,19 +1678,18 @@ void RunView::completeLap() {
 }
 
 void RunView::replayClip() {
-    if (!session_ || !context_.store().protocol().clips.enabled) return;
+    if (!session_ || !flow_ || !context_.store().protocol().clips.enabled) return;
     if (!session_->playing()) {
         play();
         return;
     }
-    if (!context_.store().protocol().clips.replay) {
-        setMessage(tr("This protocol does not allow replaying a clip."));
+    const exp::FlowResult r = flow_->replay();
+    if (r.refusal == exp::Refusal::NotAllowed) {
+        setMessage(q(r.message));
         return;
     }
-    try {
-        session_->presentClip();
-    } catch (const std::exception& e) {
-        setMessage(tr("Not replayed: %1").arg(q(e.what())));
+    if (!r) {
+        setMessage(tr("Not replayed: %1").arg(q(r.message)));
         return;
     }
     refreshProtocolStatus();
@@ -1821,6 +1731,66 @@ bool RunView::startDemoTrialForScreenshot() {
     t.start();
     while (t.elapsed() < 700) QCoreApplication::processEvents(QEventLoop::AllEvents, 50);
     return true;
+}
+
+} // namespace underfoot::gui
+
+namespace underfoot::gui {
+
+ParticipantWindow* RunView::participantWindow() const {
+    return participantWindow_.data();
+}
+
+ParticipantWindow* RunView::openParticipantWindow() {
+    if (!participantWindow_) {
+        participantWindow_ = new ParticipantWindow(); // a top-level window, deleted below
+        connect(this, &RunView::flowChanged, participantWindow_.data(), [this] {
+            if (!participantWindow_) return;
+            participantWindow_->setHeld(paused_);
+            participantWindow_->setFlow(flow_.get());
+        });
+        connect(participantWindow_.data(), &ParticipantWindow::draftChanged, this, [this] {
+            renderDraft();
+            message_->clear();
+        });
+        connect(participantWindow_.data(), &ParticipantWindow::commitRequested, this,
+                &RunView::next);
+        connect(participantWindow_.data(), &ParticipantWindow::replayRequested, this,
+                &RunView::replayClip);
+        connect(participantWindow_.data(), &ParticipantWindow::closed, this,
+                [this] { setAnswerKeyShown(true); });
+    }
+    participantWindow_->setFlow(flow_.get());
+    const bool ownScreen = participantWindow_->showOnParticipantScreen(window()->screen());
+    // Sharing this view's screen: the participant could read the answer key here.
+    setAnswerKeyShown(ownScreen);
+    return participantWindow_.data();
+}
+
+void RunView::closeParticipantWindow() {
+    if (!participantWindow_) return;
+    participantWindow_->disconnect(this);
+    delete participantWindow_.data();
+    setAnswerKeyShown(true);
+}
+
+void RunView::setAnswerKeyShown(bool shown) {
+    answerKeyShown_ = shown;
+    stimulus_->setVisible(shown);
+    planList_->setVisible(shown);
+    if (session_ && pages_->currentIndex() == BriefingPage) showPhase();
+}
+
+QString RunView::trialHeader() const {
+    return header_->text();
+}
+
+QString RunView::stimulusText() const {
+    return stimulus_->isHidden() ? QString() : stimulus_->text();
+}
+
+QString RunView::briefingText() const {
+    return briefing_->text();
 }
 
 } // namespace underfoot::gui

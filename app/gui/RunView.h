@@ -18,7 +18,15 @@
 /// scales asked in this block are shown. Lap protocols ([laps]): L (or Ctrl+L when L is an
 /// answer letter) completes the lap being walked; Next is refused until every lap is done.
 /// Every answer is committed to the study file (durably) by Next before anything else happens.
+///
+/// The trial logic (answer draft, validation, lock rule, laps, clip replays, what the participant
+/// may see) is experiment::TrialFlow's; this view only maps keys and buttons onto it. The
+/// participant window (ParticipantWindow, F11) shows the same flow to the participant; while it
+/// shares the screen with this view, the answer key (stimulus, plan, notes) is hidden here.
 #include "experiment/Session.h"
+#include "experiment/TrialFlow.h"
+
+#include <QPointer>
 
 #include <QWidget>
 
@@ -65,6 +73,7 @@ struct GrfMeter;
 class TrialPanel;
 class AudioOutput;
 class ConsolePlayer;
+class ParticipantWindow;
 
 class RunView : public QWidget {
     Q_OBJECT
@@ -85,8 +94,8 @@ class RunView : public QWidget {
     /// Loads the previous trial's answer for a change (lock rule permitting); false with the
     /// reason in the message line otherwise.
     bool revisePrevious();
-    /// The trial whose answer is being changed, or -1.
-    int revising() const { return revising_; }
+    /// The trial whose answer is being changed (stored index), or -1.
+    int revising() const { return flow_ && flow_->revising() ? *flow_->revising() : -1; }
     /// Folder of the listening-test clips of the open study (default: `clips/<protocol id>`
     /// next to the study file; empty when the protocol has no [clips]).
     QString clipFolder() const { return clipDir_; }
@@ -138,6 +147,30 @@ class RunView : public QWidget {
     QString sensorFaultText() const;
     /// The running session (nullptr when none).
     experiment::Session* session() const { return session_.get(); }
+    /// The running session's trial flow (nullptr when none).
+    experiment::TrialFlow* flow() const { return flow_.get(); }
+
+    /// Opens the participant window (full screen on a second screen when there is one, else a
+    /// window over this one) and returns it; F11 toggles it. While it shares this view's screen
+    /// the answer key is hidden here (Ctrl+K shows it again for the experimenter).
+    ParticipantWindow* openParticipantWindow();
+    void closeParticipantWindow();
+    /// The participant window (nullptr when not open).
+    ParticipantWindow* participantWindow() const;
+    /// Whether this view shows the answer key (stimulus, its details, the plan, the notes).
+    bool answerKeyShown() const { return answerKeyShown_; }
+    void setAnswerKeyShown(bool shown);
+    /// The texts of the trial page's header and stimulus line (tests).
+    QString trialHeader() const;
+    QString stimulusText() const;
+    /// The briefing page's text.
+    QString briefingText() const;
+
+  signals:
+    /// The session, the trial or the draft changed (the participant window refreshes).
+    void flowChanged();
+
+  public:
     /// The widget that receives the trial keys (answer letters, digits, Enter, Space).
     QWidget* trialPanel() const;
     /// Milliseconds the last Next took to commit the answer to the store.
@@ -157,10 +190,10 @@ class RunView : public QWidget {
 
   private:
     friend class TrialPanel;
-    enum class SectionKind { Surface, Scale, Soundscape };
+    using SectionKind = experiment::SectionKind;
     struct Section {
         SectionKind kind = SectionKind::Surface;
-        int scale = -1; ///< index into the protocol's scales
+        const experiment::Scale* scale = nullptr;
         QGroupBox* box = nullptr;
         std::vector<QPushButton*> buttons;
     };
@@ -170,7 +203,8 @@ class RunView : public QWidget {
     void refreshStart();
     void showPhase();
     void showTrial();
-    void rebuildAnswerSections(const experiment::TrialRecord& trial);
+    void rebuildAnswerSections();
+    void showFlowResult(const experiment::FlowResult& result);
     void refreshClips();
     void completeLap();
     void replayClip();
@@ -199,6 +233,9 @@ class RunView : public QWidget {
     std::function<LiveSensors()> sensors_;
     engine::LiveEngine* engineOverride_ = nullptr;
     std::unique_ptr<experiment::Session> session_;
+    std::unique_ptr<experiment::TrialFlow> flow_;
+    QPointer<ParticipantWindow> participantWindow_;
+    bool answerKeyShown_ = true;
     QStackedWidget* pages_ = nullptr;
 
     // Start page.
@@ -247,18 +284,12 @@ class RunView : public QWidget {
     QListWidget* planList_ = nullptr;
     QWidget* sectionsHost_ = nullptr;
     std::vector<Section> sections_;
-    int active_ = 0;
-    int pendingDigits_ = -1;
     bool paused_ = false;
 
-    // The answer being entered for the current trial.
-    std::string surface_;
-    std::string soundscape_;
-    std::map<std::string, int> ratings_;
     double lastCommitMs_ = 0;
     QString lastTrialStats_; ///< the live engine's figures of the trial just answered
-    int revising_ = -1;
-    std::optional<double> revisingResponseS_;
+    QString notes_;          ///< the briefing page's experimenter notes (protocol description)
+    QLabel* notesLabel_ = nullptr;
 };
 
 } // namespace underfoot::gui

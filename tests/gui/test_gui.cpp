@@ -170,7 +170,8 @@ class GuiTest : public QObject {
         w->showView(2);
         auto* results = w->resultsView();
         const std::string group = w->context().store().participant("P001").groupId;
-        results->groupBox()->setCurrentText(QString::fromStdString(group));
+        results->groupBox()->setCurrentIndex(
+            results->groupBox()->findData(QString::fromStdString(group)));
         const auto& m = results->heatMap()->matrix();
         QCOMPARE(QString::fromStdString(m.group), QString::fromStdString(group));
         QCOMPARE(results->heatMap()->total(), static_cast<double>(typed.size()));

@@ -1,0 +1,436 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "experiment/TrialFlow.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+
+namespace underfoot::experiment {
+
+std::vector<std::string> anchorTexts(const Scale& scale) {
+    std::vector<std::string> out;
+    for (const auto& [value, wording] : scale.anchors)
+        out.push_back(fmt::format("{} = {}", value, wording));
+    if (out.empty()) {
+        if (!scale.minLabel.empty())
+            out.push_back(fmt::format("{} = {}", scale.min, scale.minLabel));
+        if (!scale.maxLabel.empty())
+            out.push_back(fmt::format("{} = {}", scale.max, scale.maxLabel));
+    }
+    return out;
+}
+
+std::string trialLabel(int index, int count, bool practice) {
+    return fmt::format("{} {} of {}", practice ? "Practice trial" : "Trial", index + 1, count);
+}
+
+TrialFlow::TrialFlow(StudyStore& store, Session& session) : store_(store), session_(session) {
+    reset();
+}
+
+bool TrialFlow::inTrial() const {
+    const SessionPhase p = session_.phase();
+    return p == SessionPhase::Trial || p == SessionPhase::Practice;
+}
+
+void TrialFlow::reset() {
+    revising_.reset();
+    revisedTrial_.reset();
+    draft_ = {};
+    pendingDigit_ = -1;
+    active_ = 0;
+    sections_.clear();
+    if (inTrial()) buildSections(session_.current());
+}
+
+void TrialFlow::buildSections(const TrialRecord& trial) {
+    sections_.clear();
+    const Questions& q = protocol().questions;
+    if (q.asksSurface()) {
+        AnswerSection s;
+        s.kind = SectionKind::Surface;
+        s.prompt = q.surfacePrompt;
+        s.options = q.surfaceOptions;
+        sections_.push_back(std::move(s));
+    }
+    // Only the scales asked after this stimulus in this block.
+    for (const Scale* asked : askedScales(protocol(), trial.stimulus, trial.block)) {
+        AnswerSection s;
+        s.kind = SectionKind::Scale;
+        s.prompt = asked->prompt;
+        s.scale = asked;
+        sections_.push_back(std::move(s));
+    }
+    if (q.asksSoundscape(session_.participant().groupId)) {
+        AnswerSection s;
+        s.kind = SectionKind::Soundscape;
+        s.prompt = q.soundscapePrompt;
+        s.options = q.soundscapeOptions;
+        sections_.push_back(std::move(s));
+    }
+}
+
+int TrialFlow::firstSection(SectionKind kind) const {
+    for (std::size_t i = 0; i < sections_.size(); ++i)
+        if (sections_[i].kind == kind) return static_cast<int>(i);
+    return -1;
+}
+
+void TrialFlow::setActive(int index) {
+    pendingDigit_ = -1;
+    if (sections_.empty()) {
+        active_ = 0;
+        return;
+    }
+    active_ = std::clamp(index, 0, static_cast<int>(sections_.size()) - 1);
+}
+
+FlowResult TrialFlow::chooseLetter(char letter) {
+    if (sections_.empty()) return {Refusal::NotInTrial, "no question is asked now"};
+    if (sections_[static_cast<std::size_t>(active_)].kind == SectionKind::Soundscape)
+        return choose(SectionKind::Soundscape, letter);
+    if (firstSection(SectionKind::Surface) >= 0) return choose(SectionKind::Surface, letter);
+    return {Refusal::NotAllowed, "this trial asks no question answered by a letter"};
+}
+
+FlowResult TrialFlow::choose(SectionKind kind, char letter) {
+    const int section = firstSection(kind);
+    if (section < 0 || kind == SectionKind::Scale)
+        return {Refusal::NotAllowed, "this trial does not ask that question"};
+    const Questions& q = protocol().questions;
+    const char lower =
+        static_cast<char>(letter >= 'A' && letter <= 'Z' ? letter - 'A' + 'a' : letter);
+    const AnswerOption* o = kind == SectionKind::Surface ? q.surfaceOptionByLetter(lower)
+                                                         : q.soundscapeOptionByLetter(lower);
+    if (!o) return {Refusal::NotAllowed, fmt::format("No answer has the letter '{}' here.", lower)};
+    (kind == SectionKind::Surface ? draft_.answer : draft_.soundscapeAnswer) = o->id;
+    setActive(section + 1); // on to the next question
+    return {};
+}
+
+FlowResult TrialFlow::typeDigit(int digit) {
+    if (sections_.empty() || digit < 0 || digit > 9)
+        return {Refusal::NotInTrial, "no rating is asked now"};
+    int section = active_;
+    if (sections_[static_cast<std::size_t>(section)].kind != SectionKind::Scale) {
+        section = -1;
+        for (std::size_t i = 0; i < sections_.size(); ++i)
+            if (sections_[i].kind == SectionKind::Scale &&
+                !draft_.ratings.count(sections_[i].scale->id)) {
+                section = static_cast<int>(i);
+                break;
+            }
+        if (section < 0) return {Refusal::NotAllowed, "every rating of this trial is given"};
+        setActive(section);
+    }
+    const Scale& sc = *sections_[static_cast<std::size_t>(section)].scale;
+    int value = digit;
+    if (pendingDigit_ >= 0 && pendingDigit_ * 10 + digit <= sc.max)
+        value = pendingDigit_ * 10 + digit;
+    if (value < sc.min || value > sc.max) {
+        pendingDigit_ = -1;
+        return {Refusal::OutOfRange,
+                fmt::format("{} is outside the scale {}–{}.", value, sc.min, sc.max)};
+    }
+    draft_.ratings[sc.id] = value;
+    if (value != 0 && value * 10 <= sc.max) {
+        pendingDigit_ = value; // a second digit may follow
+    } else {
+        setActive(section + 1 < static_cast<int>(sections_.size()) ? section + 1 : section);
+    }
+    return {};
+}
+
+void TrialFlow::adjust(int delta) {
+    if (sections_.empty()) return;
+    const auto& s = sections_[static_cast<std::size_t>(active_)];
+    if (s.kind != SectionKind::Scale) return;
+    const Scale& sc = *s.scale;
+    const auto it = draft_.ratings.find(sc.id);
+    const int from = it == draft_.ratings.end() ? (sc.min + sc.max) / 2 - delta : it->second;
+    draft_.ratings[sc.id] = std::clamp(from + delta, sc.min, sc.max);
+    pendingDigit_ = -1;
+}
+
+FlowResult TrialFlow::setRating(const std::string& scaleId, int value) {
+    for (std::size_t i = 0; i < sections_.size(); ++i) {
+        const auto& s = sections_[i];
+        if (s.kind != SectionKind::Scale || s.scale->id != scaleId) continue;
+        if (value < s.scale->min || value > s.scale->max)
+            return {Refusal::OutOfRange, fmt::format("{} is outside the scale {}–{}.", value,
+                                                     s.scale->min, s.scale->max)};
+        draft_.ratings[scaleId] = value;
+        setActive(static_cast<int>(i));
+        return {};
+    }
+    return {Refusal::NotAllowed, fmt::format("scale '{}' is not asked in this trial", scaleId)};
+}
+
+std::vector<std::string> TrialFlow::problems() const {
+    if (!inTrial()) return {"no trial is current"};
+    const TrialRecord& t = revisedTrial_ ? *revisedTrial_ : session_.current();
+    return store_.checkAnswer(session_.participant().groupId, draft_, t.stimulus, t.block);
+}
+
+FlowResult TrialFlow::start() {
+    if (!inTrial()) return {Refusal::NotInTrial, "no trial is current"};
+    if (session_.paused())
+        return {Refusal::Paused,
+                fmt::format("paused by a sensor fault: {}", session_.pauseReason())};
+    if (revising_)
+        return {Refusal::Locked, "store or cancel the change of the previous answer first"};
+    if (session_.playing()) {
+        if (protocol().clips.enabled) return replay();
+        return {Refusal::AlreadyStarted, "the stimulus is already playing"};
+    }
+    try {
+        session_.play();
+    } catch (const std::exception& e) {
+        return {Refusal::Failed, e.what()};
+    }
+    return {};
+}
+
+FlowResult TrialFlow::replay() {
+    if (!inTrial() || !protocol().clips.enabled)
+        return {Refusal::NotAllowed, "only clips of a listening test are replayed"};
+    if (!session_.playing()) return start();
+    if (!protocol().clips.replay)
+        return {Refusal::NotAllowed, "This protocol does not allow replaying a clip."};
+    try {
+        session_.presentClip();
+    } catch (const std::exception& e) {
+        return {Refusal::Failed, e.what()};
+    }
+    return {};
+}
+
+FlowResult TrialFlow::completeLap() {
+    if (!inTrial()) return {Refusal::NotInTrial, "no trial is current"};
+    const int total = session_.lapCount();
+    if (total == 0) return {Refusal::NotAllowed, "this protocol has no laps"};
+    if (!session_.playing())
+        return {Refusal::NotStarted, "Start the condition first, then complete each lap."};
+    if (session_.lapsDone() >= total)
+        return {Refusal::NotAllowed,
+                fmt::format("All {} laps are done; enter the answers and commit them.", total)};
+    try {
+        session_.completeLap();
+    } catch (const std::exception& e) {
+        return {Refusal::Failed, e.what()};
+    }
+    return {};
+}
+
+FlowResult TrialFlow::commit() {
+    if (revising_) return commitRevision();
+    if (!inTrial()) return {Refusal::NotInTrial, "no trial is current"};
+    if (session_.paused())
+        return {Refusal::Paused,
+                fmt::format("paused by a sensor fault: {}", session_.pauseReason())};
+    if (!session_.playing())
+        return {Refusal::NotStarted,
+                "Start the stimulus first; the answer belongs to what was heard."};
+    if (session_.lapCount() > 0 && session_.lapsDone() < session_.lapCount())
+        return {Refusal::LapsPending,
+                fmt::format("Lap {} of {} is being walked: the questions come after the last lap.",
+                            session_.lapsDone() + 1, session_.lapCount())};
+    const auto missing = problems();
+    if (!missing.empty()) {
+        std::string list;
+        for (const auto& p : missing) list += (list.empty() ? "" : "; ") + p;
+        return {Refusal::Incomplete, list};
+    }
+    try {
+        session_.answer(draft_);
+    } catch (const std::exception& e) {
+        if (session_.paused()) return {Refusal::Paused, e.what()};
+        return {Refusal::Failed, e.what()};
+    }
+    reset();
+    return {};
+}
+
+FlowResult TrialFlow::revisePrevious() {
+    if (!inTrial()) return {Refusal::NotInTrial, "no trial is current"};
+    if (protocol().lock == LockRule::OnAnswer)
+        return {Refusal::Locked,
+                "Answers are locked once given (protocol rule lock = \"answer\")."};
+    if (session_.playing())
+        return {Refusal::Locked, "The previous answer is locked: this trial's stimulus has started "
+                                 "(protocol rule lock = \"next_trial\")."};
+    const int current = session_.current().index;
+    std::optional<TrialRecord> previous;
+    for (auto& t : store_.trials(session_.participant().code))
+        if (t.answered && t.index < current && (!previous || t.index > previous->index))
+            previous = std::move(t);
+    if (!previous) return {Refusal::NoPrevious, "No earlier answer in this session to change."};
+    draft_ = previous->answer;
+    pendingDigit_ = -1;
+    revising_ = previous->index;
+    revisedTrial_ = previous;
+    buildSections(*revisedTrial_);
+    setActive(0);
+    return {};
+}
+
+FlowResult TrialFlow::commitRevision() {
+    if (!revising_) return {Refusal::NotAllowed, "no answer is being changed"};
+    if (session_.playing())
+        return {Refusal::Locked,
+                "The previous answer is locked: this trial's stimulus has started."};
+    try {
+        store_.commitAnswer(session_.participant().code, *revising_, draft_,
+                            revisedTrial_->responseTimeS);
+    } catch (const std::exception& e) {
+        return {Refusal::Failed, e.what()};
+    }
+    reset();
+    return {};
+}
+
+void TrialFlow::cancelRevision() {
+    reset();
+}
+
+std::optional<int> TrialFlow::exclusionTarget(bool previous, std::string* why) const {
+    if (previous) {
+        int index = -1;
+        for (const auto& t : store_.trials(session_.participant().code))
+            if (t.answered) index = std::max(index, t.index);
+        if (index < 0) {
+            if (why) *why = "No trial has been answered yet in this session.";
+            return std::nullopt;
+        }
+        return index;
+    }
+    if (!inTrial()) {
+        if (why) *why = "No trial is current.";
+        return std::nullopt;
+    }
+    return session_.current().index;
+}
+
+std::vector<std::string> TrialFlow::experimenterStatus() const {
+    std::vector<std::string> lines;
+    if (!inTrial()) return lines;
+    const Protocol& p = protocol();
+    if (p.clips.enabled) {
+        if (!session_.playing())
+            lines.push_back("Clip not presented yet — Space plays it.");
+        else
+            lines.push_back(p.clips.replay ? fmt::format("Clip presented · replays: {}  (Space or "
+                                                         "R replays)",
+                                                         session_.replayCount())
+                                           : "Clip presented · replay not allowed by the protocol");
+    }
+    if (session_.lapCount() > 0) {
+        const int done = session_.lapsDone();
+        const int total = session_.lapCount();
+        if (!session_.playing())
+            lines.push_back(
+                fmt::format("Laps: 0 of {} · press Space when the participant sets off", total));
+        else if (done >= total)
+            lines.push_back(fmt::format("Laps: {0} of {0} done · ask the questions now", total));
+        else
+            lines.push_back(
+                fmt::format("Lap {} of {} · {}  (L completes the lap)", done + 1, total,
+                            session_.currentLapSilent() ? "SILENT baseline" : "WITH SOUND"));
+    }
+    return lines;
+}
+
+bool TrialFlow::silentLapNow() const {
+    return inTrial() && session_.lapCount() > 0 && session_.playing() &&
+           session_.lapsDone() < session_.lapCount() && session_.currentLapSilent();
+}
+
+std::string TrialFlow::participantBriefing() const {
+    const Protocol& p = protocol();
+    const Questions& q = p.questions;
+    int practice = 0;
+    int total = 0;
+    for (const auto& t : store_.trials(session_.participant().code)) {
+        ++total;
+        practice += t.practice ? 1 : 0;
+    }
+    std::string text;
+    if (p.clips.enabled)
+        text += fmt::format("You will hear {} sound clips{}.", total,
+                            practice ? fmt::format(" ({} for practice first)", practice) : "");
+    else if (p.laps.total() > 0)
+        text += fmt::format(
+            "You will walk {} conditions{}. In each one you walk {} laps{}; the questions come "
+            "after the last lap.",
+            total, practice ? fmt::format(" ({} for practice first)", practice) : "",
+            p.laps.total(),
+            p.laps.baseline > 0 ? fmt::format(": the first {} without sound, then {} with sound",
+                                              p.laps.baseline, p.laps.feedback)
+                                : "");
+    else
+        text += fmt::format("There are {} trials{}.", total,
+                            practice ? fmt::format(" ({} for practice first)", practice) : "");
+    std::vector<std::string> asked;
+    if (q.asksSurface()) asked.push_back(q.surfacePrompt);
+    for (const auto& s : q.scales) asked.push_back(s.prompt);
+    if (q.asksSoundscape(session_.participant().groupId)) asked.push_back(q.soundscapePrompt);
+    if (!asked.empty()) {
+        text += "\n\nAfter each one you will be asked:";
+        for (const auto& a : asked) text += "\n  • " + a;
+    }
+    if (p.clips.enabled && p.clips.replay) text += "\n\nYou may listen to a clip again.";
+    if (p.ordering.breakEvery > 0)
+        text += fmt::format("\n\nThere is a break after every {} trials.", p.ordering.breakEvery);
+    text += "\n\nThere are no right or wrong answers: answer what you perceive.";
+    return text;
+}
+
+ParticipantScreen TrialFlow::participantScreen() const {
+    ParticipantScreen s;
+    s.total = session_.trialCount();
+    s.answered = session_.answeredCount();
+    switch (session_.phase()) {
+    case SessionPhase::Briefing:
+        s.page = ParticipantScreen::Page::Briefing;
+        s.heading = "Welcome";
+        s.text = participantBriefing();
+        return s;
+    case SessionPhase::Break:
+        s.page = ParticipantScreen::Page::Break;
+        s.heading = "Break";
+        s.text = fmt::format("{} of {} trials done. Please rest; the experimenter will continue.",
+                             s.answered, s.total);
+        return s;
+    case SessionPhase::Finished:
+        s.page = ParticipantScreen::Page::Finished;
+        s.heading = "Thank you";
+        s.text = "The session is over. Thank you for taking part.";
+        return s;
+    case SessionPhase::Practice:
+    case SessionPhase::Trial:
+        break;
+    }
+    const TrialRecord& t = session_.current();
+    s.page = ParticipantScreen::Page::Trial;
+    s.heading = trialLabel(t.index, s.total, t.practice);
+    s.sections = sections_;
+    s.activeSection = active_;
+    s.draft = draft_;
+    const Protocol& p = protocol();
+    if (session_.paused()) {
+        s.text = "Please wait a moment.";
+    } else if (!session_.playing()) {
+        s.text = p.laps.total() > 0 ? "Please wait: the experimenter starts the condition."
+                                    : "Please wait for the sound.";
+    } else if (session_.lapCount() > 0 && session_.lapsDone() < session_.lapCount()) {
+        s.text =
+            fmt::format("Lap {} of {}: please walk.", session_.lapsDone() + 1, session_.lapCount());
+    } else {
+        s.answering = true;
+        s.text = p.clips.enabled && p.clips.replay ? "Please answer. You may listen again."
+                                                   : "Please answer.";
+    }
+    return s;
+}
+
+} // namespace underfoot::experiment

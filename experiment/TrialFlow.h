@@ -1,0 +1,177 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+/// The trial flow every front end shares (the console's Run view and participant window, the
+/// terminal session, the web server), on top of experiment::Session:
+///
+/// - the answer being entered for the current trial: its sections (surface question, the scales
+///   asked in this trial's block, soundscape question), the active section, letters, digits
+///   (two-digit values on 0–10 scales), Left/Right adjustments;
+/// - its validation before commit (stimulus started, every lap walked, the store's per-trial
+///   checkAnswer) and the commit itself;
+/// - the lock rule (changing the previous answer only under lock = "next_trial" and before the
+///   next stimulus starts), replay counts of listening-test clips and laps;
+/// - what the participant may see (ParticipantScreen: a neutral briefing made from the
+///   questions, the question, the answer list, the scales with their anchors, progress and
+///   breaks) as opposed to what only the experimenter sees (stimulus, order, notes).
+///
+/// Trial numbers for people are 1-based ("Trial 3 of 40" is the trial stored with index 2).
+/// No Qt, no engine: the front ends map their keys to the calls below.
+#include "experiment/Session.h"
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace underfoot::experiment {
+
+enum class SectionKind { Surface, Scale, Soundscape };
+
+/// One question of the current trial as shown to whoever answers it.
+struct AnswerSection {
+    SectionKind kind = SectionKind::Surface;
+    /// The protocol's prompt ("Which surface are you walking on?", the scale's prompt).
+    std::string prompt;
+    /// Answer list (Surface / Soundscape sections), with their letters.
+    std::vector<AnswerOption> options;
+    /// The scale (Scale sections; points into the protocol, which outlives the flow).
+    const Scale* scale = nullptr;
+};
+
+/// Why an action was refused (None: done).
+enum class Refusal {
+    None,
+    NotInTrial,     ///< no trial is current (briefing, break, finished, no session)
+    Paused,         ///< paused by a sensor fault
+    NotStarted,     ///< the stimulus has not started
+    AlreadyStarted, ///< the stimulus is already playing
+    LapsPending,    ///< laps still to walk before the questions
+    Incomplete,     ///< the answer is missing something (checkAnswer's problems)
+    Locked,         ///< the protocol's lock rule forbids the change
+    NoPrevious,     ///< no earlier answer to change
+    NotAllowed,     ///< the protocol does not allow it (replay = false, no laps, no such letter)
+    OutOfRange,     ///< a rating outside its scale
+    Failed,         ///< the store or the player failed (message says why)
+};
+
+struct FlowResult {
+    Refusal refusal = Refusal::None;
+    std::string message;
+    explicit operator bool() const { return refusal == Refusal::None; }
+};
+
+/// Every anchor of a scale as "value = wording" (min and max labels when it has no anchors).
+std::vector<std::string> anchorTexts(const Scale& scale);
+
+/// "Trial 3 of 40" / "Practice trial 1 of 40" (1-based; `index` is the stored 0-based index).
+std::string trialLabel(int index, int count, bool practice);
+
+/// What the participant's screen may show. Built only from the protocol's questions, the
+/// session's progress and the participant's own draft: never the stimulus (its id, surface,
+/// soundscape, input), the order of the plan, the group or the experimenter's notes.
+struct ParticipantScreen {
+    enum class Page { Waiting, Briefing, Trial, Break, Finished };
+    Page page = Page::Waiting;
+    /// "Trial 3 of 40", "Break", "Thank you".
+    std::string heading;
+    /// Briefing / break / end text, or what to do now in a trial ("Listen.", "Lap 2 of 6").
+    std::string text;
+    /// The questions of the current trial (Trial page).
+    std::vector<AnswerSection> sections;
+    int activeSection = 0;
+    /// The participant's answer so far (highlights).
+    TrialAnswer draft;
+    /// Whether answers can be given now (stimulus started, laps walked, not paused).
+    bool answering = false;
+    /// Answered and planned trials of this participant (progress bar).
+    int answered = 0;
+    int total = 0;
+};
+
+class TrialFlow {
+  public:
+    /// `store` must be the store `session` writes to; both outlive the flow.
+    TrialFlow(StudyStore& store, Session& session);
+
+    Session& session() const { return session_; }
+    const Protocol& protocol() const { return store_.protocol(); }
+
+    /// Starts a fresh draft for the session's current trial (call after every phase change;
+    /// answer() does it itself). Outside a trial the draft has no sections.
+    void reset();
+
+    // The draft.
+    const std::vector<AnswerSection>& sections() const { return sections_; }
+    int activeSection() const { return active_; }
+    /// Activates section `index` (clamped) and forgets a pending first digit.
+    void setActive(int index);
+    const TrialAnswer& draft() const { return draft_; }
+    void setComment(const std::string& comment) { draft_.comment = comment; }
+    /// A letter typed by whoever answers: the soundscape option when the soundscape section is
+    /// active, else the surface option. Moves on to the next section.
+    FlowResult chooseLetter(char letter);
+    /// The option with `letter` in the first section of `kind` (pointer clicks).
+    FlowResult choose(SectionKind kind, char letter);
+    /// A digit for the active scale (or the first scale without a rating): "1" then "0" gives
+    /// 10 on a 0–10 scale; a complete value moves on to the next section.
+    FlowResult typeDigit(int digit);
+    /// Lowers (-1) or raises (+1) the active scale's rating (starts in its middle).
+    void adjust(int delta);
+    /// Sets a rating directly (pointer clicks); refuses scales not asked here or out of range.
+    FlowResult setRating(const std::string& scaleId, int value);
+    /// What is still missing before the draft can be committed (empty: it can).
+    std::vector<std::string> problems() const;
+
+    // The session's actions, refused with a reason instead of throwing.
+
+    /// Starts the stimulus; for listening tests a second call replays the clip (counted).
+    FlowResult start();
+    /// Replays the current clip (listening tests, [clips] replay = true).
+    FlowResult replay();
+    /// Completes the lap being walked ([laps]).
+    FlowResult completeLap();
+    /// Validates and commits the draft (durably) and moves on; a fresh draft follows.
+    FlowResult commit();
+
+    // Changing the previous answer (lock rule).
+
+    /// Loads the previous answered trial's answer as the draft (only under lock = "next_trial"
+    /// and before the current stimulus starts).
+    FlowResult revisePrevious();
+    /// The stored index of the trial being changed, or nullopt.
+    std::optional<int> revising() const { return revising_; }
+    /// Stores the changed answer (validated against that trial) and returns to the current trial.
+    FlowResult commitRevision();
+    /// Drops the change and returns to the current trial's fresh draft.
+    void cancelRevision();
+
+    /// The stored index of the trial to exclude: the current one, or with `previous` the last
+    /// answered one (nullopt with the reason in `why`).
+    std::optional<int> exclusionTarget(bool previous, std::string* why = nullptr) const;
+
+    /// The experimenter's clip / lap lines ("Clip presented · replays: 2", "Lap 2 of 6 · SILENT
+    /// baseline"); empty outside listening tests and lap protocols.
+    std::vector<std::string> experimenterStatus() const;
+    /// Whether the current lap is a silent baseline lap being walked.
+    bool silentLapNow() const;
+
+    /// What the participant's screen shows now.
+    ParticipantScreen participantScreen() const;
+    /// The briefing for the participant, made from the protocol's questions and ordering.
+    std::string participantBriefing() const;
+
+  private:
+    bool inTrial() const;
+    void buildSections(const TrialRecord& trial);
+    int firstSection(SectionKind kind) const;
+
+    StudyStore& store_;
+    Session& session_;
+    std::vector<AnswerSection> sections_;
+    int active_ = 0;
+    int pendingDigit_ = -1;
+    TrialAnswer draft_;
+    std::optional<int> revising_;
+    std::optional<TrialRecord> revisedTrial_; ///< the trial being changed (its stimulus, block)
+};
+
+} // namespace underfoot::experiment

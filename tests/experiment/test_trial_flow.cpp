@@ -1,0 +1,250 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The trial flow shared by the console, the terminal and the web front end: the answer draft,
+// validation, lock rule, laps and clips, and what the participant's screen may show.
+#include "TestSupport.h"
+#include "experiment/TrialFlow.h"
+
+#include <gtest/gtest.h>
+
+using namespace underfoot::experiment;
+using namespace underfoot::experiment::test;
+
+namespace {
+class FakePlayer : public StimulusPlayer {
+  public:
+    StimulusStart start(const Stimulus& s, std::uint64_t plannedSeed) override {
+        ++starts;
+        last = s.id;
+        return {plannedSeed, std::nullopt};
+    }
+    void stop() override {}
+    int starts = 0;
+    std::string last;
+};
+
+const char* kNotes = "EXPERIMENTER NOTES: group B hears mismatching soundscapes";
+
+std::string protocolText(const std::string& lock) {
+    return miniProtocol("[[questions.scales]]\nid = \"quality\"\nprompt = \"Quality\"\nmin = 0\n"
+                        "max = 10\nanchors = { 0 = \"bad\", 10 = \"excellent\" }\n"
+                        "[rules]\nlock = \"" +
+                            lock + "\"\n",
+                        "repetitions = 2\nno_immediate_repeat = true\n");
+}
+
+StudyStore makeStudy(const TempDir& dir, const std::string& lock) {
+    std::string text = protocolText(lock);
+    // The protocol's description is the experimenter's notes.
+    text.insert(text.find("[design]"), std::string("description = \"") + kNotes + "\"\n");
+    StudyStore store = StudyStore::create(dir.file("s.db"), parseProtocol(text, "mini.toml"),
+                                          {"S", "lab", 7, "t"});
+    store.registerParticipant({"P1", {}, "", "", "", {}, ""});
+    return store;
+}
+
+/// Every text the participant's screen holds.
+std::string screenText(const ParticipantScreen& s) {
+    std::string all = s.heading + "\n" + s.text + "\n";
+    for (const auto& sec : s.sections) {
+        all += sec.prompt + "\n";
+        for (const auto& o : sec.options) all += std::string(1, o.letter) + " " + o.label + "\n";
+        if (sec.scale)
+            for (const auto& a : anchorTexts(*sec.scale)) all += a + "\n";
+    }
+    return all;
+}
+} // namespace
+
+TEST(TrialFlow, DraftLettersDigitsValidationAndCommit) {
+    TempDir dir;
+    StudyStore store = makeStudy(dir, "next_trial");
+    FakePlayer player;
+    Session session(store, "P1", player, {});
+    TrialFlow flow(store, session);
+    EXPECT_TRUE(flow.sections().empty()) << "no questions during the briefing";
+    EXPECT_EQ(flow.start().refusal, Refusal::NotInTrial);
+    session.finishBriefing();
+    flow.reset();
+    ASSERT_EQ(flow.sections().size(), 3u); // surface, realism 1-7, quality 0-10
+    EXPECT_EQ(flow.sections()[0].kind, SectionKind::Surface);
+    EXPECT_EQ(flow.sections()[2].scale->id, "quality");
+
+    EXPECT_EQ(flow.commit().refusal, Refusal::NotStarted);
+    EXPECT_EQ(flow.chooseLetter('z').refusal, Refusal::NotAllowed);
+    EXPECT_TRUE(flow.chooseLetter('B'));
+    EXPECT_EQ(flow.draft().answer, "gravel");
+    EXPECT_EQ(flow.activeSection(), 1) << "a chosen answer moves on to the next question";
+    EXPECT_EQ(flow.typeDigit(9).refusal, Refusal::OutOfRange) << "realism is 1-7";
+    EXPECT_TRUE(flow.typeDigit(6));
+    EXPECT_EQ(flow.activeSection(), 2);
+    EXPECT_TRUE(flow.typeDigit(1));
+    EXPECT_TRUE(flow.typeDigit(0));
+    EXPECT_EQ(flow.draft().ratings.at("quality"), 10) << "'1' '0' types 10 on a 0-10 scale";
+    flow.adjust(-1);
+    EXPECT_EQ(flow.draft().ratings.at("quality"), 9);
+    flow.adjust(+5);
+    EXPECT_EQ(flow.draft().ratings.at("quality"), 10) << "Right stops at the scale's end";
+    EXPECT_EQ(flow.setRating("quality", 11).refusal, Refusal::OutOfRange);
+    EXPECT_EQ(flow.setRating("speed", 3).refusal, Refusal::NotAllowed);
+
+    ASSERT_TRUE(flow.start());
+    EXPECT_EQ(flow.start().refusal, Refusal::AlreadyStarted);
+    TrialAnswer saved = flow.draft();
+    flow.reset();
+    flow.setActive(1);
+    EXPECT_TRUE(flow.typeDigit(4));
+    const FlowResult incomplete = flow.commit();
+    EXPECT_EQ(incomplete.refusal, Refusal::Incomplete);
+    EXPECT_NE(incomplete.message.find("quality"), std::string::npos) << incomplete.message;
+    EXPECT_EQ(session.answeredCount(), 0);
+    EXPECT_TRUE(flow.choose(SectionKind::Surface, 'a'));
+    EXPECT_TRUE(flow.setRating("quality", 3));
+    const int index = session.current().index;
+    ASSERT_TRUE(flow.commit());
+    EXPECT_TRUE(flow.draft().ratings.empty()) << "a fresh draft follows the commit";
+    const auto stored = store.trials("P1")[static_cast<std::size_t>(index)];
+    EXPECT_TRUE(stored.answered);
+    EXPECT_EQ(stored.answer.answer, "wood");
+    EXPECT_EQ(stored.answer.ratings.at("realism"), 4);
+    EXPECT_EQ(stored.answer.ratings.at("quality"), 3);
+    (void)saved;
+}
+
+TEST(TrialFlow, LockRuleNextTrialAllowsChangeUntilTheNextStimulus) {
+    TempDir dir;
+    StudyStore store = makeStudy(dir, "next_trial");
+    FakePlayer player;
+    Session session(store, "P1", player, {});
+    session.finishBriefing();
+    TrialFlow flow(store, session);
+    EXPECT_EQ(flow.revisePrevious().refusal, Refusal::NoPrevious);
+    ASSERT_TRUE(flow.start());
+    flow.chooseLetter('a');
+    flow.typeDigit(2);
+    flow.typeDigit(5);
+    const int first = session.current().index;
+    ASSERT_TRUE(flow.commit());
+    ASSERT_TRUE(flow.revisePrevious());
+    EXPECT_EQ(flow.revising(), first);
+    EXPECT_EQ(flow.draft().answer, "wood") << "the stored answer is loaded";
+    EXPECT_EQ(flow.start().refusal, Refusal::Locked) << "no stimulus while a change is open";
+    flow.chooseLetter('c');
+    ASSERT_TRUE(flow.commit()) << "commit stores the change";
+    EXPECT_FALSE(flow.revising());
+    EXPECT_EQ(store.trials("P1")[static_cast<std::size_t>(first)].answer.answer, "metal");
+    EXPECT_EQ(session.answeredCount(), 1) << "the current trial is still unanswered";
+    ASSERT_TRUE(flow.start());
+    EXPECT_EQ(flow.revisePrevious().refusal, Refusal::Locked) << "the next stimulus started";
+    std::string why;
+    EXPECT_EQ(flow.exclusionTarget(true, &why), first);
+    EXPECT_EQ(flow.exclusionTarget(false), session.current().index);
+}
+
+TEST(TrialFlow, LockRuleAnswerRefusesEveryChange) {
+    TempDir dir;
+    StudyStore store = makeStudy(dir, "answer");
+    FakePlayer player;
+    Session session(store, "P1", player, {});
+    session.finishBriefing();
+    TrialFlow flow(store, session);
+    ASSERT_TRUE(flow.start());
+    flow.chooseLetter('a');
+    flow.typeDigit(2);
+    flow.typeDigit(5);
+    ASSERT_TRUE(flow.commit());
+    const FlowResult r = flow.revisePrevious();
+    EXPECT_EQ(r.refusal, Refusal::Locked);
+    EXPECT_NE(r.message.find("lock = \"answer\""), std::string::npos) << r.message;
+}
+
+TEST(TrialFlow, ParticipantScreenNeverShowsStimulusOrderOrNotes) {
+    TempDir dir;
+    StudyStore store = makeStudy(dir, "next_trial");
+    FakePlayer player;
+    Session session(store, "P1", player, {});
+    TrialFlow flow(store, session);
+    const auto plan = store.trials("P1");
+    ParticipantScreen s = flow.participantScreen();
+    EXPECT_EQ(s.page, ParticipantScreen::Page::Briefing);
+    EXPECT_EQ(screenText(s).find("EXPERIMENTER"), std::string::npos) << screenText(s);
+    EXPECT_NE(s.text.find("6 trials"), std::string::npos) << s.text;
+    EXPECT_NE(s.text.find("Realism"), std::string::npos) << "the questions are announced";
+    session.finishBriefing();
+    flow.reset();
+    std::string firstBody;
+    for (int n = 1; session.phase() != SessionPhase::Finished; ++n) {
+        const TrialRecord& t = session.current();
+        s = flow.participantScreen();
+        EXPECT_EQ(s.heading, "Trial " + std::to_string(n) + " of 6") << "1-based, for people";
+        EXPECT_FALSE(s.answering) << "no answers before the stimulus";
+        ASSERT_TRUE(flow.start());
+        s = flow.participantScreen();
+        EXPECT_TRUE(s.answering);
+        const std::string text = screenText(s);
+        // Nothing that depends on the stimulus: the body is the same on every trial.
+        const std::string body = text.substr(text.find('\n'));
+        if (firstBody.empty()) firstBody = body;
+        EXPECT_EQ(body, firstBody) << "trial " << n << " (" << t.stimulus.id << ")";
+        for (const auto& p : plan) {
+            EXPECT_EQ(text.find(p.stimulus.id), std::string::npos) << p.stimulus.id;
+            EXPECT_EQ(text.find("hall"), std::string::npos) << "reverb of a stimulus";
+        }
+        EXPECT_EQ(text.find("EXPERIMENTER"), std::string::npos);
+        flow.chooseLetter('a');
+        flow.typeDigit(3);
+        flow.typeDigit(7);
+        ASSERT_TRUE(flow.commit());
+    }
+    s = flow.participantScreen();
+    EXPECT_EQ(s.page, ParticipantScreen::Page::Finished);
+    EXPECT_EQ(s.answered, 6);
+}
+
+TEST(TrialFlow, LapsAndClipsOfTheShippedProtocols) {
+    {
+        TempDir dir;
+        StudyStore store = StudyStore::create(dir.file("laps.db"),
+                                              loadProtocol(shipped("wading_interactive.toml")),
+                                              {"W", "lab", 3, "t"});
+        store.registerParticipant({"P1", {}, "", "", "", {}, ""});
+        FakePlayer player;
+        Session session(store, "P1", player, {});
+        session.finishBriefing();
+        TrialFlow flow(store, session);
+        EXPECT_EQ(flow.completeLap().refusal, Refusal::NotStarted);
+        ASSERT_TRUE(flow.start());
+        const int laps = session.lapCount();
+        ASSERT_GT(laps, 1);
+        for (int lap = 1; lap <= laps; ++lap) {
+            EXPECT_NE(flow.participantScreen().text.find("Lap " + std::to_string(lap) + " of"),
+                      std::string::npos);
+            EXPECT_EQ(flow.commit().refusal, Refusal::LapsPending);
+            ASSERT_TRUE(flow.completeLap());
+        }
+        EXPECT_EQ(flow.completeLap().refusal, Refusal::NotAllowed);
+        EXPECT_TRUE(flow.participantScreen().answering);
+        EXPECT_NE(flow.experimenterStatus().front().find("done"), std::string::npos);
+    }
+    {
+        TempDir dir;
+        StudyStore store =
+            StudyStore::create(dir.file("clips.db"), loadProtocol(shipped("wading_listening.toml")),
+                               {"L", "lab", 3, "t"});
+        store.registerParticipant({"P1", {}, "", "", "", {}, ""});
+        FakePlayer player;
+        Session session(store, "P1", player, {});
+        session.finishBriefing();
+        TrialFlow flow(store, session);
+        ASSERT_EQ(flow.sections().size(), 1u) << "one scale per block";
+        ASSERT_TRUE(flow.start());
+        ASSERT_TRUE(flow.start()) << "Space again replays the clip";
+        ASSERT_TRUE(flow.replay());
+        EXPECT_EQ(session.replayCount(), 2);
+        EXPECT_EQ(player.starts, 3);
+        EXPECT_NE(flow.experimenterStatus().front().find("replays: 2"), std::string::npos);
+        // The participant sees the scale and its anchors, not which clip plays.
+        const std::string text = screenText(flow.participantScreen());
+        EXPECT_EQ(text.find(player.last), std::string::npos) << text;
+        EXPECT_NE(text.find(flow.sections()[0].prompt), std::string::npos);
+    }
+}
