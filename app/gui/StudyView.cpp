@@ -381,11 +381,19 @@ void StudyView::refresh() {
     for (std::size_t i = 0; i < progress.participants.size(); ++i) {
         const auto& pp = progress.participants[i];
         QString registered;
+        bool simulated = false;
         for (const auto& person : people)
-            if (person.code == pp.code) registered = q(person.registeredAt);
+            if (person.code == pp.code) {
+                registered = q(person.registeredAt);
+                simulated = person.simulated;
+            }
+        // Simulated participants are marked as such: their answers are synthetic and `analyze`
+        // leaves them out unless asked (--include-simulated).
+        const QString status = simulated ? tr("%1 (simulated)").arg(q(exp::toString(pp.status)))
+                                         : q(exp::toString(pp.status));
         setRow(participants_, static_cast<int>(i),
-               {q(pp.code), q(pp.groupId), q(exp::toString(pp.status)),
-                tr("%1 / %2").arg(pp.answered).arg(pp.planned), registered});
+               {q(pp.code), q(pp.groupId), status, tr("%1 / %2").arg(pp.answered).arg(pp.planned),
+                registered});
     }
     participants_->resizeColumnsToContents();
     int row = 0;

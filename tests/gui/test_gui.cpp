@@ -2,6 +2,7 @@
 // The console driven through its widgets on Qt's offscreen platform: a complete session answered
 // from the keyboard and checked in the study file, closing mid-session and resuming, the results
 // view against the stored answers, protocol errors with file:line:column, and the sound palette.
+#include "app/gui/DemoStudy.h"
 #include "app/gui/HeatMap.h"
 #include "app/gui/MainWindow.h"
 #include "app/gui/PaletteView.h"
@@ -15,6 +16,7 @@
 #include "experiment/Store.h"
 
 #include <QComboBox>
+#include <QDir>
 #include <QElapsedTimer>
 #include <QFile>
 #include <QFileInfo>
@@ -26,6 +28,7 @@
 #include <QSignalSpy>
 #include <QSpinBox>
 #include <QTabWidget>
+#include <QTableWidget>
 #include <QTemporaryDir>
 #include <QTest>
 
@@ -402,6 +405,25 @@ lock = "answer"
         QCOMPARE(run->pageName(), QString("trial"));
         QTest::keyClick(run->trialPanel(), Qt::Key_Space);
         QVERIFY(run->session()->playing());
+    }
+
+    void studyViewMarksSimulatedParticipants() {
+        // The demo study's participants are simulated: the Study view says so on every row, so
+        // nobody mistakes synthetic answers for a real participant's.
+        const QString dir = home_.filePath("demo-simulated");
+        QVERIFY(QDir().mkpath(dir));
+        QVERIFY2(gui::ensureDemoStudy(dir, 2).isEmpty(), "demo study not created");
+        auto w = makeWindow(gui::demoStudyPath(dir));
+        QVERIFY(w->context().hasStudy());
+        w->showView(0);
+        QTableWidget* table = nullptr;
+        for (auto* t : w->studyView()->findChildren<QTableWidget*>())
+            if (t->accessibleName() == "Participants") table = t;
+        QVERIFY(table != nullptr);
+        QCOMPARE(table->rowCount(), 2);
+        for (int r = 0; r < table->rowCount(); ++r)
+            QVERIFY2(table->item(r, 2)->text().contains("(simulated)"),
+                     qPrintable(table->item(r, 2)->text()));
     }
 
     void badProtocolShowsFileLineColumnAndWhatToDo() {
