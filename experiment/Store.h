@@ -34,9 +34,9 @@ struct StoreError : std::runtime_error {
 /// Current schema version written by this code.
 /// Version 2 adds clip replay counts and laps walked per trial, and participant fields
 /// (expertise, listening device...); version 3 adds per-trial audio figures (TrialAudioStats),
-/// the sensor log reference and sensor-fault interruptions. Older studies are migrated when
-/// opened.
-inline constexpr int kSchemaVersion = 3;
+/// the sensor log reference and sensor-fault interruptions; version 4 adds the online tables
+/// of `underfoot serve` (experiment/Invitations.h). Older studies are migrated when opened.
+inline constexpr int kSchemaVersion = 4;
 
 /// Time source (injectable for tests).
 struct Clock {
