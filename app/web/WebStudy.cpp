@@ -148,12 +148,16 @@ Invitation WebStudy::invitation(const std::string& token) {
 
 void WebStudy::refuse(const Invitation& inv, std::optional<int> trial, const std::string& request,
                       int status, const std::string& reason) {
+    const std::string detail = jsonObject({{"participant", inv.participantCode},
+                                           {"request", request},
+                                           {"status", std::to_string(status)},
+                                           {"reason", reason}});
     try {
-        store_.journal("online_refused", "", trial,
-                       jsonObject({{"participant", inv.participantCode},
-                                   {"request", request},
-                                   {"status", std::to_string(status)},
-                                   {"reason", reason}}));
+        try {
+            store_.journal("online_refused", inv.participantCode, trial, detail);
+        } catch (const StoreError&) {
+            store_.journal("online_refused", "", trial, detail); // not registered yet
+        }
     } catch (const std::exception&) {
         // A journal failure must not turn a refusal into an acceptance.
     }
