@@ -389,8 +389,9 @@
          form);
     playBtn.focus();
     onKeys((ev) => {
-      if (ev.key === ' ' && ev.target.tagName !== 'BUTTON') { play(); return true; }
-      if (ev.key === ' ' && ev.target === playBtn) return false; // the button's own click
+      // Space plays unless a control has the focus (Space checks a radio / presses a button).
+      if (ev.key === ' ' && !['INPUT', 'BUTTON', 'TEXTAREA', 'SELECT'].includes(ev.target.tagName)) { play(); return true; }
+      if (ev.key === ' ') return false;
       if (form.hidden) return false;
       const k = ev.key.toLowerCase();
       if (keyed.has(k) && ev.target.tagName !== 'TEXTAREA') { keyed.get(k).checked = true; keyed.get(k).focus(); return true; }

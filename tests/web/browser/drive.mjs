@@ -161,6 +161,9 @@ try {
     }
     await shot(label);
     await tabTo(`document.activeElement && document.activeElement.id === 'next'`, 'Next');
+    // Only the one deliberate replay was counted (keys used to answer never replay).
+    const shownReplays = await page.evaluate(() => (document.querySelector('main').textContent.match(/Played again (\d+)/) || [0, '0'])[1]);
+    if (Number(shownReplays) !== (replayable && trials === 1 ? 1 : 0)) throw new Error(`unexpected replays: ${shownReplays}`);
     const answered = await page.evaluate(() => document.querySelector('#progress').textContent);
     await page.keyboard.press('Enter');
     await waitFor((was) => document.querySelector('#progress').textContent !== was, 'the acknowledgement', 30_000, answered);

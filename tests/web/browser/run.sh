@@ -75,6 +75,9 @@ PY
     || fail "$name: user agent / audio sample rate not stored"
   [ "$(q "$db" "SELECT screening_passed FROM online_invitations WHERE participant_code = 'W001'")" = 1 ] \
     || fail "$name: headphone screening not passed/stored"
+  local want_replays=1; grep -q '^replay = false' "$protocol" && want_replays=0
+  [ "$(q "$db" "SELECT sum(replays) FROM trials WHERE participant_id = $pid_sql")" = "$want_replays" ] \
+    || fail "$name: expected $want_replays counted replay(s)"
   local code; code=$(python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["completionCode"])' "$d/result.json")
   [ "$(q "$db" "SELECT completion_code FROM online_invitations WHERE participant_code = 'W001'")" = "$code" ] \
     || fail "$name: the completion code shown is not the stored one"
