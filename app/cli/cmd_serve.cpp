@@ -10,6 +10,7 @@
 
 #include <fmt/core.h>
 
+#include <atomic>
 #include <csignal>
 #include <cstdio>
 #include <pthread.h>
@@ -77,9 +78,11 @@ int serve(const Options& o) {
                    o.bind);
     std::fflush(stdout);
 
-    int caught = 0;
+    std::atomic<int> caught{0};
     std::thread waiter([&] {
-        sigwait(&stopSignals, &caught);
+        int signal = 0;
+        sigwait(&stopSignals, &signal);
+        caught = signal;
         server.stop();
     });
     server.run();
