@@ -120,12 +120,17 @@ try {
   await shot('3-level');
   await page.keyboard.press('Enter');
 
-  let trials = 0;
+  let trials = 0, reloaded = false;
   while (Date.now() < deadline) {
-    await waitFor(() => ['Thank you!', 'Break', 'Practice'].includes(document.querySelector('h1')?.textContent)
+    if (trials === 2 && !reloaded) { // a reload mid-test resumes at the first unanswered trial
+      reloaded = true;
+      await page.reload({ waitUntil: 'load' });
+    }
+    await waitFor(() => ['Thank you!', 'Break', 'Practice', 'Set the volume'].includes(document.querySelector('h1')?.textContent)
       || /^Sound \d+ of \d+$/.test(document.querySelector('h1')?.textContent || ''), 'the next page');
     const h = await heading();
     if (h === 'Thank you!') { await shot('9-end'); break; }
+    if (h === 'Set the volume') { await page.keyboard.press('Enter'); await waitFor(() => document.querySelector('h1')?.textContent !== 'Set the volume', 'the trials after the reload'); continue; }
     if (h === 'Break') { await shot('6-break'); await page.keyboard.press('Enter'); await waitFor(() => document.querySelector('h1')?.textContent !== 'Break', 'the end of the break'); continue; }
     const label = h === 'Practice' ? '4-practice' : '5-trial';
     await waitFor(() => document.activeElement && document.activeElement.id === 'play', 'the play button');
