@@ -136,7 +136,7 @@ TEST(WebApi, RetriedAnswerIsStoredOnceAndAcknowledgedAgain) {
 TEST(WebApi, BadTokensAreRefused) {
     StudyFixture f(1);
     InProcessServer s(f);
-    for (const std::string token :
+    for (const std::string& token :
          {std::string(), std::string("nonsense"), std::string(43, 'A'),
           f.links[0].token.substr(0, 42) + (f.links[0].token.back() == 'A' ? "B" : "A"),
           f.links[0].token + "x", std::string("../../etc/passwd")}) {
@@ -398,7 +398,7 @@ TEST(WebApi, TokensAreLongRandomAndStoredOnlyAsHashes) {
     EXPECT_EQ(rows, 20);
     // No byte of the study (file and write-ahead log) holds a token.
     std::string bytes;
-    for (const std::string file : {f.study, f.study + "-wal"}) {
+    for (const std::string& file : {f.study, f.study + "-wal"}) {
         std::ifstream in(file, std::ios::binary);
         bytes += std::string(std::istreambuf_iterator<char>(in), {});
     }
