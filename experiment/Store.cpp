@@ -143,6 +143,39 @@ ALTER TABLE participants ADD COLUMN simulated INTEGER NOT NULL DEFAULT 0
   CHECK (simulated IN (0, 1));
 ALTER TABLE sessions ADD COLUMN sound_played INTEGER CHECK (sound_played IN (0, 1));
 )sql",
+    // 4 -> 5 (issue 14, `underfoot serve`, task "web"): online invitations (token stored only
+    // as its SHA-256), online sessions (user agent, audio output rate) and answer attempts
+    // (idempotent submissions, browser response times). Used by experiment/Invitations.cpp.
+    R"sql(
+CREATE TABLE IF NOT EXISTS online_invitations (
+  id INTEGER PRIMARY KEY,
+  token_sha256 TEXT NOT NULL UNIQUE,
+  participant_code TEXT NOT NULL UNIQUE,
+  group_override TEXT,
+  completion_code TEXT NOT NULL,
+  created_at TEXT NOT NULL,
+  consented_at TEXT,
+  screening_passed INTEGER,
+  screening_detail TEXT NOT NULL DEFAULT '',
+  screened_at TEXT
+);
+CREATE TABLE IF NOT EXISTS online_sessions (
+  invitation_id INTEGER NOT NULL REFERENCES online_invitations(id),
+  session_number INTEGER NOT NULL,
+  started_at TEXT NOT NULL,
+  user_agent TEXT NOT NULL DEFAULT '',
+  audio_sample_rate_hz REAL,
+  PRIMARY KEY (invitation_id, session_number)
+);
+CREATE TABLE IF NOT EXISTS online_answers (
+  invitation_id INTEGER NOT NULL REFERENCES online_invitations(id),
+  trial_index INTEGER NOT NULL,
+  attempt_id TEXT NOT NULL,
+  client_response_time_ms REAL,
+  received_at TEXT NOT NULL,
+  PRIMARY KEY (invitation_id, trial_index)
+);
+)sql",
 };
 constexpr int kMigrationCount = static_cast<int>(sizeof(kMigrations) / sizeof(kMigrations[0]));
 static_assert(kMigrationCount == kSchemaVersion);

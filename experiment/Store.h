@@ -35,9 +35,10 @@ struct StoreError : std::runtime_error {
 /// Version 2 adds clip replay counts and laps walked per trial, and participant fields
 /// (expertise, listening device...); version 3 adds per-trial audio figures (TrialAudioStats),
 /// the sensor log reference and sensor-fault interruptions; version 4 flags simulated
-/// participants and stores with each session whether sound was played. Older studies are
-/// migrated when opened.
-inline constexpr int kSchemaVersion = 4;
+/// participants and stores with each session whether sound was played; version 5 adds the
+/// online tables of `underfoot serve` (experiment/Invitations.h). Older studies are migrated
+/// when opened.
+inline constexpr int kSchemaVersion = 5;
 
 /// Time source (injectable for tests).
 struct Clock {

@@ -23,6 +23,9 @@ PACKAGES=(
   qt6-svg-dev  # console figures exported as SVG (QSvgGenerator)
   # tests and benchmarks
   googletest libgtest-dev libgmock-dev libbenchmark-dev valgrind
+  # online listening tests (`underfoot serve`, app/web): HTTP server; the browser test drives
+  # Debian's Chromium with puppeteer-core from npm (tests/web/browser)
+  libcpp-httplib-dev chromium nodejs npm
 )
 
 if [ "${UNDERFOOT_SKIP_APT:-0}" != "1" ]; then
@@ -40,6 +43,12 @@ if [ "${UNDERFOOT_SKIP_APT:-0}" != "1" ]; then
   else
     echo "setup: all ${#PACKAGES[@]} Debian packages already installed"
   fi
+fi
+
+# The browser test's driver (puppeteer-core, pinned by package-lock.json; Debian's chromium is
+# used, no browser download).
+if [ -f tests/web/browser/package-lock.json ] && command -v npm > /dev/null; then
+  (cd tests/web/browser && PUPPETEER_SKIP_DOWNLOAD=1 npm ci --no-audit --no-fund --silent)
 fi
 
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo

@@ -3,6 +3,7 @@
 // inspect a study, its journal and what replay needs for a trial.
 #include "app/cli/CommandRegistry.h"
 #include "experiment/Export.h"
+#include "experiment/Invitations.h"
 #include "experiment/Protocol.h"
 #include "experiment/Store.h"
 
@@ -254,6 +255,49 @@ const underfoot::cli::CommandRegistrar registrar{
                                e.participant,
                                e.trialIndex ? std::to_string(*e.trialIndex + 1) : "", // 1-based
                                e.detail);
+            });
+            exitCode = 0;
+        });
+
+        // Online participation (issue 14): one secret link per future participant.
+        struct InviteOptions {
+            int count = 0;
+            std::string group, prefix = "W", baseUrl = "http://127.0.0.1:8080";
+        };
+        static InviteOptions io;
+        auto* invite = cmd->add_subcommand(
+            "invite", "Create secret links for online participants (`underfoot serve`); the CSV "
+                      "holds the only copy of each link (the study stores a hash)");
+        invite->add_option("--study", o.study, "study file")->required();
+        invite->add_option("--count", io.count, "number of links")
+            ->required()
+            ->check(CLI::Range(1, 10000));
+        invite->add_option("--group", io.group, "register them in this group (override)");
+        invite->add_option("--prefix", io.prefix, "participant code prefix (codes W001, ...)");
+        invite->add_option("--base-url", io.baseUrl,
+                           "public address of `underfoot serve` (or its TLS reverse proxy)");
+        invite->add_option("-o,--output", o.output, "links CSV")->required();
+        invite->callback([&exitCode, &o] {
+            guarded([&] {
+                StudyStore store = StudyStore::open(o.study);
+                if (std::filesystem::exists(o.output))
+                    throw StoreError(fmt::format("{}: the file already exists; expected a new "
+                                                 "links file (links are shown only once)",
+                                                 o.output));
+                std::ofstream out(o.output, std::ios::binary);
+                if (!out) throw StoreError(fmt::format("{}: cannot write the file", o.output));
+                Invitations inv(store);
+                const auto links = inv.create(
+                    store, io.count, io.group.empty() ? std::nullopt : std::optional(io.group),
+                    io.prefix);
+                std::string base = io.baseUrl;
+                while (!base.empty() && base.back() == '/') base.pop_back();
+                out << "participant,link\n";
+                for (const auto& l : links)
+                    out << l.participantCode << ',' << base << "/p#" << l.token << '\n';
+                if (!out.flush()) throw StoreError(fmt::format("{}: write failed", o.output));
+                fmt::print("{} links written to {} ({} to {})\n", links.size(), o.output,
+                           links.front().participantCode, links.back().participantCode);
             });
             exitCode = 0;
         });

@@ -1,0 +1,108 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+/// The online participant API of `underfoot serve`, independent of HTTP: every call takes the
+/// participant's link token and a JSON body and returns JSON, or throws ApiError (status code
+/// and a message for the page). It drives one experiment::Session per participant (the same
+/// plans, lock rule, replay counts and ratings as the terminal session and the console) with a
+/// silent player: the browser plays the clip, the server stores what happened.
+///
+/// Everything is validated against the protocol before it is stored; a refused request of a
+/// known participant is journaled ("online_refused"). One mutex serialises the store.
+#include "experiment/Invitations.h"
+#include "experiment/Session.h"
+#include "experiment/Store.h"
+
+#include <nlohmann/json.hpp>
+
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <stdexcept>
+#include <string>
+
+namespace underfoot::web {
+
+/// A refused request: HTTP status and a message naming what was expected.
+struct ApiError : std::runtime_error {
+    ApiError(int statusCode, const std::string& message)
+        : std::runtime_error(message), status(statusCode) {}
+    int status;
+};
+
+/// What happens when a participant fails the headphone screening.
+enum class ScreeningFailure { Flag, End };
+
+struct WebOptions {
+    /// Folder of the protocol's clips (`underfoot clips -o DIR`).
+    std::string clipsDir;
+    ScreeningFailure screeningFailure = ScreeningFailure::Flag;
+    /// Longest comment / answer text accepted (characters).
+    std::size_t maxText = 2000;
+};
+
+/// A clip file resolved inside the clips folder.
+struct ClipFile {
+    std::string path;
+    std::string contentType;
+    std::uintmax_t size = 0;
+};
+
+/// Throws std::runtime_error with a clear message when `protocol` cannot run in a browser
+/// (laps, live sensor input, no [clips]).
+void checkOnlineProtocol(const experiment::Protocol& protocol);
+
+class WebStudy {
+  public:
+    /// Opens the study (refusing protocols that cannot run online and missing clip files).
+    WebStudy(const std::string& studyPath, WebOptions options);
+    ~WebStudy();
+
+    nlohmann::json state(const std::string& token);
+    /// Consent with answers to the protocol's participant fields: registers the participant.
+    nlohmann::json consent(const std::string& token, const nlohmann::json& body);
+    /// The browser's audio output rate (and the user agent header).
+    nlohmann::json client(const std::string& token, const nlohmann::json& body,
+                          const std::string& userAgent);
+    nlohmann::json screening(const std::string& token, const nlohmann::json& body);
+    /// Presents (first time) or replays (counted) the current trial's clip.
+    nlohmann::json present(const std::string& token, const nlohmann::json& body);
+    /// Commits an answer (idempotent by attempt id).
+    nlohmann::json answer(const std::string& token, const nlohmann::json& body);
+    nlohmann::json finishBreak(const std::string& token, const nlohmann::json& body);
+    /// The clip of the participant's current trial.
+    ClipFile clip(const std::string& token, int trialIndex);
+
+    /// Closes every open session as interrupted (resumable); the server's clean stop.
+    void stop();
+    /// Participants with an open session.
+    int openSessions() const;
+    const std::string& studyPath() const { return studyPath_; }
+
+  private:
+    struct Participant {
+        experiment::Invitation invitation;
+        std::unique_ptr<experiment::Session> session;
+    };
+    experiment::Invitation invitation(const std::string& token);
+    /// The participant's session, opened (or resumed) when needed; null when finished/dropped.
+    experiment::Session* session(const experiment::Invitation& inv);
+    nlohmann::json stateOf(const experiment::Invitation& inv);
+    nlohmann::json trialJson(const experiment::Session& s) const;
+    [[noreturn]] void refuse(const experiment::Invitation& inv, std::optional<int> trial,
+                             const std::string& request, int status, const std::string& reason);
+    int currentTrialChecked(const experiment::Invitation& inv, experiment::Session* s,
+                            const nlohmann::json& body, const std::string& request);
+
+    std::string studyPath_;
+    WebOptions options_;
+    mutable std::mutex mutex_;
+    experiment::StudyStore store_;
+    std::unique_ptr<experiment::Invitations> invitations_;
+    experiment::SilentPlayer player_;
+    std::map<std::string, std::unique_ptr<experiment::Session>> sessions_;
+    /// The last play id of each participant (trial:attempt), for idempotent presentations.
+    std::map<std::string, std::string> lastPresent_;
+};
+
+} // namespace underfoot::web

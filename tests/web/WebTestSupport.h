@@ -1,0 +1,191 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+// Shared helpers of the web tests: a study with invitations and clips in a temporary folder,
+// an in-process server on a loopback port, and a small JSON client over cpp-httplib.
+#include "app/web/Server.h"
+#include "app/web/WebStudy.h"
+#include "experiment/Invitations.h"
+#include "experiment/Protocol.h"
+#include "experiment/Store.h"
+
+#include <httplib.h>
+#include <nlohmann/json.hpp>
+
+#include <atomic>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <thread>
+#include <unistd.h>
+#include <vector>
+
+namespace underfoot::web::test {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+class TempDir {
+  public:
+    TempDir() {
+        static std::atomic<int> counter{0};
+        path_ = fs::temp_directory_path() /
+                ("underfoot-web-" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
+        fs::remove_all(path_);
+        fs::create_directories(path_);
+    }
+    ~TempDir() {
+        std::error_code ec;
+        fs::remove_all(path_, ec);
+    }
+    std::string file(const std::string& name) const { return (path_ / name).string(); }
+
+  private:
+    fs::path path_;
+};
+
+/// An identification + rating listening test: practice, 6 main trials, a break after 3,
+/// a required participant field, a comment. `extra` is appended to [clips].
+inline std::string webProtocol(const std::string& clipsExtra = "replay = true\n") {
+    return "[protocol]\nid = \"web_ident\"\nversion = 1\n"
+           "title = \"Web <b>identification</b> & \\\"escape\\\"\"\n"
+           "description = \"Listen & identify <script>alert(1)</script>.\"\n"
+           "[design]\ntype = \"within\"\n"
+           "[input]\ntype = \"walker\"\n"
+           "[clips]\nseconds = 1\nseed = 7\n" +
+           clipsExtra +
+           "[[stimuli]]\nid = \"WD\"\nsurface = \"wood\"\n"
+           "[[stimuli]]\nid = \"GL\"\nsurface = \"gravel\"\n"
+           "[[stimuli]]\nid = \"MT\"\nsurface = \"metal\"\n"
+           "[ordering]\nrepetitions = 2\npractice = [\"WD\"]\nbreak_every = 3\n"
+           "[questions]\ncomment = true\n[questions.surface]\nprompt = \"Which surface?\"\n"
+           "options = [\"wood\", \"gravel\", \"metal\"]\n"
+           "[[questions.scales]]\nid = \"realism\"\nprompt = \"How realistic?\"\nmin = 1\nmax = 7\n"
+           "anchors = { 1 = \"not at all\", 7 = \"very\" }\n"
+           "[[participant_fields]]\nid = \"listening_device\"\nlabel = \"Listening device\"\n"
+           "options = [\"laptop_speakers\", \"headphones\"]\n";
+}
+
+/// A valid 16-bit mono WAV of `frames` samples of a quiet tone.
+inline void writeWav(const std::string& path, int frames = 4800, int rate = 48000) {
+    std::ofstream out(path, std::ios::binary);
+    auto u32 = [&](std::uint32_t v) { out.write(reinterpret_cast<const char*>(&v), 4); };
+    auto u16 = [&](std::uint16_t v) { out.write(reinterpret_cast<const char*>(&v), 2); };
+    out.write("RIFF", 4);
+    u32(36 + static_cast<std::uint32_t>(frames) * 2);
+    out.write("WAVEfmt ", 8);
+    u32(16);
+    u16(1);
+    u16(1);
+    u32(static_cast<std::uint32_t>(rate));
+    u32(static_cast<std::uint32_t>(rate) * 2);
+    u16(2);
+    u16(16);
+    out.write("data", 4);
+    u32(static_cast<std::uint32_t>(frames) * 2);
+    for (int i = 0; i < frames; ++i)
+        u16(static_cast<std::uint16_t>(static_cast<std::int16_t>((i % 48) < 24 ? 800 : -800)));
+}
+
+/// A study file with `invites` links and a clips folder holding every clip.
+struct StudyFixture {
+    TempDir dir;
+    std::string study = dir.file("online.db");
+    std::string clips = dir.file("clips");
+    std::vector<experiment::NewInvitation> links;
+
+    explicit StudyFixture(int invites, const std::string& protocolText = webProtocol()) {
+        const experiment::Protocol p = experiment::parseProtocol(protocolText, "web.toml");
+        experiment::StudyStore store =
+            experiment::StudyStore::create(study, p, {"WEB", "web", 4, "test"});
+        experiment::Invitations inv(store);
+        links = inv.create(store, invites, std::nullopt);
+        fs::create_directories(clips);
+        for (const auto& s : p.stimuli) writeWav(experiment::clipPath(s, clips));
+    }
+};
+
+/// WebStudy + WebServer on a free loopback port, served by a thread.
+struct InProcessServer {
+    std::unique_ptr<WebStudy> study;
+    std::unique_ptr<WebServer> server;
+    std::thread thread;
+    int port = 0;
+
+    InProcessServer(const StudyFixture& f, ServerOptions so = {}, WebOptions wo = {}) {
+        wo.clipsDir = f.clips;
+        study = std::make_unique<WebStudy>(f.study, wo);
+        so.port = 0;
+        server = std::make_unique<WebServer>(*study, so);
+        port = server->bind();
+        thread = std::thread([this] { server->run(); });
+    }
+    ~InProcessServer() {
+        server->stop();
+        thread.join();
+        study->stop();
+    }
+};
+
+/// One HTTP answer: status and parsed JSON (null when not JSON).
+struct Reply {
+    int status = 0;
+    json body;
+    std::string raw;
+};
+
+/// A participant's client (a fresh connection per call when `fresh`).
+class ApiClient {
+  public:
+    ApiClient(int port, std::string token) : port_(port), token_(std::move(token)) {}
+    void setToken(std::string token) { token_ = std::move(token); }
+    void setPort(int port) { port_ = port; }
+
+    Reply get(const std::string& path) const {
+        httplib::Client c("127.0.0.1", port_);
+        c.set_connection_timeout(2, 0);
+        c.set_read_timeout(10, 0);
+        return convert(c.Get(path.c_str(), headers()));
+    }
+    Reply post(const std::string& path, const json& body) const {
+        return postRaw(path, body.dump());
+    }
+    Reply postRaw(const std::string& path, const std::string& body) const {
+        httplib::Client c("127.0.0.1", port_);
+        c.set_connection_timeout(2, 0);
+        c.set_read_timeout(10, 0);
+        return convert(c.Post(path.c_str(), headers(), body, "application/json"));
+    }
+
+  private:
+    httplib::Headers headers() const {
+        httplib::Headers h{{"User-Agent", "underfoot-web-test/1"}};
+        if (!token_.empty()) h.emplace("Authorization", "Bearer " + token_);
+        return h;
+    }
+    static Reply convert(const httplib::Result& r) {
+        Reply out;
+        if (!r) return out; // status 0: no connection
+        out.status = r->status;
+        out.raw = r->body;
+        out.body = json::parse(r->body, nullptr, false);
+        if (out.body.is_discarded()) out.body = nullptr;
+        return out;
+    }
+    int port_;
+    std::string token_;
+};
+
+/// The answer a simulated participant gives to the trial in `state` (valid for webProtocol()).
+inline json validAnswer(const json& state, const std::string& attempt) {
+    const json& t = state.at("trial");
+    json a{{"trial", t.at("index")}, {"attempt", attempt}, {"clientMs", 1234.5}};
+    if (t.contains("surface")) a["answer"] = t["surface"]["options"][0]["id"];
+    json ratings = json::object();
+    for (const auto& s : t.at("scales")) ratings[s.at("id").get<std::string>()] = s.at("max");
+    a["ratings"] = ratings;
+    return a;
+}
+
+} // namespace underfoot::web::test
