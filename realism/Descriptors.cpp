@@ -76,20 +76,20 @@ std::vector<double> envelope(const std::vector<float>& x, std::size_t b, std::si
 }
 
 const DescriptorInfo kInfo[kDescriptorCount] = {
-    {"centroid", "spectral centroid", "Hz", true, 0.2},
-    {"rolloff85", "85 % spectral roll-off", "Hz", true, 0.2},
-    {"flatness", "spectral flatness", "dB", false, 1.0},
-    {"band_20_250", "energy 20-250 Hz re total", "dB", false, 1.0},
-    {"band_250_1k", "energy 250 Hz-1 kHz re total", "dB", false, 1.0},
-    {"band_1k_4k", "energy 1-4 kHz re total", "dB", false, 1.0},
-    {"band_4k_16k", "energy 4-16 kHz (to the shared band limit) re total", "dB", false, 1.0},
-    {"peakiness", "spectral crest (tonality): top bin over mean", "dB", false, 1.0},
-    {"grain_rate", "micro-events per second of active step", "1/s", true, 0.3},
-    {"crest", "crest factor (peak over RMS)", "dB", false, 1.0},
-    {"decay20", "decay from the peak to -20 dB", "s", true, 0.3},
-    {"attack", "rise from -30 dB to the peak", "s", true, 0.3},
-    {"active", "time within 30 dB of the peak", "s", true, 0.2},
-    {"temporal_centroid", "energy centroid after the onset", "s", true, 0.2},
+    {"centroid", "spectral centroid", "Hz", true, 0.5},
+    {"rolloff85", "85 % spectral roll-off", "Hz", true, 0.5},
+    {"flatness", "spectral flatness", "dB", false, 3.0},
+    {"band_20_250", "energy 20-250 Hz re total", "dB", false, 3.0},
+    {"band_250_1k", "energy 250 Hz-1 kHz re total", "dB", false, 3.0},
+    {"band_1k_4k", "energy 1-4 kHz re total", "dB", false, 3.0},
+    {"band_4k_16k", "energy 4-16 kHz (to the shared band limit) re total", "dB", false, 3.0},
+    {"peakiness", "spectral crest (tonality): top bin over mean", "dB", false, 3.0},
+    {"grain_rate", "micro-events per second of active step", "1/s", true, 0.5},
+    {"crest", "crest factor (peak over RMS)", "dB", false, 3.0},
+    {"decay20", "decay from the peak to -20 dB", "s", true, 0.5},
+    {"attack", "rise from -30 dB to the peak", "s", true, 0.5},
+    {"active", "time within 30 dB of the peak", "s", true, 0.5},
+    {"temporal_centroid", "energy centroid after the onset", "s", true, 0.5},
 };
 
 } // namespace

@@ -42,7 +42,8 @@ Comparison compareSteps(const std::vector<StepDescriptors>& synthetic,
         out.realMedian = back(mr);
         out.realQ1 = back(q1);
         out.realQ3 = back(q3);
-        out.z = std::fabs(ms - mr) / std::max((q3 - q1) / 1.349, descriptorInfo(d).floor);
+        const double floor = descriptorInfo(d).floor;
+        out.z = std::fabs(ms - mr) / std::clamp((q3 - q1) / 1.349, floor, 2.0 * floor);
         sum += out.z;
     }
     c.distance = sum / double(kDescriptorCount);

@@ -6,9 +6,12 @@
 /// of the synthetic steps, m_s, and the median m_r and interquartile range IQR_r of the recorded
 /// steps, all on the descriptor's comparison scale (log2 for frequencies, rates and times, i.e.
 /// octaves; dB as they are). Its robust z-score is
-///     z_d = |m_s - m_r| / max(IQR_r / 1.349, floor_d)
-/// (IQR / 1.349 is the standard deviation of a normal distribution with that IQR; floor_d keeps
-/// a few very similar recordings from making any difference look huge: 0.2-0.3 octave, 1 dB).
+///     z_d = |m_s - m_r| / clamp(IQR_r / 1.349, s_d, 2 s_d)
+/// (IQR / 1.349 is the standard deviation of a normal distribution with that IQR). The scale
+/// s_d is a tolerance a listener would grant (0.5 octave for frequencies, rates and times, 3 dB
+/// for levels and ratios): below it, two near-identical recordings would make any difference
+/// look huge; above twice it, a heterogeneous set (two sources far apart) would make anything
+/// look close, and distances to different materials would not be comparable.
 /// The distance is the mean of z_d over the scalar descriptors: 0 when the synthetic medians
 /// sit on the recorded ones, about 1 when they are one recorded spread away on average.
 #include "realism/Descriptors.h"

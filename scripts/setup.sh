@@ -22,6 +22,8 @@ PACKAGES=(
   qt6-base-dev qt6-charts-dev libqt6opengl6-dev libqt6sql6-sqlite libgl-dev xvfb xauth
   # tests and benchmarks
   googletest libgtest-dev libgmock-dev libbenchmark-dev valgrind
+  # realism: derivative-free fitting (underfoot fit)
+  libnlopt-cxx-dev
 )
 
 if [ "${UNDERFOOT_SKIP_APT:-0}" != "1" ]; then
@@ -44,3 +46,7 @@ fi
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo
 cmake --build build --parallel "$(nproc)"
 echo "setup: built into build/ (program: build/app/cli/underfoot)"
+# Recorded footsteps (Debian game data packages, fetched with apt-get download) for
+# `underfoot compare` / `underfoot fit` and tests/realism, which skip them when they are absent.
+bash scripts/fetch-recordings.sh build/recordings ||
+  echo "setup: warning: could not fetch the recorded footsteps; tests/realism will skip those tests"

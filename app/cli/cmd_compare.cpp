@@ -6,6 +6,7 @@
 // Without --real, recordings come from the cache of scripts/fetch-recordings.sh
 // (--recordings DIR, default $UNDERFOOT_RECORDINGS or build/recordings).
 #include "app/cli/CommandRegistry.h"
+#include "engine/control/VirtualWalker.h"
 #include "engine/surfaces/Surface.h"
 #include "realism/Compare.h"
 #include "realism/Listener.h"

@@ -152,7 +152,7 @@ TEST(RealismDescriptors, SegmentationFindsEveryStep) {
                  std::invalid_argument);
 }
 
-TEST(RealismDistance, ZeroForTheSameStepsAndTheRobustZOtherwise) {
+TEST(RealismDistance, ZeroForTheSameStepsAndTheBoundedRobustZOtherwise) {
     std::vector<StepDescriptors> a;
     for (int i = 0; i < 9; ++i) {
         StepDescriptors s;
@@ -165,10 +165,19 @@ TEST(RealismDistance, ZeroForTheSameStepsAndTheRobustZOtherwise) {
     auto b = a;
     for (auto& s : b) s.value[kFlatness] += 6.0;
     const auto c = compareSteps(b, a);
-    EXPECT_NEAR(c.d[kFlatness].z, 6.0 / (4.0 / 1.349), 1e-9);
+    // IQR 4 dB -> spread 2.97 dB, below the 3 dB scale: z = 6 / 3
+    EXPECT_NEAR(c.d[kFlatness].z, 2.0, 1e-9);
     EXPECT_NEAR(c.distance, c.d[kFlatness].z / double(kDescriptorCount), 1e-12);
-    for (auto& s : b) s.value[kCentroid] = 2000; // one octave, floor 0.2 octave -> z = 5
-    EXPECT_NEAR(compareSteps(b, a).d[kCentroid].z, 5.0, 1e-9);
+    for (auto& s : b) s.value[kCentroid] = 2000; // one octave, scale 0.5 octave -> z = 2
+    EXPECT_NEAR(compareSteps(b, a).d[kCentroid].z, 2.0, 1e-9);
+    // A very wide recorded spread counts as at most twice the scale (6 dB here).
+    auto wide = a;
+    for (std::size_t i = 0; i < wide.size(); ++i)
+        wide[i].value[kFlatness] = -40.0 + 10.0 * double(i);
+    auto mid = wide;
+    for (auto& s : mid)
+        s.value[kFlatness] = quantile({-40, -30, -20, -10, 0, 10, 20, 30, 40}, 0.5) + 12;
+    EXPECT_NEAR(compareSteps(mid, wide).d[kFlatness].z, 2.0, 1e-9);
     EXPECT_THROW(compareSteps({}, a), std::invalid_argument);
     EXPECT_NEAR(quantile({1, 2, 3, 4}, 0.25), 1.75, 1e-12); // R type 7
 }
