@@ -15,6 +15,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <regex>
 #include <sstream>
 #include <stdexcept>
 
@@ -161,10 +162,23 @@ std::vector<Knob> knobsFor(const toml::table& root) {
     return k;
 }
 
+// TOML text with every long decimal written with 6 significant digits (readable presets).
 std::string toText(const toml::table& t) {
     std::ostringstream s;
     s << t << "\n";
-    return s.str();
+    const std::string text = s.str();
+    static const std::regex longNumber(R"(-?\d+\.\d{7,}(e[-+]?\d+)?)");
+    std::string out;
+    auto it = std::sregex_iterator(text.begin(), text.end(), longNumber);
+    std::size_t last = 0;
+    for (; it != std::sregex_iterator(); ++it) {
+        out += text.substr(last, static_cast<std::size_t>(it->position()) - last);
+        std::string v = fmt::format("{:.6g}", std::stod(it->str()));
+        if (v.find_first_of(".e") == std::string::npos) v += ".0";
+        out += v;
+        last = static_cast<std::size_t>(it->position() + it->length());
+    }
+    return out + text.substr(last);
 }
 
 double peakOf(const engine::AudioBuffer& a) {
@@ -189,8 +203,8 @@ FitResult fitSurface(const std::string& presetFile, const std::vector<Recording>
         throw std::invalid_argument(fmt::format(
             "{}: a `base` preset; fit its base preset instead (it inherits the fit)", presetFile));
     Ranges ranges;
-    for (const auto& p : engine::Surface::load(presetFile)->parameters())
-        ranges[p.path] = {p.minValue, p.maxValue};
+    const auto original = engine::Surface::load(presetFile); // keeps parameters() alive
+    for (const auto& p : original->parameters()) ranges[p.path] = {p.minValue, p.maxValue};
     auto knobs = knobsFor(root);
     if (knobs.empty())
         throw std::invalid_argument(
