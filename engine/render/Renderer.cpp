@@ -74,7 +74,7 @@ RenderResult renderSurface(const std::string& surface, const GrfSignal& grf,
     std::vector<std::vector<float>> in(grf.channels.size(), std::vector<float>(bs));
     std::vector<const float*> inPtr(grf.channels.size());
     std::vector<float> l(bs), r(bs);
-    SafetyLimiter limiter;
+    StereoSafetyLimiter limiter;
     limiter.prepare(options.sampleRateHz);
     const double t0 = threadCpuSeconds();
     for (std::size_t start = 0; start < frames; start += bs) {

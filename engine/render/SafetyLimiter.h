@@ -35,7 +35,7 @@ class SafetyLimiter {
         gain_ = 1.0;
         report_ = {};
     }
-    /// Limits n stereo frames in place (right may be null for mono).
+    /// Limits n frames in place; with both channels the gain is linked (right may be null).
     void process(float* left, float* right, int n) noexcept {
         for (int i = 0; i < n; ++i) {
             if (gain_ < 1.0) {
@@ -66,6 +66,30 @@ class SafetyLimiter {
     }
     double ceiling_ = 1.0, release_ = 1.0, gain_ = 1.0;
     LimiterReport report_;
+};
+
+/// The offline renderers' output stage: left and right limited independently, exactly as the
+/// live engine limits each device output on its own, so that a render and what the live path
+/// played stay sample-identical even when the limiter acts.
+class StereoSafetyLimiter {
+  public:
+    void prepare(double sampleRateHz) noexcept {
+        left_.prepare(sampleRateHz);
+        right_.prepare(sampleRateHz);
+    }
+    void process(float* left, float* right, int n) noexcept {
+        left_.process(left, nullptr, n);
+        right_.process(right, nullptr, n);
+    }
+    LimiterReport report() const noexcept {
+        LimiterReport r;
+        r.samplesLimited = left_.report().samplesLimited + right_.report().samplesLimited;
+        r.maxReductionDb = std::max(left_.report().maxReductionDb, right_.report().maxReductionDb);
+        return r;
+    }
+
+  private:
+    SafetyLimiter left_, right_;
 };
 
 } // namespace underfoot::engine

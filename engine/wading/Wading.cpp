@@ -123,7 +123,7 @@ AudioBuffer renderFrames(const WadingOptions& o, const std::vector<GaitFrame>& g
     out.sampleRateHz = o.sampleRateHz;
     out.channels = 2;
     out.samples.assign(totalSamples * 2, 0.0f);
-    SafetyLimiter limiter; // the output stage of every offline render
+    StereoSafetyLimiter limiter; // the output stage of every offline render
     limiter.prepare(o.sampleRateHz);
     std::vector<float> l(kBlock), r(kBlock);
     std::vector<TimedGaitFrame> events;
