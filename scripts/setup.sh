@@ -26,6 +26,8 @@ PACKAGES=(
   # online listening tests (`underfoot serve`, app/web): HTTP server; the browser test drives
   # Debian's Chromium with puppeteer-core from npm (tests/web/browser)
   libcpp-httplib-dev chromium nodejs npm
+  # realism: derivative-free fitting (underfoot fit)
+  libnlopt-cxx-dev
 )
 
 if [ "${UNDERFOOT_SKIP_APT:-0}" != "1" ]; then
@@ -54,3 +56,7 @@ fi
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo
 cmake --build build --parallel "$(nproc)"
 echo "setup: built into build/ (program: build/app/cli/underfoot)"
+# Recorded footsteps (Debian game data packages, fetched with apt-get download) for
+# `underfoot compare` / `underfoot fit` and tests/realism, which skip them when they are absent.
+bash scripts/fetch-recordings.sh build/recordings ||
+  echo "setup: warning: could not fetch the recorded footsteps; tests/realism will skip those tests"

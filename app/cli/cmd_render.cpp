@@ -103,6 +103,12 @@ int runRender(const RenderArgs& a) {
             throw UserError(fmt::format("{}: the render peaks at {:.1f} dBFS and would clip in {}; "
                                         "lower the surface's gain_db or use --format float",
                                         s, 20 * std::log10(peak), a.format));
+        if (r.limiter.acted())
+            fmt::print(stderr,
+                       "underfoot: note: {}: the output safety limiter acted on {} samples (up to "
+                       "{:.2f} dB of gain reduction); lower the surface's gain_db for a clean "
+                       "render\n",
+                       s, r.limiter.samplesLimited, r.limiter.maxReductionDb);
         eng::writeAudioFile(path, r.audio, format);
         if (!a.quiet)
             fmt::print("{}: {:.1f} s from {}, seed {}, peak {:.1f} dBFS, {:.0f}x real time -> {}\n",

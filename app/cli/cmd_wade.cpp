@@ -260,6 +260,7 @@ int runWade(const WadeArgs& a) {
         const eng::SampleFormat fmtOut = format(a.format);
         const double cpu0 = eng::threadCpuSeconds();
         eng::AudioBuffer audio;
+        eng::LimiterReport limited;
         std::string source;
         if (!a.gait.empty()) {
             bool shanks = true;
@@ -269,10 +270,10 @@ int runWade(const WadeArgs& a) {
                            "underfoot: warning: {} has no shank columns; algorithm v2 "
                            "hears only the thighs (bubbling and splash stay silent)\n",
                            a.gait);
-            audio = eng::renderWading(o, frames);
+            audio = eng::renderWading(o, frames, &limited);
             source = a.gait;
         } else {
-            audio = eng::renderWading(o, seconds);
+            audio = eng::renderWading(o, seconds, &limited);
             eng::VirtualGaitParameters p;
             p.cadenceStepsPerMin = o.cadenceStepsPerMin;
             p.strideM = o.strideM;
@@ -280,6 +281,11 @@ int runWade(const WadeArgs& a) {
                                  o.cadenceStepsPerMin, p.effectiveStrideM());
         }
         const double cpu = eng::threadCpuSeconds() - cpu0;
+        if (limited.acted())
+            fmt::print(stderr,
+                       "underfoot: note: the output safety limiter acted on {} samples (up to "
+                       "{:.2f} dB of gain reduction)\n",
+                       limited.samplesLimited, limited.maxReductionDb);
         eng::writeAudioFile(a.output, audio, fmtOut);
         fmt::print("wrote {}: {:.2f} s stereo at {} Hz; depth {}, algorithm {}, filter {}, seed "
                    "{}; {}\n",

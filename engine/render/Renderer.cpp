@@ -74,6 +74,8 @@ RenderResult renderSurface(const std::string& surface, const GrfSignal& grf,
     std::vector<std::vector<float>> in(grf.channels.size(), std::vector<float>(bs));
     std::vector<const float*> inPtr(grf.channels.size());
     std::vector<float> l(bs), r(bs);
+    StereoSafetyLimiter limiter;
+    limiter.prepare(options.sampleRateHz);
     const double t0 = threadCpuSeconds();
     for (std::size_t start = 0; start < frames; start += bs) {
         const std::size_t n = std::min(bs, frames - start);
@@ -85,6 +87,7 @@ RenderResult renderSurface(const std::string& surface, const GrfSignal& grf,
             inPtr[c] = in[c].data();
         }
         scene.process(inPtr.data(), l.data(), r.data(), static_cast<int>(n));
+        limiter.process(l.data(), r.data(), static_cast<int>(n));
         for (std::size_t i = 0; i < n; ++i) {
             result.audio.samples[2 * (start + i)] = l[i];
             result.audio.samples[2 * (start + i) + 1] = r[i];
@@ -95,6 +98,7 @@ RenderResult renderSurface(const std::string& surface, const GrfSignal& grf,
         (double(frames) / options.sampleRateHz) / std::max(result.cpuSeconds, 1e-9);
     result.cost = scene.cost();
     result.flushedDenormals = scene.flushedDenormals();
+    result.limiter = limiter.report();
     for (float v : result.audio.samples)
         if (!std::isfinite(v))
             throw std::runtime_error("render produced a non-finite sample (engine bug)");

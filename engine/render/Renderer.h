@@ -6,6 +6,7 @@
 #include "engine/control/VirtualWalker.h"
 #include "engine/io/AudioFile.h"
 #include "engine/render/FootstepScene.h"
+#include "engine/render/SafetyLimiter.h"
 
 #include <cstdint>
 #include <string>
@@ -26,6 +27,9 @@ struct RenderResult {
     double realTimeFactor = 0; ///< audio seconds per CPU second
     SceneCost cost;
     bool flushedDenormals = false; ///< FTZ/DAZ was in effect while the scene ran
+    /// The output safety limiter (-0.3 dBFS ceiling, as on the live path): whether and how much
+    /// it acted. When it did not, the samples are the scene's own, bit for bit.
+    LimiterReport limiter;
 };
 
 /// CPU time consumed by the calling thread (immune to other processes on a shared machine).

@@ -66,6 +66,8 @@ struct LiveEngine::Published {
     std::atomic<std::uint64_t> xruns{0}, blocks{0}, frames{0}, swapped{0}, retired{0}, dropped{0};
     std::atomic<double> lastBlock{0}, maxBlock{0}, totalBlock{0}, lastLoad{0}, maxLoad{0};
     std::atomic<long long> probe{-1};
+    std::atomic<std::uint64_t> limited{0};
+    std::atomic<double> limiterMaxDb{0};
     std::atomic<bool> busy{false}; ///< a scene is fading or waits to be handed back
 };
 
@@ -85,6 +87,7 @@ void LiveEngine::openCommon(const AudioSettings& s) {
     pub_ = std::make_unique<Published>();
     framesTotal_ = 0;
     probe_ = {};
+    for (auto& l : limiters_) l.prepare(s.sampleRateHz);
 }
 
 void LiveEngine::openOffline(const AudioSettings& settings) {
@@ -371,6 +374,8 @@ LiveMeters LiveEngine::meters() const noexcept {
     m.scenesRetired = pub_->retired.load(std::memory_order_relaxed);
     m.droppedCommands = pub_->dropped.load(std::memory_order_relaxed);
     m.probeLatencyFrames = pub_->probe.load(std::memory_order_relaxed);
+    m.limitedSamples = pub_->limited.load(std::memory_order_relaxed);
+    m.limiterMaxReductionDb = pub_->limiterMaxDb.load(std::memory_order_relaxed);
     return m;
 }
 
@@ -435,6 +440,22 @@ void LiveEngine::processBlock(const float* const* inputs, float* const* outputs,
             out[static_cast<std::size_t>(ch)] = outputs[ch] + start;
         if (current_) current_->process(in.data(), numInputs_, out.data(), numOutputs_, m);
         if (fading_) fading_->process(in.data(), numInputs_, out.data(), numOutputs_, m);
+    }
+    // Output safety limiter: transparent below -0.3 dBFS, reported in the meters when it acts.
+    {
+        std::uint64_t limited = 0;
+        double deepest = pub_->limiterMaxDb.load(std::memory_order_relaxed);
+        for (int ch = 0; ch < numOutputs_ && ch < 64; ++ch) {
+            auto& lim = limiters_[static_cast<std::size_t>(ch)];
+            const auto before = lim.report().samplesLimited;
+            lim.process(outputs[ch], nullptr, n);
+            limited += static_cast<std::uint64_t>(lim.report().samplesLimited - before);
+            deepest = std::max(deepest, lim.report().maxReductionDb);
+        }
+        if (limited > 0) {
+            pub_->limited.fetch_add(limited, std::memory_order_relaxed);
+            store(pub_->limiterMaxDb, deepest);
+        }
     }
     if (fading_ && fading_->fadedOut()) {
         retire(fading_);

@@ -13,6 +13,7 @@
 /// Without a device (openOffline) the same callback body runs from processBlock(): tests and
 /// benchmarks drive it block by block.
 #include "engine/io/AudioDevice.h"
+#include "engine/render/SafetyLimiter.h"
 #include "engine/scene/LiveScene.h"
 
 #include <array>
@@ -48,6 +49,11 @@ struct LiveMeters {
     /// Last latency-probe result: frames from the probe impulse leaving an output to it arriving
     /// at an input; -1 = none measured (or still waiting).
     long long probeLatencyFrames = -1;
+    /// Output safety limiter (engine/render/SafetyLimiter.h, -0.3 dBFS ceiling per output
+    /// channel): output samples it reduced since the engine was opened, and its deepest
+    /// reduction. 0 means it never acted (the output passed bit for bit).
+    std::uint64_t limitedSamples = 0;
+    double limiterMaxReductionDb = 0;
 };
 
 /// Hooks run by the callback on the audio thread at its start and end (tests arm an
@@ -153,6 +159,7 @@ class LiveEngine {
     std::array<const float*, 64> callbackIn_{};
     std::array<float*, 64> callbackOut_{};
     std::vector<float> silence_;
+    std::array<SafetyLimiter, 64> limiters_{}; ///< one per output channel, before the meters
     struct Probe {
         int out = -1, in = -1;
         long long emittedAt = -1;

@@ -47,7 +47,8 @@ void Surface::loadLayers(const std::string& file, const toml::table& root,
     const std::string prefix = depth == 0 ? "" : fs::path(file).stem().string() + ":";
     PresetReader top(file, root, prefix, &params_);
     // Header keys are read by loadSurfaceFromString() for the outermost file.
-    for (const char* k : {"id", "name", "category", "description", "gain_db", "reverb", "base"})
+    for (const char* k :
+         {"id", "name", "category", "description", "gain_db", "reverb", "base", "provenance"})
         top.allow(k);
     if (const auto* baseNode = root.get("base")) {
         const auto base = baseNode->value<std::string>();

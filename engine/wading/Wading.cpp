@@ -111,7 +111,7 @@ WadingOptions wadingOptionsFromParameters(const std::map<std::string, std::strin
 
 namespace {
 AudioBuffer renderFrames(const WadingOptions& o, const std::vector<GaitFrame>& gait,
-                         std::size_t totalSamples) {
+                         std::size_t totalSamples, LimiterReport* report) {
     validateWadingOptions(o);
     const WadingPreset preset = loadWadingPreset(o.depth);
     WadingScene scene;
@@ -123,6 +123,8 @@ AudioBuffer renderFrames(const WadingOptions& o, const std::vector<GaitFrame>& g
     out.sampleRateHz = o.sampleRateHz;
     out.channels = 2;
     out.samples.assign(totalSamples * 2, 0.0f);
+    StereoSafetyLimiter limiter; // the output stage of every offline render
+    limiter.prepare(o.sampleRateHz);
     std::vector<float> l(kBlock), r(kBlock);
     std::vector<TimedGaitFrame> events;
     events.reserve(kBlock);
@@ -140,17 +142,19 @@ AudioBuffer renderFrames(const WadingOptions& o, const std::vector<GaitFrame>& g
             ++next;
         }
         scene.process(events.data(), static_cast<int>(events.size()), l.data(), r.data(), n);
+        limiter.process(l.data(), r.data(), n);
         for (int i = 0; i < n; ++i) {
             out.samples[2 * (start + static_cast<std::size_t>(i))] = l[static_cast<std::size_t>(i)];
             out.samples[2 * (start + static_cast<std::size_t>(i)) + 1] =
                 r[static_cast<std::size_t>(i)];
         }
     }
+    if (report) *report = limiter.report();
     return out;
 }
 } // namespace
 
-AudioBuffer renderWading(const WadingOptions& options, double seconds) {
+AudioBuffer renderWading(const WadingOptions& options, double seconds, LimiterReport* limiter) {
     validateWadingOptions(options);
     if (!std::isfinite(seconds) || seconds <= 0 || seconds > 3600)
         throw WadingOptionError(
@@ -160,14 +164,17 @@ AudioBuffer renderWading(const WadingOptions& options, double seconds) {
     p.strideM = options.strideM;
     const auto gait = virtualGait(p, seconds, options.seed);
     return renderFrames(options, gait,
-                        static_cast<std::size_t>(std::llround(seconds * options.sampleRateHz)));
+                        static_cast<std::size_t>(std::llround(seconds * options.sampleRateHz)),
+                        limiter);
 }
 
-AudioBuffer renderWading(const WadingOptions& options, const std::vector<GaitFrame>& gait) {
+AudioBuffer renderWading(const WadingOptions& options, const std::vector<GaitFrame>& gait,
+                         LimiterReport* limiter) {
     if (gait.empty()) throw WadingOptionError("wading: the gait recording has no frames");
     const double seconds = static_cast<double>(gait.size()) / kGaitFrameRateHz;
     return renderFrames(options, gait,
-                        static_cast<std::size_t>(std::llround(seconds * options.sampleRateHz)));
+                        static_cast<std::size_t>(std::llround(seconds * options.sampleRateHz)),
+                        limiter);
 }
 
 } // namespace underfoot::engine

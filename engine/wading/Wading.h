@@ -6,6 +6,7 @@
 /// byte-identical audio.
 #include "engine/control/GyroFrame.h"
 #include "engine/io/AudioFile.h"
+#include "engine/render/SafetyLimiter.h"
 
 #include <cstdint>
 #include <map>
@@ -45,10 +46,14 @@ void validateWadingOptions(const WadingOptions& options);
 
 /// Renders `seconds` of stereo audio driven by the virtual gait (options.cadenceStepsPerMin,
 /// options.strideM, seeded by options.seed).
-AudioBuffer renderWading(const WadingOptions& options, double seconds);
+/// The output passes the same safety limiter as every render (engine/render/SafetyLimiter.h);
+/// `limiter`, when given, receives whether and how much it acted.
+AudioBuffer renderWading(const WadingOptions& options, double seconds,
+                         LimiterReport* limiter = nullptr);
 
 /// Renders stereo audio driven by recorded gait frames (100 Hz, e.g. from readGaitCsv()); the
 /// length is that of the recording. Cadence and stride of the options are not used.
-AudioBuffer renderWading(const WadingOptions& options, const std::vector<GaitFrame>& gait);
+AudioBuffer renderWading(const WadingOptions& options, const std::vector<GaitFrame>& gait,
+                         LimiterReport* limiter = nullptr);
 
 } // namespace underfoot::engine

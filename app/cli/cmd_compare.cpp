@@ -1,0 +1,330 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// `underfoot compare`: how close a surface's footsteps are to recorded ones (docs/realism.md).
+//   compare --surface gravel [--real FILES_OR_DIRS...] [-o report.html]
+//   compare --all [-o report.html]          every surface with recordings of its material
+//   compare --listener [-o report.html]     the listener's real baseline and its verdicts
+// Without --real, recordings come from the cache of scripts/fetch-recordings.sh
+// (--recordings DIR, default $UNDERFOOT_RECORDINGS or build/recordings).
+#include "app/cli/CommandRegistry.h"
+#include "engine/control/VirtualWalker.h"
+#include "engine/surfaces/Surface.h"
+#include "realism/Compare.h"
+#include "realism/Listener.h"
+
+#include <fmt/core.h>
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <set>
+
+namespace underfoot::cli {
+namespace {
+namespace eng = underfoot::engine;
+namespace rl = underfoot::realism;
+namespace fs = std::filesystem;
+
+struct CompareArgs {
+    std::string surface;
+    std::vector<std::string> real;
+    std::string recordings;
+    bool all = false;
+    bool listener = false;
+    std::string output;
+    rl::RenderSpec spec;
+};
+
+std::vector<rl::Recording> manifest(const CompareArgs& a) {
+    const auto dir = a.recordings.empty() ? rl::defaultRecordingsDir() : a.recordings;
+    try {
+        return rl::loadManifest(dir);
+    } catch (const std::runtime_error& e) {
+        throw UserError(e.what());
+    }
+}
+
+std::vector<rl::Recording> ofMaterial(const std::vector<rl::Recording>& all, const std::string& m) {
+    std::vector<rl::Recording> out;
+    for (const auto& r : all)
+        if (r.material == m) out.push_back(r);
+    return out;
+}
+
+const char* kStyle =
+    "<style>body{font-family:sans-serif;max-width:1200px;margin:auto}table{border-collapse:"
+    "collapse;margin:8px 0}td,th{border:1px solid #ccc;padding:3px 8px;text-align:right}"
+    ".far{background:#fdd}figure{display:inline-block;margin:4px}</style>";
+
+// Writes the pictures of one comparison beside the report and returns their HTML.
+std::string figures(const rl::SurfaceComparison& c, const fs::path& dir) {
+    fs::create_directories(dir);
+    const auto id = fs::path(c.surface).stem().string();
+    std::string html;
+    auto put = [&](const std::string& name, const std::string& svg) {
+        std::ofstream(dir / name) << svg;
+        html += "<figure>" + svg + "<figcaption>" + (dir.filename() / name).string() +
+                "</figcaption></figure>\n";
+    };
+    put(id + "_bands.svg", rl::bandPlotSvg(c));
+    put(id + "_recorded_step.svg",
+        rl::spectrogramSvg(c.realExample, c.options.analysisRateHz, c.options.maxHz,
+                           "recorded " + c.material + " step"));
+    put(id + "_synthetic_step.svg",
+        rl::spectrogramSvg(c.syntheticExample, c.options.analysisRateHz, c.options.maxHz,
+                           "synthetic " + id + " step"));
+    return html;
+}
+
+void writeHtml(const std::string& path, const std::string& title, const std::string& body) {
+    std::ofstream out(path);
+    if (!out) throw UserError(fmt::format("-o {}: cannot write this file", path));
+    out << "<!doctype html><html><head><meta charset=\"utf-8\"><title>" << title << "</title>"
+        << kStyle << "</head><body><h1>" << title << "</h1>\n"
+        << body << "</body></html>\n";
+    fmt::print("report -> {}\n", path);
+}
+
+fs::path figureDir(const std::string& output) {
+    const fs::path p(output);
+    return p.parent_path() / (p.stem().string() + "_figures");
+}
+
+std::string definitionHtml() {
+    return "<p>Distance: for every descriptor, z = |synthetic median − recorded median| / "
+           "max(recorded IQR / 1.349, floor), on octaves for frequencies, rates and times and on "
+           "dB otherwise; the distance is the mean z over the descriptors (docs/realism.md).</p>\n";
+}
+
+int runOne(const CompareArgs& a) {
+    std::vector<rl::Recording> real;
+    try {
+        if (!a.real.empty())
+            real = rl::collectRecordings(a.real);
+        else {
+            const auto m = rl::materialOfSurface(a.surface);
+            if (m.empty())
+                throw UserError(fmt::format("compare: no recorded material is known for \"{}\"; "
+                                            "name recordings with --real",
+                                            a.surface));
+            real = ofMaterial(manifest(a), m);
+            if (real.empty())
+                throw UserError(fmt::format("compare: the recordings cache has no {} recordings; "
+                                            "name some with --real",
+                                            m));
+        }
+    } catch (const std::runtime_error& e) {
+        throw UserError(e.what());
+    }
+    rl::SurfaceComparison c;
+    try {
+        c = rl::compareSurface(a.surface, real, a.spec);
+    } catch (const eng::PresetError& e) {
+        throw UserError(e.what());
+    } catch (const eng::FileError& e) {
+        throw UserError(e.what());
+    } catch (const std::invalid_argument& e) {
+        throw UserError(std::string("compare: ") + e.what());
+    }
+    fmt::print("{} vs {} recording(s) ({}), walker {}, {} s, seed {}\n", a.surface, real.size(),
+               c.material.empty() ? "user files" : c.material, a.spec.walker, a.spec.seconds,
+               a.spec.seed);
+    fmt::print("{}", rl::descriptorTableText(c));
+    if (!a.output.empty()) {
+        std::string body = definitionHtml() + "<p>Recordings: ";
+        for (const auto& f : c.realFiles) body += f + " ";
+        body += "</p>" + rl::descriptorTableHtml(c) + figures(c, figureDir(a.output));
+        writeHtml(a.output, "Underfoot compare: " + a.surface, body);
+    }
+    return 0;
+}
+
+int runAll(const CompareArgs& a) {
+    const auto recs = manifest(a);
+    std::set<std::string> recorded;
+    for (const auto& r : recs) recorded.insert(r.material);
+    std::string body = definitionHtml() +
+                       "<table><tr><th>surface</th><th>material</th><th>distance to its "
+                       "recordings</th><th>nearest other material</th><th>its distance</th><th>"
+                       "closer to its own</th></tr>\n";
+    std::string figs;
+    fmt::print("{:<22} {:<7} {:>9} {:>14} {:>9}  {}\n", "surface", "material", "distance",
+               "nearest other", "distance", "own closest");
+    int closer = 0, compared = 0;
+    for (const auto& info : eng::listSurfaces()) {
+        const auto m = rl::materialOfSurface(info.id);
+        if (m.empty() || !recorded.count(m)) {
+            fmt::print("{:<22} {:<7} (no recordings of its material)\n", info.id,
+                       m.empty() ? "-" : m);
+            continue;
+        }
+        const auto audio = rl::renderForComparison(info.id, a.spec);
+        std::map<std::string, double> dist;
+        rl::SurfaceComparison own;
+        for (const auto& mat : recorded) {
+            auto c = rl::compareAudio(info.id, audio, ofMaterial(recs, mat));
+            dist[mat] = c.comparison.distance;
+            if (mat == m) own = std::move(c);
+        }
+        std::string other;
+        double otherD = 1e300;
+        for (const auto& [mat, d] : dist)
+            if (mat != m && d < otherD) {
+                other = mat;
+                otherD = d;
+            }
+        const bool ok = dist[m] < otherD;
+        closer += ok;
+        ++compared;
+        fmt::print("{:<22} {:<7} {:>9.2f} {:>14} {:>9.2f}  {}\n", info.id, m, dist[m], other,
+                   otherD, ok ? "yes" : "no");
+        body += fmt::format("<tr><td>{}</td><td>{}</td><td>{:.2f}</td><td>{}</td><td>{:.2f}</td>"
+                            "<td>{}</td></tr>\n",
+                            info.id, m, dist[m], other, otherD, ok ? "yes" : "no");
+        if (!a.output.empty())
+            figs += "<h2>" + info.id + "</h2>" + rl::descriptorTableHtml(own) +
+                    figures(own, figureDir(a.output));
+    }
+    fmt::print("{} of {} compared surfaces are closer to their own material's recordings than to "
+               "any other's\n",
+               closer, compared);
+    body += "</table>\n" + figs;
+    if (!a.output.empty()) writeHtml(a.output, "Underfoot compare --all", body);
+    return 0;
+}
+
+int runListener(const CompareArgs& a) {
+    const auto recs = manifest(a);
+    rl::AnalysisOptions o;
+    o.maxHz = rl::sharedMaxHz(recs, a.spec.rateHz);
+    std::vector<rl::Example> ex;
+    for (const auto& r : recs) {
+        auto steps = rl::describeFile(r.path, o);
+        if (steps.empty()) {
+            fmt::print("warning: {}: no step found, left out\n", r.file);
+            continue;
+        }
+        ex.push_back({r.file, r.source, r.material, rl::fileFeatures(steps)});
+    }
+    const auto loso = rl::leaveOneSourceOut(ex);
+    std::string body = fmt::format(
+        "<p>Nearest-centroid listener on {} descriptors and {} third-octave bands (band "
+        "{:.0f}-{:.0f} Hz), trained on recordings only.</p>",
+        int(rl::kDescriptorCount), rl::thirdOctaveCentres(o.maxHz).size(), o.minHz, o.maxHz);
+    fmt::print("listener, leave-one-source-out over {} recordings: material {}/{} ({:.0f} %), "
+               "category {}/{} ({:.0f} %); {} held-out files of a material no other source has "
+               "were not scored\n",
+               ex.size(), loso.materialCorrect, loso.files,
+               100.0 * loso.materialCorrect / std::max(loso.files, 1), loso.categoryCorrect,
+               loso.files, 100.0 * loso.categoryCorrect / std::max(loso.files, 1),
+               loso.unseenMaterialFiles);
+    body += fmt::format("<p>Leave-one-source-out: material {}/{}, category {}/{}.</p><table><tr>"
+                        "<th>true \\ heard</th>",
+                        loso.materialCorrect, loso.files, loso.categoryCorrect, loso.files);
+    std::set<std::string> cols;
+    for (const auto& [t, row] : loso.confusion)
+        for (const auto& [p, n] : row) cols.insert(p), cols.insert(t);
+    for (const auto& c : cols) body += "<th>" + c + "</th>";
+    body += "</tr>";
+    fmt::print("confusion (rows: true material, columns: heard):\n{:<8}", "");
+    for (const auto& c : cols) fmt::print(" {:>6}", c);
+    fmt::print("\n");
+    for (const auto& t : cols) {
+        if (!loso.confusion.count(t)) continue;
+        fmt::print("{:<8}", t);
+        body += "<tr><th>" + t + "</th>";
+        for (const auto& c : cols) {
+            const auto& row = loso.confusion.at(t);
+            const int n = row.count(c) ? row.at(c) : 0;
+            fmt::print(" {:>6}", n);
+            body += fmt::format("<td>{}</td>", n);
+        }
+        fmt::print("\n");
+        body += "</tr>";
+    }
+    body += "</table>";
+    rl::Listener l;
+    l.train(ex);
+    fmt::print("\n{:<22} {:<9} {:<9} {:<9} {:<9} {}\n", "surface", "category", "heard cat",
+               "material", "heard", "verdict");
+    body += "<h2>Verdict on every surface (listener trained on all recordings)</h2><table><tr><th>"
+            "surface</th><th>category</th><th>heard category</th><th>material</th><th>heard as</th>"
+            "</tr>\n";
+    int catOk = 0, matOk = 0, matN = 0, n = 0;
+    for (const auto& info : eng::listSurfaces()) {
+        const auto audio = rl::renderForComparison(info.id, a.spec);
+        const auto steps = rl::describeSteps(audio, o);
+        if (steps.empty()) continue;
+        const auto heard = l.classify(rl::fileFeatures(steps));
+        const auto cat = std::string(eng::toString(info.category));
+        const auto heardCat = rl::categoryOfMaterial(heard);
+        const auto mat = rl::materialOfSurface(info.id);
+        ++n;
+        catOk += heardCat == cat;
+        if (!mat.empty()) {
+            ++matN;
+            matOk += heard == mat;
+        }
+        fmt::print("{:<22} {:<9} {:<9} {:<9} {:<9} {}{}\n", info.id, cat, heardCat,
+                   mat.empty() ? "-" : mat, heard,
+                   heardCat == cat ? "category ok" : "WRONG category",
+                   mat.empty() ? "" : (heard == mat ? ", material ok" : ", wrong material"));
+        body += fmt::format("<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>\n",
+                            info.id, cat, heardCat, mat.empty() ? "-" : mat, heard);
+    }
+    fmt::print("synthetic: category right for {}/{}, material right for {}/{} surfaces with a "
+               "recorded material\n",
+               catOk, n, matOk, matN);
+    body += fmt::format("</table><p>Category right for {}/{}; material right for {}/{}.</p>", catOk,
+                        n, matOk, matN);
+    if (!a.output.empty()) writeHtml(a.output, "Underfoot listener", body);
+    return 0;
+}
+
+int runCompare(const CompareArgs& a) {
+    const int modes = int(!a.surface.empty()) + int(a.all) + int(a.listener);
+    if (modes != 1)
+        throw UserError("compare: give exactly one of --surface S, --all or --listener");
+    if (!a.real.empty() && a.surface.empty())
+        throw UserError("compare: --real goes with --surface");
+    try {
+        eng::WalkerParameters::parse(a.spec.walker).validate();
+    } catch (const std::invalid_argument& e) {
+        throw UserError(std::string("--walker: ") + e.what());
+    }
+    if (!a.surface.empty()) return runOne(a);
+    try {
+        return a.all ? runAll(a) : runListener(a);
+    } catch (const eng::FileError& e) {
+        throw UserError(e.what());
+    }
+}
+
+CommandRegistrar reg("compare", [](CLI::App& app, int& exitCode) {
+    auto args = std::make_shared<CompareArgs>();
+    auto* cmd = app.add_subcommand(
+        "compare", "Compare a surface's footsteps with recorded footsteps (descriptors, distance, "
+                   "listener; see docs/realism.md)");
+    cmd->add_option("-s,--surface", args->surface, "surface id or preset .toml");
+    cmd->add_option("--real", args->real,
+                    "recorded footsteps: audio files or folders (default: the recordings cache, "
+                    "material of the surface)");
+    cmd->add_option(
+        "--recordings", args->recordings,
+        "recordings cache of scripts/fetch-recordings.sh (default $UNDERFOOT_RECORDINGS "
+        "or build/recordings)");
+    cmd->add_flag("--all", args->all, "compare every surface that has recordings of its material");
+    cmd->add_flag("--listener", args->listener,
+                  "the listener: leave-one-source-out baseline and its verdict on every surface");
+    cmd->add_option("--walker", args->spec.walker, "virtual walker of the render")
+        ->capture_default_str();
+    cmd->add_option("--seconds", args->spec.seconds, "length of the render")
+        ->capture_default_str()
+        ->check(CLI::Range(1.0, 600.0));
+    cmd->add_option("--seed", args->spec.seed, "seed of the render")->capture_default_str();
+    cmd->add_option("-o,--output", args->output, "HTML report (SVG figures beside it)");
+    cmd->callback([args, &exitCode] { exitCode = runCompare(*args); });
+});
+
+} // namespace
+} // namespace underfoot::cli

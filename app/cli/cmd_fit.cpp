@@ -1,0 +1,125 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// `underfoot fit`: fit a surface preset to recorded footsteps (analysis by synthesis, NLopt).
+//   fit --surface gravel [--real FILES_OR_DIRS...] -o gravel_fitted.toml [--evaluations 80]
+// Without --real the recordings of the surface's material come from the cache of
+// scripts/fetch-recordings.sh. The output is a normal preset with a [provenance] table.
+#include "app/cli/CommandRegistry.h"
+#include "engine/surfaces/Surface.h"
+#include "realism/Fit.h"
+
+#include <fmt/core.h>
+
+#include <filesystem>
+#include <fstream>
+#include <memory>
+
+namespace underfoot::cli {
+namespace {
+namespace eng = underfoot::engine;
+namespace rl = underfoot::realism;
+namespace fs = std::filesystem;
+
+struct FitArgs {
+    std::string surface, output, recordings;
+    std::vector<std::string> real;
+    int evaluations = 80;
+    rl::FitOptions options;
+    bool quiet = false;
+};
+
+std::string presetFile(const std::string& s) {
+    if (s.size() > 5 && s.substr(s.size() - 5) == ".toml") return s;
+    return (fs::path(eng::surfacesDirectory()) / (s + ".toml")).string();
+}
+
+int runFit(FitArgs& a) {
+    if (a.surface.empty()) throw UserError("fit: --surface is required");
+    if (a.output.empty()) throw UserError("fit: -o FILE.toml is required");
+    const auto file = presetFile(a.surface);
+    if (!fs::exists(file))
+        throw UserError(fmt::format("fit: no preset {} (see `underfoot surfaces`)", file));
+    std::vector<rl::Recording> real;
+    try {
+        if (!a.real.empty()) {
+            real = rl::collectRecordings(a.real);
+        } else {
+            const auto m = rl::materialOfSurface(a.surface);
+            if (m.empty())
+                throw UserError(fmt::format(
+                    "fit: no recorded material is known for \"{}\"; name recordings with --real",
+                    a.surface));
+            for (auto& r :
+                 rl::loadManifest(a.recordings.empty() ? rl::defaultRecordingsDir() : a.recordings))
+                if (r.material == m) real.push_back(r);
+            if (real.empty())
+                throw UserError(fmt::format("fit: the recordings cache has no {} recordings", m));
+        }
+    } catch (const std::runtime_error& e) {
+        throw UserError(e.what());
+    }
+    a.options.maxEvaluations = a.evaluations;
+    if (!a.quiet)
+        a.options.progress = [](int n, double d, double best) {
+            if (n % 10 == 0)
+                fmt::print("  evaluation {}: distance {:.3f} (best {:.3f})\n", n, d, best);
+            return true;
+        };
+    rl::FitResult r;
+    try {
+        r = rl::fitSurface(file, real, a.options);
+    } catch (const eng::PresetError& e) {
+        throw UserError(e.what());
+    } catch (const eng::FileError& e) {
+        throw UserError(e.what());
+    } catch (const std::invalid_argument& e) {
+        throw UserError(std::string("fit: ") + e.what());
+    }
+    std::ofstream out(a.output);
+    if (!out) throw UserError(fmt::format("-o {}: cannot write this file", a.output));
+    out << "# Fitted by `underfoot fit` to " << real.size()
+        << " recording(s); see [provenance] at the end and docs/realism.md.\n"
+        << r.presetText;
+    out.close();
+    // The result must load as a normal preset.
+    try {
+        eng::Surface::load(a.output);
+    } catch (const eng::PresetError& e) {
+        throw UserError(
+            fmt::format("fit: the fitted preset does not load (engine bug): {}", e.what()));
+    }
+    fmt::print("{}: distance {:.3f} -> {:.3f} after {} evaluations ({}) in {:.1f} s -> {}\n",
+               a.surface, r.distanceBefore, r.distanceAfter, r.evaluations, r.optimiser, r.seconds,
+               a.output);
+    for (const auto& k : r.knobs)
+        fmt::print("  {:<14} {:>7.3f}   ({})\n", k.name, k.value, k.meaning);
+    return 0;
+}
+
+CommandRegistrar reg("fit", [](CLI::App& app, int& exitCode) {
+    auto args = std::make_shared<FitArgs>();
+    auto* cmd = app.add_subcommand(
+        "fit",
+        "Fit a surface preset to recorded footsteps (analysis by synthesis; docs/realism.md)");
+    cmd->add_option("-s,--surface", args->surface, "surface id or preset .toml");
+    cmd->add_option("--real", args->real,
+                    "recorded footsteps: files or folders (default: the recordings cache, "
+                    "material of the surface)");
+    cmd->add_option("--recordings", args->recordings,
+                    "recordings cache (default build/recordings)");
+    cmd->add_option("--evaluations", args->evaluations, "renders the optimiser may try")
+        ->capture_default_str()
+        ->check(CLI::Range(5, 2000));
+    cmd->add_option("--walker", args->options.spec.walker, "virtual walker of the renders")
+        ->capture_default_str();
+    cmd->add_option("--seconds", args->options.spec.seconds, "length of each render")
+        ->capture_default_str()
+        ->check(CLI::Range(2.0, 60.0));
+    cmd->add_option("--seed", args->options.spec.seed, "seed of the renders")
+        ->capture_default_str();
+    cmd->add_option("-o,--output", args->output, "fitted preset (.toml)");
+    cmd->add_flag("-q,--quiet", args->quiet, "no progress lines");
+    cmd->callback([args, &exitCode] { exitCode = runFit(*args); });
+});
+
+} // namespace
+} // namespace underfoot::cli

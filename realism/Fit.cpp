@@ -1,0 +1,337 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "realism/Fit.h"
+
+#include "engine/render/Renderer.h"
+#include "engine/surfaces/Surface.h"
+
+#include <fmt/core.h>
+#include <nlopt.hpp>
+#include <toml++/toml.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <regex>
+#include <sstream>
+#include <stdexcept>
+
+namespace underfoot::realism {
+namespace fs = std::filesystem;
+
+namespace {
+
+using Ranges = std::map<std::string, std::pair<double, double>>;
+
+struct Knob {
+    FitKnob info;
+    std::function<void(toml::table& root, double k, const Ranges& ranges)> apply;
+};
+
+double clampTo(const Ranges& r, const std::string& path, double v) {
+    auto it = r.find(path);
+    if (it == r.end()) return v;
+    return std::clamp(v, it->second.first, it->second.second);
+}
+
+// Applies f(old value) -> new value to `key` of every layer of type `type` (when present).
+void eachLayerKey(toml::table& root, const std::string& type, const std::string& key,
+                  const Ranges& ranges, const std::function<double(double, int)>& f) {
+    auto* layers = root["layer"].as_array();
+    if (!layers) return;
+    int i = 0, ofType = 0;
+    for (auto& node : *layers) {
+        auto* t = node.as_table();
+        if (t && t->get("type") && t->get("type")->value<std::string>() == type) {
+            if (auto v = (*t)[key].value<double>())
+                t->insert_or_assign(
+                    key, clampTo(ranges, fmt::format("layer[{}].{}", i, key), f(*v, ofType)));
+            ++ofType;
+        }
+        ++i;
+    }
+}
+
+void eachMode(toml::table& root, const Ranges& ranges,
+              const std::function<void(toml::table& mode, const std::string& path)>& f) {
+    auto* layers = root["layer"].as_array();
+    if (!layers) return;
+    int i = 0;
+    for (auto& node : *layers) {
+        auto* t = node.as_table();
+        if (t && t->get("type") && t->get("type")->value<std::string>() == "impact")
+            if (auto* modes = (*t)["modes"].as_array()) {
+                int j = 0;
+                for (auto& m : *modes)
+                    if (auto* mt = m.as_table()) f(*mt, fmt::format("layer[{}].modes[{}]", i, j++));
+            }
+        ++i;
+    }
+    (void)ranges;
+}
+
+bool hasLayer(const toml::table& root, const std::string& type, int* count = nullptr) {
+    int n = 0;
+    if (const auto* layers = root["layer"].as_array())
+        for (const auto& node : *layers)
+            if (const auto* t = node.as_table())
+                if (t->get("type") && t->get("type")->value<std::string>() == type) ++n;
+    if (count) *count = n;
+    return n > 0;
+}
+
+std::vector<Knob> knobsFor(const toml::table& root) {
+    std::vector<Knob> k;
+    auto mul2 = [](double k2) { return [k2](double v, int) { return v * std::exp2(k2); }; };
+    if (hasLayer(root, "impact")) {
+        k.push_back({{"decay", "every mode's t60_s x 2^k", -4.5, 1, 0, 0},
+                     [](toml::table& r, double x, const Ranges& rg) {
+                         eachMode(r, rg, [&](toml::table& m, const std::string& p) {
+                             if (auto v = m["t60_s"].value<double>())
+                                 m.insert_or_assign("t60_s",
+                                                    clampTo(rg, p + ".t60_s", *v * std::exp2(x)));
+                         });
+                     }});
+        k.push_back({{"stiffness", "contact stiffness x 10^k", -1, 1, 0, 0},
+                     [](toml::table& r, double x, const Ranges& rg) {
+                         eachLayerKey(r, "impact", "stiffness", rg,
+                                      [x](double v, int) { return v * std::pow(10.0, x); });
+                     }});
+        k.push_back({{"tilt", "mode gains x (f / 1 kHz)^k", -1.5, 1.5, 0, 0},
+                     [](toml::table& r, double x, const Ranges& rg) {
+                         eachMode(r, rg, [&](toml::table& m, const std::string& p) {
+                             auto g = m["gain"].value<double>();
+                             auto f = m["freq_hz"].value<double>();
+                             if (g && f)
+                                 m.insert_or_assign("gain", clampTo(rg, p + ".gain",
+                                                                    *g * std::pow(*f / 1000.0, x)));
+                         });
+                     }});
+    }
+    int grainLayers = 0;
+    if (hasLayer(root, "grains", &grainLayers)) {
+        k.push_back(
+            {{"grain_band", "grain resonance band (freq_min/max_hz) x 2^k", -1.5, 1.5, 0, 0},
+             [mul2](toml::table& r, double x, const Ranges& rg) {
+                 eachLayerKey(r, "grains", "freq_min_hz", rg, mul2(x));
+                 eachLayerKey(r, "grains", "freq_max_hz", rg, mul2(x));
+             }});
+        k.push_back({{"grain_q", "grain resonance Q (q_min/max) x 2^k", -2, 2, 0, 0},
+                     [mul2](toml::table& r, double x, const Ranges& rg) {
+                         eachLayerKey(r, "grains", "q_min", rg, mul2(x));
+                         eachLayerKey(r, "grains", "q_max", rg, mul2(x));
+                     }});
+        k.push_back({{"grain_rate", "event rates (events_per_*) x 2^k", -2, 1, 0, 0},
+                     [mul2](toml::table& r, double x, const Ranges& rg) {
+                         for (const char* key :
+                              {"events_per_kn_rise", "events_per_kn_fall", "events_per_s_per_kn"})
+                             eachLayerKey(r, "grains", key, rg, mul2(x));
+                     }});
+        if (grainLayers > 1)
+            k.push_back(
+                {{"layer_balance", "first grain layer +k dB, the others -k dB", -12, 12, 0, 0},
+                 [](toml::table& r, double x, const Ranges& rg) {
+                     eachLayerKey(r, "grains", "gain_db", rg,
+                                  [x](double v, int i) { return i == 0 ? v + x : v - x; });
+                 }});
+    }
+    if (hasLayer(root, "bubbles")) {
+        k.push_back({{"bubble_size", "bubble radii (radius_min/max_mm) x 2^k", -2, 1, 0, 0},
+                     [mul2](toml::table& r, double x, const Ranges& rg) {
+                         eachLayerKey(r, "bubbles", "radius_min_mm", rg, mul2(x));
+                         eachLayerKey(r, "bubbles", "radius_max_mm", rg, mul2(x));
+                     }});
+        k.push_back({{"splash_band", "splash noise centre (splash_hz) x 2^k", -1, 2.5, 0, 0},
+                     [mul2](toml::table& r, double x, const Ranges& rg) {
+                         eachLayerKey(r, "bubbles", "splash_hz", rg, mul2(x));
+                     }});
+        k.push_back({{"splash_level", "splash_noise_db + k", -12, 12, 0, 0},
+                     [](toml::table& r, double x, const Ranges& rg) {
+                         eachLayerKey(r, "bubbles", "splash_noise_db", rg,
+                                      [x](double v, int) { return v + x; });
+                     }});
+        k.push_back({{"slosh_level", "slosh_db + k", -20, 6, 0, 0},
+                     [](toml::table& r, double x, const Ranges& rg) {
+                         eachLayerKey(r, "bubbles", "slosh_db", rg,
+                                      [x](double v, int) { return v + x; });
+                     }});
+    }
+    return k;
+}
+
+// TOML text with every long decimal written with 6 significant digits (readable presets).
+std::string toText(const toml::table& t) {
+    std::ostringstream s;
+    s << t << "\n";
+    const std::string text = s.str();
+    static const std::regex longNumber(R"(-?\d+\.\d{7,}(e[-+]?\d+)?)");
+    std::string out;
+    auto it = std::sregex_iterator(text.begin(), text.end(), longNumber);
+    std::size_t last = 0;
+    for (; it != std::sregex_iterator(); ++it) {
+        out += text.substr(last, static_cast<std::size_t>(it->position()) - last);
+        std::string v = fmt::format("{:.6g}", std::stod(it->str()));
+        if (v.find_first_of(".e") == std::string::npos) v += ".0";
+        out += v;
+        last = static_cast<std::size_t>(it->position() + it->length());
+    }
+    return out + text.substr(last);
+}
+
+double peakOf(const engine::AudioBuffer& a) {
+    double p = 0;
+    for (float v : a.samples) p = std::max(p, std::fabs(double(v)));
+    return p;
+}
+
+} // namespace
+
+FitResult fitSurface(const std::string& presetFile, const std::vector<Recording>& real,
+                     const FitOptions& options) {
+    const auto t0 = std::chrono::steady_clock::now();
+    toml::table root;
+    try {
+        root = toml::parse_file(presetFile);
+    } catch (const toml::parse_error& e) {
+        throw std::invalid_argument(
+            fmt::format("{}: not a TOML preset: {}", presetFile, e.description()));
+    }
+    if (root.get("base"))
+        throw std::invalid_argument(fmt::format(
+            "{}: a `base` preset; fit its base preset instead (it inherits the fit)", presetFile));
+    Ranges ranges;
+    const auto original = engine::Surface::load(presetFile); // keeps parameters() alive
+    for (const auto& p : original->parameters()) ranges[p.path] = {p.minValue, p.maxValue};
+    auto knobs = knobsFor(root);
+    if (knobs.empty())
+        throw std::invalid_argument(
+            fmt::format("{}: no impact, grains or bubbles layer to fit", presetFile));
+
+    AnalysisOptions ao;
+    ao.maxHz = sharedMaxHz(real, options.spec.rateHz);
+    std::vector<StepDescriptors> realSteps;
+    for (const auto& r : real) {
+        auto s = describeFile(r.path, ao);
+        realSteps.insert(realSteps.end(), s.begin(), s.end());
+    }
+    if (realSteps.empty()) throw std::runtime_error("no footstep found in the recordings");
+
+    const auto id = fs::path(presetFile).stem().string();
+    const fs::path tmp = fs::temp_directory_path() /
+                         fmt::format("underfoot-fit-{}-{}", static_cast<long>(::getpid()), id);
+    fs::create_directories(tmp);
+    const auto tmpFile = (tmp / (id + ".toml")).string();
+
+    auto build = [&](const std::vector<double>& x) {
+        toml::table t = root;
+        for (std::size_t i = 0; i < knobs.size(); ++i) knobs[i].apply(t, x[i], ranges);
+        return t;
+    };
+    auto render = [&](const toml::table& t) {
+        std::ofstream(tmpFile) << toText(t);
+        return renderForComparison(tmpFile, options.spec);
+    };
+    auto distanceOf = [&](const toml::table& t) {
+        try {
+            const auto steps = describeSteps(render(t), ao);
+            if (steps.empty()) return 100.0;
+            return compareSteps(steps, realSteps).distance;
+        } catch (const engine::PresetError&) {
+            return 100.0; // a knob combination the preset's ranges refuse
+        }
+    };
+
+    FitResult result;
+    result.optimiser = "NLopt LN_BOBYQA";
+    std::vector<double> x(knobs.size(), 0.0), lo, hi;
+    for (const auto& k : knobs) {
+        lo.push_back(k.info.lo);
+        hi.push_back(k.info.hi);
+    }
+    result.distanceBefore = distanceOf(root);
+    int evals = 0;
+    double best = result.distanceBefore;
+    std::vector<double> bestX = x;
+    struct Ctx {
+        std::function<double(const std::vector<double>&)> f;
+    } ctx{[&](const std::vector<double>& xv) {
+        const double d = distanceOf(build(xv));
+        ++evals;
+        if (d < best) {
+            best = d;
+            bestX = xv;
+        }
+        if (options.progress && !options.progress(evals, d, best)) throw nlopt::forced_stop();
+        return d;
+    }};
+    nlopt::opt opt(nlopt::LN_BOBYQA, static_cast<unsigned>(knobs.size()));
+    opt.set_lower_bounds(lo);
+    opt.set_upper_bounds(hi);
+    std::vector<double> step;
+    for (std::size_t i = 0; i < knobs.size(); ++i) step.push_back(0.25 * (hi[i] - lo[i]));
+    opt.set_initial_step(step);
+    opt.set_maxeval(options.maxEvaluations);
+    opt.set_xtol_abs(1e-3);
+    opt.set_min_objective([](const std::vector<double>& xv, std::vector<double>&,
+                             void* data) { return static_cast<Ctx*>(data)->f(xv); },
+                          &ctx);
+    double fmin = 0;
+    try {
+        opt.optimize(x, fmin);
+    } catch (const nlopt::forced_stop&) {
+    } catch (const nlopt::roundoff_limited&) {
+    }
+    // Keep the original's loudness: the render's peak equals the original's.
+    toml::table fitted = build(bestX);
+    const double peakBefore = peakOf(render(root));
+    const double peakAfter = peakOf(render(fitted));
+    if (peakBefore > 0 && peakAfter > 0) {
+        const double g = root["gain_db"].value<double>().value_or(0.0) +
+                         20.0 * std::log10(peakBefore / peakAfter);
+        fitted.insert_or_assign("gain_db", std::round(g * 10.0) / 10.0);
+    }
+    result.distanceAfter = distanceOf(fitted);
+    fs::remove_all(tmp);
+    result.evaluations = evals;
+    for (std::size_t i = 0; i < knobs.size(); ++i) {
+        knobs[i].info.value = bestX[i];
+        result.knobs.push_back(knobs[i].info);
+    }
+
+    toml::table prov;
+    toml::array files, licences, sources;
+    for (const auto& r : real) {
+        files.push_back(r.file);
+        if (std::find_if(licences.begin(), licences.end(), [&](const toml::node& n) {
+                return n.value<std::string>() == r.licence;
+            }) == licences.end())
+            licences.push_back(r.licence);
+        if (std::find_if(sources.begin(), sources.end(), [&](const toml::node& n) {
+                return n.value<std::string>() == r.package;
+            }) == sources.end())
+            sources.push_back(r.package);
+    }
+    prov.insert("tool", fmt::format("underfoot fit {}", UNDERFOOT_VERSION));
+    prov.insert("optimiser", result.optimiser);
+    prov.insert("recordings", files);
+    prov.insert("sources", sources);
+    prov.insert("licences", licences);
+    prov.insert("distance_before", std::round(result.distanceBefore * 1000) / 1000);
+    prov.insert("distance_after", std::round(result.distanceAfter * 1000) / 1000);
+    prov.insert("walker", options.spec.walker);
+    prov.insert("seconds", options.spec.seconds);
+    prov.insert("seed", static_cast<std::int64_t>(options.spec.seed));
+    prov.insert("evaluations", evals);
+    toml::table kt;
+    for (const auto& k : result.knobs) kt.insert(k.name, std::round(k.value * 1000) / 1000);
+    prov.insert("knobs", kt);
+    fitted.insert_or_assign("provenance", prov);
+    result.presetText = toText(fitted);
+    result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return result;
+}
+
+} // namespace underfoot::realism

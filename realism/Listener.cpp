@@ -1,0 +1,128 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "realism/Listener.h"
+
+#include "realism/Distance.h"
+#include "realism/Recordings.h"
+
+#include <fmt/core.h>
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+#include <stdexcept>
+
+namespace underfoot::realism {
+
+std::vector<double> fileFeatures(const std::vector<StepDescriptors>& steps) {
+    if (steps.empty()) throw std::invalid_argument("a file without steps has no features");
+    std::vector<double> f;
+    for (int d = 0; d < kDescriptorCount; ++d) {
+        std::vector<double> v;
+        for (const auto& s : steps)
+            v.push_back(comparisonScale(d, s.value[static_cast<std::size_t>(d)]));
+        f.push_back(quantile(v, 0.5));
+    }
+    const std::size_t bands = steps.front().thirdOctaveDb.size();
+    for (std::size_t b = 0; b < bands; ++b) {
+        std::vector<double> v;
+        for (const auto& s : steps) v.push_back(s.thirdOctaveDb.at(b));
+        f.push_back(quantile(v, 0.5));
+    }
+    return f;
+}
+
+void Listener::train(const std::vector<Example>& ex) {
+    if (ex.empty()) throw std::invalid_argument("the listener needs at least one example");
+    const std::size_t n = ex.front().features.size();
+    for (const auto& e : ex)
+        if (e.features.size() != n || e.material.empty())
+            throw std::invalid_argument(
+                fmt::format("example {}: features of another length or no material label", e.name));
+    centre_.assign(n, 0);
+    scale_.assign(n, 1);
+    weight_.assign(n, 1);
+    const std::size_t bands = n > kDescriptorCount ? n - kDescriptorCount : 0;
+    for (std::size_t k = 0; k < n; ++k) {
+        std::vector<double> v;
+        for (const auto& e : ex) v.push_back(e.features[k]);
+        centre_[k] = quantile(v, 0.5);
+        const double floor = k < kDescriptorCount ? descriptorInfo(int(k)).floor : 1.0;
+        scale_[k] = std::max((quantile(v, 0.75) - quantile(v, 0.25)) / 1.349, floor);
+        if (k >= kDescriptorCount && bands > 0)
+            weight_[k] = std::sqrt(double(kDescriptorCount) / double(bands));
+    }
+    std::set<std::string> mats;
+    for (const auto& e : ex) mats.insert(e.material);
+    materials_.assign(mats.begin(), mats.end());
+    centroids_.clear();
+    for (const auto& m : materials_) {
+        std::vector<double> c(n);
+        for (std::size_t k = 0; k < n; ++k) {
+            std::vector<double> v;
+            for (const auto& e : ex)
+                if (e.material == m) v.push_back((e.features[k] - centre_[k]) / scale_[k]);
+            c[k] = quantile(v, 0.5);
+        }
+        centroids_.push_back(std::move(c));
+    }
+}
+
+std::vector<std::pair<std::string, double>>
+Listener::distances(const std::vector<double>& f) const {
+    if (f.size() != centre_.size())
+        throw std::invalid_argument(fmt::format(
+            "features of length {}, the listener was trained on {}", f.size(), centre_.size()));
+    std::vector<std::pair<std::string, double>> out;
+    for (std::size_t m = 0; m < materials_.size(); ++m) {
+        double d2 = 0;
+        for (std::size_t k = 0; k < f.size(); ++k) {
+            const double z = ((f[k] - centre_[k]) / scale_[k] - centroids_[m][k]) * weight_[k];
+            d2 += z * z;
+        }
+        out.emplace_back(materials_[m], std::sqrt(d2));
+    }
+    std::sort(out.begin(), out.end(), [](auto& a, auto& b) { return a.second < b.second; });
+    return out;
+}
+
+std::string Listener::classify(const std::vector<double>& f) const {
+    if (materials_.empty()) throw std::logic_error("the listener is not trained");
+    return distances(f).front().first;
+}
+
+LosoResult leaveOneSourceOut(const std::vector<Example>& ex) {
+    std::set<std::string> sources;
+    for (const auto& e : ex) sources.insert(e.source);
+    if (sources.size() < 2)
+        throw std::invalid_argument(
+            "leave-one-source-out needs recordings from two sources or more");
+    LosoResult r;
+    for (const auto& held : sources) {
+        std::vector<Example> train;
+        for (const auto& e : ex)
+            if (e.source != held) train.push_back(e);
+        Listener l;
+        l.train(train);
+        const auto& mats = l.materials();
+        for (const auto& e : ex) {
+            if (e.source != held) continue;
+            if (std::find(mats.begin(), mats.end(), e.material) == mats.end()) {
+                ++r.unseenMaterialFiles;
+                continue;
+            }
+            const auto p = l.classify(e.features);
+            ++r.confusion[e.material][p];
+            ++r.files;
+            auto& ps = r.perSource[held];
+            ++ps.second;
+            if (p == e.material) {
+                ++r.materialCorrect;
+                ++ps.first;
+            }
+            if (categoryOfMaterial(p) == categoryOfMaterial(e.material)) ++r.categoryCorrect;
+        }
+    }
+    return r;
+}
+
+} // namespace underfoot::realism

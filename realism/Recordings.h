@@ -1,0 +1,51 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+/// Recorded footsteps: the manifest written by scripts/fetch-recordings.sh, the material each
+/// bundled surface is compared with, and loading recordings into per-step descriptors.
+#include "realism/Descriptors.h"
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace underfoot::realism {
+
+struct Recording {
+    std::string path;     ///< absolute path of the audio file
+    std::string file;     ///< as named in the manifest (relative to the cache)
+    std::string source;   ///< independent source (package or lab), e.g. "minetest"
+    std::string package;  ///< Debian package (or "lab")
+    std::string licence;  ///< SPDX-like licence of the audio
+    std::string material; ///< wood, metal, hard, gravel, sand, snow, dirt, grass, ice, water
+    std::string recordist;
+};
+
+/// Where the recordings cache is: $UNDERFOOT_RECORDINGS, else <source tree>/build/recordings.
+std::string defaultRecordingsDir();
+
+/// Reads DIR/manifest.csv. Throws std::runtime_error naming the file and line when it is
+/// missing or malformed (a line with the wrong number of columns, an empty field).
+std::vector<Recording> loadManifest(const std::string& dir);
+
+/// Audio files (.wav .ogg .flac .aiff) named directly or found below the given folders,
+/// sorted; material and source unknown. Throws std::runtime_error for a path that does not exist.
+std::vector<Recording> collectRecordings(const std::vector<std::string>& paths);
+
+/// The recorded material a bundled surface is compared with ("" when none was recorded, e.g.
+/// carpet, dry leaves, underbrush).
+std::string materialOfSurface(const std::string& surfaceId);
+
+/// "solid", "aggregate" or "liquid" for a recorded material; throws for an unknown one.
+std::string categoryOfMaterial(const std::string& material);
+
+/// The materials the listener knows, in a fixed order.
+const std::vector<std::string>& knownMaterials();
+
+/// Descriptors of every step of one recording file. Throws engine::FileError for a bad file.
+std::vector<StepDescriptors> describeFile(const std::string& path, const AnalysisOptions& o);
+
+/// The analysis band limit for a set of files: 0.95 x the lowest Nyquist among them and
+/// `otherRateHz` (the synthetic render's rate), at most 16 kHz.
+double sharedMaxHz(const std::vector<Recording>& recordings, double otherRateHz);
+
+} // namespace underfoot::realism

@@ -1,0 +1,138 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The listener, the manifest and, when the recordings cache is there, the real recordings.
+#include "realism/Compare.h"
+#include "realism/Listener.h"
+#include "realism/Recordings.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <random>
+
+using namespace underfoot::realism;
+namespace fs = std::filesystem;
+
+namespace {
+Example example(const std::string& source, const std::string& material, double centre,
+                std::mt19937& g) {
+    std::normal_distribution<double> n(0.0, 0.3);
+    Example e;
+    e.name = source + "/" + material;
+    e.source = source;
+    e.material = material;
+    for (int k = 0; k < kDescriptorCount + 4; ++k) e.features.push_back(centre + n(g));
+    return e;
+}
+
+fs::path scratch(const std::string& name) {
+    auto p = fs::temp_directory_path() / ("underfoot_realism_" + name);
+    fs::remove_all(p);
+    fs::create_directories(p);
+    return p;
+}
+} // namespace
+
+TEST(RealismListener, NearestCentroidAndLeaveOneSourceOut) {
+    std::mt19937 g(4);
+    std::vector<Example> ex;
+    for (const char* src : {"a", "b", "c"})
+        for (int i = 0; i < 3; ++i) {
+            ex.push_back(example(src, "metal", 0.0, g));
+            ex.push_back(example(src, "gravel", 3.0, g));
+            ex.push_back(example(src, "water", 6.0, g));
+        }
+    Listener l;
+    l.train(ex);
+    EXPECT_EQ(l.materials().size(), 3u);
+    EXPECT_EQ(l.classify(std::vector<double>(kDescriptorCount + 4, 5.8)), "water");
+    EXPECT_EQ(l.classify(std::vector<double>(kDescriptorCount + 4, 0.3)), "metal");
+    const auto r = leaveOneSourceOut(ex);
+    EXPECT_EQ(r.files, 27);
+    EXPECT_EQ(r.materialCorrect, 27);
+    EXPECT_EQ(r.categoryCorrect, 27);
+    EXPECT_EQ(r.confusion.at("gravel").at("gravel"), 9);
+    // A material only one source has cannot be scored when that source is held out.
+    ex.push_back(example("c", "sand", 9.0, g));
+    EXPECT_EQ(leaveOneSourceOut(ex).unseenMaterialFiles, 1);
+    EXPECT_THROW(l.classify({1.0}), std::invalid_argument);
+    std::vector<Example> one = {example("a", "metal", 0, g)};
+    EXPECT_THROW(leaveOneSourceOut(one), std::invalid_argument);
+}
+
+TEST(RealismRecordings, ManifestErrorsNameTheFileAndLine) {
+    const auto dir = scratch("manifest");
+    EXPECT_THROW(loadManifest(dir.string()), std::runtime_error); // missing
+    { std::ofstream(dir / "manifest.csv") << "file,source\n"; }
+    try {
+        loadManifest(dir.string());
+        FAIL() << "a bad header was accepted";
+    } catch (const std::runtime_error& e) {
+        EXPECT_NE(std::string(e.what()).find("manifest.csv:1"), std::string::npos) << e.what();
+    }
+    {
+        std::ofstream(dir / "manifest.csv")
+            << "file,source,package,version,licence,material,recordist\n"
+            << "a/b.wav,src,pkg,1,CC0-1.0,metal,someone\n"
+            << "a/c.wav,src,pkg,1,CC0-1.0\n";
+    }
+    try {
+        loadManifest(dir.string());
+        FAIL() << "a short line was accepted";
+    } catch (const std::runtime_error& e) {
+        EXPECT_NE(std::string(e.what()).find("manifest.csv:3"), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(materialOfSurface("gravel"), "gravel");
+    EXPECT_EQ(materialOfSurface("carpet"), "");
+    EXPECT_EQ(categoryOfMaterial("water"), "liquid");
+    EXPECT_THROW(categoryOfMaterial("lava"), std::invalid_argument);
+    EXPECT_THROW(collectRecordings({(dir / "nope").string()}), std::runtime_error);
+    fs::remove_all(dir);
+}
+
+// The real recordings (scripts/fetch-recordings.sh). Skipped, saying so, without the cache.
+class RealRecordings : public ::testing::Test {
+  protected:
+    void SetUp() override {
+        dir_ = defaultRecordingsDir();
+        if (!fs::exists(fs::path(dir_) / "manifest.csv"))
+            GTEST_SKIP()
+                << "no recordings cache at " << dir_
+                << ": run `bash scripts/fetch-recordings.sh` (or set UNDERFOOT_RECORDINGS)";
+        recs_ = loadManifest(dir_);
+    }
+    std::string dir_;
+    std::vector<Recording> recs_;
+};
+
+TEST_F(RealRecordings, EveryRecordingHasStepsAndTheListenerBeatsChance) {
+    ASSERT_GE(recs_.size(), 20u);
+    AnalysisOptions o;
+    o.maxHz = sharedMaxHz(recs_, 48000);
+    std::vector<Example> ex;
+    for (const auto& r : recs_) {
+        ASSERT_TRUE(fs::exists(r.path)) << r.path;
+        const auto steps = describeFile(r.path, o);
+        ASSERT_FALSE(steps.empty()) << r.file << ": no step found";
+        ex.push_back({r.file, r.source, r.material, fileFeatures(steps)});
+    }
+    const auto loso = leaveOneSourceOut(ex);
+    ASSERT_GT(loso.files, 0);
+    // Three materials are shared between the sources, so chance is 1/3 for the material.
+    EXPECT_GT(double(loso.materialCorrect) / loso.files, 0.4)
+        << loso.materialCorrect << "/" << loso.files;
+}
+
+TEST_F(RealRecordings, RecordedMetalDecaysFasterThanTheOldRingingMetal) {
+    std::vector<Recording> metal;
+    for (const auto& r : recs_)
+        if (r.material == "metal") metal.push_back(r);
+    ASSERT_FALSE(metal.empty());
+    RenderSpec spec;
+    spec.seconds = 4;
+    const auto c = compareSurface("metal", metal, spec);
+    EXPECT_GT(c.comparison.realSteps, 3);
+    EXPECT_GT(c.comparison.syntheticSteps, 4);
+    EXPECT_GT(c.comparison.distance, 0.0);
+    EXPECT_TRUE(std::isfinite(c.comparison.distance));
+}
