@@ -268,6 +268,12 @@ void StudyStore::configure() {
         throw StoreError(fmt::format("{}: schema version {} was written by a newer Underfoot; "
                                      "this version reads up to {}",
                                      path_, version, kSchemaVersion));
+    // A damaged or foreign file can carry any 32-bit user_version; only 0..kSchemaVersion are
+    // ours (a negative one used to index the migrations at -1, issue #16).
+    if (version < 0)
+        throw StoreError(fmt::format("{}: schema version {} is not one Underfoot ever wrote "
+                                     "(expected 1 to {}); the file is damaged or not a study",
+                                     path_, version, kSchemaVersion));
     for (int v = version; v < kSchemaVersion; ++v) {
         SQLite::Transaction tx(*db_, SQLite::TransactionBehavior::IMMEDIATE);
         db_->exec(kMigrations[v]);
@@ -336,8 +342,10 @@ StudyStore StudyStore::open(const std::string& path, Clock clock, const Catalogu
     }
     StudyStore store(path, std::move(db), std::move(clock));
     const int version = store.db_->execAndGet("PRAGMA user_version").getInt();
-    if (version == 0)
-        throw StoreError(fmt::format("{}: not an Underfoot study (schema version 0)", path));
+    if (version <= 0)
+        throw StoreError(fmt::format("{}: not an Underfoot study (schema version {}; expected "
+                                     "1 to {})",
+                                     path, version, kSchemaVersion));
     store.configure();
     store.loadProtocol(catalogue);
     return store;
