@@ -39,15 +39,20 @@ check export_damaged refused "damaged.db: not an Underfoot study (schema version
     "$underfoot" export --study damaged.db -o out/
 
 # 3. A GRF WAV claiming 1 Hz (and one claiming a 4 GB data chunk).
-python3 - <<'PY'
-import struct
-def wav(name, rate, frames, claimed):
-    data = b''.join(struct.pack('<h', (i * 97) % 3000) for i in range(frames))
-    hdr = b'RIFF' + struct.pack('<I', 36 + claimed) + b'WAVEfmt ' + struct.pack('<IHHIIHH', 16, 1, 1, rate, rate * 2, 2, 16)
-    open(name, 'wb').write(hdr + b'data' + struct.pack('<I', claimed) + data)
-wav('one_hz.wav', 1, 400, 800)
-wav('huge_claim.wav', 1000, 400, 0xfffffff0)
-PY
+# Little-endian fields written with printf (no python needed on a fresh machine).
+le() { # le VALUE BYTES
+    local v=$1 i
+    for ((i = 0; i < $2; i++)); do printf "\\x$(printf %02x $(((v >> (8 * i)) & 255)))"; done
+}
+wav() { # wav FILE RATE FRAMES CLAIMED_DATA_BYTES  (16-bit PCM mono)
+    {
+        printf 'RIFF'; le $((36 + $4)) 4; printf 'WAVEfmt '; le 16 4; le 1 2; le 1 2
+        le "$2" 4; le $(($2 * 2)) 4; le 2 2; le 16 2; printf 'data'; le "$4" 4
+        for ((i = 0; i < $3; i++)); do le $(((i * 97) % 3000)) 2; done
+    } > "$1"
+}
+wav one_hz.wav 1 400 800
+wav huge_claim.wav 1000 400 $((0xfffffff0))
 check grf_one_hz refused "one_hz.wav: sample rate 1 Hz" -- \
     "$underfoot" render --surface wood --grf one_hz.wav -o one_hz_out.wav
 check grf_huge_claim ok "" -- "$underfoot" render --surface wood --grf huge_claim.wav -o huge_out.wav -q
