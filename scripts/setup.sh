@@ -22,6 +22,8 @@ PACKAGES=(
   qt6-base-dev qt6-charts-dev libqt6opengl6-dev libqt6sql6-sqlite libgl-dev xvfb xauth
   # tests and benchmarks
   googletest libgtest-dev libgmock-dev libbenchmark-dev valgrind
+  # fuzzing (libFuzzer: tests/fuzz, scripts/test.sh's fuzz build)
+  clang-14 libclang-rt-14-dev
 )
 
 if [ "${UNDERFOOT_SKIP_APT:-0}" != "1" ]; then

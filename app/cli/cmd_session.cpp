@@ -41,6 +41,7 @@ struct Options {
     std::string audio = "default";
     std::string sensor = "default";
     bool ack = false;
+    bool takeOver = false; ///< take over another process's session lease (after a crash)
     bool showStimulus = false;
     bool simulate = false;
     std::vector<std::string> confusion;
@@ -237,7 +238,7 @@ int runInteractive(const Options& o) {
                                         : silent;
     Session session(store, o.participant, player,
                     {o.experimenter, o.audio, o.clips.empty() ? o.sensor : "clips " + o.clips,
-                     UNDERFOOT_VERSION});
+                     UNDERFOOT_VERSION, o.takeOver});
     const Questions& q = p.questions;
     fmt::print("{} — participant {} (group {}), session {}{}\n", p.title, o.participant,
                session.participant().groupId, session.sessionNumber(),
@@ -427,6 +428,9 @@ const underfoot::cli::CommandRegistrar registrar{
         cmd->add_option("--audio", o.audio, "audio configuration (recorded)");
         cmd->add_option("--sensor", o.sensor, "sensor configuration (recorded)");
         cmd->add_flag("--ack", o.ack, "print 'ack CODE TRIAL' after each committed answer");
+        cmd->add_flag("--take-over", o.takeOver,
+                      "take over the participant's session from another process that holds it "
+                      "(after a crash on another machine; journaled)");
         cmd->add_flag("--show-stimulus", o.showStimulus,
                       "show the stimulus id to the "
                       "experimenter");

@@ -105,3 +105,43 @@ TEST(IoLimits, ShippedGrfStillLoads) {
     const auto g = loadGrfFile(std::string(UNDERFOOT_SOURCE_DIR) + "/engine/data/grf/heel_1.wav");
     EXPECT_GT(g.frames(), 0u);
 }
+
+// Issue #16: empty or truncated settings and calibration files are refused with the file and
+// what is missing, never silently read as defaults.
+#include "engine/control/StepCalibration.h"
+#include "engine/io/AudioDevice.h"
+
+TEST(IoLimits, EmptyOrTruncatedSettingsAndCalibrationFilesAreRefused) {
+    const auto dir = underfoot::test::scratchDir("io_limits");
+    const auto empty = (dir / "empty_audio.toml").string();
+    std::ofstream(empty) << "\n";
+    try {
+        (void)loadAudioSettings(empty);
+        FAIL() << "an empty audio settings file was read as defaults";
+    } catch (const AudioSettingsError& e) {
+        EXPECT_NE(std::string(e.what()).find(empty + ": the file is empty"), std::string::npos)
+            << e.what();
+    }
+    const auto cut = (dir / "cut_audio.toml").string();
+    std::ofstream(cut) << "# written by underfoot devices --save\n";
+    EXPECT_THROW((void)loadAudioSettings(cut), AudioSettingsError);
+
+    StepThresholds t;
+    t.participant = "P07";
+    const auto full = (dir / "P07.toml").string();
+    saveStepThresholds(full, t);
+    std::ifstream in(full);
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const auto truncated = (dir / "P07_cut.toml").string();
+    std::ofstream(truncated) << text.substr(0, text.find("[left_toe]"));
+    try {
+        (void)loadStepThresholds(truncated);
+        FAIL() << "a truncated calibration file was accepted";
+    } catch (const std::runtime_error& e) {
+        EXPECT_NE(std::string(e.what()).find(truncated), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("left_toe"), std::string::npos) << e.what();
+    }
+    const auto emptyCal = (dir / "P07_empty.toml").string();
+    std::ofstream(emptyCal) << "";
+    EXPECT_THROW((void)loadStepThresholds(emptyCal), std::runtime_error);
+}

@@ -214,6 +214,7 @@ TEST(WadingListeningMode, VersionOneStudyFilesAreMigrated) {
     {
         // Turn the file back into schema version 1 (what Underfoot wrote before this version).
         SQLite::Database db(path, SQLite::OPEN_READWRITE);
+        db.exec("DROP TABLE IF EXISTS session_leases"); // version 4's (issue #16)
         for (const char* column :
              {"audio_sample_rate_hz", "audio_block_size", "audio_frames", "audio_xruns",
               "audio_average_load_percent", "audio_max_load_percent", "audio_max_block_ms",
@@ -226,7 +227,7 @@ TEST(WadingListeningMode, VersionOneStudyFilesAreMigrated) {
     }
     StudyStore store = StudyStore::open(path);
     EXPECT_EQ(store.info().schemaVersion, kSchemaVersion);
-    EXPECT_EQ(kSchemaVersion, 3);
+    EXPECT_GE(kSchemaVersion, 3);
     const auto trials = store.trials("P1");
     ASSERT_EQ(trials.size(), 24u);
     EXPECT_EQ(trials[0].replays, 0);
