@@ -417,8 +417,8 @@ StudyStore StudyStore::open(const std::string& path, Clock clock, const Catalogu
     // fail to create its -wal/-shm files, with a misleading message; issue #16).
     const std::string folder = std::filesystem::absolute(path).parent_path().string();
     if (::access(path.c_str(), R_OK) != 0)
-        throw StoreError(fmt::format("{}: cannot read the study file ({})", path,
-                                     std::strerror(errno)));
+        throw StoreError(
+            fmt::format("{}: cannot read the study file ({})", path, std::strerror(errno)));
     if (::access(path.c_str(), W_OK) != 0)
         throw StoreError(fmt::format("{}: the study file is read-only for this user ({}); "
                                      "expected a writable file: make it writable (and its "
@@ -484,9 +484,8 @@ void StudyStore::writeFailed(const std::string& what, const std::exception& e) c
         break;
     case SQLITE_CORRUPT:
     case SQLITE_NOTADB:
-        throw StoreError(
-            fmt::format("{}: {} failed: the study file is damaged ({}); {}", path_, what,
-                        e.what(), recoveryHint(path_)));
+        throw StoreError(fmt::format("{}: {} failed: the study file is damaged ({}); {}", path_,
+                                     what, e.what(), recoveryHint(path_)));
     default:
         cause = "SQLite refused the write";
         todo = "resume the session once the cause is fixed";
@@ -904,7 +903,8 @@ int StudyStore::startSession(const std::string& code, const SessionSettings& set
         SQLite::Transaction tx(*db_, SQLite::TransactionBehavior::IMMEDIATE);
         const ParticipantInfo p = participant(code);
         if (p.status == ParticipantStatus::Dropped)
-            throw StoreError(fmt::format("participant '{}' dropped out; a session cannot start", code));
+            throw StoreError(
+                fmt::format("participant '{}' dropped out; a session cannot start", code));
         if (p.status == ParticipantStatus::Completed)
             throw StoreError(fmt::format("participant '{}' has completed every trial", code));
         SQLite::Statement n(*db_, "SELECT coalesce(max(number), 0) + 1 FROM sessions WHERE "
@@ -942,9 +942,10 @@ int StudyStore::startSession(const std::string& code, const SessionSettings& set
                                         {"session", std::to_string(lease.getColumn(5).getInt())}}));
             }
         }
-        SQLite::Statement take(*db_, "INSERT OR REPLACE INTO session_leases (participant_id, token, "
-                                     "pid, host, experimenter, session_number, since) VALUES "
-                                     "(?, ?, ?, ?, ?, ?, ?)");
+        SQLite::Statement take(*db_,
+                               "INSERT OR REPLACE INTO session_leases (participant_id, token, "
+                               "pid, host, experimenter, session_number, since) VALUES "
+                               "(?, ?, ?, ?, ?, ?, ?)");
         take.bind(1, p.id);
         take.bind(2, leaseToken_);
         take.bind(3, myPid);
@@ -1130,13 +1131,15 @@ void StudyStore::markTrialStarted(const std::string& code, int trialIndex, int s
             throw StoreError(
                 fmt::format("participant '{}' trial {} is already answered", code, trialIndex));
         const bool restarted = !check.getColumn(1).isNull();
-        // A restarted trial's earlier sensor log and audio figures belong to the earlier presentation.
-        SQLite::Statement q(*db_, "UPDATE trials SET started_at = ?, render_seed = ?, grf_recording = "
-                                  "?, session_number = ?, sensor_log = NULL, audio_sample_rate_hz = "
-                                  "NULL, audio_block_size = NULL, audio_frames = NULL, audio_xruns = "
-                                  "NULL, audio_average_load_percent = NULL, audio_max_load_percent = "
-                                  "NULL, audio_max_block_ms = NULL, audio_dropped_grf_frames = NULL "
-                                  "WHERE participant_id = ? AND trial_index = ?");
+        // A restarted trial's earlier sensor log and audio figures belong to the earlier
+        // presentation.
+        SQLite::Statement q(*db_,
+                            "UPDATE trials SET started_at = ?, render_seed = ?, grf_recording = "
+                            "?, session_number = ?, sensor_log = NULL, audio_sample_rate_hz = "
+                            "NULL, audio_block_size = NULL, audio_frames = NULL, audio_xruns = "
+                            "NULL, audio_average_load_percent = NULL, audio_max_load_percent = "
+                            "NULL, audio_max_block_ms = NULL, audio_dropped_grf_frames = NULL "
+                            "WHERE participant_id = ? AND trial_index = ?");
         q.bind(1, now());
         q.bind(2, toDb(renderSeed));
         if (grfRecording) q.bind(3, *grfRecording);
@@ -1150,7 +1153,8 @@ void StudyStore::markTrialStarted(const std::string& code, int trialIndex, int s
                                 {"grf", grfRecording.value_or("")}}));
         tx.commit();
     } catch (const SQLite::Exception& e) {
-        writeFailed(fmt::format("recording the start of participant '{}' trial {}", code, trialIndex), e);
+        writeFailed(
+            fmt::format("recording the start of participant '{}' trial {}", code, trialIndex), e);
     }
 }
 
@@ -1164,8 +1168,8 @@ void StudyStore::commitAnswer(const std::string& code, int trialIndex, const Tri
         SQLite::Transaction tx(*db_, SQLite::TransactionBehavior::IMMEDIATE);
         const ParticipantInfo p = participant(code);
         checkLease(p.id, code);
-        SQLite::Statement cur = selectTrial(p.id, code, trialIndex,
-                                            "id, started_at, answered_at, stimulus, block, laps_done");
+        SQLite::Statement cur = selectTrial(
+            p.id, code, trialIndex, "id, started_at, answered_at, stimulus, block, laps_done");
         const Stimulus trialStimulus = stimulusFromToml(cur.getColumn(3).getString());
         if (const auto problems =
                 checkAnswer(p.groupId, answer, trialStimulus, cur.getColumn(4).getInt());
@@ -1176,9 +1180,10 @@ void StudyStore::commitAnswer(const std::string& code, int trialIndex, const Tri
         }
         if (const int laps = protocol_->laps.total();
             laps > 0 && !cur.getColumn(1).isNull() && cur.getColumn(5).getInt() < laps)
-            throw StoreError(fmt::format("participant '{}' trial {}: {} of {} laps walked; expected "
-                                         "every lap (baseline and feedback) before the questions",
-                                         code, trialIndex, cur.getColumn(5).getInt(), laps));
+            throw StoreError(
+                fmt::format("participant '{}' trial {}: {} of {} laps walked; expected "
+                            "every lap (baseline and feedback) before the questions",
+                            code, trialIndex, cur.getColumn(5).getInt(), laps));
         const std::int64_t trialId = cur.getColumn(0).getInt64();
         if (cur.getColumn(1).isNull())
             throw StoreError(fmt::format("participant '{}' trial {} has not started; expected its "
@@ -1195,12 +1200,14 @@ void StudyStore::commitAnswer(const std::string& code, int trialIndex, const Tri
             later.bind(1, p.id);
             later.bind(2, trialIndex);
             if (later.executeStep())
-                throw StoreError(fmt::format("participant '{}' trial {}: the answer is locked because "
-                                             "the next trial has started",
-                                             code, trialIndex));
+                throw StoreError(
+                    fmt::format("participant '{}' trial {}: the answer is locked because "
+                                "the next trial has started",
+                                code, trialIndex));
         }
-        SQLite::Statement q(*db_, "UPDATE trials SET answered_at = ?, response_time_s = ?, answer = ?, "
-                                  "soundscape_answer = ?, comment = ? WHERE id = ?");
+        SQLite::Statement q(*db_,
+                            "UPDATE trials SET answered_at = ?, response_time_s = ?, answer = ?, "
+                            "soundscape_answer = ?, comment = ? WHERE id = ?");
         q.bind(1, now());
         if (responseTimeS) q.bind(2, *responseTimeS);
         if (!answer.answer.empty()) q.bind(3, answer.answer);
@@ -1211,7 +1218,8 @@ void StudyStore::commitAnswer(const std::string& code, int trialIndex, const Tri
         SQLite::Statement del(*db_, "DELETE FROM ratings WHERE trial_id = ?");
         del.bind(1, trialId);
         del.exec();
-        SQLite::Statement rate(*db_, "INSERT INTO ratings (trial_id, scale, value) VALUES (?, ?, ?)");
+        SQLite::Statement rate(*db_,
+                               "INSERT INTO ratings (trial_id, scale, value) VALUES (?, ?, ?)");
         std::string ratingsText;
         for (const auto& [scale, value] : answer.ratings) {
             rate.reset();
@@ -1230,7 +1238,8 @@ void StudyStore::commitAnswer(const std::string& code, int trialIndex, const Tri
                                  responseTimeS ? fmt::format("{:.3f}", *responseTimeS) : ""}}));
         tx.commit();
     } catch (const SQLite::Exception& e) {
-        writeFailed(fmt::format("saving the answer of participant '{}' trial {}", code, trialIndex), e);
+        writeFailed(fmt::format("saving the answer of participant '{}' trial {}", code, trialIndex),
+                    e);
     }
     checkpoint();
 }

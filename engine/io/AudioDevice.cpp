@@ -284,8 +284,9 @@ AudioSettings loadAudioSettings(const std::string& path) {
         throw AudioSettingsError(fmt::format(
             "{}: {} has no [audio] table with the device settings; expected the file "
             "`underfoot devices --save` writes (was it emptied or cut short?)",
-            path, text.find_first_not_of(" \t\r\n") == std::string::npos ? "the file is empty and"
-                                                                              : "the file"));
+            path,
+            text.find_first_not_of(" \t\r\n") == std::string::npos ? "the file is empty and"
+                                                                   : "the file"));
     return settings;
 }
 

@@ -90,10 +90,9 @@ std::vector<std::string> answersOf(const StudyStore& s, const std::string& code)
     std::vector<std::string> out;
     for (const auto& t : s.trials(code))
         if (t.answered)
-            out.push_back(fmt::format("{}:{}:{}", t.index, t.answer.answer,
-                                      t.answer.ratings.count("realism")
-                                          ? t.answer.ratings.at("realism")
-                                          : -1));
+            out.push_back(fmt::format(
+                "{}:{}:{}", t.index, t.answer.answer,
+                t.answer.ratings.count("realism") ? t.answer.ratings.at("realism") : -1));
     return out;
 }
 
