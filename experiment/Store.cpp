@@ -768,7 +768,7 @@ StudyStore::checkAnswerScales(const std::string& groupId, const TrialAnswer& ans
         if (!q.scale(scaleId))
             problems.push_back(fmt::format("unknown scale '{}' (value {})", scaleId, value));
         else if (std::none_of(asked.begin(), asked.end(),
-                              [&](const Scale* s) { return s->id == scaleId; }))
+                              [&id = scaleId](const Scale* s) { return s->id == id; }))
             problems.push_back(fmt::format("scale '{}' is not asked in this trial", scaleId));
     }
     if (q.asksSoundscape(groupId)) {
