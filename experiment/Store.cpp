@@ -1042,7 +1042,13 @@ TrialRecord readTrial(SQLite::Database& db, SQLite::Statement& q) {
     r.index = q.getColumn(2).getInt();
     r.block = q.getColumn(3).getInt();
     r.practice = q.getColumn(4).getInt() != 0;
-    r.stimulus = stimulusFromToml(q.getColumn(5).getString());
+    try {
+        r.stimulus = stimulusFromToml(q.getColumn(5).getString());
+    } catch (const std::runtime_error& e) { // a damaged file (found by fuzz_study_db)
+        throw StoreError(fmt::format("{}: participant '{}' trial {}: {}; the study file is "
+                                     "damaged",
+                                     db.getFilename(), r.participant, r.index, e.what()));
+    }
     r.repetition = q.getColumn(6).getInt();
     r.plannedSeed = fromDb(q.getColumn(7).getInt64());
     if (!q.getColumn(8).isNull()) r.renderSeed = fromDb(q.getColumn(8).getInt64());

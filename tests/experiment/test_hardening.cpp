@@ -297,9 +297,18 @@ TEST(StoreFaults, DiskFullNamesFileAndCauseLosesNothingAndResumes) {
         while (filler.write(block.data(), block.size())) {
         }
     }
+    // Answers with long comments: the file must grow (small answers reuse freed pages).
     std::string message;
     try {
-        acked += answerNext(s, "P1", session, 100);
+        for (int k = 0; k < 4; ++k) {
+            const auto next = s.firstUnanswered("P1");
+            ASSERT_TRUE(next);
+            s.markTrialStarted("P1", *next, session, 7, std::nullopt);
+            TrialAnswer a = validAnswer(*next);
+            a.comment = std::string(300000, static_cast<char>('a' + k));
+            s.commitAnswer("P1", *next, a, 1.0);
+            ++acked;
+        }
     } catch (const StoreError& e) {
         message = e.what();
     }
