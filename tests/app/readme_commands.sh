@@ -25,7 +25,8 @@ skip_reason() {
     *"--serial /dev/"* | *"underfoot sensors"*) echo "needs the FSR shoes on a serial port" ;;
     *"--osc "*) echo "needs gyroscopes sending OSC" ;;
     *"--confusion none=..."*) echo "placeholder '--confusion none=...' in the document (to be filled in by the README fix)" ;;
-    *"wading_realism.toml -o clips3"* | *"--clips clips3"*) echo "needs the lab's own recordings in clips3/real/ (the document says: put them there first)" ;;
+    *"wading_realism.toml -o clips3"* | *"--clips clips3"* | *"--study wading3.db --format html"*) echo "needs the lab's own recordings in clips3/real/ (the document says: put them there first)" ;;
+    *"underfoot replay --study exp2.db --participant P01 --trial 3"*) echo "needs P01 to have answered trial 3 in the interactive session above (stdin is empty here)" ;;
     *) echo "" ;;
     esac
 }
