@@ -52,7 +52,8 @@ void validateOptions(const std::string& path, const GrfLoadOptions& o) {
 // size and work follow duration x target rate).
 void checkGrfLimits(const std::string& path, double rateHz, std::size_t frames,
                     const char* rateSource) {
-    if (!(rateHz >= kMinGrfRateHz && rateHz <= kMaxGrfRateHz))
+    // A relative tolerance: a CSV's 1 / median step is 100 Hz only to within rounding.
+    if (!(rateHz >= kMinGrfRateHz * (1 - 1e-6) && rateHz <= kMaxGrfRateHz * (1 + 1e-6)))
         throw FileError(fmt::format("{}: sample rate {:g} Hz ({}); expected a GRF sampled at {:g} "
                                     "to {:g} Hz",
                                     path, rateHz, rateSource, kMinGrfRateHz, kMaxGrfRateHz));
