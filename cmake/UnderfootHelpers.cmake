@@ -8,6 +8,9 @@ function(underfoot_target_defaults target)
                                              -fno-sanitize-recover=undefined)
     target_link_options(${target} PRIVATE -fsanitize=address,undefined)
   endif()
+  if(UNDERFOOT_FUZZ) # coverage for libFuzzer in every target; fuzz targets link -fsanitize=fuzzer
+    target_compile_options(${target} PRIVATE -fsanitize=fuzzer-no-link)
+  endif()
 endfunction()
 
 # A library made of every .cpp below one folder (each part of the project is one library).

@@ -545,8 +545,9 @@ std::vector<AnswerOption> readOptions(Reader& r, const toml::table& t, std::stri
     // Optional relabelling: labels = { deep_snow = "snow" }.
     if (auto labels = r.table(t, "labels", context, false)) {
         for (auto&& [key, node] : *labels) {
+            const std::string_view keyName = key.str(); // clang 14 cannot capture a binding
             auto it = std::find_if(options.begin(), options.end(),
-                                   [&](const AnswerOption& o) { return o.id == key.str(); });
+                                   [&](const AnswerOption& o) { return o.id == keyName; });
             if (it == options.end())
                 r.problem(node, fmt::format("label for '{}' in {}.labels, which is not an option",
                                             key.str(), context));

@@ -7,9 +7,17 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cerrno>
+#include <chrono>
 #include <cmath>
+#include <cstring>
 #include <ctime>
 #include <filesystem>
+#include <random>
+
+#include <signal.h>
+#include <sqlite3.h>
+#include <unistd.h>
 
 namespace underfoot::experiment {
 
@@ -176,6 +184,18 @@ CREATE TABLE IF NOT EXISTS online_answers (
   PRIMARY KEY (invitation_id, trial_index)
 );
 )sql",
+    // 5 -> 6 (issue #16, hardening): session leases, one live session per participant.
+    R"sql(
+CREATE TABLE session_leases (
+  participant_id INTEGER PRIMARY KEY REFERENCES participants(id),
+  token TEXT NOT NULL,
+  pid INTEGER NOT NULL,
+  host TEXT NOT NULL,
+  experimenter TEXT NOT NULL,
+  session_number INTEGER NOT NULL,
+  since TEXT NOT NULL
+);
+)sql",
 };
 constexpr int kMigrationCount = static_cast<int>(sizeof(kMigrations) / sizeof(kMigrations[0]));
 static_assert(kMigrationCount == kSchemaVersion);
@@ -289,8 +309,68 @@ std::string jsonObject(std::initializer_list<std::pair<std::string_view, std::st
 
 // ----------------------------------------------------------------------------------------------
 
+namespace {
+
+std::string hostName() {
+    char buf[256] = {};
+    if (::gethostname(buf, sizeof buf - 1) != 0) return "unknown-host";
+    return buf;
+}
+
+std::string newLeaseToken() {
+    std::random_device rd;
+    return fmt::format("{:08x}{:08x}{:08x}", rd(), rd(), static_cast<unsigned>(::getpid()));
+}
+
+/// True when `pid` on this host is certainly gone (a crashed session).
+bool processIsGone(std::int64_t pid) {
+    if (pid <= 0) return true;
+    return ::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH;
+}
+
+/// The first problems PRAGMA quick_check reports ("ok" -> empty), within a time bound.
+std::string quickCheck(SQLite::Database& db, std::chrono::milliseconds bound) {
+    struct Deadline {
+        std::chrono::steady_clock::time_point at;
+        bool expired = false;
+    } deadline{std::chrono::steady_clock::now() + bound};
+    sqlite3_progress_handler(
+        db.getHandle(), 10000,
+        [](void* p) -> int {
+            auto* d = static_cast<Deadline*>(p);
+            d->expired = std::chrono::steady_clock::now() > d->at;
+            return d->expired ? 1 : 0;
+        },
+        &deadline);
+    std::string problems;
+    try {
+        SQLite::Statement q(db, "PRAGMA quick_check(5)");
+        while (q.executeStep()) {
+            const std::string line = q.getColumn(0).getString();
+            if (line == "ok") break;
+            problems += (problems.empty() ? "" : "; ") + line;
+        }
+    } catch (const SQLite::Exception& e) {
+        if (!deadline.expired) problems = e.what(); // interrupted by the bound: not checked
+    }
+    sqlite3_progress_handler(db.getHandle(), 0, nullptr, nullptr);
+    return problems;
+}
+
+std::string recoveryHint(const std::string& path) {
+    return fmt::format(
+        "nothing was written to it. To recover: keep the file as it is, make a copy, and "
+        "rebuild it with `sqlite3 {0} \".recover\" | sqlite3 recovered.db`, or go back to "
+        "a backup (`sqlite3 {0} \".backup copy.db\"` makes one); the events table is the "
+        "journal of every acknowledged answer to check the result against",
+        path);
+}
+
+} // namespace
+
 StudyStore::StudyStore(std::string path, std::unique_ptr<SQLite::Database> db, Clock clock)
-    : path_(std::move(path)), db_(std::move(db)), clock_(std::move(clock)) {}
+    : path_(std::move(path)), db_(std::move(db)), clock_(std::move(clock)),
+      leaseToken_(newLeaseToken()) {}
 StudyStore::StudyStore(StudyStore&&) noexcept = default;
 StudyStore& StudyStore::operator=(StudyStore&&) noexcept = default;
 StudyStore::~StudyStore() = default;
@@ -309,6 +389,12 @@ void StudyStore::configure() {
     if (version > kSchemaVersion)
         throw StoreError(fmt::format("{}: schema version {} was written by a newer Underfoot; "
                                      "this version reads up to {}",
+                                     path_, version, kSchemaVersion));
+    // A damaged or foreign file can carry any 32-bit user_version; only 0..kSchemaVersion are
+    // ours (a negative one used to index the migrations at -1, issue #16).
+    if (version < 0)
+        throw StoreError(fmt::format("{}: schema version {} is not one Underfoot ever wrote "
+                                     "(expected 1 to {}); the file is damaged or not a study",
                                      path_, version, kSchemaVersion));
     for (int v = version; v < kSchemaVersion; ++v) {
         SQLite::Transaction tx(*db_, SQLite::TransactionBehavior::IMMEDIATE);
@@ -369,6 +455,22 @@ StudyStore StudyStore::open(const std::string& path, Clock clock, const Catalogu
         throw StoreError(fmt::format("{}: no such study file; expected a file made by "
                                      "`underfoot study create`",
                                      path));
+    // Say plainly when this user may not write the study (SQLite would open it read-only, or
+    // fail to create its -wal/-shm files, with a misleading message; issue #16).
+    const std::string folder = std::filesystem::absolute(path).parent_path().string();
+    if (::access(path.c_str(), R_OK) != 0)
+        throw StoreError(
+            fmt::format("{}: cannot read the study file ({})", path, std::strerror(errno)));
+    if (::access(path.c_str(), W_OK) != 0)
+        throw StoreError(fmt::format("{}: the study file is read-only for this user ({}); "
+                                     "expected a writable file: make it writable (and its "
+                                     "folder {}), or work on a copy",
+                                     path, std::strerror(errno), folder));
+    if (::access(folder.c_str(), W_OK | X_OK) != 0)
+        throw StoreError(fmt::format("{}: the folder {} is read-only for this user ({}); SQLite "
+                                     "must create {}-wal and {}-shm next to the study: make the "
+                                     "folder writable, or work on a copy elsewhere",
+                                     path, folder, std::strerror(errno), path, path));
     std::unique_ptr<SQLite::Database> db;
     try {
         db = std::make_unique<SQLite::Database>(path, SQLite::OPEN_READWRITE);
@@ -376,13 +478,88 @@ StudyStore StudyStore::open(const std::string& path, Clock clock, const Catalogu
     } catch (const SQLite::Exception& e) {
         throw StoreError(fmt::format("{}: not a readable study file ({})", path, e.what()));
     }
+    // A damaged file is refused before anything is written to it (issue #16).
+    if (const std::string problems = quickCheck(*db, std::chrono::seconds(10)); !problems.empty())
+        throw StoreError(fmt::format("{}: the study file is damaged (SQLite integrity check: {}); "
+                                     "{}",
+                                     path, problems, recoveryHint(path)));
     StudyStore store(path, std::move(db), std::move(clock));
     const int version = store.db_->execAndGet("PRAGMA user_version").getInt();
-    if (version == 0)
-        throw StoreError(fmt::format("{}: not an Underfoot study (schema version 0)", path));
-    store.configure();
-    store.loadProtocol(catalogue);
+    if (version <= 0)
+        throw StoreError(fmt::format("{}: not an Underfoot study (schema version {}; expected "
+                                     "1 to {})",
+                                     path, version, kSchemaVersion));
+    try {
+        store.configure();
+        store.loadProtocol(catalogue);
+    } catch (const SQLite::Exception& e) {
+        store.writeFailed("opening the study", e);
+    }
     return store;
+}
+
+void StudyStore::writeFailed(const std::string& what, const std::exception& e) const {
+    const auto* sq = dynamic_cast<const SQLite::Exception*>(&e);
+    const int code = sq ? (sq->getErrorCode() & 0xff) : -1;
+    const std::string folder = std::filesystem::absolute(path_).parent_path().string();
+    std::string cause, todo;
+    switch (code) {
+    case SQLITE_FULL:
+        cause = "the disk is full";
+        todo = fmt::format("free space on the disk holding {}, then resume the session", folder);
+        break;
+    case SQLITE_READONLY:
+        cause = "the study file is read-only for this user";
+        todo = fmt::format("make {} writable by this user (and its folder {}, where SQLite "
+                           "keeps {}-wal and -shm), then resume the session",
+                           path_, folder, path_);
+        break;
+    case SQLITE_CANTOPEN:
+        cause = fmt::format("SQLite cannot create its journal files {}-wal / -shm (is the "
+                            "folder {} read-only?)",
+                            path_, folder);
+        todo = "make the folder writable by this user, then resume the session";
+        break;
+    case SQLITE_IOERR:
+        cause = "an input/output error (disk full, removed or failing?)";
+        todo = "check the disk, then resume the session";
+        break;
+    case SQLITE_CORRUPT:
+    case SQLITE_NOTADB:
+        throw StoreError(fmt::format("{}: {} failed: the study file is damaged ({}); {}", path_,
+                                     what, e.what(), recoveryHint(path_)));
+    default:
+        cause = "SQLite refused the write";
+        todo = "resume the session once the cause is fixed";
+        break;
+    }
+    throw StoreError(fmt::format("{}: {} failed: {} ({}). Every answer acknowledged before this "
+                                 "one is safe in the file; {} (it resumes at the first "
+                                 "unanswered trial)",
+                                 path_, what, cause, e.what(), todo));
+}
+
+void StudyStore::checkpoint() {
+    // wal_checkpoint(FULL) copies every committed frame into the main file and syncs it; a
+    // deleted -wal then loses nothing acknowledged. A busy reader (the console) may keep some
+    // frames in the WAL; they are committed durably there and copied at the next checkpoint.
+    try {
+        db_->execAndGet("PRAGMA wal_checkpoint(FULL)");
+    } catch (const SQLite::Exception& e) {
+        writeFailed("copying the answers into the study file (checkpoint)", e);
+    }
+}
+
+void StudyStore::checkLease(std::int64_t participantId, const std::string& code) const {
+    SQLite::Statement q(*db_, "SELECT token, pid, host, experimenter, since FROM session_leases "
+                              "WHERE participant_id = ?");
+    q.bind(1, participantId);
+    if (!q.executeStep() || q.getColumn(0).getString() == leaseToken_) return;
+    throw StoreError(fmt::format(
+        "{}: participant '{}': the session lease is now held by process {} on host {} "
+        "(experimenter '{}') since {}; this session was taken over and writes nothing more",
+        path_, code, q.getColumn(1).getInt64(), q.getColumn(2).getString(),
+        q.getColumn(3).getString(), q.getColumn(4).getString()));
 }
 
 void StudyStore::loadProtocol(const Catalogue& catalogue) {
@@ -634,7 +811,7 @@ StudyStore::checkAnswerScales(const std::string& groupId, const TrialAnswer& ans
         if (!q.scale(scaleId))
             problems.push_back(fmt::format("unknown scale '{}' (value {})", scaleId, value));
         else if (std::none_of(asked.begin(), asked.end(),
-                              [&](const Scale* s) { return s->id == scaleId; }))
+                              [&id = scaleId](const Scale* s) { return s->id == id; }))
             problems.push_back(fmt::format("scale '{}' is not asked in this trial", scaleId));
     }
     if (q.asksSoundscape(groupId)) {
@@ -767,45 +944,93 @@ void StudyStore::dropParticipant(const std::string& code, const std::string& rea
 }
 
 int StudyStore::startSession(const std::string& code, const SessionSettings& settings) {
-    SQLite::Transaction tx(*db_, SQLite::TransactionBehavior::IMMEDIATE);
-    const ParticipantInfo p = participant(code);
-    if (p.status == ParticipantStatus::Dropped)
-        throw StoreError(fmt::format("participant '{}' dropped out; a session cannot start", code));
-    if (p.status == ParticipantStatus::Completed)
-        throw StoreError(fmt::format("participant '{}' has completed every trial", code));
-    SQLite::Statement n(*db_, "SELECT coalesce(max(number), 0) + 1 FROM sessions WHERE "
-                              "participant_id = ?");
-    n.bind(1, p.id);
-    n.executeStep();
-    const int number = n.getColumn(0).getInt();
-    SQLite::Statement ins(*db_, "INSERT INTO sessions (participant_id, number, group_id, seed, "
-                                "app_version, audio_config, sensor_config, experimenter, "
-                                "started_at, sound_played) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
-    ins.bind(1, p.id);
-    ins.bind(2, number);
-    ins.bind(3, p.groupId);
-    ins.bind(4, toDb(participantSeed(info().seed, p.index)));
-    ins.bind(5, settings.appVersion);
-    ins.bind(6, settings.audioConfig);
-    ins.bind(7, settings.sensorConfig);
-    ins.bind(8, settings.experimenter);
-    ins.bind(9, now());
-    if (settings.soundPlayed) ins.bind(10, *settings.soundPlayed ? 1 : 0);
-    ins.exec();
-    SQLite::Statement st(*db_, "UPDATE participants SET status = 'active' WHERE id = ?");
-    st.bind(1, p.id);
-    st.exec();
-    appendEvent("session_started", p.id, std::nullopt,
-                jsonObject({{"session", std::to_string(number)},
-                            {"experimenter", settings.experimenter},
-                            {"audio", settings.audioConfig},
-                            {"sensor", settings.sensorConfig},
-                            {"sound", !settings.soundPlayed   ? "unknown"
-                                      : *settings.soundPlayed ? "played"
-                                                              : "none (data entry)"},
-                            {"app_version", settings.appVersion}}));
-    tx.commit();
-    return number;
+    try {
+        SQLite::Transaction tx(*db_, SQLite::TransactionBehavior::IMMEDIATE);
+        const ParticipantInfo p = participant(code);
+        if (p.status == ParticipantStatus::Dropped)
+            throw StoreError(
+                fmt::format("participant '{}' dropped out; a session cannot start", code));
+        if (p.status == ParticipantStatus::Completed)
+            throw StoreError(fmt::format("participant '{}' has completed every trial", code));
+        SQLite::Statement n(*db_, "SELECT coalesce(max(number), 0) + 1 FROM sessions WHERE "
+                                  "participant_id = ?");
+        n.bind(1, p.id);
+        n.executeStep();
+        const int number = n.getColumn(0).getInt();
+        // The participant's lease (issue #16): one live session per participant.
+        const std::string host = hostName();
+        const std::int64_t myPid = ::getpid();
+        {
+            SQLite::Statement lease(*db_, "SELECT token, pid, host, experimenter, since, "
+                                          "session_number FROM session_leases WHERE "
+                                          "participant_id = ?");
+            lease.bind(1, p.id);
+            if (lease.executeStep() && lease.getColumn(0).getString() != leaseToken_) {
+                const std::int64_t holderPid = lease.getColumn(1).getInt64();
+                const std::string holderHost = lease.getColumn(2).getString();
+                const bool sameProcess = holderHost == host && holderPid == myPid;
+                const bool gone = holderHost == host && processIsGone(holderPid);
+                if (!sameProcess && !gone && !settings.takeOver)
+                    throw StoreError(fmt::format(
+                        "{}: participant '{}' is in session {} held by process {} on host {} "
+                        "(experimenter '{}') since {}; one session per participant at a time. If "
+                        "that session crashed or its machine is gone, take the session over with "
+                        "`underfoot session ... --take-over`",
+                        path_, code, lease.getColumn(5).getInt(), holderPid, holderHost,
+                        lease.getColumn(3).getString(), lease.getColumn(4).getString()));
+                appendEvent(sameProcess || gone ? "lease_recovered" : "lease_taken_over", p.id,
+                            std::nullopt,
+                            jsonObject({{"pid", std::to_string(holderPid)},
+                                        {"host", holderHost},
+                                        {"experimenter", lease.getColumn(3).getString()},
+                                        {"since", lease.getColumn(4).getString()},
+                                        {"session", std::to_string(lease.getColumn(5).getInt())}}));
+            }
+        }
+        SQLite::Statement take(*db_,
+                               "INSERT OR REPLACE INTO session_leases (participant_id, token, "
+                               "pid, host, experimenter, session_number, since) VALUES "
+                               "(?, ?, ?, ?, ?, ?, ?)");
+        take.bind(1, p.id);
+        take.bind(2, leaseToken_);
+        take.bind(3, myPid);
+        take.bind(4, host);
+        take.bind(5, settings.experimenter);
+        take.bind(6, number);
+        take.bind(7, now());
+        take.exec();
+        SQLite::Statement ins(*db_, "INSERT INTO sessions (participant_id, number, group_id, seed, "
+                                    "app_version, audio_config, sensor_config, experimenter, "
+                                    "started_at, sound_played) VALUES (?, ?, ?, ?, ?, ?, ?, ?, "
+                                    "?, ?)");
+        ins.bind(1, p.id);
+        ins.bind(2, number);
+        ins.bind(3, p.groupId);
+        ins.bind(4, toDb(participantSeed(info().seed, p.index)));
+        ins.bind(5, settings.appVersion);
+        ins.bind(6, settings.audioConfig);
+        ins.bind(7, settings.sensorConfig);
+        ins.bind(8, settings.experimenter);
+        ins.bind(9, now());
+        if (settings.soundPlayed) ins.bind(10, *settings.soundPlayed ? 1 : 0);
+        ins.exec();
+        SQLite::Statement st(*db_, "UPDATE participants SET status = 'active' WHERE id = ?");
+        st.bind(1, p.id);
+        st.exec();
+        appendEvent("session_started", p.id, std::nullopt,
+                    jsonObject({{"session", std::to_string(number)},
+                                {"experimenter", settings.experimenter},
+                                {"audio", settings.audioConfig},
+                                {"sensor", settings.sensorConfig},
+                                {"sound", !settings.soundPlayed   ? "unknown"
+                                          : *settings.soundPlayed ? "played"
+                                                                  : "none (data entry)"},
+                                {"app_version", settings.appVersion}}));
+        tx.commit();
+        return number;
+    } catch (const SQLite::Exception& e) {
+        writeFailed(fmt::format("starting a session of participant '{}'", code), e);
+    }
 }
 
 std::vector<SessionRecord> StudyStore::sessions(const std::string& code) const {
@@ -845,6 +1070,11 @@ void StudyStore::endSession(const std::string& code, int sessionNumber, bool com
         st.bind(1, pid);
         st.exec();
     }
+    SQLite::Statement release(*db_, "DELETE FROM session_leases WHERE participant_id = ? AND "
+                                    "token = ?");
+    release.bind(1, pid);
+    release.bind(2, leaseToken_);
+    release.exec();
     appendEvent("session_ended", pid, std::nullopt,
                 jsonObject({{"session", std::to_string(sessionNumber)},
                             {"outcome", completed ? "completed" : "interrupted"}}));
@@ -884,7 +1114,13 @@ TrialRecord readTrial(SQLite::Database& db, SQLite::Statement& q) {
     r.index = q.getColumn(2).getInt();
     r.block = q.getColumn(3).getInt();
     r.practice = q.getColumn(4).getInt() != 0;
-    r.stimulus = stimulusFromToml(q.getColumn(5).getString());
+    try {
+        r.stimulus = stimulusFromToml(q.getColumn(5).getString());
+    } catch (const std::runtime_error& e) { // a damaged file (found by fuzz_study_db)
+        throw StoreError(fmt::format("{}: participant '{}' trial {}: {}; the study file is "
+                                     "damaged",
+                                     db.getFilename(), r.participant, r.index, e.what()));
+    }
     r.repetition = q.getColumn(6).getInt();
     r.plannedSeed = fromDb(q.getColumn(7).getInt64());
     if (!q.getColumn(8).isNull()) r.renderSeed = fromDb(q.getColumn(8).getInt64());
@@ -964,32 +1200,41 @@ std::optional<int> StudyStore::firstUnanswered(const std::string& code) const {
 void StudyStore::markTrialStarted(const std::string& code, int trialIndex, int sessionNumber,
                                   std::uint64_t renderSeed,
                                   const std::optional<std::string>& grfRecording) {
-    SQLite::Transaction tx(*db_, SQLite::TransactionBehavior::IMMEDIATE);
-    const std::int64_t pid = participantId(code);
-    SQLite::Statement check = selectTrial(pid, code, trialIndex, "answered_at, started_at");
-    if (!check.getColumn(0).isNull())
-        throw StoreError(
-            fmt::format("participant '{}' trial {} is already answered", code, trialIndex + 1));
-    const bool restarted = !check.getColumn(1).isNull();
-    // A restarted trial's earlier sensor log and audio figures belong to the earlier presentation.
-    SQLite::Statement q(*db_, "UPDATE trials SET started_at = ?, render_seed = ?, grf_recording = "
-                              "?, session_number = ?, sensor_log = NULL, audio_sample_rate_hz = "
-                              "NULL, audio_block_size = NULL, audio_frames = NULL, audio_xruns = "
-                              "NULL, audio_average_load_percent = NULL, audio_max_load_percent = "
-                              "NULL, audio_max_block_ms = NULL, audio_dropped_grf_frames = NULL "
-                              "WHERE participant_id = ? AND trial_index = ?");
-    q.bind(1, now());
-    q.bind(2, toDb(renderSeed));
-    if (grfRecording) q.bind(3, *grfRecording);
-    q.bind(4, sessionNumber);
-    q.bind(5, pid);
-    q.bind(6, trialIndex);
-    q.exec();
-    appendEvent(restarted ? "trial_restarted" : "trial_started", pid, trialIndex,
-                jsonObject({{"session", std::to_string(sessionNumber)},
-                            {"render_seed", std::to_string(renderSeed)},
-                            {"grf", grfRecording.value_or("")}}));
-    tx.commit();
+    try {
+        SQLite::Transaction tx(*db_, SQLite::TransactionBehavior::IMMEDIATE);
+        const std::int64_t pid = participantId(code);
+        checkLease(pid, code);
+        SQLite::Statement check = selectTrial(pid, code, trialIndex, "answered_at, started_at");
+        if (!check.getColumn(0).isNull())
+            throw StoreError(
+                fmt::format("participant '{}' trial {} is already answered", code, trialIndex + 1));
+        const bool restarted = !check.getColumn(1).isNull();
+        // A restarted trial's earlier sensor log and audio figures belong to the earlier
+        // presentation.
+        SQLite::Statement q(*db_,
+                            "UPDATE trials SET started_at = ?, render_seed = ?, grf_recording = "
+                            "?, session_number = ?, sensor_log = NULL, audio_sample_rate_hz = "
+                            "NULL, audio_block_size = NULL, audio_frames = NULL, audio_xruns = "
+                            "NULL, audio_average_load_percent = NULL, audio_max_load_percent = "
+                            "NULL, audio_max_block_ms = NULL, audio_dropped_grf_frames = NULL "
+                            "WHERE participant_id = ? AND trial_index = ?");
+        q.bind(1, now());
+        q.bind(2, toDb(renderSeed));
+        if (grfRecording) q.bind(3, *grfRecording);
+        q.bind(4, sessionNumber);
+        q.bind(5, pid);
+        q.bind(6, trialIndex);
+        q.exec();
+        appendEvent(restarted ? "trial_restarted" : "trial_started", pid, trialIndex,
+                    jsonObject({{"session", std::to_string(sessionNumber)},
+                                {"render_seed", std::to_string(renderSeed)},
+                                {"grf", grfRecording.value_or("")}}));
+        tx.commit();
+    } catch (const SQLite::Exception& e) {
+        writeFailed(
+            fmt::format("recording the start of participant '{}' trial {}", code, trialIndex + 1),
+            e);
+    }
 }
 
 void StudyStore::commitAnswer(const std::string& code, int trialIndex, const TrialAnswer& answer,
@@ -998,73 +1243,85 @@ void StudyStore::commitAnswer(const std::string& code, int trialIndex, const Tri
         throw StoreError(fmt::format("participant '{}' trial {}: response time must be a finite "
                                      "number >= 0",
                                      code, trialIndex + 1));
-    SQLite::Transaction tx(*db_, SQLite::TransactionBehavior::IMMEDIATE);
-    const ParticipantInfo p = participant(code);
-    SQLite::Statement cur = selectTrial(p.id, code, trialIndex,
-                                        "id, started_at, answered_at, stimulus, block, laps_done");
-    const Stimulus trialStimulus = stimulusFromToml(cur.getColumn(3).getString());
-    if (const auto problems =
-            checkAnswer(p.groupId, answer, trialStimulus, cur.getColumn(4).getInt());
-        !problems.empty()) {
-        std::string all;
-        for (const auto& s : problems) all += (all.empty() ? "" : "; ") + s;
-        throw StoreError(fmt::format("participant '{}' trial {}: {}", code, trialIndex + 1, all));
-    }
-    if (const int laps = protocol_->laps.total();
-        laps > 0 && !cur.getColumn(1).isNull() && cur.getColumn(5).getInt() < laps)
-        throw StoreError(fmt::format("participant '{}' trial {}: {} of {} laps walked; expected "
-                                     "every lap (baseline and feedback) before the questions",
-                                     code, trialIndex + 1, cur.getColumn(5).getInt(), laps));
-    const std::int64_t trialId = cur.getColumn(0).getInt64();
-    if (cur.getColumn(1).isNull())
-        throw StoreError(fmt::format("participant '{}' trial {} has not started; expected its "
-                                     "stimulus to be played first",
-                                     code, trialIndex + 1));
-    const bool changing = !cur.getColumn(2).isNull();
-    if (changing) {
-        if (protocol_->lock == LockRule::OnAnswer)
-            throw StoreError(fmt::format("participant '{}' trial {}: answers are locked once "
-                                         "given (protocol rule lock = \"answer\")",
+    try {
+        SQLite::Transaction tx(*db_, SQLite::TransactionBehavior::IMMEDIATE);
+        const ParticipantInfo p = participant(code);
+        checkLease(p.id, code);
+        SQLite::Statement cur = selectTrial(
+            p.id, code, trialIndex, "id, started_at, answered_at, stimulus, block, laps_done");
+        const Stimulus trialStimulus = stimulusFromToml(cur.getColumn(3).getString());
+        if (const auto problems =
+                checkAnswer(p.groupId, answer, trialStimulus, cur.getColumn(4).getInt());
+            !problems.empty()) {
+            std::string all;
+            for (const auto& s : problems) all += (all.empty() ? "" : "; ") + s;
+            throw StoreError(
+                fmt::format("participant '{}' trial {}: {}", code, trialIndex + 1, all));
+        }
+        if (const int laps = protocol_->laps.total();
+            laps > 0 && !cur.getColumn(1).isNull() && cur.getColumn(5).getInt() < laps)
+            throw StoreError(
+                fmt::format("participant '{}' trial {}: {} of {} laps walked; expected "
+                            "every lap (baseline and feedback) before the questions",
+                            code, trialIndex, cur.getColumn(5).getInt(), laps));
+        const std::int64_t trialId = cur.getColumn(0).getInt64();
+        if (cur.getColumn(1).isNull())
+            throw StoreError(fmt::format("participant '{}' trial {} has not started; expected its "
+                                         "stimulus to be played first",
                                          code, trialIndex + 1));
-        SQLite::Statement later(*db_, "SELECT 1 FROM trials WHERE participant_id = ? AND "
-                                      "trial_index > ? AND started_at IS NOT NULL");
-        later.bind(1, p.id);
-        later.bind(2, trialIndex);
-        if (later.executeStep())
-            throw StoreError(fmt::format("participant '{}' trial {}: the answer is locked because "
-                                         "the next trial has started",
-                                         code, trialIndex + 1));
+        const bool changing = !cur.getColumn(2).isNull();
+        if (changing) {
+            if (protocol_->lock == LockRule::OnAnswer)
+                throw StoreError(fmt::format("participant '{}' trial {}: answers are locked once "
+                                             "given (protocol rule lock = \"answer\")",
+                                             code, trialIndex + 1));
+            SQLite::Statement later(*db_, "SELECT 1 FROM trials WHERE participant_id = ? AND "
+                                          "trial_index > ? AND started_at IS NOT NULL");
+            later.bind(1, p.id);
+            later.bind(2, trialIndex);
+            if (later.executeStep())
+                throw StoreError(
+                    fmt::format("participant '{}' trial {}: the answer is locked because "
+                                "the next trial has started",
+                                code, trialIndex + 1));
+        }
+        SQLite::Statement q(*db_,
+                            "UPDATE trials SET answered_at = ?, response_time_s = ?, answer = ?, "
+                            "soundscape_answer = ?, comment = ? WHERE id = ?");
+        q.bind(1, now());
+        if (responseTimeS) q.bind(2, *responseTimeS);
+        if (!answer.answer.empty()) q.bind(3, answer.answer);
+        if (!answer.soundscapeAnswer.empty()) q.bind(4, answer.soundscapeAnswer);
+        if (!answer.comment.empty()) q.bind(5, answer.comment);
+        q.bind(6, trialId);
+        q.exec();
+        SQLite::Statement del(*db_, "DELETE FROM ratings WHERE trial_id = ?");
+        del.bind(1, trialId);
+        del.exec();
+        SQLite::Statement rate(*db_,
+                               "INSERT INTO ratings (trial_id, scale, value) VALUES (?, ?, ?)");
+        std::string ratingsText;
+        for (const auto& [scale, value] : answer.ratings) {
+            rate.reset();
+            rate.bind(1, trialId);
+            rate.bind(2, scale);
+            rate.bind(3, value);
+            rate.exec();
+            ratingsText += fmt::format("{}{}={}", ratingsText.empty() ? "" : " ", scale, value);
+        }
+        appendEvent(changing ? "answer_changed" : "answered", p.id, trialIndex,
+                    jsonObject({{"answer", answer.answer},
+                                {"ratings", ratingsText},
+                                {"soundscape", answer.soundscapeAnswer},
+                                {"comment", answer.comment},
+                                {"response_time_s",
+                                 responseTimeS ? fmt::format("{:.3f}", *responseTimeS) : ""}}));
+        tx.commit();
+    } catch (const SQLite::Exception& e) {
+        writeFailed(
+            fmt::format("saving the answer of participant '{}' trial {}", code, trialIndex + 1), e);
     }
-    SQLite::Statement q(*db_, "UPDATE trials SET answered_at = ?, response_time_s = ?, answer = ?, "
-                              "soundscape_answer = ?, comment = ? WHERE id = ?");
-    q.bind(1, now());
-    if (responseTimeS) q.bind(2, *responseTimeS);
-    if (!answer.answer.empty()) q.bind(3, answer.answer);
-    if (!answer.soundscapeAnswer.empty()) q.bind(4, answer.soundscapeAnswer);
-    if (!answer.comment.empty()) q.bind(5, answer.comment);
-    q.bind(6, trialId);
-    q.exec();
-    SQLite::Statement del(*db_, "DELETE FROM ratings WHERE trial_id = ?");
-    del.bind(1, trialId);
-    del.exec();
-    SQLite::Statement rate(*db_, "INSERT INTO ratings (trial_id, scale, value) VALUES (?, ?, ?)");
-    std::string ratingsText;
-    for (const auto& [scale, value] : answer.ratings) {
-        rate.reset();
-        rate.bind(1, trialId);
-        rate.bind(2, scale);
-        rate.bind(3, value);
-        rate.exec();
-        ratingsText += fmt::format("{}{}={}", ratingsText.empty() ? "" : " ", scale, value);
-    }
-    appendEvent(changing ? "answer_changed" : "answered", p.id, trialIndex,
-                jsonObject({{"answer", answer.answer},
-                            {"ratings", ratingsText},
-                            {"soundscape", answer.soundscapeAnswer},
-                            {"comment", answer.comment},
-                            {"response_time_s",
-                             responseTimeS ? fmt::format("{:.3f}", *responseTimeS) : ""}}));
-    tx.commit();
+    checkpoint();
 }
 
 void StudyStore::recordReplay(const std::string& code, int trialIndex) {

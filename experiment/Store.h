@@ -36,9 +36,9 @@ struct StoreError : std::runtime_error {
 /// (expertise, listening device...); version 3 adds per-trial audio figures (TrialAudioStats),
 /// the sensor log reference and sensor-fault interruptions; version 4 flags simulated
 /// participants and stores with each session whether sound was played; version 5 adds the
-/// online tables of `underfoot serve` (experiment/Invitations.h). Older studies are migrated
-/// when opened.
-inline constexpr int kSchemaVersion = 5;
+/// online tables of `underfoot serve` (experiment/Invitations.h); version 6 (issue #16) adds
+/// session leases: one live session per participant. Older studies are migrated when opened.
+inline constexpr int kSchemaVersion = 6;
 
 /// Time source (injectable for tests).
 struct Clock {
@@ -128,6 +128,9 @@ struct SessionSettings {
     /// Whether the stimuli are played as sound (true), not at all (false: data entry, answers
     /// typed in without sound), or unknown (nullopt).
     std::optional<bool> soundPlayed = std::nullopt;
+    /// Take over the participant's session lease even when another live process holds it
+    /// (`underfoot session --take-over`, after a crash on another machine); journaled.
+    bool takeOver = false;
 };
 
 /// A stored session of a participant.
@@ -262,10 +265,16 @@ class StudyStore {
     std::string nextGroup(int participantIndex) const;
 
     /// Opens a session for a participant; returns its number (1, 2, ... per participant).
+    /// A participant's session is exclusive: it takes the participant's lease (a row in the
+    /// store naming process, host, experimenter and since when). A lease held by another live
+    /// process is refused with who holds it and since when, unless settings.takeOver; a lease
+    /// of a dead process on this host (a crash) is recovered; both are journaled. While another
+    /// store holds the lease, markTrialStarted and commitAnswer of this store are refused.
     int startSession(const std::string& code, const SessionSettings& settings);
     /// The sessions of a participant, in order.
     std::vector<SessionRecord> sessions(const std::string& code) const;
-    /// Closes a session; `completed` also marks the participant completed.
+    /// Closes a session (and releases the lease); `completed` also marks the participant
+    /// completed.
     void endSession(const std::string& code, int sessionNumber, bool completed);
 
     /// Marks a participant whose every trial is answered as completed (recovers a crash between
@@ -333,6 +342,13 @@ class StudyStore {
     std::vector<std::string> checkAnswerScales(const std::string& groupId,
                                                const TrialAnswer& answer,
                                                const std::vector<const Scale*>& asked) const;
+    /// Refuses a write for a participant whose lease another store holds (issue #16).
+    void checkLease(std::int64_t participantId, const std::string& code) const;
+    /// Re-throws a failed write as a StoreError naming the file, what was being written and
+    /// the cause (disk full, read-only file or folder, I/O error), with what to do.
+    [[noreturn]] void writeFailed(const std::string& what, const std::exception& e) const;
+    /// Copies the WAL into the main file so that nothing acknowledged lives only in -wal.
+    void checkpoint();
     void appendEvent(const std::string& kind, std::optional<std::int64_t> participantId,
                      std::optional<int> trialIndex, const std::string& detail);
     std::string now() const;
@@ -341,6 +357,7 @@ class StudyStore {
     std::unique_ptr<SQLite::Database> db_;
     Clock clock_;
     std::unique_ptr<Protocol> protocol_;
+    std::string leaseToken_; ///< identifies this store's session leases
 };
 
 /// Minimal JSON object writer for journal details: {"k":"v",...} with escaping.

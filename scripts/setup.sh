@@ -28,6 +28,8 @@ PACKAGES=(
   libcpp-httplib-dev chromium nodejs npm
   # realism: derivative-free fitting (underfoot fit)
   libnlopt-cxx-dev
+  # fuzzing (libFuzzer: tests/fuzz, scripts/test.sh's fuzz build)
+  clang-14 libclang-rt-14-dev
 )
 
 if [ "${UNDERFOOT_SKIP_APT:-0}" != "1" ]; then

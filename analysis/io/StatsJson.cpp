@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 #include <stdexcept>
@@ -311,15 +312,32 @@ json run(const std::string& test, const json& body) {
 
 } // namespace
 
+std::pair<std::size_t, std::size_t> jsonErrorPosition(std::string_view text, std::size_t byte) {
+    // nlohmann counts the byte it failed on from 1; 0 means before any input.
+    const std::size_t end = std::min(byte == 0 ? 0 : byte - 1, text.size());
+    std::size_t line = 1, column = 1;
+    for (std::size_t i = 0; i < end; ++i) {
+        if (text[i] == '\n') {
+            ++line;
+            column = 1;
+        } else {
+            ++column;
+        }
+    }
+    return {line, column};
+}
+
 StatsResponse runStatsRequest(std::string_view test, std::string_view requestJson) {
     try {
         const json body = json::parse(requestJson.begin(), requestJson.end());
         return {true,
                 run(std::string(test), body).dump(-1, ' ', false, json::error_handler_t::replace)};
     } catch (const json::parse_error& e) {
-        return {false,
-                json{{"error", fmt::format("invalid JSON at byte {}: {}", e.byte, e.what())}}.dump(
-                    -1, ' ', false, json::error_handler_t::replace)};
+        const auto [line, column] = jsonErrorPosition(requestJson, e.byte);
+        return {false, json{{"error", fmt::format("invalid JSON at line {}, column {} (byte {}): "
+                                                  "{}",
+                                                  line, column, e.byte, e.what())}}
+                           .dump(-1, ' ', false, json::error_handler_t::replace)};
     } catch (const RequestError& e) {
         return {false,
                 json{{"error", e.what()}}.dump(-1, ' ', false, json::error_handler_t::replace)};

@@ -4,6 +4,7 @@
 /// one result object out, so that scripts in any language use the same tested code.
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 namespace underfoot::analysis {
@@ -30,5 +31,9 @@ const std::vector<std::string>& statsTestNames();
 /// alternative, warnings; `adjusted` for p_adjust and `rho` for spearman. NaN is null and
 /// infinities are the strings "Inf" / "-Inf".
 StatsResponse runStatsRequest(std::string_view test, std::string_view requestJson);
+
+/// Line and column (both from 1) of the byte a JSON parser reports (nlohmann's parse_error::byte,
+/// counted from 1), for error messages that say where the request is wrong.
+std::pair<std::size_t, std::size_t> jsonErrorPosition(std::string_view text, std::size_t byte);
 
 } // namespace underfoot::analysis

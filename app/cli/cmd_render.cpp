@@ -178,7 +178,10 @@ CommandRegistrar regSurfaces("surfaces", [](CLI::App& app, int& exitCode) {
                        s.reverb ? fmt::format(" [reverb: {}]", s.reverb->impulseResponse) : "");
             if (*verbose) {
                 for (const auto& l : s.layerPurposes) fmt::print("    layer {}\n", l);
-                for (const auto& p : eng::Surface::load(s.file)->parameters())
+                // Keep the surface alive while iterating: a range-for over a member of a
+                // temporary reads freed memory (issue #16).
+                const auto surface = eng::Surface::load(s.file);
+                for (const auto& p : surface->parameters())
                     fmt::print("      {:<36} {:>12g} {:<14} [{:g}, {:g}]  {}\n", p.path, p.value,
                                p.unit, p.minValue, p.maxValue, p.help);
             }

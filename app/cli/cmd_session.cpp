@@ -42,6 +42,7 @@ struct Options {
     std::string audio = "default";
     std::string sensor = "default";
     bool ack = false;
+    bool takeOver = false; ///< take over another process's session lease (after a crash)
     bool showStimulus = false;
     bool simulate = false;
     std::vector<std::string> confusion;
@@ -283,7 +284,8 @@ int runInteractive(const Options& o) {
                                         : silent;
     Session session(store, o.participant, player,
                     {o.experimenter, o.live ? o.audio : "none (data entry, no sound)",
-                     o.clips.empty() ? o.sensor : "clips " + o.clips, UNDERFOOT_VERSION, o.live});
+                     o.clips.empty() ? o.sensor : "clips " + o.clips, UNDERFOOT_VERSION, o.live,
+                     o.takeOver});
     const Questions& q = p.questions;
     fmt::print("{} — participant {} (group {}), session {}{}\n", p.title, o.participant,
                session.participant().groupId, session.sessionNumber(),
@@ -508,6 +510,9 @@ const underfoot::cli::CommandRegistrar registrar{
         cmd->add_flag("--ack", o.ack,
                       "print 'ack CODE TRIAL' (1-based trial number) after each committed "
                       "answer");
+        cmd->add_flag("--take-over", o.takeOver,
+                      "take over the participant's session from another process that holds it "
+                      "(after a crash on another machine; journaled)");
         cmd->add_flag("--show-stimulus", o.showStimulus,
                       "show the stimulus id to the "
                       "experimenter");

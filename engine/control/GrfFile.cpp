@@ -48,6 +48,22 @@ void validateOptions(const std::string& path, const GrfLoadOptions& o) {
                                     o.bodyMassKg));
 }
 
+// The documented limits on what a GRF file may claim (checked before resampling, whose output
+// size and work follow duration x target rate).
+void checkGrfLimits(const std::string& path, double rateHz, std::size_t frames,
+                    const char* rateSource) {
+    // A relative tolerance: a CSV's 1 / median step is 100 Hz only to within rounding.
+    if (!(rateHz >= kMinGrfRateHz * (1 - 1e-6) && rateHz <= kMaxGrfRateHz * (1 + 1e-6)))
+        throw FileError(fmt::format("{}: sample rate {:g} Hz ({}); expected a GRF sampled at {:g} "
+                                    "to {:g} Hz",
+                                    path, rateHz, rateSource, kMinGrfRateHz, kMaxGrfRateHz));
+    const double seconds = static_cast<double>(frames) / rateHz;
+    if (!(seconds <= kMaxGrfSeconds))
+        throw FileError(fmt::format("{}: the GRF lasts {:.1f} s ({} samples at {:g} Hz); expected "
+                                    "at most {:g} s (split a longer recording)",
+                                    path, seconds, frames, rateHz, kMaxGrfSeconds));
+}
+
 // Resampling in stages of at most 256x (libsamplerate's limit), then clamping ringing below 0.
 GrfSignal resampleGrf(GrfSignal in, double targetRateHz) {
     if (in.sampleRateHz == targetRateHz) return in;
@@ -95,6 +111,7 @@ void checkNegative(const std::string& path, GrfSignal& grf, Where&& where) {
 
 GrfSignal loadAudioGrf(const std::string& path, const GrfLoadOptions& o) {
     const AudioBuffer audio = readAudioFile(path);
+    checkGrfLimits(path, audio.sampleRateHz, audio.frames(), "from the file's header");
     const auto ch = static_cast<std::size_t>(audio.channels);
     GrfSignal grf;
     grf.sampleRateHz = audio.sampleRateHz;
@@ -256,6 +273,7 @@ GrfSignal loadCsvGrf(const std::string& path, const GrfLoadOptions& o) {
                 path, rowLines[i + 1], steps[i], dt));
     // Interpolate onto the exact uniform grid of the median step, then resample.
     grf.sampleRateHz = 1.0 / dt;
+    checkGrfLimits(path, grf.sampleRateHz, times.size(), "1 / the median time step");
     const auto n =
         static_cast<std::size_t>(std::floor((times.back() - times.front()) / dt + 1e-9)) + 1;
     grf.channels.assign(grf.names.size(), std::vector<float>(n));

@@ -19,6 +19,10 @@
 /// clipped data (3 or more consecutive samples at digital full scale, |x| >= 0.9999, in audio
 /// files; pass allowClipped to accept them), negative forces beyond noise (below -2 % of the
 /// channel's peak; smaller negative values, the offset noise of force plates, are set to 0).
+/// Limits (outside input is bounded before anything is allocated or rendered from it): the
+/// file's sample rate (audio header, or 1 / median time step of a CSV) must lie in
+/// [kMinGrfRateHz, kMaxGrfRateHz] and the GRF must last at most kMaxGrfSeconds; audio files
+/// are further bounded by readAudioFile's limits and the file's real size.
 /// The signal is resampled to `targetRateHz` (libsamplerate, best sinc); the resampler's ringing
 /// below 0 N is clamped, since a ground reaction force never pulls.
 #include "engine/io/AudioFile.h"
@@ -27,6 +31,13 @@
 #include <vector>
 
 namespace underfoot::engine {
+
+/// Lowest and highest sample rate of a GRF file, Hz (force plates and FSR shoes sample at
+/// 100 Hz to a few kHz; audio-rate recordings at up to 192 kHz).
+inline constexpr double kMinGrfRateHz = 100.0;
+inline constexpr double kMaxGrfRateHz = 192000.0;
+/// Longest GRF file read, seconds (a trial or a recorded walk; a render from it is as long).
+inline constexpr double kMaxGrfSeconds = 900.0;
 
 /// A multichannel vertical GRF in newtons at one sample rate.
 struct GrfSignal {

@@ -274,7 +274,20 @@ AudioSettings loadAudioSettings(const std::string& path) {
                         path));
     std::stringstream ss;
     ss << in.rdbuf();
-    return parseAudioSettings(ss.str(), path);
+    const std::string text = ss.str();
+    AudioSettings settings = parseAudioSettings(text, path);
+    // An empty or truncated file is refused rather than silently read as the defaults
+    // (issue #16): the file `underfoot devices --save` writes always has an [audio] table.
+    const toml::table root = toml::parse(text, path);
+    const toml::table* audio = root["audio"].as_table();
+    if (!audio || audio->empty())
+        throw AudioSettingsError(fmt::format(
+            "{}: {} has no [audio] table with the device settings; expected the file "
+            "`underfoot devices --save` writes (was it emptied or cut short?)",
+            path,
+            text.find_first_not_of(" \t\r\n") == std::string::npos ? "the file is empty and"
+                                                                   : "the file"));
+    return settings;
 }
 
 std::string audioSettingsToToml(const AudioSettings& s) {

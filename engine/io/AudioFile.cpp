@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <system_error>
@@ -54,20 +55,44 @@ AudioBuffer readAudioFile(const std::string& path) {
     if (info.frames <= 0 || info.channels <= 0)
         throw FileError(
             fmt::format("{}: empty audio file (0 frames); expected at least one sample", path));
-    if (!(info.samplerate > 0))
-        throw FileError(fmt::format("{}: invalid sample rate {}", path, info.samplerate));
+    if (info.samplerate < kMinAudioFileRateHz || info.samplerate > kMaxAudioFileRateHz)
+        throw FileError(fmt::format("{}: sample rate {} Hz in the header; expected {} to {} Hz",
+                                    path, info.samplerate, kMinAudioFileRateHz,
+                                    kMaxAudioFileRateHz));
+    if (info.channels > kMaxAudioFileChannels)
+        throw FileError(fmt::format("{}: {} channels in the header; expected 1 to {}", path,
+                                    info.channels, kMaxAudioFileChannels));
+    const auto ch = static_cast<std::size_t>(info.channels);
+    const std::size_t maxFrames = kMaxAudioFileSamples / ch;
+    if (static_cast<std::uint64_t>(info.frames) > maxFrames)
+        throw FileError(fmt::format("{}: the header claims {} frames of {} channels; expected at "
+                                    "most {} samples in all (about {:.0f} s at this rate)",
+                                    path, info.frames, info.channels, kMaxAudioFileSamples,
+                                    static_cast<double>(maxFrames) / info.samplerate));
     AudioBuffer out;
     out.sampleRateHz = info.samplerate;
     out.channels = info.channels;
     const int subtype = info.format & SF_FORMAT_SUBMASK;
     out.floatingPoint = subtype == SF_FORMAT_FLOAT || subtype == SF_FORMAT_DOUBLE;
-    out.samples.resize(static_cast<std::size_t>(info.frames) *
-                       static_cast<std::size_t>(info.channels));
-    const sf_count_t got = sf_readf_float(file.get(), out.samples.data(), info.frames);
-    if (got <= 0)
+    // Read in chunks: memory follows the samples that are really there (a damaged header may
+    // claim far more than the file holds), capped at the frames the header claims.
+    constexpr sf_count_t kChunkFrames = 1 << 16;
+    std::size_t got = 0;
+    const auto claimed = static_cast<std::size_t>(info.frames);
+    while (got < claimed) {
+        const auto want =
+            static_cast<sf_count_t>(std::min<std::size_t>(kChunkFrames, claimed - got));
+        out.samples.resize((got + static_cast<std::size_t>(want)) * ch);
+        const sf_count_t n = sf_readf_float(file.get(), out.samples.data() + got * ch, want);
+        if (n <= 0) break;
+        got += static_cast<std::size_t>(n);
+        if (n < want) break;
+    }
+    if (got == 0)
         throw FileError(
             fmt::format("{}: could not read any sample ({})", path, sf_strerror(file.get())));
-    out.samples.resize(static_cast<std::size_t>(got) * static_cast<std::size_t>(info.channels));
+    out.samples.resize(got * ch);
+    out.samples.shrink_to_fit();
     for (std::size_t i = 0; i < out.samples.size(); ++i) {
         if (!std::isfinite(out.samples[i])) {
             const std::size_t frame = i / static_cast<std::size_t>(out.channels);

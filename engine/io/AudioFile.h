@@ -42,8 +42,19 @@ struct AudioBuffer {
     }
 };
 
+/// Limits of what readAudioFile accepts (a header is outside input: what it claims is checked
+/// against these and against the file's real size before anything is allocated).
+inline constexpr int kMinAudioFileRateHz = 100;    ///< lowest sample rate read
+inline constexpr int kMaxAudioFileRateHz = 768000; ///< highest sample rate read
+inline constexpr int kMaxAudioFileChannels = 64;   ///< most channels read
+/// Most samples (frames x channels) read from one file: 2^28 floats (1 GiB), e.g. 46 minutes
+/// of stereo at 48 kHz.
+inline constexpr std::size_t kMaxAudioFileSamples = std::size_t{1} << 28;
+
 /// Reads a WAV/FLAC/OGG (anything libsndfile reads) file. Throws FileError for a missing,
-/// unreadable or empty file, or one that holds NaN/Inf samples.
+/// unreadable or empty file, one that holds NaN/Inf samples, and one beyond the limits above
+/// (rate, channels, length). Memory grows with the samples actually decoded, never with the
+/// length a header claims.
 AudioBuffer readAudioFile(const std::string& path);
 
 /// Reads a file and resamples it to `targetRateHz` when its rate differs.

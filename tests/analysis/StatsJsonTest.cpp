@@ -250,3 +250,23 @@ TEST(StatsJson, PairwiseWilcoxonAdjustsAllPairsTogether) {
                   .find("same length"),
               std::string::npos);
 }
+
+// Issue #16: a parse error says where (line and column), a wrong type or a missing field names
+// the key.
+TEST(StatsJson, ParseErrorsGiveLineAndColumn) {
+    const std::string msg = error("chisq", "{\n  \"table\": [[1, 2],\n            [3, x]]\n}");
+    EXPECT_NE(msg.find("line 3, column 17"), std::string::npos) << msg;
+    EXPECT_NE(error("chisq", "").find("line 1, column 1"), std::string::npos);
+    const auto pos = jsonErrorPosition("ab\ncd", 5);
+    EXPECT_EQ(pos.first, 2u);
+    EXPECT_EQ(pos.second, 2u);
+}
+
+TEST(StatsJson, WrongTypeAndMissingFieldNameTheKey) {
+    EXPECT_NE(error("chisq", R"({"table": [[1, 2], [3, "x"]]})").find("'table[1][1]'"),
+              std::string::npos);
+    EXPECT_NE(error("chisq", R"({"table": 3})").find("'table'"), std::string::npos);
+    EXPECT_NE(error("t", R"({"y": [1, 2]})").find("missing field 'x'"), std::string::npos);
+    EXPECT_NE(error("binom", R"({"x": 3, "n": "ten"})").find("'n'"), std::string::npos);
+    EXPECT_NE(error("t", R"({"x": [1, 2, 3], "paired": 1})").find("'paired'"), std::string::npos);
+}

@@ -9,10 +9,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <fcntl.h>
 #include <map>
 #include <optional>
@@ -162,4 +164,62 @@ TEST(ExperimentCrash, SigkillAtRandomPointsLosesNoAcknowledgedAnswer) {
         EXPECT_EQ(p.status, ParticipantStatus::Completed) << p.code;
     }
     for (const auto& [code, index] : acknowledged) EXPECT_TRUE(after.trial(code, index).answered);
+}
+
+// The SIGKILL soak of issue #16 (label soak; run by ctest -L soak, not in the default run):
+// hundreds of kills at random moments (start-up, registration, inside commits, mid-session),
+// then every acknowledged answer must be present once and as typed: answered exactly once in
+// the journal (no "answer_changed"), the stored answer equal to the journaled one.
+// UNDERFOOT_SIGKILL_SOAK_KILLS sets the number of kills (default 300).
+TEST(ExperimentCrashSoak, DISABLED_HundredsOfSigkillsLoseAndDuplicateNothing) {
+    TempDir dir;
+    const std::string study = dir.file("soak.db");
+    {
+        StudyStore::create(study, loadProtocol(shipped("tvcg2011_exp1.toml")),
+                           {"SK", "ci", 16, "t"});
+    }
+    const std::string matrix = dataFile("tvcg2011_exp1_confusion.csv");
+    const char* env = std::getenv("UNDERFOOT_SIGKILL_SOAK_KILLS");
+    const int kills = env ? std::max(1, std::atoi(env)) : 300;
+    Rng rng(20261125);
+    std::set<std::pair<std::string, int>> acknowledged;
+    int totalAcks = 0, duplicated = 0, lost = 0, changed = 0;
+    for (int k = 0; k < kills; ++k) {
+        const bool fromFirstAck = k % 3 != 0;
+        const int killAfterMs = static_cast<int>(rng.below(fromFirstAck ? 150 : 300));
+        const ChildRun run = runChild(study, matrix, 100000, killAfterMs, fromFirstAck);
+        for (const auto& a : run.acks) acknowledged.insert(a);
+        totalAcks += static_cast<int>(run.acks.size());
+    }
+    StudyStore store = StudyStore::open(study);
+    std::map<std::pair<std::string, int>, std::vector<std::string>> journaled;
+    for (const auto& e : store.events()) {
+        if (e.kind == "answer_changed") ++changed;
+        if (e.kind == "answered" && e.trialIndex)
+            journaled[{e.participant, *e.trialIndex}].push_back(e.detail);
+    }
+    for (const auto& key : acknowledged) {
+        const TrialRecord t = store.trial(key.first, key.second);
+        if (!t.answered) {
+            ++lost;
+            ADD_FAILURE() << "acknowledged answer lost: " << key.first << " trial " << key.second;
+            continue;
+        }
+        const auto& j = journaled[key];
+        if (j.size() != 1) {
+            ++duplicated;
+            ADD_FAILURE() << key.first << " trial " << key.second << " answered " << j.size()
+                          << " times in the journal";
+            continue;
+        }
+        EXPECT_NE(j[0].find("\"answer\":\"" + t.answer.answer + "\""), std::string::npos)
+            << key.first << " trial " << key.second << ": stored answer '" << t.answer.answer
+            << "' differs from the journaled " << j[0];
+    }
+    EXPECT_EQ(changed, 0);
+    RecordProperty("kills", kills);
+    RecordProperty("acknowledged_answers", totalAcks);
+    std::printf("SIGKILL soak: %d kills, %d acknowledged answers (%zu distinct), %d lost, %d "
+                "duplicated, %d changed\n",
+                kills, totalAcks, acknowledged.size(), lost, duplicated, changed);
 }

@@ -57,6 +57,10 @@ TrialAnswer answerFor(const TrialRecord& t) {
 /// Turns a current file back into what version `version` (1 or 2) wrote.
 void downgrade(const std::string& path, int version) {
     SQLite::Database db(path, SQLite::OPEN_READWRITE);
+    db.exec("DROP TABLE IF EXISTS session_leases"); // version 6's (issue #16)
+    db.exec("DROP TABLE IF EXISTS online_answers"); // version 5's (issue #14)
+    db.exec("DROP TABLE IF EXISTS online_sessions");
+    db.exec("DROP TABLE IF EXISTS online_invitations");
     db.exec("ALTER TABLE participants DROP COLUMN simulated"); // version 4's (issue #17)
     db.exec("ALTER TABLE sessions DROP COLUMN sound_played");
     for (const char* column :

@@ -1,0 +1,64 @@
+#!/usr/bin/env bash
+# Issue #16 regressions through the `underfoot` program: each input used to crash, hang or
+# allocate without bound; each must now end normally or be refused with a message naming the
+# input. Usage: hardening_cli.sh <underfoot> <source dir> <work dir>
+set -uo pipefail
+underfoot="$1"
+src="$2"
+work="$3"
+rm -rf "$work" && mkdir -p "$work" && cd "$work" || exit 1
+fail=0
+check() { # check NAME EXPECTED_STATUS(ok|refused) PATTERN -- command...
+    local name="$1" want="$2" pattern="$3"
+    shift 4
+    timeout 120 "$@" > "$name.out" 2>&1
+    local st=$?
+    if [ "$st" -ge 124 ]; then
+        echo "FAIL $name: status $st (crash, sanitizer report or timeout)"; cat "$name.out" | tail -30; fail=1; return
+    fi
+    if [ "$want" = ok ] && [ "$st" != 0 ]; then
+        echo "FAIL $name: status $st, expected success"; tail -30 "$name.out"; fail=1; return
+    fi
+    if [ "$want" = refused ] && [ "$st" = 0 ]; then
+        echo "FAIL $name: accepted, expected a refusal"; tail -30 "$name.out"; fail=1; return
+    fi
+    if [ -n "$pattern" ] && ! grep -q -- "$pattern" "$name.out"; then
+        echo "FAIL $name: output lacks \"$pattern\""; tail -30 "$name.out"; fail=1; return
+    fi
+    echo "ok   $name"
+}
+
+# 1. `underfoot surfaces -v` read freed memory (range-for over a temporary's parameters).
+check surfaces_verbose ok "layer" -- "$underfoot" surfaces -v
+
+# 2. A study whose user_version is not ours indexed the migrations at -1.
+"$underfoot" study create --study damaged.db --protocol "$src/protocols/tvcg2011_exp1.toml" \
+    --code D1 --site lab --seed 1 > /dev/null || { echo "FAIL: study create"; exit 1; }
+sqlite3 damaged.db "PRAGMA user_version = -1" || exit 1
+check export_damaged refused "damaged.db: not an Underfoot study (schema version -1" -- \
+    "$underfoot" export --study damaged.db -o out/
+
+# 3. A GRF WAV claiming 1 Hz (and one claiming a 4 GB data chunk).
+# Little-endian fields written with printf (no python needed on a fresh machine).
+le() { # le VALUE BYTES
+    local v=$1 i
+    for ((i = 0; i < $2; i++)); do printf "\\x$(printf %02x $(((v >> (8 * i)) & 255)))"; done
+}
+wav() { # wav FILE RATE FRAMES CLAIMED_DATA_BYTES  (16-bit PCM mono)
+    {
+        printf 'RIFF'; le $((36 + $4)) 4; printf 'WAVEfmt '; le 16 4; le 1 2; le 1 2
+        le "$2" 4; le $(($2 * 2)) 4; le 2 2; le 16 2; printf 'data'; le "$4" 4
+        for ((i = 0; i < $3; i++)); do le $(((i * 97) % 3000)) 2; done
+    } > "$1"
+}
+wav one_hz.wav 1 400 800
+wav huge_claim.wav 1000 400 $((0xfffffff0))
+check grf_one_hz refused "one_hz.wav: sample rate 1 Hz" -- \
+    "$underfoot" render --surface wood --grf one_hz.wav -o one_hz_out.wav
+check grf_huge_claim ok "" -- "$underfoot" render --surface wood --grf huge_claim.wav -o huge_out.wav -q
+
+# 4. `underfoot stats` names line and column of a parse error, and the key of a wrong type.
+check stats_parse refused "line 2, column 12" -- bash -c "printf '{\"table\":\n [[8, 12], x]}' | '$underfoot' stats chisq"
+check stats_type refused "'table\[1\]\[0\]'" -- bash -c "echo '{\"table\": [[8, 12], [\"a\", 2]]}' | '$underfoot' stats chisq"
+
+exit $fail

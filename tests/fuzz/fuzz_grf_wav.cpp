@@ -1,0 +1,12 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// GRF audio file (engine/control/GrfFile.h: loadGrfFile on a .wav, through readAudioFile);
+// refusal: FileError naming the file. Allocation and work are bounded by the documented limits.
+#include "FuzzSupport.h"
+#include "engine/control/GrfFile.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+    using namespace underfoot;
+    const std::string path = fuzz::writeInput("grf.wav", data, size);
+    fuzz::expectReadOrRefusal<engine::FileError>(path, [&] { (void)engine::loadGrfFile(path); });
+    return 0;
+}
