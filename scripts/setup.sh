@@ -25,7 +25,7 @@ PACKAGES=(
   googletest libgtest-dev libgmock-dev libbenchmark-dev valgrind
   # online listening tests (`underfoot serve`, app/web): HTTP server; the browser test drives
   # Debian's Chromium with puppeteer-core from npm (tests/web/browser)
-  libcpp-httplib-dev chromium nodejs npm
+  libcpp-httplib-dev chromium
   # realism: derivative-free fitting (underfoot fit)
   libnlopt-cxx-dev
   # fuzzing (libFuzzer: tests/fuzz, scripts/test.sh's fuzz build)
@@ -40,6 +40,14 @@ if [ "${UNDERFOOT_SKIP_APT:-0}" != "1" ]; then
   for p in "${PACKAGES[@]}"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
   done
+  # Node.js and npm drive the browser test (puppeteer-core). Many machines already carry a
+  # newer Node.js than Debian's (whose npm package would conflict with it): install Debian's
+  # only when there is none.
+  if ! command -v npm > /dev/null; then
+    for p in nodejs npm; do
+      dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+    done
+  fi
   if [ ${#missing[@]} -gt 0 ]; then
     echo "setup: installing ${#missing[@]} Debian packages: ${missing[*]}"
     $SUDO apt-get update -qq
