@@ -495,6 +495,12 @@ LogisticFit fitLogistic(const Design& d, int nAGQ, bool derivatives) {
         return deviance(v);
     };
     fit.opt = minimise(f, x, lower, 0.2);
+    if (fit.opt.x[0] > 0) { // a flat deviance near the boundary: the optimum is theta = 0
+        auto x0 = fit.opt.x;
+        x0[0] = 0.0;
+        const double f0 = f(x0);
+        if (f0 <= fit.opt.value + 1e-9) fit.opt.x = x0, fit.opt.value = f0;
+    }
     if (!fit.opt.converged) fit.warnings.push_back("convergence failure: " + fit.opt.message);
     if (!derivatives) return fit;
     VectorXd gradient;

@@ -5,6 +5,7 @@
 #include "analysis/io/TrialCsv.h"
 #include "analysis/ratings/RatingAnalysis.h"
 #include "analysis/report/Export.h"
+#include "analysis/report/MixedModelReport.h"
 #include "analysis/report/RatingReport.h"
 #include "analysis/tables/Tables.h"
 #include "app/cli/CommandRegistry.h"
@@ -192,10 +193,12 @@ int analyze(const AnalyzeOptions& o) {
                                                    analysis::labelFor(analysis::kDontKnowId)});
             }
             report = analysis::analyzeTrials(trials, options);
+            analysis::addMixedModelComparisons(report, trials, options); // issue #15
             report.source = o.study;
         } else if (!o.trials.empty()) {
             const auto trials = analysis::readTrialCsv(o.trials);
             report = analysis::analyzeTrials(trials, options);
+            analysis::addMixedModelComparisons(report, trials, options); // issue #15
             report.source = o.trials;
         } else {
             std::vector<analysis::ConfusionMatrix> tables;

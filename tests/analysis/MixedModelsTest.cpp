@@ -97,10 +97,12 @@ TEST_P(MixedModelReference, MatchesR) {
     const bool singular = c.at("singular").get<bool>();
     EXPECT_EQ(anyWarningContains(r, "boundary (singular) fit"), singular);
     if (compare == "loglik") {
-        // separation: the estimates diverge (R stops wherever its optimiser gives up); the
-        // log-likelihood tends to its supremum and the LRT is stable.
+        // separation or one answer per participant: the estimates diverge or lie on a flat
+        // ridge (R stops wherever its optimiser gives up); the log-likelihood tends to its
+        // supremum and the LRT is stable.
         expectClose(r.logLik, value(c.at("loglik")), 0, 2e-3, "logLik");
-        EXPECT_TRUE(anyWarningContains(r, "separation"));
+        if (GetParam().find("separation") != std::string::npos)
+            EXPECT_TRUE(anyWarningContains(r, "separation"));
         if (c.contains("lrt"))
             expectClose(r.lrt.statistic, value(c.at("lrt").at("statistic")), 0, 5e-3, "LRT");
         return;
