@@ -51,7 +51,7 @@ Outcome analyse(const std::vector<SimulatedAnswer>& answers, int groups,
         d.participant.push_back(fmt::format("p{:06d}", a.participant));
         if (surface) d.surface.push_back(fmt::format("s{:03d}", std::max(a.surface, 0)));
     }
-    const auto fit = fitLogisticMixedModel(d, options.nAGQ);
+    const auto fit = fitLogisticMixedModel(d, options.nAGQ, false); // LRT only
     if (!fit.ok() || std::isnan(fit.lrt.p)) {
         o.mixedFailed = true;
         return o;

@@ -546,7 +546,7 @@ void gaussHermiteRule(int points, std::vector<double>& nodes, std::vector<double
     if (points % 2 == 1) nodes[static_cast<std::size_t>(points / 2)] = 0.0;
 }
 
-MixedModelResult fitLogisticMixedModel(const MixedModelData& data, int nAGQ) {
+MixedModelResult fitLogisticMixedModel(const MixedModelData& data, int nAGQ, bool standardErrors) {
     MixedModelResult r;
     r.nAGQ = nAGQ;
     r.statisticName = "z";
@@ -582,7 +582,7 @@ MixedModelResult fitLogisticMixedModel(const MixedModelData& data, int nAGQ) {
     }
     r.warnings = d.warnings;
     separationWarnings(d, r.warnings);
-    LogisticFit fit = fitLogistic(d, nAGQ, true);
+    LogisticFit fit = fitLogistic(d, nAGQ, standardErrors);
     const double theta = fit.opt.x[0];
     r.randomVariance = theta * theta;
     r.deviance = fit.opt.value;

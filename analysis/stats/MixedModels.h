@@ -65,8 +65,11 @@ struct MixedModelResult {
 };
 
 /// Logistic GLMM, lme4::glmer(y ~ condition (+ surface) + (1 | participant), family =
-/// binomial, nAGQ = nAGQ). nAGQ in 1..25 (R's limit); y must be 0 or 1.
-MixedModelResult fitLogisticMixedModel(const MixedModelData& data, int nAGQ = 1);
+/// binomial, nAGQ = nAGQ). nAGQ in 1..25 (R's limit); y must be 0 or 1. Without
+/// `standardErrors` the Hessian (SEs, Wald tests, convergence checks) is skipped: estimates,
+/// variance, logLik and LRT only (power simulations).
+MixedModelResult fitLogisticMixedModel(const MixedModelData& data, int nAGQ = 1,
+                                       bool standardErrors = true);
 
 /// Linear mixed model by REML, lmerTest::lmer(y ~ condition (+ surface) + (1 | participant));
 /// the LRT refits both models by ML as R's anova() does.

@@ -95,14 +95,18 @@ TEST_P(MixedModelReference, MatchesR) {
     ASSERT_TRUE(r.ok()) << r.error;
     const std::string compare = c.at("compare").get<std::string>();
     const bool singular = c.at("singular").get<bool>();
-    EXPECT_EQ(anyWarningContains(r, "boundary (singular) fit"), singular);
+    // (on the flat ridge of a non-identified design, R's theta stops near the 1e-4 threshold)
+    if (compare != "loglik" || GetParam().find("separation") != std::string::npos) {
+        EXPECT_EQ(anyWarningContains(r, "boundary (singular) fit"), singular);
+    }
     if (compare == "loglik") {
         // separation or one answer per participant: the estimates diverge or lie on a flat
         // ridge (R stops wherever its optimiser gives up); the log-likelihood tends to its
         // supremum and the LRT is stable.
         expectClose(r.logLik, value(c.at("loglik")), 0, 2e-3, "logLik");
-        if (GetParam().find("separation") != std::string::npos)
+        if (GetParam().find("separation") != std::string::npos) {
             EXPECT_TRUE(anyWarningContains(r, "separation"));
+        }
         if (c.contains("lrt"))
             expectClose(r.lrt.statistic, value(c.at("lrt").at("statistic")), 0, 5e-3, "LRT");
         return;
