@@ -462,7 +462,14 @@ void separationWarnings(const Design& d, std::vector<std::string>& warnings) {
         double n = 0, s = 0;
         for (Eigen::Index i = 0; i < d.X.rows(); ++i)
             if (d.X(i, c) != 0) n += 1, s += d.y(i);
-        if (n > 0 && (s == 0 || s == n)) separated.push_back(d.names[static_cast<std::size_t>(c)]);
+        if (n > 0 && (s == 0 || s == n))
+            separated.push_back(d.names[static_cast<std::size_t>(c)] + " = 1");
+    }
+    { // the reference cell (every dummy 0)
+        double n = 0, s = 0;
+        for (Eigen::Index i = 0; i < d.X.rows(); ++i)
+            if (d.X.row(i).tail(d.X.cols() - 1).isZero()) n += 1, s += d.y(i);
+        if (n > 0 && (s == 0 || s == n)) separated.emplace_back("the reference levels");
     }
     double total = d.y.sum();
     if (total == 0 || total == dbl(d.y.size()))
@@ -471,7 +478,7 @@ void separationWarnings(const Design& d, std::vector<std::string>& warnings) {
             total == 0 ? 0 : 1));
     else if (!separated.empty())
         warnings.push_back(fmt::format(
-            "quasi-complete separation: every answer is the same where {} = 1 (its estimate "
+            "quasi-complete separation: every answer is the same where {} (its estimate "
             "diverges and its Wald test is meaningless; use the likelihood-ratio test)",
             fmt::join(separated, ", ")));
 }
