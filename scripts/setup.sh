@@ -14,6 +14,8 @@ PACKAGES=(
   libtomlplusplus-dev libcli11-dev libfmt-dev nlohmann-json3-dev
   # statistics and real-time containers
   libboost-dev
+  # mixed-effects models (analysis/stats/MixedModels): linear algebra and optimisation
+  libeigen3-dev libnlopt-cxx-dev
   # storage
   libsqlite3-dev libsqlitecpp-dev sqlite3
   # SHA-256 of protocol texts (experiment/)

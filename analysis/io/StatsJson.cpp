@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "analysis/io/StatsJson.h"
 
+#include "analysis/io/StatsJsonMixed.h"
 #include "analysis/stats/Tests.h"
 
 #include <fmt/format.h>
@@ -16,11 +17,23 @@ namespace underfoot::analysis {
 using nlohmann::json;
 
 const std::vector<std::string>& statsTestNames() {
-    static const std::vector<std::string> names{"binom",  "chisq",    "chisq_gof",
-                                                "fisher", "friedman", "kruskal",
-                                                "levene", "p_adjust", "pairwise_wilcoxon",
-                                                "prop",   "shapiro",  "spearman",
-                                                "t",      "wilcoxon", "wilson"};
+    static const std::vector<std::string> names{"binom",
+                                                "chisq",
+                                                "chisq_gof",
+                                                "fisher",
+                                                "friedman",
+                                                "glmm",
+                                                "kruskal",
+                                                "levene",
+                                                "lmm",
+                                                "p_adjust",
+                                                "pairwise_wilcoxon",
+                                                "prop",
+                                                "shapiro",
+                                                "spearman",
+                                                "t",
+                                                "wilcoxon",
+                                                "wilson"};
     return names;
 }
 
@@ -328,6 +341,7 @@ std::pair<std::size_t, std::size_t> jsonErrorPosition(std::string_view text, std
 }
 
 StatsResponse runStatsRequest(std::string_view test, std::string_view requestJson) {
+    if (isMixedModelTest(test)) return runMixedModelRequest(test, requestJson); // mixed models
     try {
         const json body = json::parse(requestJson.begin(), requestJson.end());
         return {true,

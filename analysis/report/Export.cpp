@@ -188,12 +188,53 @@ TextTable comparisonTable(const AnalysisReport& r) {
     return t;
 }
 
+TextTable mixedModelTable(const AnalysisReport& r) {
+    TextTable t;
+    t.caption = "Mixed models beside the comparisons (participant as random intercept): "
+                "logistic (glmer) on correct answers, linear (lmer, REML, Satterthwaite df) on "
+                "ratings; estimate = group B against group A (log-odds ratio / mean difference); "
+                "LRT = likelihood-ratio test of the group; \"all\" has surface as a fixed factor";
+    t.header = {"Measure", "Surface",  "Groups", "Model",   "Estimate (SE)",    "z / t",
+                "df",      "p (Wald)", "LRT X²", "p (LRT)", "Participant var.", "Classic p",
+                "Warnings"};
+    t.numeric = {false, false, false, false, true, true, true, true, true, true, true, true, false};
+    for (const auto& m : r.mixedModels) {
+        std::vector<std::string> row{measureName(m.measure),
+                                     m.surfaceId.empty() ? "all" : labelFor(m.surfaceId),
+                                     m.groupA + " vs " + m.groupB, m.model};
+        if (!m.error.empty()) {
+            row.push_back(m.error);
+            for (int k = 0; k < 7; ++k) row.push_back("");
+            row.push_back(std::isnan(m.classicP) ? "" : pValue(m.classicP));
+            row.push_back("");
+        } else {
+            row.push_back(fixed(m.estimate, 3) + " (" + fixed(m.se, 3) + ")");
+            row.push_back(fixed(m.statistic, 3));
+            row.push_back(std::isnan(m.df) ? "" : fixed(m.df, 1));
+            row.push_back(pValue(m.p));
+            row.push_back(fixed(m.lrtStatistic, 3));
+            row.push_back(pValue(m.lrtP));
+            row.push_back(fixed(m.randomVariance, 3));
+            row.push_back(std::isnan(m.classicP) ? "" : pValue(m.classicP));
+            std::string w;
+            for (const auto& x : m.warnings) {
+                std::string one = x.substr(0, x.find('\n'));
+                w += (w.empty() ? "" : "; ") + one;
+            }
+            row.push_back(w);
+        }
+        t.rows.push_back(std::move(row));
+    }
+    return t;
+}
+
 std::vector<TextTable> allTables(const AnalysisReport& r) {
     std::vector<TextTable> tables;
     for (const auto& m : r.confusions) tables.push_back(confusionTable(m));
     for (const auto& m : r.categories) tables.push_back(categoryTable(m));
     tables.push_back(summaryTable(r));
     if (!r.comparisons.empty()) tables.push_back(comparisonTable(r));
+    if (!r.mixedModels.empty()) tables.push_back(mixedModelTable(r));
     return tables;
 }
 
@@ -277,6 +318,29 @@ std::string renderCsv(const AnalysisReport& r) {
         if (!std::isnan(c.fisherP)) row("fisher_p", c.fisherP);
         row(c.effectName == "phi" ? "phi" : "cohens_d", c.effect);
     }
+    for (const auto& m : r.mixedModels) {
+        const std::string groups = m.groupA + " vs " + m.groupB;
+        std::string note = m.model;
+        if (!m.error.empty()) note += ": " + m.error;
+        for (const auto& w : m.warnings) note += "; " + w.substr(0, w.find('\n'));
+        auto row = [&](const char* stat, double v) {
+            tidy(out, "mixed_model", groups, m.surfaceId.empty() ? "all" : m.surfaceId, "",
+                 measureName(m.measure), stat, v, note);
+        };
+        row("observations", m.observations);
+        row("participants", m.participants);
+        row("estimate", m.estimate);
+        row("se", m.se);
+        row("statistic", m.statistic);
+        if (!std::isnan(m.df)) row("df", m.df);
+        row("p", m.p);
+        row("lrt_statistic", m.lrtStatistic);
+        row("lrt_p", m.lrtP);
+        row("random_variance", m.randomVariance);
+        row("classic_p", m.classicP);
+    }
+    if (!r.mixedModelAdvice.empty())
+        tidy(out, "mixed_model_advice", "", "", "", "", "", std::nan(""), r.mixedModelAdvice);
     return out;
 }
 
@@ -302,6 +366,8 @@ std::string renderLatex(const AnalysisReport& r) {
         }
         out += "\\bottomrule\n\\end{tabular}\n\\end{table}\n\n";
     }
+    if (!r.mixedModelAdvice.empty())
+        out += "\\paragraph{Which test to cite.} " + latexEscape(r.mixedModelAdvice) + "\n";
     return out;
 }
 
@@ -324,6 +390,7 @@ std::string renderMarkdown(const AnalysisReport& r) {
         }
         out += "\n";
     }
+    if (!r.mixedModelAdvice.empty()) out += "**" + markdownCell(r.mixedModelAdvice) + "**\n";
     return out;
 }
 
@@ -389,6 +456,13 @@ std::string renderHtml(const AnalysisReport& r) {
     for (const auto& m : r.categories) out += htmlTable(categoryTable(m));
     out += "<h2>Summary</h2>\n" + htmlTable(summaryTable(r));
     if (!r.comparisons.empty()) out += "<h2>Tests</h2>\n" + htmlTable(comparisonTable(r));
+    if (!r.mixedModels.empty()) {
+        out += "<h2>Mixed models</h2>\n";
+        if (!r.mixedModelAdvice.empty())
+            out +=
+                "<p class=\"advice\"><strong>" + xmlEscape(r.mixedModelAdvice) + "</strong></p>\n";
+        out += htmlTable(mixedModelTable(r));
+    }
     out += "</body>\n</html>\n";
     return out;
 }

@@ -96,6 +96,28 @@ struct ComparisonRow {
     double pHolm = std::numeric_limits<double>::quiet_NaN(); ///< Holm across surfaces
 };
 
+/// The mixed model beside a between-group comparison (issue #15): the participant as a random
+/// intercept, groupB's coefficient against groupA (log-odds ratio for correct answers, mean
+/// difference for ratings). Filled by addMixedModelComparisons (report/MixedModelReport.h).
+struct MixedComparisonRow {
+    Measure measure = Measure::Correct;
+    std::string surfaceId; ///< empty = all surfaces, surface as a fixed factor
+    std::string groupA, groupB;
+    double observations = 0, participants = 0;
+    std::string model; ///< "glmer (Laplace)" / "lmer (REML, Satterthwaite)"
+    double estimate = std::numeric_limits<double>::quiet_NaN();
+    double se = std::numeric_limits<double>::quiet_NaN();
+    double statistic = std::numeric_limits<double>::quiet_NaN(); ///< Wald z or t
+    double df = std::numeric_limits<double>::quiet_NaN();        ///< Satterthwaite (ratings)
+    double p = std::numeric_limits<double>::quiet_NaN();         ///< Wald p
+    double lrtStatistic = std::numeric_limits<double>::quiet_NaN();
+    double lrtP = std::numeric_limits<double>::quiet_NaN();
+    double randomVariance = std::numeric_limits<double>::quiet_NaN();
+    double classicP = std::numeric_limits<double>::quiet_NaN(); ///< the matching chi-square / t p
+    std::vector<std::string> warnings;
+    std::string error;
+};
+
 /// Options of an analysis.
 struct AnalysisOptions {
     AnswerList answers = defaultAnswerList();
@@ -115,6 +137,8 @@ struct AnalysisReport {
     std::vector<CategoryMatrix> categories;
     std::vector<SummaryRow> summary;
     std::vector<ComparisonRow> comparisons;
+    std::vector<MixedComparisonRow> mixedModels; ///< mixed models beside the comparisons
+    std::string mixedModelAdvice;                ///< which test to cite, and why
     bool hasRatings = false;
     std::vector<std::string> notes; ///< import warnings and remarks shown with the report
 };

@@ -5,6 +5,7 @@
 #include "analysis/io/TrialCsv.h"
 #include "analysis/ratings/RatingAnalysis.h"
 #include "analysis/report/Export.h"
+#include "analysis/report/MixedModelReport.h"
 #include "analysis/report/RatingReport.h"
 #include "analysis/tables/Tables.h"
 #include "app/cli/CommandRegistry.h"
@@ -209,6 +210,7 @@ int analyze(const AnalyzeOptions& o) {
                                                    analysis::labelFor(analysis::kDontKnowId)});
             }
             report = analysis::analyzeTrials(trials, options);
+            analysis::addMixedModelComparisons(report, trials, options); // issue #15
             report.source = o.study;
         } else if (!o.trials.empty()) {
             auto trials = analysis::readTrialCsv(o.trials);
@@ -222,6 +224,7 @@ int analyze(const AnalyzeOptions& o) {
                                before - trials.size());
             }
             report = analysis::analyzeTrials(trials, options);
+            analysis::addMixedModelComparisons(report, trials, options); // issue #15
             report.source = o.trials;
         } else {
             std::vector<analysis::ConfusionMatrix> tables;

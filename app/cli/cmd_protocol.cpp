@@ -1,14 +1,24 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // `underfoot protocol check FILE`: validates a protocol and prints its plan summary.
+// `underfoot protocol power FILE --effect ...`: how many participants (issue #15).
+#include "analysis/power/Power.h"
 #include "app/cli/CommandRegistry.h"
+#include "experiment/Catalogue.h"
 #include "experiment/Plan.h"
 #include "experiment/Protocol.h"
+#include "experiment/Random.h"
+#include "experiment/Simulation.h"
 
 #include <fmt/core.h>
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <map>
+#include <memory>
+#include <thread>
 
 namespace {
 
@@ -87,6 +97,278 @@ void printSummary(const Protocol& p, std::uint64_t seed, int participants) {
     }
 }
 
+// ------------------------------------------------------------------ power (issue #15)
+
+struct PowerArgs {
+    std::string file;
+    std::vector<std::string> effect{"published"};
+    std::string participants = "10..60";
+    int simulations = 2000;
+    std::uint64_t seed = 1;
+    unsigned threads = 0;
+    double participantSd = 0.8;
+    double alpha = 0.05;
+    double target = 0.8;
+    std::vector<std::string> groups;
+    bool noMixed = false;
+    int nAGQ = 1;
+    std::string publishedDir = std::string(UNDERFOOT_SOURCE_DIR) + "/tests/analysis/data/published";
+};
+
+/// "10..60" (step 10), "10..60:5" or "10,15,20".
+std::vector<int> parseSizes(const std::string& text) {
+    std::vector<int> out;
+    auto number = [&](const std::string& t) {
+        std::size_t used = 0;
+        int v = 0;
+        try {
+            v = std::stoi(t, &used);
+        } catch (const std::exception&) {
+            used = 0;
+        }
+        if (used != t.size() || v < 2 || v > 100000)
+            throw underfoot::cli::UserError(fmt::format(
+                "--participants {}: '{}' is not a group size (an integer from 2)", text, t));
+        return v;
+    };
+    if (const auto dots = text.find(".."); dots != std::string::npos) {
+        std::string rest = text.substr(dots + 2);
+        int step = 10;
+        if (const auto colon = rest.find(':'); colon != std::string::npos) {
+            step = number(rest.substr(colon + 1));
+            rest = rest.substr(0, colon);
+        }
+        const int from = number(text.substr(0, dots)), to = number(rest);
+        if (to < from)
+            throw underfoot::cli::UserError(
+                fmt::format("--participants {}: the range is empty", text));
+        for (int v = from; v <= to; v += step) out.push_back(v);
+        if (out.back() != to) out.push_back(to);
+    } else {
+        std::size_t start = 0;
+        while (start <= text.size()) {
+            const auto comma = text.find(',', start);
+            out.push_back(number(text.substr(start, comma - start)));
+            if (comma == std::string::npos) break;
+            start = comma + 1;
+        }
+    }
+    return out;
+}
+
+/// The published confusion matrices of the reference studies, by protocol and group.
+std::map<std::string, std::string> publishedFiles(const std::string& protocolId) {
+    if (protocolId == "tvcg2011_exp2")
+        return {{"none", "tvcg2011_exp2_cond1_no_soundscape_confusion.csv"},
+                {"coherent", "tvcg2011_exp2_cond2_coherent_confusion.csv"},
+                {"incoherent", "tvcg2011_exp2_cond3_incoherent_confusion.csv"}};
+    if (protocolId == "eurohaptics2010")
+        return {{"audio", "eurohaptics2010_audio_confusion.csv"},
+                {"haptic", "eurohaptics2010_haptic_confusion.csv"},
+                {"audiohaptic", "eurohaptics2010_audiohaptic_confusion.csv"}};
+    return {};
+}
+
+/// A participant's own matrix: the row's share of correct answers shifted by `ability` on the
+/// logit scale (a row with every answer correct or none counts as half an answer off, so that it
+/// can move), the wrong answers keeping their proportions: participants differ as real ones do.
+ConfusionMatrix withAbility(const ConfusionMatrix& m, double ability) {
+    if (ability == 0.0) return m;
+    ConfusionMatrix out = m;
+    for (auto& row : out.rows) {
+        double correct = 0, total = 0;
+        std::size_t rightColumn = row.counts.size(), wrongColumn = row.counts.size();
+        for (std::size_t c = 0; c < row.counts.size(); ++c) {
+            total += row.counts[c];
+            const bool right = answerIsCorrect(m.answers[c], row.surface);
+            if (right) correct += row.counts[c];
+            if (right && rightColumn == row.counts.size()) rightColumn = c;
+            if (!right && m.answers[c] == kDontKnow) wrongColumn = c;
+        }
+        if (total <= 0 || rightColumn == row.counts.size()) continue;
+        const double p = std::clamp(correct / total, 0.5 / total, 1.0 - 0.5 / total);
+        const double shifted = 1.0 / (1.0 + std::exp(-(std::log(p / (1 - p)) + ability)));
+        const double wrong = total - correct;
+        for (std::size_t c = 0; c < row.counts.size(); ++c) {
+            const bool right = answerIsCorrect(m.answers[c], row.surface);
+            if (right)
+                row.counts[c] = correct > 0 ? row.counts[c] * shifted * total / correct : 0.0;
+            else
+                row.counts[c] = wrong > 0 ? row.counts[c] * (1 - shifted) * total / wrong : 0.0;
+        }
+        if (correct <= 0) row.counts[rightColumn] = shifted * total;
+        if (wrong <= 0 && wrongColumn < row.counts.size())
+            row.counts[wrongColumn] = (1 - shifted) * total;
+    }
+    return out;
+}
+
+int runPower(const PowerArgs& a) {
+    Protocol p;
+    try {
+        p = loadProtocol(a.file);
+    } catch (const ProtocolError& e) {
+        throw underfoot::cli::UserError(e.what());
+    }
+    if (!p.questions.asksSurface())
+        throw underfoot::cli::UserError(fmt::format(
+            "{}: protocol {} asks no surface question; power is computed for correct answers",
+            a.file, p.id));
+    std::vector<const Group*> groups;
+    for (const auto& g : p.groups)
+        if (a.groups.empty() || std::find(a.groups.begin(), a.groups.end(), g.id) != a.groups.end())
+            groups.push_back(&g);
+    for (const auto& id : a.groups)
+        if (!p.group(id))
+            throw underfoot::cli::UserError(
+                fmt::format("--groups: '{}' is not a group of protocol {}", id, p.id));
+    if (groups.size() < 2)
+        throw underfoot::cli::UserError(
+            fmt::format("protocol {} has {} group(s) to compare; power needs at least two", p.id,
+                        groups.size()));
+    // --effect: "published", or [GROUP=]FILE confusion matrices (published CSV format)
+    std::map<std::string, ConfusionMatrix> matrices;
+    for (const auto& spec : a.effect) {
+        if (spec == "published") {
+            const auto files = publishedFiles(p.id);
+            if (files.empty())
+                throw underfoot::cli::UserError(fmt::format(
+                    "--effect published: no published confusion matrices for protocol {} (known: "
+                    "tvcg2011_exp2, eurohaptics2010); give --effect GROUP=FILE per group",
+                    p.id));
+            for (const auto& [group, name] : files) {
+                try {
+                    matrices[group] = loadConfusionMatrix(a.publishedDir + "/" + name);
+                } catch (const std::runtime_error& e) {
+                    throw underfoot::cli::UserError(
+                        fmt::format("--effect published: {} (see --published-dir)", e.what()));
+                }
+            }
+            continue;
+        }
+        const auto eq = spec.find('=');
+        const std::string group = eq == std::string::npos ? "" : spec.substr(0, eq);
+        const std::string path = eq == std::string::npos ? spec : spec.substr(eq + 1);
+        if (!group.empty() && !p.group(group))
+            throw underfoot::cli::UserError(
+                fmt::format("--effect {}: '{}' is not a group of protocol {}", spec, group, p.id));
+        try {
+            matrices[group] = loadConfusionMatrix(path);
+        } catch (const std::runtime_error& e) {
+            throw underfoot::cli::UserError(fmt::format("--effect {}: {}", spec, e.what()));
+        }
+    }
+    std::vector<const ConfusionMatrix*> byGroup;
+    for (const Group* g : groups) {
+        auto it = matrices.count(g->id) ? matrices.find(g->id) : matrices.find("");
+        if (it == matrices.end())
+            throw underfoot::cli::UserError(fmt::format(
+                "--effect: no confusion matrix for group '{}' (give {}=FILE)", g->id, g->id));
+        Protocol one = p;
+        one.groups = {*g};
+        if (auto problems = checkMatrixAgainst(it->second, one); !problems.empty())
+            throw underfoot::cli::UserError(fmt::format("{}", fmt::join(problems, "\n")));
+        byGroup.push_back(&it->second);
+    }
+    // surfaces as indices for the mixed model's surface factor
+    std::map<std::string, int> surfaceIndex;
+    for (const Group* g : groups)
+        for (const auto& s : groupStimuli(p, *g))
+            surfaceIndex.try_emplace(s.surface, static_cast<int>(surfaceIndex.size()));
+
+    const double sd = a.participantSd;
+    const underfoot::analysis::StudySimulator simulate = [&](int perGroup, std::uint64_t seed) {
+        std::vector<underfoot::analysis::SimulatedAnswer> answers;
+        int participant = 0;
+        for (std::size_t gi = 0; gi < groups.size(); ++gi) {
+            for (int i = 0; i < perGroup; ++i, ++participant) {
+                const std::uint64_t ps = deriveSeed(seed, {gi, static_cast<std::uint64_t>(i)});
+                Rng abilityRng(deriveSeed(ps, {0xAB1E}));
+                const ConfusionMatrix own = withAbility(*byGroup[gi], sd * abilityRng.gaussian());
+                SimulatedParticipant answerer(own, p, groups[gi]->id, deriveSeed(ps, {0xA5}));
+                for (const auto& planned : generatePlan(p, groups[gi]->id, seed, i)) {
+                    if (planned.practice) continue;
+                    TrialRecord trial;
+                    trial.index = planned.index;
+                    trial.block = planned.block;
+                    trial.stimulus = planned.stimulus;
+                    trial.repetition = planned.repetition;
+                    const TrialAnswer answer = answerer.answer(trial);
+                    underfoot::analysis::SimulatedAnswer out;
+                    out.participant = participant;
+                    out.group = static_cast<int>(gi);
+                    out.surface = surfaceIndex.at(planned.stimulus.surface);
+                    out.correct = answerIsCorrect(answer.answer, planned.stimulus.surface);
+                    answers.push_back(out);
+                }
+            }
+        }
+        return answers;
+    };
+
+    underfoot::analysis::PowerOptions o;
+    o.participantsPerGroup = parseSizes(a.participants);
+    o.simulations = a.simulations;
+    o.seed = a.seed;
+    o.threads = a.threads;
+    o.alpha = a.alpha;
+    o.target = a.target;
+    o.mixedModel = !a.noMixed;
+    o.nAGQ = a.nAGQ;
+    const auto started = std::chrono::steady_clock::now();
+    int lastPercent = -1;
+    o.progress = [&](std::size_t done, std::size_t total) {
+        const int percent = static_cast<int>(100 * done / total);
+        if (percent == lastPercent) return;
+        lastPercent = percent;
+        const int width = 40, filled = percent * width / 100;
+        fmt::print(stderr, "\r[{:<{}}] {:3d}% {} / {} studies",
+                   std::string(static_cast<std::size_t>(filled), '#'), width, percent, done, total);
+        if (done == total) fmt::print(stderr, "\n");
+        std::fflush(stderr);
+    };
+    const auto curve =
+        underfoot::analysis::simulatePower(simulate, static_cast<int>(groups.size()), o);
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+
+    std::vector<std::string> names;
+    for (const Group* g : groups) names.push_back(g->id);
+    fmt::print("power of {} — groups {} ({} simulated studies per size, seed {}, alpha {:g})\n",
+               p.id, fmt::join(names, ", "), a.simulations, a.seed, a.alpha);
+    fmt::print("answers from {}; participants differ: SD {:g} of ability on the logit scale\n",
+               fmt::join(a.effect, ", "), sd);
+    fmt::print("classic: {}\nmixed:   {}\n\n", curve.classicMethod,
+               o.mixedModel ? curve.mixedMethod : std::string("(not fitted: --no-mixed)"));
+    fmt::print("{:>12}  {:>7} {:>17} {:>17}", "per group", "classic", "Wilson 95%",
+               "Clopper-Pearson");
+    if (o.mixedModel)
+        fmt::print("  {:>7} {:>17} {:>17} {:>8}", "mixed", "Wilson 95%", "Clopper-Pearson",
+                   "singular");
+    fmt::print("\n");
+    auto interval = [](const underfoot::analysis::Interval& i) {
+        return fmt::format("[{:.3f}, {:.3f}]", i.lower, i.upper);
+    };
+    for (const auto& pt : curve.points) {
+        fmt::print("{:>12}  {:>7.3f} {:>17} {:>17}", pt.participantsPerGroup, pt.classic.power,
+                   interval(pt.classic.wilson), interval(pt.classic.clopperPearson));
+        if (o.mixedModel)
+            fmt::print("  {:>7.3f} {:>17} {:>17} {:>8}", pt.mixed.power, interval(pt.mixed.wilson),
+                       interval(pt.mixed.clopperPearson), pt.mixedSingular);
+        fmt::print("\n");
+    }
+    auto smallest = [&](int n) {
+        return n < 0 ? fmt::format("none of the simulated sizes reaches {:g} %", 100 * a.target)
+                     : fmt::format("{} participants per group", n);
+    };
+    fmt::print("\nsmallest group size reaching {:g} % power: classic test {}", 100 * a.target,
+               smallest(curve.smallestClassic));
+    if (o.mixedModel) fmt::print("; mixed model {}", smallest(curve.smallestMixed));
+    fmt::print("\n({:.1f} s on {} thread(s))\n", seconds,
+               a.threads ? a.threads : std::max(1u, std::thread::hardware_concurrency()));
+    return 0;
+}
+
 const underfoot::cli::CommandRegistrar registrar{
     "protocol", [](CLI::App& app, int& exitCode) {
         auto* cmd = app.add_subcommand("protocol", "Protocol files: validate and summarise");
@@ -104,6 +386,53 @@ const underfoot::cli::CommandRegistrar registrar{
                          "participants per group for the balance table (default: the group "
                          "target, else 20)")
             ->check(CLI::Range(0, 100000));
+        auto* power = cmd->add_subcommand(
+            "power", "How many participants: simulate whole studies (synthetic participants, "
+                     "per-participant variability) and give the power of the classic test and of "
+                     "the mixed model per group size, with Monte-Carlo intervals");
+        static PowerArgs pa;
+        power->add_option("FILE", pa.file, "protocol TOML file")->required();
+        power->add_option("--effect", pa.effect,
+                          "'published' (the reference study's confusion matrices) or "
+                          "[GROUP=]FILE confusion matrix CSV per group (repeat)");
+        power
+            ->add_option("--participants", pa.participants,
+                         "group sizes: FROM..TO (step 10), FROM..TO:STEP or a,b,c")
+            ->capture_default_str();
+        power->add_option("--simulations", pa.simulations, "simulated studies per group size")
+            ->check(CLI::Range(1, 1000000))
+            ->capture_default_str();
+        power->add_option("--seed", pa.seed, "seed of the simulations")->capture_default_str();
+        power->add_option("--threads", pa.threads, "worker threads (0 = all cores)")
+            ->capture_default_str();
+        power
+            ->add_option("--participant-sd", pa.participantSd,
+                         "SD of participants' ability on the logit scale (0 = identical)")
+            ->check(CLI::Range(0.0, 10.0))
+            ->capture_default_str();
+        power->add_option("--alpha", pa.alpha, "significance level")
+            ->check(CLI::Range(1e-6, 0.5))
+            ->capture_default_str();
+        power->add_option("--target", pa.target, "power to reach")
+            ->check(CLI::Range(0.01, 0.999))
+            ->capture_default_str();
+        power->add_option("--groups", pa.groups, "compare only these groups (ids, comma separated)")
+            ->delimiter(',');
+        power->add_flag("--no-mixed", pa.noMixed, "classic test only (faster)");
+        power->add_option("--nagq", pa.nAGQ, "quadrature points of the mixed model (1 = Laplace)")
+            ->check(CLI::Range(1, 25))
+            ->capture_default_str();
+        power
+            ->add_option("--published-dir", pa.publishedDir,
+                         "folder of the published confusion matrices")
+            ->capture_default_str();
+        power->callback([&exitCode] {
+            try {
+                exitCode = runPower(pa);
+            } catch (const std::invalid_argument& e) {
+                throw underfoot::cli::UserError(e.what());
+            }
+        });
         check->callback([&exitCode] {
             Protocol p;
             try {

@@ -38,7 +38,12 @@ const cli::CommandRegistrar registrar("stats", [](CLI::App& app, int& exitCode) 
         "Examples:\n"
         "  echo '{\"table\": [[8,12],[18,2]]}' | underfoot stats chisq\n"
         "  echo '{\"x\": [1.83,0.50,1.62], \"y\": [0.878,0.647,0.598], \"paired\": true}' | "
-        "underfoot stats wilcoxon");
+        "underfoot stats wilcoxon\n"
+        "  echo '{\"y\": [1,0,1,1,0,1,1,1], \"condition\": "
+        "[\"a\",\"a\",\"b\",\"b\",\"a\",\"a\",\"b\",\"b\"], "
+        "\"participant\": [1,1,2,2,3,3,4,4], \"nAGQ\": 10}' | underfoot stats glmm\n"
+        "  (glmm / lmm: mixed models with a random intercept per participant, as lme4::glmer / "
+        "lmerTest::lmer; see analysis/io/StatsJsonMixed.h)");
     cmd->callback([&exitCode, test] { exitCode = runStats(*test); });
 });
 

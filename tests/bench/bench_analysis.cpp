@@ -1,9 +1,12 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Speed of the analysis: a full study (200 participants x 26 trials = 5,200 trials, two groups)
-// from CSV text to every table, test and export, and the exact tests at their largest exact n.
+// from CSV text to every table, test and export, and the exact tests at their largest exact n;
+// the logistic mixed model (60 participants x 16 trials, nAGQ = 10) and a power curve (issue #15).
 //   build-analysis/tests/bench/bench_analysis
 #include "analysis/io/TrialCsv.h"
+#include "analysis/power/Power.h"
 #include "analysis/report/Export.h"
+#include "analysis/stats/MixedModels.h"
 #include "analysis/stats/Tests.h"
 #include "analysis/tables/Tables.h"
 #include "engine/dsp/Random.h"
@@ -128,6 +131,75 @@ void shapiroN5000(benchmark::State& state) {
     for (auto _ : state) benchmark::DoNotOptimize(shapiroTest(x).p);
 }
 BENCHMARK(shapiroN5000)->Unit(benchmark::kMicrosecond);
+
+/// 60 participants x 16 trials (4 surfaces x 2 conditions x 2 repetitions, condition within or
+/// between participants), random intercepts SD 1, seeded.
+MixedModelData glmmData(bool within) {
+    engine::Random rng(20261125);
+    MixedModelData d;
+    const char* surfaces[] = {"s1", "s2", "s3", "s4"};
+    for (int p = 0; p < 60; ++p) {
+        const double b = rng.gaussian();
+        for (int t = 0; t < 16; ++t) {
+            const int condition = within ? t % 2 : p % 2;
+            const int surface = (t / 2) % 4;
+            const double eta = 0.4 + 0.7 * condition - 0.3 * surface + b;
+            d.y.push_back(rng.uniform() < 1 / (1 + std::exp(-eta)) ? 1 : 0);
+            d.condition.push_back(condition ? "b" : "a");
+            d.participant.push_back("p" + std::to_string(p));
+            d.surface.push_back(surfaces[surface]);
+        }
+    }
+    return d;
+}
+
+void glmm60x16Agq10Between(benchmark::State& state) {
+    const auto d = glmmData(false);
+    for (auto _ : state) benchmark::DoNotOptimize(fitLogisticMixedModel(d, 10).logLik);
+}
+BENCHMARK(glmm60x16Agq10Between)->Unit(benchmark::kMillisecond);
+
+void glmm60x16Agq10Within(benchmark::State& state) {
+    const auto d = glmmData(true);
+    for (auto _ : state) benchmark::DoNotOptimize(fitLogisticMixedModel(d, 10).logLik);
+}
+BENCHMARK(glmm60x16Agq10Within)->Unit(benchmark::kMillisecond);
+
+void lmm60x16(benchmark::State& state) {
+    auto d = glmmData(true);
+    engine::Random rng(7);
+    for (auto& y : d.y) y = 4 + y + rng.gaussian();
+    for (auto _ : state) benchmark::DoNotOptimize(fitLinearMixedModel(d).logLik);
+}
+BENCHMARK(lmm60x16)->Unit(benchmark::kMillisecond);
+
+/// Power curve: 6 group sizes (10..60) x 2,000 simulated studies of two groups, 10 answers per
+/// participant over 5 surfaces, participant SD 0.8; chi-square and glmer (Laplace) LRT each, on
+/// all cores. (`underfoot protocol power` adds the protocol's plans and synthetic participants.)
+void powerCurve6x2000(benchmark::State& state) {
+    const StudySimulator sim = [](int perGroup, std::uint64_t seed) {
+        engine::Random rng(seed);
+        std::vector<SimulatedAnswer> out;
+        for (int g = 0; g < 2; ++g)
+            for (int i = 0; i < perGroup; ++i) {
+                const double b = 0.8 * rng.gaussian();
+                for (int k = 0; k < 10; ++k) {
+                    const double eta = 0.8 + 0.4 * g - 0.2 * (k % 5) + b;
+                    out.push_back(
+                        {g * perGroup + i, g, k % 5, rng.uniform() < 1 / (1 + std::exp(-eta))});
+                }
+            }
+        return out;
+    };
+    PowerOptions o;
+    o.simulations = 2000;
+    for (auto _ : state) {
+        const auto curve = simulatePower(sim, 2, o);
+        state.counters["smallest_mixed"] = curve.smallestMixed;
+        state.counters["smallest_classic"] = curve.smallestClassic;
+    }
+}
+BENCHMARK(powerCurve6x2000)->Unit(benchmark::kSecond)->Iterations(1);
 
 } // namespace
 

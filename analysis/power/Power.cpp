@@ -1,0 +1,159 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "analysis/power/Power.h"
+
+#include "analysis/stats/MixedModels.h"
+#include "analysis/stats/Tests.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <atomic>
+#include <mutex>
+#include <stdexcept>
+#include <thread>
+
+namespace underfoot::analysis {
+
+namespace {
+
+std::uint64_t splitmix(std::uint64_t x) {
+    x += 0x9E3779B97F4A7C15ULL;
+    x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ULL;
+    x = (x ^ (x >> 27)) * 0x94D049BB133111EBULL;
+    return x ^ (x >> 31);
+}
+
+struct Outcome {
+    bool classic = false;
+    bool mixed = false;
+    bool mixedFailed = false;
+    bool mixedSingular = false;
+};
+
+Outcome analyse(const std::vector<SimulatedAnswer>& answers, int groups,
+                const PowerOptions& options) {
+    Outcome o;
+    CountTable table(static_cast<std::size_t>(groups), std::vector<double>(2, 0.0));
+    for (const auto& a : answers)
+        table.at(static_cast<std::size_t>(a.group))[a.correct ? 0 : 1] += 1;
+    const auto chi =
+        chisqTest(table, options.yates ? Continuity::Corrected : Continuity::Uncorrected);
+    o.classic = chi.ok() && chi.p < options.alpha;
+    if (!options.mixedModel) return o;
+    MixedModelData d;
+    const bool surface =
+        options.withSurface && std::any_of(answers.begin(), answers.end(),
+                                           [](const SimulatedAnswer& a) { return a.surface >= 0; });
+    d.y.reserve(answers.size());
+    for (const auto& a : answers) {
+        d.y.push_back(a.correct ? 1.0 : 0.0);
+        d.condition.push_back(fmt::format("g{:03d}", a.group));
+        d.participant.push_back(fmt::format("p{:06d}", a.participant));
+        if (surface) d.surface.push_back(fmt::format("s{:03d}", std::max(a.surface, 0)));
+    }
+    const auto fit = fitLogisticMixedModel(d, options.nAGQ, false); // LRT only
+    if (!fit.ok() || std::isnan(fit.lrt.p)) {
+        o.mixedFailed = true;
+        return o;
+    }
+    o.mixed = fit.lrt.p < options.alpha;
+    o.mixedSingular = fit.randomVariance < 1e-8;
+    return o;
+}
+
+PowerEstimate estimate(double significant, double studies, double confLevel) {
+    PowerEstimate e;
+    e.significant = significant;
+    e.studies = studies;
+    e.power = studies > 0 ? significant / studies : 0.0;
+    e.wilson = wilsonInterval(significant, studies, confLevel);
+    const auto exact = binomTest(significant, studies, 0.5, Alternative::TwoSided, confLevel);
+    if (exact.confInt) e.clopperPearson = *exact.confInt;
+    return e;
+}
+
+} // namespace
+
+std::uint64_t powerTaskSeed(std::uint64_t seed, int participantsPerGroup, int simulation) {
+    std::uint64_t s = splitmix(seed);
+    s = splitmix(s ^ static_cast<std::uint64_t>(participantsPerGroup));
+    return splitmix(s ^ (static_cast<std::uint64_t>(simulation) << 20));
+}
+
+PowerCurve simulatePower(const StudySimulator& simulator, int groups, const PowerOptions& options) {
+    if (groups < 2) throw std::invalid_argument("power needs at least two groups to compare");
+    if (options.simulations < 1) throw std::invalid_argument("--simulations must be at least 1");
+    PowerCurve curve;
+    curve.groups = groups;
+    curve.classicMethod =
+        groups == 2 && options.yates
+            ? "chisq.test on the pooled counts (Yates' continuity correction), as the papers"
+            : "chisq.test on the pooled counts (groups x correct/not correct)";
+    curve.mixedMethod = fmt::format("glmer(correct ~ group{} + (1 | participant), binomial, "
+                                    "nAGQ = {}): likelihood-ratio test of group",
+                                    options.withSurface ? " (+ surface)" : "", options.nAGQ);
+    const std::size_t sizes = options.participantsPerGroup.size();
+    const auto sims = static_cast<std::size_t>(options.simulations);
+    const std::size_t total = sizes * sims;
+    std::vector<Outcome> outcomes(total);
+    std::atomic<std::size_t> next{0};
+    std::mutex progressLock;
+    std::size_t done = 0;
+    std::exception_ptr failure;
+    auto worker = [&] {
+        for (;;) {
+            const std::size_t task = next.fetch_add(1);
+            if (task >= total) return;
+            const int size = options.participantsPerGroup[task / sims];
+            const int sim = static_cast<int>(task % sims);
+            try {
+                const auto answers = simulator(size, powerTaskSeed(options.seed, size, sim));
+                outcomes[task] = analyse(answers, groups, options);
+            } catch (...) {
+                std::lock_guard lock(progressLock);
+                if (!failure) failure = std::current_exception();
+                next.store(total);
+                return;
+            }
+            std::lock_guard lock(progressLock);
+            ++done;
+            if (options.progress) options.progress(done, total);
+        }
+    };
+    unsigned threads = options.threads ? options.threads : std::thread::hardware_concurrency();
+    threads = std::max(1u, std::min<unsigned>(threads, static_cast<unsigned>(total)));
+    std::vector<std::thread> pool;
+    for (unsigned t = 1; t < threads; ++t) pool.emplace_back(worker);
+    worker();
+    for (auto& t : pool) t.join();
+    if (failure) std::rethrow_exception(failure);
+    for (std::size_t s = 0; s < sizes; ++s) {
+        PowerPoint p;
+        p.participantsPerGroup = options.participantsPerGroup[s];
+        double classic = 0, mixed = 0;
+        for (std::size_t k = 0; k < sims; ++k) {
+            const Outcome& o = outcomes[s * sims + k];
+            classic += o.classic ? 1 : 0;
+            mixed += o.mixed ? 1 : 0;
+            p.mixedFailures += o.mixedFailed ? 1 : 0;
+            p.mixedSingular += o.mixedSingular ? 1 : 0;
+        }
+        p.classic = estimate(classic, static_cast<double>(sims), options.confLevel);
+        if (options.mixedModel)
+            p.mixed = estimate(mixed, static_cast<double>(sims), options.confLevel);
+        curve.points.push_back(p);
+    }
+    std::vector<PowerPoint> sorted = curve.points;
+    std::sort(sorted.begin(), sorted.end(), [](const auto& a, const auto& b) {
+        return a.participantsPerGroup < b.participantsPerGroup;
+    });
+    for (const auto& p : sorted) {
+        if (curve.smallestClassic < 0 && p.classic.power >= options.target)
+            curve.smallestClassic = p.participantsPerGroup;
+        if (options.mixedModel && curve.smallestMixed < 0 && p.mixed.power >= options.target)
+            curve.smallestMixed = p.participantsPerGroup;
+    }
+    return curve;
+}
+
+} // namespace underfoot::analysis
