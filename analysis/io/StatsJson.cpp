@@ -17,23 +17,11 @@ namespace underfoot::analysis {
 using nlohmann::json;
 
 const std::vector<std::string>& statsTestNames() {
-    static const std::vector<std::string> names{"binom",
-                                                "chisq",
-                                                "chisq_gof",
-                                                "fisher",
-                                                "friedman",
-                                                "glmm",
-                                                "kruskal",
-                                                "levene",
-                                                "lmm",
-                                                "p_adjust",
-                                                "pairwise_wilcoxon",
-                                                "prop",
-                                                "shapiro",
-                                                "spearman",
-                                                "t",
-                                                "wilcoxon",
-                                                "wilson"};
+    static const std::vector<std::string> names{
+        "binom",   "chisq",   "chisq_gof", "fisher",   "friedman", "glmm",
+        "kendall", "kruskal", "levene",    "lmm",      "p_adjust", "pairwise_wilcoxon",
+        "pearson", "prop",    "shapiro",   "spearman", "t",        "wilcoxon",
+        "wilson"};
     return names;
 }
 
@@ -199,6 +187,15 @@ json run(const std::string& test, const json& body) {
     }
     if (test == "fisher") {
         const Request q(body, {"table", "conf_level", "alternative"});
+        const auto table = q.matrix("table");
+        // r x c tables (issue #15): exact p by enumeration, two-sided only, as R.
+        if (table.size() != 2 || std::any_of(table.begin(), table.end(),
+                                             [](const auto& row) { return row.size() != 2; })) {
+            if (q.alternative() != Alternative::TwoSided)
+                throw RequestError("'alternative' other than \"two.sided\" is only for 2 x 2 "
+                                   "tables (as R's fisher.test)");
+            return resultJson(test, fisherTestRxC(table));
+        }
         return resultJson(
             test, fisherTest(q.matrix("table"), q.number("conf_level", 0.95), q.alternative()));
     }
@@ -217,17 +214,23 @@ json run(const std::string& test, const json& body) {
         return resultJson(test, tTest(q.numbers("x"), q.numbers("y"), o));
     }
     if (test == "wilcoxon") {
-        const Request q(body, {"x", "y", "paired", "correct", "exact", "mu", "alternative"});
+        const Request q(body, {"x", "y", "paired", "correct", "exact", "mu", "alternative",
+                               "conf_int", "conf_level"});
         WilcoxonOptions o;
         o.alternative = q.alternative();
         o.mu = q.number("mu", 0);
         o.pairing = q.flag("paired", false) ? Pairing::Paired : Pairing::Independent;
         o.continuity = continuity(q);
         o.exactness = q.exactness();
-        if (!q.has("y")) {
-            if (o.pairing == Pairing::Paired) throw RequestError("'y' is missing for paired test");
-            return resultJson(test, wilcoxonTest(q.numbers("x"), o));
+        if (!q.has("y") && o.pairing == Pairing::Paired)
+            throw RequestError("'y' is missing for paired test");
+        if (q.flag("conf_int", false)) { // Hodges-Lehmann estimate and interval (issue #15)
+            const double level = q.number("conf_level", 0.95);
+            if (!q.has("y")) return resultJson(test, wilcoxonTestCi(q.numbers("x"), o, level));
+            return resultJson(test, wilcoxonTestCi(q.numbers("x"), q.numbers("y"), o, level));
         }
+        if (q.has("conf_level")) throw RequestError("'conf_level' needs \"conf_int\": true");
+        if (!q.has("y")) return resultJson(test, wilcoxonTest(q.numbers("x"), o));
         return resultJson(test, wilcoxonTest(q.numbers("x"), q.numbers("y"), o));
     }
     if (test == "pairwise_wilcoxon") {
@@ -267,6 +270,20 @@ json run(const std::string& test, const json& body) {
         const auto r = spearmanTest(q.numbers("x"), q.numbers("y"), q.alternative(), q.exactness());
         json out = resultJson(test, r);
         out["rho"] = number(r.estimate.empty() ? std::nan("") : r.estimate[0].value);
+        return out;
+    }
+    if (test == "pearson") {
+        const Request q(body, {"x", "y", "alternative", "conf_level"});
+        return resultJson(test, pearsonTest(q.numbers("x"), q.numbers("y"), q.alternative(),
+                                            q.number("conf_level", 0.95)));
+    }
+    if (test == "kendall") {
+        const Request q(body, {"x", "y", "alternative", "exact", "continuity"});
+        const auto r = kendallTest(q.numbers("x"), q.numbers("y"), q.alternative(), q.exactness(),
+                                   q.flag("continuity", false) ? Continuity::Corrected
+                                                               : Continuity::Uncorrected);
+        json out = resultJson(test, r);
+        out["tau"] = number(r.estimate.empty() ? std::nan("") : r.estimate[0].value);
         return out;
     }
     if (test == "p_adjust") {

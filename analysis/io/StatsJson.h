@@ -19,17 +19,20 @@ struct StatsResponse {
 const std::vector<std::string>& statsTestNames();
 
 /// Runs one test on a JSON request. Input fields (all optional ones take R's defaults):
-/// chisq {table, correct}, chisq_gof {x, p}, fisher {table, conf_level, alternative},
+/// chisq {table, correct}, chisq_gof {x, p}, fisher {table, conf_level, alternative} (r x c
+/// tables: exact two-sided p only, see fisherTestRxC),
 /// t {x, y?, paired, var_equal, mu, conf_level, alternative},
-/// wilcoxon {x, y?, paired, correct, exact?, mu, alternative}, kruskal {groups},
+/// wilcoxon {x, y?, paired, correct, exact?, mu, alternative, conf_int, conf_level} (conf_int:
+/// Hodges-Lehmann estimate and interval), kruskal {groups},
+/// pearson {x, y, alternative, conf_level}, kendall {x, y, alternative, exact?, continuity},
 /// friedman {y}, spearman {x, y, alternative, exact?}, p_adjust {p, method},
 /// pairwise_wilcoxon {groups, paired, correct, exact?, method},
 /// shapiro {x}, levene {groups, center}, binom {x, n, p, conf_level, alternative},
 /// prop {x, n, p, correct, conf_level, alternative}, wilson {x, n, conf_level, correct}.
 /// null in a numeric array is a missing value (R's NA). Output: statistic, statistic_name, df
 /// (number or array), p, conf_int, conf_level, estimate (+ estimate_names), method,
-/// alternative, warnings; `adjusted` for p_adjust and `rho` for spearman. NaN is null and
-/// infinities are the strings "Inf" / "-Inf".
+/// alternative, warnings; `adjusted` for p_adjust, `rho` for spearman, `tau` for kendall. NaN is
+/// null and infinities are the strings "Inf" / "-Inf".
 StatsResponse runStatsRequest(std::string_view test, std::string_view requestJson);
 
 /// Line and column (both from 1) of the byte a JSON parser reports (nlohmann's parse_error::byte,

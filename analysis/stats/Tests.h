@@ -130,4 +130,46 @@ double phiCoefficient(const CountTable& table);
 /// Cramér's V of an r x c table (uncorrected chi-square).
 double cramersV(const CountTable& table);
 
+// ---------------------------------------------------------------- issue #15 "holes" (stats2)
+
+/// Largest table total and number of tables with the observed margins that fisherTestRxC
+/// enumerates; beyond them it refuses with a message (as R reports FEXACT's workspace limit).
+inline constexpr double kMaxFisherRxCTotal = 1000;
+inline constexpr double kMaxFisherRxCTables = 1e8;
+
+/// fisher.test(table) on an r x c table (any size >= 2 x 2): two-sided exact p-value, the sum
+/// of the probabilities of every table with the observed margins that is at most as probable as
+/// the observed one (relative tolerance 1e-7, as R's FEXACT). Enumerates the tables; refuses
+/// totals above kMaxFisherRxCTotal or more than `maxTables` tables (about 4e7 tables a second
+/// here). No estimate.
+TestResult fisherTestRxC(const CountTable& table, double maxTables = kMaxFisherRxCTables);
+
+/// Largest n for which kendallTest computes the exact distribution (R's default: n < 50).
+inline constexpr std::size_t kMaxExactKendallN = 100;
+
+/// cor.test(x, y, method = "pearson", alternative, conf.level): r, t on n - 2 df, p, and the
+/// Fisher-z interval (for n > 3, as R).
+TestResult pearsonTest(std::span<const double> x, std::span<const double> y,
+                       Alternative alternative = Alternative::TwoSided, double confLevel = 0.95);
+
+/// cor.test(x, y, method = "kendall", alternative, exact, continuity): tau-b; exact p (statistic
+/// T) for n < 50 without ties, otherwise the normal approximation z with R's tie-corrected
+/// variance (and continuity correction when asked; R's default continuity = FALSE).
+TestResult kendallTest(std::span<const double> x, std::span<const double> y,
+                       Alternative alternative = Alternative::TwoSided,
+                       Exactness exactness = Exactness::Auto,
+                       Continuity continuity = Continuity::Uncorrected);
+
+/// wilcox.test(x, mu, conf.int = TRUE, conf.level): the signed-rank test of wilcoxonTest plus
+/// the Hodges-Lehmann "(pseudo)median" and its interval: exact (Walsh averages at qsignrank's
+/// quantiles) when the p-value is exact without ties or zeros, else R's inversion of the
+/// normal approximation with uniroot(tol = 1e-4), with R's level adjustments and warnings.
+TestResult wilcoxonTestCi(std::span<const double> x, const WilcoxonOptions& options = {},
+                          double confLevel = 0.95);
+/// wilcox.test(x, y, conf.int = TRUE, ...): paired (signed rank on x - y) or two-sample
+/// ("difference in location": exact from the m n differences and qwilcox without ties,
+/// otherwise the normal approximation inverted with uniroot).
+TestResult wilcoxonTestCi(std::span<const double> x, std::span<const double> y,
+                          const WilcoxonOptions& options = {}, double confLevel = 0.95);
+
 } // namespace underfoot::analysis
