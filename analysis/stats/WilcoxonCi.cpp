@@ -337,6 +337,25 @@ bool validLevel(double c) {
     return std::isfinite(c) && c > 0 && c < 1;
 }
 
+/// R's order of warnings: those of the interval computation first, then each "cannot compute
+/// exact p-value with X" of the test followed by its "cannot compute exact confidence interval
+/// with X". `base` are the test's warnings, r.warnings those the interval added.
+void orderWarningsAsR(TestResult& r, const std::vector<std::string>& base) {
+    std::vector<std::string> out, exactCi;
+    for (const auto& w : r.warnings)
+        (w.rfind("cannot compute exact confidence interval", 0) == 0 ? exactCi : out).push_back(w);
+    for (const auto& w : base) {
+        out.push_back(w);
+        const std::string prefix = "cannot compute exact p-value with ";
+        if (w.rfind(prefix, 0) == 0) {
+            const std::string ci =
+                "cannot compute exact confidence interval with " + w.substr(prefix.size());
+            if (std::find(exactCi.begin(), exactCi.end(), ci) != exactCi.end()) out.push_back(ci);
+        }
+    }
+    r.warnings = std::move(out);
+}
+
 TestResult signedRankWithCi(TestResult r, const std::vector<double>& d, const WilcoxonOptions& o,
                             double confLevel) {
     std::vector<double> x;
@@ -363,8 +382,11 @@ TestResult signedRankWithCi(TestResult r, const std::vector<double>& d, const Wi
     const bool ties = anyTies(averageRanks(absx));
     const bool exact =
         o.exactness == Exactness::Auto ? x.size() < 50 : o.exactness == Exactness::Exact;
+    const auto base = std::move(r.warnings);
+    r.warnings.clear();
     try {
         signedRankCi(r, x, o, exact, ties, zeroes, confLevel);
+        orderWarningsAsR(r, base);
     } catch (const std::exception& e) {
         return failedTest(r.method, e.what());
     }
@@ -404,8 +426,11 @@ TestResult wilcoxonTestCi(std::span<const double> x, std::span<const double> y,
     const bool ties = anyTies(averageRanks(all));
     const bool exact = options.exactness == Exactness::Auto ? xs.size() < 50 && ys.size() < 50
                                                             : options.exactness == Exactness::Exact;
+    const auto base = std::move(r.warnings);
+    r.warnings.clear();
     try {
         rankSumCi(r, xs, ys, options, exact, ties, confLevel);
+        orderWarningsAsR(r, base);
     } catch (const std::exception& e) {
         return failedTest(r.method, e.what());
     }

@@ -236,9 +236,9 @@ TEST(WilcoxonCi, UnachievableLevelIsLoweredWithRsWarning) {
 }
 
 TEST(WilcoxonCi, TiesInvertTheNormalApproximationAsR) {
-    // Roots come from uniroot(tol = 1e-4): both R and we stop within 1e-4 of the root, the same
-    // Brent steps give the same figures to ~1e-9.
-    const double rel = 1e-6;
+    // Roots come from uniroot(tol = 1e-4): R and we take the same Brent steps (R's zeroin), so the
+    // figures agree far beyond the 1e-4 tolerance.
+    const double rel = 1e-9;
     // R: wilcox.test(a, b, conf.int=TRUE)
     const auto two = wilcoxonTestCi(kA, kB);
     expectRel(two.statistic, 122.5);
@@ -265,10 +265,16 @@ TEST(WilcoxonCi, TiesInvertTheNormalApproximationAsR) {
     expectRel(s.p, 0.00909069801592506);
     expectRel(s.estimate[0].value, -1.40003067218735, rel);
     expectCi(s, -2.94992079954078, -1.05001799066454, 0.95, rel);
+    // R's warnings, in R's order
+    const std::vector<std::string> warnings{"cannot compute exact p-value with ties",
+                                            "cannot compute exact confidence interval with ties",
+                                            "cannot compute exact p-value with zeroes",
+                                            "cannot compute exact confidence interval with zeroes"};
+    EXPECT_EQ(s.warnings, warnings);
 }
 
 TEST(WilcoxonCi, ForcedNormalApproximationWithoutTies) {
-    const double rel = 1e-6;
+    const double rel = 1e-9;
     // R: wilcox.test(rx, ry, exact=FALSE, correct=FALSE, conf.int=TRUE)
     WilcoxonOptions o;
     o.exactness = Exactness::Approximate;
