@@ -28,8 +28,6 @@ PACKAGES=(
   # online listening tests (`underfoot serve`, app/web): HTTP server; the browser test drives
   # Debian's Chromium with puppeteer-core from npm (tests/web/browser)
   libcpp-httplib-dev chromium
-  # realism: derivative-free fitting (underfoot fit)
-  libnlopt-cxx-dev
   # fuzzing (libFuzzer: tests/fuzz, scripts/test.sh's fuzz build)
   clang-14 libclang-rt-14-dev
 )
