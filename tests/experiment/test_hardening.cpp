@@ -167,6 +167,17 @@ TEST(StoreFaults, TwoSessionsOnOneParticipantAreRefusedWithHolderAndSince) {
         }
         ::_exit(code);
     }
+    // Whatever fails below, the child never outlives the test (it would wait on its pipe forever).
+    struct ChildGuard {
+        pid_t pid;
+        bool reaped = false;
+        ~ChildGuard() {
+            if (!reaped) {
+                ::kill(pid, SIGKILL);
+                ::waitpid(pid, nullptr, 0);
+            }
+        }
+    } guard{child};
     char acked = 0;
     ASSERT_EQ(::read(toParent[0], &acked, 1), 1);
     ASSERT_EQ(acked, '2');
@@ -186,7 +197,9 @@ TEST(StoreFaults, TwoSessionsOnOneParticipantAreRefusedWithHolderAndSince) {
     }
     // Nothing was written by the refusal; the documented take-over works and is journaled.
     EXPECT_EQ(answersOf(s, "P1"), before);
-    const int session = s.startSession("P1", {"ben", "", "", "t", /*takeOver=*/true});
+    SessionSettings takeOver{"ben", "", "", "t"};
+    takeOver.takeOver = true;
+    const int session = s.startSession("P1", takeOver);
     bool journaled = false;
     for (const auto& e : s.events()) journaled = journaled || e.kind == "lease_taken_over";
     EXPECT_TRUE(journaled);
@@ -194,6 +207,7 @@ TEST(StoreFaults, TwoSessionsOnOneParticipantAreRefusedWithHolderAndSince) {
     ASSERT_EQ(::write(toChild[1], &go, 1), 1);
     int status = 0;
     ::waitpid(child, &status, 0);
+    guard.reaped = true;
     ASSERT_TRUE(WIFEXITED(status));
     EXPECT_EQ(WEXITSTATUS(status), 0) << "the old session wrote after the take-over";
     // The old session's answers are kept as they were typed; the new session goes on.
