@@ -35,6 +35,13 @@ Root uniroot(const std::function<double(double)>& f, double lower, double upper,
 /// R's rank(x) with ties.method = "average" (1-based ranks).
 std::vector<double> averageRanks(std::span<const double> x);
 
+/// Exact null distribution of the signed-rank statistic V = 0..n(n+1)/2 for n untied,
+/// non-zero values (R's csignrank): counts of subsets of {1..n} with each sum.
+std::vector<double> signedRankCounts(std::size_t n);
+
+/// Exact null distribution of the rank-sum statistic W = 0..mn (Mann-Whitney U; R's cwilcox).
+std::vector<double> rankSumCounts(std::size_t m, std::size_t n);
+
 /// Sizes of the groups of tied values (every group, including singletons).
 std::vector<double> tieGroupSizes(std::span<const double> x);
 

@@ -11,14 +11,7 @@
 
 namespace underfoot::analysis {
 
-using namespace numerics;
-
-namespace {
-
-// Limits of the exact distributions when the caller forces exact p-values beyond R's defaults
-// (n < 50): counts stay finite in double and the time stays under about a second.
-constexpr std::size_t kMaxExactSignedRankN = 1000;
-constexpr std::size_t kMaxExactRankSumProduct = 10000;
+namespace numerics {
 
 /// Exact null distribution of the signed-rank statistic V for n untied, non-zero values:
 /// counts of subsets of {1..n} with each sum (exact in double for n < 50: at most 2^49).
@@ -54,6 +47,17 @@ std::vector<double> rankSumCounts(std::size_t m, std::size_t n) {
     }
     return g[m];
 }
+
+} // namespace numerics
+
+using namespace numerics;
+
+namespace {
+
+// Limits of the exact distributions when the caller forces exact p-values beyond R's defaults
+// (n < 50): counts stay finite in double and the time stays under about a second.
+constexpr std::size_t kMaxExactSignedRankN = 1000;
+constexpr std::size_t kMaxExactRankSumProduct = 10000;
 
 /// P(X <= q) or P(X > q) from a table of counts, summing the requested tail directly.
 double tailProbability(const std::vector<double>& counts, double q, bool lowerTail) {

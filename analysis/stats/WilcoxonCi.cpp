@@ -17,34 +17,6 @@ using namespace numerics;
 
 namespace {
 
-/// Counts of the signed-rank statistic V = 0..n(n+1)/2 (R's csignrank).
-std::vector<double> signedRankCounts(std::size_t n) {
-    const std::size_t maxSum = n * (n + 1) / 2;
-    std::vector<double> c(maxSum + 1, 0.0);
-    c[0] = 1;
-    for (std::size_t i = 1; i <= n; ++i)
-        for (std::size_t s = std::min(maxSum, i * (i + 1) / 2); s >= i; --s) c[s] += c[s - i];
-    return c;
-}
-
-/// Counts of the rank-sum statistic W = 0..mn (R's cwilcox), by the recursion on the last value.
-std::vector<double> rankSumCounts(std::size_t m, std::size_t n) {
-    // f[j][u]: number of ways for j of the first k values to be in x with statistic u.
-    std::vector<std::vector<double>> f(m + 1, std::vector<double>(m * n + 1, 0.0));
-    f[0][0] = 1;
-    for (std::size_t k = 1; k <= m + n; ++k)
-        for (std::size_t j = std::min(k, m); j >= 1; --j) {
-            // the k-th smallest value is in x: it exceeds the (k - j) values of y before it
-            const std::size_t add = k - j;
-            if (add > n) continue;
-            for (std::size_t u = m * n; u + 1 > add; --u) {
-                f[j][u] += f[j - 1][u - add];
-                if (u == 0) break;
-            }
-        }
-    return f[m];
-}
-
 /// R's qsignrank / qwilcox on a table of counts with total `total`.
 double quantileFromCounts(const std::vector<double>& counts, double total, double x) {
     const double maxQ = dbl(counts.size() - 1);
