@@ -212,10 +212,6 @@ void deriv12(const std::function<double(const std::vector<double>&)>& f,
 
 // ------------------------------------------------------------------------------ logistic
 
-double softplus(double x) {
-    return x > 0 ? x + std::log1p(std::exp(-x)) : std::log1p(std::exp(x));
-}
-
 /// Deviance (-2 log-likelihood) of the logistic model with a random intercept b = theta * u,
 /// u ~ N(0, 1), integrated per participant by the Laplace approximation (nAGQ = 1) or adaptive
 /// Gauss-Hermite quadrature centred at the conditional mode (nAGQ > 1).
@@ -226,6 +222,7 @@ class LogisticDeviance {
     LogisticDeviance(const Design& design, int nAGQ)
         : d_(design), u_(static_cast<std::size_t>(design.nGroups), 0.0) {
         if (nAGQ > 1) gaussHermiteRule(nAGQ, nodes_, weights_);
+        for (double w : weights_) logWeights_.push_back(std::log(w));
         // Observations of one participant with the same fixed-effects row share their linear
         // predictor: summed as binomial counts (the same likelihood, far fewer terms).
         cells_.resize(design.members.size());
@@ -280,56 +277,83 @@ class LogisticDeviance {
     }
 
   private:
-    /// g(u) = -log p(y | u) + u^2 / 2 and its first two derivatives.
-    void evaluate(std::size_t g, double theta, const VectorXd& offset, double u, double& value,
-                  double* d1, double* d2) const {
-        double v = 0.5 * u * u, s1 = 0, s2 = 0;
+    /// g(u) = -log p(y | u) + u^2 / 2 (one exp and one log1p per cell); `d2` (optional) gets
+    /// g''(u).
+    double value(std::size_t g, double theta, const VectorXd& offset, double u,
+                 double* d2 = nullptr) const {
+        double v = 0.5 * u * u, s2 = 0;
         for (const Cell& c : cells_[g]) {
             const double eta = offset(c.row) + theta * u;
+            const double e =
+                std::exp(-std::fabs(eta)); // softplus(+-eta) = max(+-eta, 0) + log1p(e)
             const double failures = c.n - c.successes;
-            if (c.successes > 0) v += c.successes * softplus(-eta);
-            if (failures > 0) v += failures * softplus(eta);
-            if (d1) {
-                const double mu = 1.0 / (1.0 + std::exp(-eta));
-                s1 += c.n * mu - c.successes;
-                s2 += c.n * mu * (1.0 - mu);
-            }
+            v += c.successes * std::max(-eta, 0.0) + failures * std::max(eta, 0.0) +
+                 c.n * std::log1p(e);
+            if (d2) s2 += c.n * e / ((1.0 + e) * (1.0 + e));
         }
-        value = v;
-        if (d1) *d1 = theta * s1 + u;
         if (d2) *d2 = theta * theta * s2 + 1.0;
+        return v;
+    }
+
+    /// g'(u) and g''(u) (one exp per cell, no logarithm).
+    void derivatives(std::size_t g, double theta, const VectorXd& offset, double u, double& d1,
+                     double& d2) const {
+        double s1 = 0, s2 = 0;
+        for (const Cell& c : cells_[g]) {
+            const double eta = offset(c.row) + theta * u;
+            const double e = std::exp(-std::fabs(eta));
+            const double mu = eta >= 0 ? 1.0 / (1.0 + e) : e / (1.0 + e);
+            s1 += c.n * mu - c.successes;
+            s2 += c.n * e / ((1.0 + e) * (1.0 + e));
+        }
+        d1 = theta * s1 + u;
+        d2 = theta * theta * s2 + 1.0;
+    }
+
+    /// Conditional mode of u: g is strictly convex (g'' >= 1), so g' has one root, found by
+    /// Newton's method kept inside the bracket of the root (bisection when a step leaves it or
+    /// does not halve the previous one, as Numerical Recipes' rtsafe). Derivatives only: the
+    /// value (logarithms) is computed once, at the mode.
+    double conditionalMode(std::size_t g, double theta, const VectorXd& offset) const {
+        double u = std::isfinite(u_[g]) ? u_[g] : 0.0;
+        double lo = -numerics::kInf, hi = numerics::kInf, previous = numerics::kInf;
+        for (int it = 0; it < 200; ++it) {
+            double d1 = 0, d2 = 1;
+            derivatives(g, theta, offset, u, d1, d2);
+            if (d1 == 0) break;
+            (d1 > 0 ? hi : lo) = u;
+            double next = u - d1 / d2;
+            const bool inside = next > lo && next < hi;
+            const bool bounded = std::isfinite(lo) && std::isfinite(hi);
+            const bool newton =
+                !bounded || (inside && std::fabs(next - u) <= 0.5 * std::fabs(previous));
+            if (!newton) next = 0.5 * (lo + hi);
+            const double step = next - u;
+            previous = step;
+            u = next;
+            // stop on a small Newton step only (quadratic convergence: u is then exact to
+            // rounding, which the finite-difference Hessian of the deviance needs)
+            if (newton && std::fabs(step) < 1e-11 * (1 + std::fabs(u))) break;
+        }
+        return u;
     }
 
     double groupDeviance(std::size_t g, double theta, const VectorXd& offset) {
-        double u = std::isfinite(u_[g]) ? u_[g] : 0.0;
-        double value = 0, d1 = 0, d2 = 1;
-        evaluate(g, theta, offset, u, value, &d1, &d2);
-        for (int it = 0; it < 100; ++it) { // Newton on a convex function, with step halving
-            double step = d1 / d2;
-            double next = u - step, nv = 0;
-            evaluate(g, theta, offset, next, nv, nullptr, nullptr);
-            for (int h = 0; h < 60 && nv > value + 1e-14 * (1 + std::fabs(value)); ++h) {
-                step *= 0.5;
-                next = u - step;
-                evaluate(g, theta, offset, next, nv, nullptr, nullptr);
-            }
-            u = next;
-            evaluate(g, theta, offset, u, value, &d1, &d2);
-            if (std::fabs(step) < 1e-11 * (1 + std::fabs(u))) break;
-        }
+        const double u = conditionalMode(g, theta, offset);
         u_[g] = u;
-        if (nodes_.empty()) return 2 * value + std::log(d2);
+        double d2 = 1;
+        const double value0 = value(g, theta, offset, u, &d2);
+        if (nodes_.empty()) return 2 * value0 + std::log(d2);
         const double s = 1.0 / std::sqrt(d2);
-        std::vector<double> terms(nodes_.size());
+        terms_.resize(nodes_.size());
         double top = -numerics::kInf;
         for (std::size_t k = 0; k < nodes_.size(); ++k) {
-            double gk = 0;
-            evaluate(g, theta, offset, u + s * nodes_[k], gk, nullptr, nullptr);
-            terms[k] = -gk + 0.5 * nodes_[k] * nodes_[k] + std::log(weights_[k]);
-            top = std::max(top, terms[k]);
+            const double gk = value(g, theta, offset, u + s * nodes_[k]);
+            terms_[k] = -gk + 0.5 * nodes_[k] * nodes_[k] + logWeights_[k];
+            top = std::max(top, terms_[k]);
         }
         double sum = 0;
-        for (double t : terms) sum += std::exp(t - top);
+        for (double t : terms_) sum += std::exp(t - top);
         return -2.0 * (std::log(s) + top + std::log(sum));
     }
 
@@ -339,7 +363,8 @@ class LogisticDeviance {
     };
     const Design& d_;
     std::vector<double> u_;
-    std::vector<double> nodes_, weights_;
+    std::vector<double> nodes_, weights_, logWeights_;
+    std::vector<double> terms_; ///< scratch of the quadrature sum
     std::vector<std::vector<Cell>> cells_;
 };
 
