@@ -250,6 +250,56 @@ class LogisticDeviance {
         return dev;
     }
 
+    /// Laplace deviance (nAGQ = 1) and its analytic gradient in (theta, beta): per participant
+    /// D = 2 g(u^) + log g''(u^) with g'(u^) = 0, differentiated through u^ by the implicit
+    /// function theorem (du^/dpsi = -g_upsi / g_uu). Used by the power simulations' optimiser.
+    double laplaceGradient(const std::vector<double>& par, std::vector<double>& grad) {
+        const double theta = par[0];
+        const auto p = d_.X.cols();
+        beta_.resize(p);
+        for (Eigen::Index j = 0; j < p; ++j) beta_(j) = par[static_cast<std::size_t>(j) + 1];
+        offset_.noalias() = d_.X * beta_;
+        grad.assign(par.size(), 0.0);
+        gBeta_.resize(p), wx_.resize(p), tx_.resize(p);
+        double dev = 0;
+        for (std::size_t g = 0; g < cells_.size(); ++g) {
+            const double u = conditionalMode(g, theta, offset_);
+            u_[g] = u;
+            double value = 0.5 * u * u, sr = 0, sw = 0, st = 0;
+            gBeta_.setZero(), wx_.setZero(), tx_.setZero();
+            for (const Cell& c : cells_[g]) {
+                const double eta = offset_(c.row) + theta * u;
+                const double e = std::exp(-std::fabs(eta));
+                const double mu = eta >= 0 ? 1.0 / (1.0 + e) : e / (1.0 + e);
+                const double failures = c.n - c.successes;
+                value += c.successes * std::max(-eta, 0.0) + failures * std::max(eta, 0.0) +
+                         c.n * std::log1p(e);
+                const double r = c.n * mu - c.successes;
+                const double w = c.n * e / ((1.0 + e) * (1.0 + e));
+                const double t = w * (1.0 - 2.0 * mu);
+                sr += r, sw += w, st += t;
+                const auto x = d_.X.row(c.row);
+                gBeta_.noalias() += r * x.transpose();
+                wx_.noalias() += w * x.transpose();
+                tx_.noalias() += t * x.transpose();
+            }
+            const double d2 = theta * theta * sw + 1.0;
+            dev += 2.0 * value + std::log(d2);
+            const double d2u = theta * theta * theta * st; // d g''/du
+            // theta: dg/dtheta = u sr; d g''/dtheta = 2 theta sw + theta^2 u st;
+            // g_utheta = sr + theta u sw
+            const double duTheta = -(sr + theta * u * sw) / d2;
+            grad[0] +=
+                2.0 * u * sr + (2.0 * theta * sw + theta * theta * u * st + d2u * duTheta) / d2;
+            for (Eigen::Index j = 0; j < p; ++j) {
+                const double duBeta = -theta * wx_(j) / d2;
+                grad[static_cast<std::size_t>(j) + 1] +=
+                    2.0 * gBeta_(j) + (theta * theta * tx_(j) + d2u * duBeta) / d2;
+            }
+        }
+        return dev;
+    }
+
     /// lme4's fallback covariance of the fixed effects, RX^-1 RX^-T: the inverse of the Schur
     /// complement X'WX - X'WZ L (L'Z'WZL + I)^-1 L'Z'WX at the conditional modes.
     MatrixXd rxVcov(const std::vector<double>& par) {
@@ -364,7 +414,8 @@ class LogisticDeviance {
     const Design& d_;
     std::vector<double> u_;
     std::vector<double> nodes_, weights_, logWeights_;
-    std::vector<double> terms_; ///< scratch of the quadrature sum
+    std::vector<double> terms_;                ///< scratch of the quadrature sum
+    VectorXd beta_, offset_, gBeta_, wx_, tx_; ///< scratch of laplaceGradient
     std::vector<std::vector<Cell>> cells_;
 };
 
@@ -438,6 +489,46 @@ Optimum minimise(const std::function<double(const std::vector<double>&)>& f, std
     }
     out.x = x;
     out.value = f(x);
+    return out;
+}
+
+/// Minimises the Laplace deviance with its analytic gradient (NLopt's L-BFGS): the optimum
+/// BOBYQA reaches, in a fraction of the deviance evaluations. Used where only the optimum is
+/// needed (power simulations, the reduced model of the LRT); the full model keeps BOBYQA, whose
+/// tight optimum the finite-difference Hessian (SEs) needs. The deviance is even in theta and
+/// theta = 0 is always a stationary point, so theta is left unbounded (a bound would let the
+/// line search stop on it) and |theta| returned.
+Optimum minimiseLaplace(LogisticDeviance& deviance, std::vector<double> x) {
+    Optimum out;
+    struct Ctx {
+        LogisticDeviance* deviance;
+        std::vector<double> scratch;
+    } ctx{&deviance, {}};
+    auto thunk = [](const std::vector<double>& v, std::vector<double>& grad, void* data) {
+        auto* c = static_cast<Ctx*>(data);
+        const double r = c->deviance->laplaceGradient(v, grad.empty() ? c->scratch : grad);
+        return std::isfinite(r) ? r : 1e300;
+    };
+    nlopt::opt opt(nlopt::LD_LBFGS, static_cast<unsigned>(x.size()));
+    opt.set_min_objective(thunk, &ctx);
+    opt.set_ftol_rel(1e-15);
+    opt.set_xtol_rel(1e-10);
+    opt.set_maxeval(5000);
+    double value = 0;
+    try {
+        const auto status = opt.optimize(x, value);
+        if (status == nlopt::MAXEVAL_REACHED) {
+            out.converged = false;
+            out.message = "maximum number of function evaluations exceeded";
+        }
+    } catch (const nlopt::roundoff_limited&) { // converged as far as rounding allows
+    } catch (const std::exception& e) {
+        out.converged = false;
+        out.message = e.what();
+    }
+    x[0] = std::fabs(x[0]);
+    out.x = x;
+    out.value = deviance(x);
     return out;
 }
 
@@ -526,7 +617,7 @@ LogisticFit fitLogistic(const Design& d, int nAGQ, bool derivatives) {
     std::function<double(const std::vector<double>&)> f = [&](const std::vector<double>& v) {
         return deviance(v);
     };
-    fit.opt = minimise(f, x, lower, 0.2);
+    fit.opt = !derivatives && nAGQ == 1 ? minimiseLaplace(deviance, x) : minimise(f, x, lower, 0.2);
     if (fit.opt.x[0] > 0) { // a flat deviance near the boundary: the optimum is theta = 0
         auto x0 = fit.opt.x;
         x0[0] = 0.0;
