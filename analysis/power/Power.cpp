@@ -7,7 +7,9 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
+#include <map>
 #include <mutex>
 #include <stdexcept>
 #include <thread>
@@ -80,18 +82,13 @@ std::uint64_t powerTaskSeed(std::uint64_t seed, int participantsPerGroup, int si
     return splitmix(s ^ (static_cast<std::uint64_t>(simulation) << 20));
 }
 
-PowerCurve simulatePower(const StudySimulator& simulator, int groups, const PowerOptions& options) {
-    if (groups < 2) throw std::invalid_argument("power needs at least two groups to compare");
+namespace {
+
+/// Runs `analyse(size, seed)` for every group size and simulation on the worker threads (seeded
+/// per task, so results do not depend on the number of threads) and fills the curve's points.
+void runSimulations(const std::function<Outcome(int, std::uint64_t)>& analyseOne,
+                    const PowerOptions& options, PowerCurve& curve) {
     if (options.simulations < 1) throw std::invalid_argument("--simulations must be at least 1");
-    PowerCurve curve;
-    curve.groups = groups;
-    curve.classicMethod =
-        groups == 2 && options.yates
-            ? "chisq.test on the pooled counts (Yates' continuity correction), as the papers"
-            : "chisq.test on the pooled counts (groups x correct/not correct)";
-    curve.mixedMethod = fmt::format("glmer(correct ~ group{} + (1 | participant), binomial, "
-                                    "nAGQ = {}): likelihood-ratio test of group",
-                                    options.withSurface ? " (+ surface)" : "", options.nAGQ);
     const std::size_t sizes = options.participantsPerGroup.size();
     const auto sims = static_cast<std::size_t>(options.simulations);
     const std::size_t total = sizes * sims;
@@ -107,8 +104,7 @@ PowerCurve simulatePower(const StudySimulator& simulator, int groups, const Powe
             const int size = options.participantsPerGroup[task / sims];
             const int sim = static_cast<int>(task % sims);
             try {
-                const auto answers = simulator(size, powerTaskSeed(options.seed, size, sim));
-                outcomes[task] = analyse(answers, groups, options);
+                outcomes[task] = analyseOne(size, powerTaskSeed(options.seed, size, sim));
             } catch (...) {
                 std::lock_guard lock(progressLock);
                 if (!failure) failure = std::current_exception();
@@ -153,6 +149,83 @@ PowerCurve simulatePower(const StudySimulator& simulator, int groups, const Powe
         if (options.mixedModel && curve.smallestMixed < 0 && p.mixed.power >= options.target)
             curve.smallestMixed = p.participantsPerGroup;
     }
+}
+
+Outcome analyseRatings(const std::vector<SimulatedRating>& ratings, const PowerOptions& options) {
+    Outcome o;
+    // each participant's mean rating per condition (participants missing one are left out)
+    std::map<int, std::array<std::pair<double, int>, 2>> cells;
+    for (const auto& r : ratings) {
+        if (r.condition < 0 || r.condition > 1)
+            throw std::invalid_argument(
+                fmt::format("simulated rating of participant {}: condition {} (0 or 1 expected)",
+                            r.participant, r.condition));
+        auto& c = cells[r.participant][static_cast<std::size_t>(r.condition)];
+        c.first += r.value;
+        c.second += 1;
+    }
+    std::vector<double> x, y;
+    for (const auto& [participant, c] : cells)
+        if (c[0].second > 0 && c[1].second > 0) {
+            x.push_back(c[0].first / c[0].second);
+            y.push_back(c[1].first / c[1].second);
+        }
+    TTestOptions t;
+    t.pairing = Pairing::Paired;
+    const auto paired = tTest(x, y, t);
+    o.classic = paired.ok() && paired.p < options.alpha;
+    if (!options.mixedModel) return o;
+    MixedModelData d;
+    d.y.reserve(ratings.size());
+    for (const auto& r : ratings) {
+        d.y.push_back(r.value);
+        d.condition.push_back(r.condition == 0 ? "c0" : "c1");
+        d.participant.push_back(fmt::format("p{:06d}", r.participant));
+    }
+    const auto fit = fitLinearMixedModel(d);
+    const FixedEffect* effect = fit.ok() ? fit.coefficient("conditionc1") : nullptr;
+    if (!effect || std::isnan(effect->p)) {
+        o.mixedFailed = true;
+        return o;
+    }
+    o.mixed = effect->p < options.alpha;
+    o.mixedSingular = fit.randomVariance < 1e-8;
+    return o;
+}
+
+} // namespace
+
+PowerCurve simulatePower(const StudySimulator& simulator, int groups, const PowerOptions& options) {
+    if (groups < 2) throw std::invalid_argument("power needs at least two groups to compare");
+    PowerCurve curve;
+    curve.groups = groups;
+    curve.classicMethod =
+        groups == 2 && options.yates
+            ? "chisq.test on the pooled counts (Yates' continuity correction), as the papers"
+            : "chisq.test on the pooled counts (groups x correct/not correct)";
+    curve.mixedMethod = fmt::format("glmer(correct ~ group{} + (1 | participant), binomial, "
+                                    "nAGQ = {}): likelihood-ratio test of group",
+                                    options.withSurface ? " (+ surface)" : "", options.nAGQ);
+    runSimulations(
+        [&](int size, std::uint64_t seed) {
+            return analyse(simulator(size, seed), groups, options);
+        },
+        options, curve);
+    return curve;
+}
+
+PowerCurve simulateRatingPower(const RatingStudySimulator& simulator, const PowerOptions& options) {
+    PowerCurve curve;
+    curve.groups = 2;
+    curve.classicMethod = "t.test(x, y, paired = TRUE) on each participant's mean rating per "
+                          "condition";
+    curve.mixedMethod = "lmer(rating ~ condition + (1 | participant)), REML: Satterthwaite "
+                        "t-test of condition (lmerTest)";
+    runSimulations(
+        [&](int size, std::uint64_t seed) {
+            return analyseRatings(simulator(size, seed), options);
+        },
+        options, curve);
     return curve;
 }
 

@@ -77,4 +77,24 @@ std::uint64_t powerTaskSeed(std::uint64_t seed, int participantsPerGroup, int si
 /// Runs the simulations; `groups` is the number of groups the simulator produces.
 PowerCurve simulatePower(const StudySimulator& simulator, int groups, const PowerOptions& options);
 
+/// One simulated rating (within-subject comparison of two conditions).
+struct SimulatedRating {
+    int participant = 0; ///< unique within one simulated study
+    int condition = 0;   ///< 0 or 1: the two conditions compared
+    double value = 0;
+};
+
+/// Simulates one whole rating study with `participants` participants (each rates both
+/// conditions). Must be deterministic in (participants, seed) and safe to call from several
+/// threads.
+using RatingStudySimulator =
+    std::function<std::vector<SimulatedRating>(int participants, std::uint64_t seed)>;
+
+/// Monte-Carlo power of a within-subject comparison of two conditions on a rating scale: the
+/// classic test is the paired t-test on each participant's mean rating per condition (t.test(x,
+/// y, paired = TRUE)); the mixed model lmerTest::lmer(rating ~ condition + (1 | participant)) by
+/// REML, the Satterthwaite t-test of the condition. `participantsPerGroup` holds the numbers of
+/// participants; `yates`, `withSurface` and `nAGQ` are not used.
+PowerCurve simulateRatingPower(const RatingStudySimulator& simulator, const PowerOptions& options);
+
 } // namespace underfoot::analysis

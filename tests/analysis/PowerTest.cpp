@@ -105,3 +105,63 @@ TEST(Power, RejectsImpossibleRequests) {
     o.simulations = 1;
     EXPECT_THROW(simulatePower(twoGroups(0.5, 0.5, 1, 0), 1, o), std::invalid_argument);
 }
+
+namespace {
+
+/// Each participant rates both conditions `ratings` times: bias N(0, sdBias) + effect (0 or
+/// `effect`) + noise N(0, sdNoise).
+RatingStudySimulator pairedRatings(double effect, double sdBias, double sdNoise, int ratings) {
+    return [=](int participants, std::uint64_t seed) {
+        std::mt19937_64 rng(seed);
+        std::normal_distribution<double> normal(0.0, 1.0);
+        std::vector<SimulatedRating> out;
+        for (int i = 0; i < participants; ++i) {
+            const double bias = sdBias * normal(rng);
+            for (int c = 0; c < 2; ++c)
+                for (int k = 0; k < ratings; ++k)
+                    out.push_back({i, c, bias + (c == 1 ? effect : 0.0) + sdNoise * normal(rng)});
+        }
+        return out;
+    };
+}
+
+} // namespace
+
+TEST(Power, RatingPowerReducesToThePairedTTest) {
+    // Rscript tests/analysis/data/power_reference.R (pwr 1.3):
+    // pwr.t.test(n = n, d = 0.6 / sqrt(2), sig.level = 0.05, type = "paired")$power
+    const std::pair<int, double> cases[] = {
+        {12, 0.2691122802}, {20, 0.4370760233}, {40, 0.7443290134}};
+    PowerOptions o;
+    o.simulations = 1500;
+    o.seed = 11;
+    o.confLevel = 0.999;
+    o.participantsPerGroup.clear();
+    for (const auto& [n, exact] : cases) o.participantsPerGroup.push_back(n);
+    const auto curve = simulateRatingPower(pairedRatings(0.6, 1.0, 1.0, 1), o);
+    ASSERT_EQ(curve.points.size(), 3u);
+    for (std::size_t i = 0; i < 3; ++i) {
+        const auto& pt = curve.points[i];
+        const double exact = cases[i].second;
+        EXPECT_LE(pt.classic.clopperPearson.lower, exact) << pt.participantsPerGroup;
+        EXPECT_GE(pt.classic.clopperPearson.upper, exact) << pt.participantsPerGroup;
+        // one rating per condition: the random-intercept model is the paired t-test whenever
+        // the participant variance is estimated positive (singular fits use 2n - 2 df instead)
+        EXPECT_NEAR(pt.mixed.power, pt.classic.power, 0.03) << pt.participantsPerGroup;
+        EXPECT_EQ(pt.mixedFailures, 0);
+    }
+    EXPECT_EQ(curve.smallestClassic, -1); // 0.744 at 40 < 0.8
+}
+
+TEST(Power, RatingPowerOfRepeatedRatingsGrowsWithParticipants) {
+    PowerOptions o;
+    o.participantsPerGroup = {30, 6};
+    o.simulations = 200;
+    o.seed = 5;
+    const auto curve = simulateRatingPower(pairedRatings(0.8, 1.5, 1.3, 2), o);
+    ASSERT_EQ(curve.points.size(), 2u);
+    EXPECT_LT(curve.points[1].classic.power, curve.points[0].classic.power);
+    EXPECT_LT(curve.points[1].mixed.power, curve.points[0].mixed.power);
+    EXPECT_GT(curve.points[0].mixed.power, 0.8);
+    EXPECT_EQ(curve.smallestMixed, 30);
+}

@@ -22,3 +22,12 @@ for (cfg in list(c(0.8, 0.6, 40), c(0.7, 0.5, 60), c(0.9, 0.7, 30))) {
   cat(sprintf("p1=%g p2=%g n=%d exact=%.10f pwr=%.10f  # pwr.2p.test(h = ES.h(%g, %g), n = %d, sig.level = 0.05)$power\n",
               p1, p2, n, exact_power(p1, p2, n), pwr.2p.test(h = ES.h(p1, p2), n = n, sig.level = 0.05)$power, p1, p2, n))
 }
+# Within-subject rating comparison that reduces to the paired t-test (PowerTest.cpp,
+# RatingPowerReducesToThePairedTTest): each participant rates both conditions once, rating =
+# bias (N(0, 1), per participant) + effect (0 / 0.6) + noise (N(0, 1)), not rounded, so the
+# differences are N(0.6, 2) and pwr.t.test(type = "paired") gives the exact power.
+for (n in c(12, 20, 40)) {
+  r <- pwr.t.test(n = n, d = 0.6 / sqrt(2), sig.level = 0.05, type = "paired")
+  cat(sprintf("n=%d power=%.10f  # pwr.t.test(n = %d, d = 0.6 / sqrt(2), sig.level = 0.05, type = \"paired\")$power\n",
+              n, r$power, n))
+}
