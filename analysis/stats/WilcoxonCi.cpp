@@ -78,6 +78,37 @@ double correctionFor(double z, Alternative a, bool correct) {
     return sgn(z) * 0.5;
 }
 
+/// Exact interval (no ties): the sorted Walsh averages (signed rank) or pairwise differences
+/// (rank sum) at the quantiles of the statistic's null distribution `counts` (R's qsignrank /
+/// qwilcox, wilcox.test.default). Returns the achieved significance level.
+double exactInterval(const std::vector<double>& sorted, const std::vector<double>& counts,
+                     double total, double alpha, Alternative alternative, Interval& ci) {
+    const double nn = dbl(sorted.size());
+    auto at = [&](double k) { return sorted[static_cast<std::size_t>(k) - 1]; };
+    const bool twoSided = alternative == Alternative::TwoSided;
+    double qu = quantileFromCounts(counts, total, twoSided ? alpha / 2 : alpha);
+    if (qu == 0) qu = 1;
+    const double achieved = (twoSided ? 2 : 1) * lowerTail(counts, total, std::trunc(qu) - 1);
+    ci.lower = alternative == Alternative::Less ? -kInf : at(qu);
+    ci.upper = alternative == Alternative::Greater ? kInf : at(nn - qu + 1);
+    return achieved;
+}
+
+/// Adds `warning` unless it is there already (the normal approximation's root finder evaluates
+/// the statistic many times).
+void warnOnce(TestResult& r, const char* warning) {
+    if (std::find(r.warnings.begin(), r.warnings.end(), warning) == r.warnings.end())
+        r.warnings.emplace_back(warning);
+}
+
+/// R's warnings when an exact interval was asked for but the normal approximation was used.
+void exactFallbackWarnings(TestResult& r, bool exact, bool ties, bool zeroes) {
+    if (exact && ties)
+        r.warnings.emplace_back("cannot compute exact confidence interval with ties");
+    if (exact && zeroes)
+        r.warnings.emplace_back("cannot compute exact confidence interval with zeroes");
+}
+
 /// Signed-rank part: x already has mu subtracted and zeros dropped.
 void signedRankCi(TestResult& r, std::vector<double> x, const WilcoxonOptions& o, bool exact,
                   bool ties, bool zeroes, double confLevel) {
@@ -91,30 +122,9 @@ void signedRankCi(TestResult& r, std::vector<double> x, const WilcoxonOptions& o
             for (std::size_t j = i; j < n; ++j) diffs.push_back((x[i] + x[j]) / 2);
         std::sort(diffs.begin(), diffs.end());
         const auto counts = signedRankCounts(n);
-        const double total = std::pow(2.0, dbl(n));
-        const double nn = dbl(n * (n + 1) / 2);
         Interval ci;
-        double achieved = 0;
-        auto at = [&](double k) { return diffs[static_cast<std::size_t>(k) - 1]; };
-        if (o.alternative == Alternative::TwoSided) {
-            double qu = quantileFromCounts(counts, total, alpha / 2);
-            if (qu == 0) qu = 1;
-            const double ql = nn - qu;
-            achieved = 2 * lowerTail(counts, total, std::trunc(qu) - 1);
-            ci.lower = at(qu);
-            ci.upper = at(ql + 1);
-        } else {
-            double qu = quantileFromCounts(counts, total, alpha);
-            if (qu == 0) qu = 1;
-            achieved = lowerTail(counts, total, std::trunc(qu) - 1);
-            if (o.alternative == Alternative::Greater) {
-                ci.lower = at(qu);
-                ci.upper = kInf;
-            } else {
-                ci.lower = -kInf;
-                ci.upper = at(nn - qu + 1);
-            }
-        }
+        const double achieved =
+            exactInterval(diffs, counts, std::pow(2.0, dbl(n)), alpha, o.alternative, ci);
         if (achieved - alpha > alpha / 2) {
             r.warnings.emplace_back("requested conf.level not achievable");
             confLevel = 1 - signif2(achieved);
@@ -141,11 +151,9 @@ void signedRankCi(TestResult& r, std::vector<double> x, const WilcoxonOptions& o
             if (xd[i] > 0) zd += dr[i];
         const double sigma =
             std::sqrt(nx * (nx + 1) * (2 * nx + 1) / 24 - tieCorrectionSum(dr) / 48);
-        if (sigma == 0 && r.warnings.end() == std::find(r.warnings.begin(), r.warnings.end(),
-                                                        "cannot compute confidence interval "
-                                                        "when all observations are zero or tied"))
-            r.warnings.emplace_back(
-                "cannot compute confidence interval when all observations are zero or tied");
+        if (sigma == 0)
+            warnOnce(r,
+                     "cannot compute confidence interval when all observations are zero or tied");
         return (zd - correctionFor(zd, o.alternative, correct)) / sigma;
     };
     const double wMin = W(mumin);
@@ -197,10 +205,7 @@ void signedRankCi(TestResult& r, std::vector<double> x, const WilcoxonOptions& o
     r.confInt = ci;
     correct = false;
     r.estimate = {{"(pseudo)median", rootOrThrow(W, mumin, mumax, W(mumin), W(mumax))}};
-    if (exact && ties)
-        r.warnings.emplace_back("cannot compute exact confidence interval with ties");
-    if (exact && zeroes)
-        r.warnings.emplace_back("cannot compute exact confidence interval with zeroes");
+    exactFallbackWarnings(r, exact, ties, zeroes);
 }
 
 void rankSumCi(TestResult& r, const std::vector<double>& x, const std::vector<double>& y,
@@ -215,29 +220,10 @@ void rankSumCi(TestResult& r, const std::vector<double>& x, const std::vector<do
             for (double b : y) diffs.push_back(a - b);
         std::sort(diffs.begin(), diffs.end());
         const auto counts = rankSumCounts(m, n);
-        const double total = std::accumulate(counts.begin(), counts.end(), 0.0);
-        auto at = [&](double k) { return diffs[static_cast<std::size_t>(k) - 1]; };
         Interval ci;
-        double achieved = 0;
-        if (o.alternative == Alternative::TwoSided) {
-            double qu = quantileFromCounts(counts, total, alpha / 2);
-            if (qu == 0) qu = 1;
-            const double ql = nx * ny - qu;
-            achieved = 2 * lowerTail(counts, total, std::trunc(qu) - 1);
-            ci.lower = at(qu);
-            ci.upper = at(ql + 1);
-        } else {
-            double qu = quantileFromCounts(counts, total, alpha);
-            if (qu == 0) qu = 1;
-            achieved = lowerTail(counts, total, std::trunc(qu) - 1);
-            if (o.alternative == Alternative::Greater) {
-                ci.lower = at(qu);
-                ci.upper = kInf;
-            } else {
-                ci.lower = -kInf;
-                ci.upper = at(nx * ny - qu + 1);
-            }
-        }
+        const double achieved =
+            exactInterval(diffs, counts, std::accumulate(counts.begin(), counts.end(), 0.0), alpha,
+                          o.alternative, ci);
         if (achieved - alpha > alpha / 2) {
             r.warnings.emplace_back("Requested conf.level not achievable");
             confLevel = 1 - achieved;
@@ -262,11 +248,8 @@ void rankSumCi(TestResult& r, const std::vector<double>& x, const std::vector<do
         for (std::size_t i = 0; i < m; ++i) dz += dr[i];
         const double sigma = std::sqrt(
             (nx * ny / 12) * ((nx + ny + 1) - tieCorrectionSum(dr) / ((nx + ny) * (nx + ny - 1))));
-        if (sigma == 0 && r.warnings.end() == std::find(r.warnings.begin(), r.warnings.end(),
-                                                        "cannot compute confidence interval "
-                                                        "when all observations are tied"))
-            r.warnings.emplace_back(
-                "cannot compute confidence interval when all observations are tied");
+        if (sigma == 0)
+            warnOnce(r, "cannot compute confidence interval when all observations are tied");
         return (dz - correctionFor(dz, o.alternative, correct)) / sigma;
     };
     const double wMin = W(mumin), wMax = W(mumax);
@@ -296,8 +279,7 @@ void rankSumCi(TestResult& r, const std::vector<double>& x, const std::vector<do
     r.confInt = ci;
     correct = false;
     r.estimate = {{"difference in location", rootOrThrow(W, mumin, mumax, W(mumin), W(mumax))}};
-    if (exact && ties)
-        r.warnings.emplace_back("cannot compute exact confidence interval with ties");
+    exactFallbackWarnings(r, exact, ties, false);
 }
 
 bool anyTies(std::vector<double> v) {
@@ -328,6 +310,21 @@ void orderWarningsAsR(TestResult& r, const std::vector<std::string>& base) {
     r.warnings = std::move(out);
 }
 
+/// The test result `r` with the interval `compute` adds (warnings in R's order); the failed
+/// test when the interval computation stops, as R's wilcox.test does.
+template <typename Compute>
+TestResult withInterval(TestResult r, Compute&& compute) {
+    const auto base = std::move(r.warnings);
+    r.warnings.clear();
+    try {
+        compute(r);
+        orderWarningsAsR(r, base);
+    } catch (const std::exception& e) {
+        return failedTest(r.method, e.what());
+    }
+    return r;
+}
+
 TestResult signedRankWithCi(TestResult r, const std::vector<double>& d, const WilcoxonOptions& o,
                             double confLevel) {
     std::vector<double> x;
@@ -354,15 +351,9 @@ TestResult signedRankWithCi(TestResult r, const std::vector<double>& d, const Wi
     const bool ties = anyTies(averageRanks(absx));
     const bool exact =
         o.exactness == Exactness::Auto ? x.size() < 50 : o.exactness == Exactness::Exact;
-    const auto base = std::move(r.warnings);
-    r.warnings.clear();
-    try {
-        signedRankCi(r, x, o, exact, ties, zeroes, confLevel);
-        orderWarningsAsR(r, base);
-    } catch (const std::exception& e) {
-        return failedTest(r.method, e.what());
-    }
-    return r;
+    return withInterval(std::move(r), [&](TestResult& out) {
+        signedRankCi(out, x, o, exact, ties, zeroes, confLevel);
+    });
 }
 
 } // namespace
@@ -398,15 +389,9 @@ TestResult wilcoxonTestCi(std::span<const double> x, std::span<const double> y,
     const bool ties = anyTies(averageRanks(all));
     const bool exact = options.exactness == Exactness::Auto ? xs.size() < 50 && ys.size() < 50
                                                             : options.exactness == Exactness::Exact;
-    const auto base = std::move(r.warnings);
-    r.warnings.clear();
-    try {
-        rankSumCi(r, xs, ys, options, exact, ties, confLevel);
-        orderWarningsAsR(r, base);
-    } catch (const std::exception& e) {
-        return failedTest(r.method, e.what());
-    }
-    return r;
+    return withInterval(std::move(r), [&](TestResult& out) {
+        rankSumCi(out, xs, ys, options, exact, ties, confLevel);
+    });
 }
 
 } // namespace underfoot::analysis
