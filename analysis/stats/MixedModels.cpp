@@ -647,6 +647,18 @@ LogisticFit fitLogistic(const Design& d, int nAGQ, bool derivatives) {
 
 } // namespace
 
+namespace {
+
+/// Records the design's size in `r`; false (with R's message in r.error) when R would stop.
+bool describeDesign(const Design& d, MixedModelResult& r) {
+    r.nObs = dbl(d.y.size());
+    r.nGroups = d.nGroups;
+    r.error = d.error;
+    return d.error.empty();
+}
+
+} // namespace
+
 const FixedEffect* MixedModelResult::coefficient(const std::string& name) const {
     for (const auto& f : fixed)
         if (f.name == name) return &f;
@@ -686,12 +698,7 @@ MixedModelResult fitLogisticMixedModel(const MixedModelData& data, int nAGQ, boo
         return r;
     }
     Design d = buildDesign(data, true);
-    r.nObs = dbl(d.y.size());
-    r.nGroups = d.nGroups;
-    if (!d.error.empty()) {
-        r.error = d.error;
-        return r;
-    }
+    if (!describeDesign(d, r)) return r;
     for (Eigen::Index i = 0; i < d.y.size(); ++i)
         if (d.y(i) != 0.0 && d.y(i) != 1.0) {
             r.error = fmt::format("y[{}] = {}: the logistic model needs 0 (not correct) or 1 "
@@ -860,12 +867,7 @@ MixedModelResult fitLinearMixedModel(const MixedModelData& data) {
     r.method = "Linear mixed model fit by REML. t-tests use Satterthwaite's method "
                "[lmerModLmerTest]";
     Design d = buildDesign(data, true);
-    r.nObs = dbl(d.y.size());
-    r.nGroups = d.nGroups;
-    if (!d.error.empty()) {
-        r.error = d.error;
-        return r;
-    }
+    if (!describeDesign(d, r)) return r;
     if (d.nGroups >= d.y.size()) {
         r.error = "number of levels of each grouping factor must be < number of observations "
                   "(problems: participant)";
