@@ -14,6 +14,7 @@
 #include <map>
 #include <numbers>
 #include <stdexcept>
+#include <string_view>
 
 namespace underfoot::analysis {
 
@@ -117,14 +118,17 @@ Design buildDesign(const MixedModelData& data, bool withCondition) {
     isCondition.push_back(false);
     auto addFactor = [&](const std::vector<std::string>& v, const std::vector<std::string>& levels,
                          const std::string& prefix, bool condition) {
+        std::map<std::string_view, std::size_t> levelOf; // one lookup per row
+        for (std::size_t l = 0; l < levels.size(); ++l) levelOf.emplace(levels[l], l);
+        const std::size_t first = columns.size();
         for (std::size_t l = 1; l < levels.size(); ++l) {
-            VectorXd c = VectorXd::Zero(static_cast<Eigen::Index>(m));
-            for (std::size_t i = 0; i < m; ++i)
-                if (v[i] == levels[l]) c(static_cast<Eigen::Index>(i)) = 1.0;
-            columns.push_back(std::move(c));
+            columns.push_back(VectorXd::Zero(static_cast<Eigen::Index>(m)));
             names.push_back(prefix + levels[l]);
             isCondition.push_back(condition);
         }
+        for (std::size_t i = 0; i < m; ++i)
+            if (const std::size_t l = levelOf.at(v[i]); l > 0)
+                columns[first + l - 1](static_cast<Eigen::Index>(i)) = 1.0;
     };
     if (withCondition) addFactor(cond, condLevels, "condition", true);
     if (hasSurface) addFactor(surf, surfLevels, "surface", false);
@@ -227,14 +231,14 @@ class LogisticDeviance {
         // predictor: summed as binomial counts (the same likelihood, far fewer terms).
         cells_.resize(design.members.size());
         for (std::size_t g = 0; g < design.members.size(); ++g) {
-            std::map<std::vector<double>, std::size_t> seen;
+            auto& cells = cells_[g];
             for (int i : design.members[g]) {
-                const Eigen::RowVectorXd row = design.X.row(i);
-                std::vector<double> key(row.data(), row.data() + row.size());
-                auto [it, inserted] = seen.try_emplace(std::move(key), cells_[g].size());
-                if (inserted) cells_[g].push_back({i, 0.0, 0.0});
-                cells_[g][it->second].n += 1;
-                cells_[g][it->second].successes += design.y(i);
+                // a participant has few distinct rows: a linear search, no allocation
+                std::size_t c = 0;
+                while (c < cells.size() && design.X.row(cells[c].row) != design.X.row(i)) ++c;
+                if (c == cells.size()) cells.push_back({i, 0.0, 0.0});
+                cells[c].n += 1;
+                cells[c].successes += design.y(i);
             }
         }
     }

@@ -393,6 +393,11 @@ int runRatingPower(const PowerArgs& a, const Protocol& p) {
         throw underfoot::cli::UserError(fmt::format(
             "{}: rating power is computed for within-subject protocols; {} is between-subject",
             a.file, p.id));
+    if (!a.groups.empty())
+        throw underfoot::cli::UserError(fmt::format(
+            "--groups: protocol {} rates within participants; choose what is compared with "
+            "--scale, --factor and --levels",
+            p.id));
     // the scale: --scale, else the protocol's first modelled scale
     const Scale* scale = nullptr;
     for (const auto& sc : p.questions.scales)

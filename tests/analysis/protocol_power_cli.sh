@@ -46,4 +46,5 @@ expect_error "not a level of depth" "$src/protocols/wading_listening.toml" --lev
 expect_error "not a scale of protocol wading_listening" "$src/protocols/wading_listening.toml" --scale loudness
 expect_error "no stimulus has this factor" "$src/protocols/wading_realism.toml" --factor depth
 expect_error "within-subject" "$src/protocols/tvcg2011_exp1.toml" --groups a,b
+expect_error "rates within participants" "$src/protocols/wading_interactive.toml" --groups order1
 exit $fail
