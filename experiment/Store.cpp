@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -498,7 +499,116 @@ StudyStore StudyStore::open(const std::string& path, Clock clock, const Catalogu
     return store;
 }
 
+namespace {
+
+/// `path` as an SQLite URI filename ("file:" + percent-encoded path) with `query`.
+std::string sqliteUri(const std::string& path, const std::string& query) {
+    std::string uri = "file:";
+    for (const char c : std::filesystem::absolute(path).string()) {
+        const auto u = static_cast<unsigned char>(c);
+        if (std::isalnum(u) || c == '/' || c == '-' || c == '_' || c == '.' || c == '~')
+            uri += c;
+        else
+            uri += fmt::format("%{:02X}", u);
+    }
+    return uri + "?" + query;
+}
+
+bool writableByThisUser(const std::string& path, int mode) {
+    return ::access(path.c_str(), mode) == 0;
+}
+
+} // namespace
+
+StudyStore StudyStore::openReadOnly(const std::string& path, Clock clock,
+                                    const Catalogue& catalogue) {
+    if (!std::filesystem::exists(path))
+        throw StoreError(fmt::format("{}: no such study file; expected a file made by "
+                                     "`underfoot study create`",
+                                     path));
+    if (::access(path.c_str(), R_OK) != 0)
+        throw StoreError(
+            fmt::format("{}: cannot read the study file ({})", path, std::strerror(errno)));
+    const std::string folder = std::filesystem::absolute(path).parent_path().string();
+    std::error_code ec;
+    const std::string wal = path + "-wal";
+    const bool walHasData =
+        std::filesystem::exists(wal, ec) && std::filesystem::file_size(wal, ec) > 0 && !ec;
+    const bool canWrite = writableByThisUser(path, W_OK) && writableByThisUser(folder, W_OK | X_OK);
+    // Immutable: SQLite takes no lock and needs no -shm (it could not create one in a read-only
+    // folder), and it would ignore a -wal, so only when the -wal holds nothing.
+    const bool immutable = !canWrite && !walHasData;
+    std::unique_ptr<SQLite::Database> db;
+    try {
+        db = std::make_unique<SQLite::Database>(
+            sqliteUri(path, immutable ? "mode=ro&immutable=1" : "mode=ro"),
+            SQLite::OPEN_READONLY | SQLite::OPEN_URI);
+        db->setBusyTimeout(5000);
+        db->execAndGet("SELECT count(*) FROM sqlite_master");
+    } catch (const SQLite::Exception& e) {
+        if (walHasData && !canWrite)
+            throw StoreError(fmt::format(
+                "{}: cannot open the study read-only ({}): {} holds committed data that SQLite "
+                "can read only with its {}-shm, which it cannot create in the read-only folder "
+                "{}; copy the study with its -wal to a writable folder and open the copy",
+                path, e.what(), wal, path, folder));
+        throw StoreError(fmt::format("{}: not a readable study file ({})", path, e.what()));
+    }
+    if (const std::string problems = quickCheck(*db, std::chrono::seconds(10)); !problems.empty())
+        throw StoreError(fmt::format("{}: the study file is damaged (SQLite integrity check: {}); "
+                                     "{}",
+                                     path, problems, recoveryHint(path)));
+    StudyStore store(path, std::move(db), std::move(clock));
+    store.readOnly_ = true;
+    const int version = store.db_->execAndGet("PRAGMA user_version").getInt();
+    if (version <= 0)
+        throw StoreError(fmt::format("{}: not an Underfoot study (schema version {}; expected "
+                                     "1 to {})",
+                                     path, version, kSchemaVersion));
+    if (version > kSchemaVersion)
+        throw StoreError(fmt::format("{}: schema version {} was written by a newer Underfoot; "
+                                     "this version reads up to {}",
+                                     path, version, kSchemaVersion));
+    if (version < kSchemaVersion)
+        throw StoreError(fmt::format(
+            "{}: the study has schema version {}; this Underfoot reads version {} and must "
+            "migrate it first, which writes to the file, but it is opened read-only{}. Migrate "
+            "a writable copy (any `underfoot study info --study COPY` does) and use the copy",
+            path, version, kSchemaVersion,
+            canWrite ? "" : " (the file or its folder is read-only for this user)"));
+    try {
+        store.loadProtocol(catalogue);
+    } catch (const SQLite::Exception& e) {
+        throw StoreError(fmt::format("{}: not a readable study file ({})", path, e.what()));
+    }
+    return store;
+}
+
+StudyStore StudyStore::openForReading(const std::string& path, Clock clock,
+                                      const Catalogue& catalogue) {
+    bool older = false;
+    if (std::filesystem::exists(path) && ::access(path.c_str(), W_OK) == 0 &&
+        ::access(std::filesystem::absolute(path).parent_path().c_str(), W_OK | X_OK) == 0) {
+        // Only a writable study can be migrated; peek at its version without writing.
+        try {
+            SQLite::Database peek(sqliteUri(path, "mode=ro"),
+                                  SQLite::OPEN_READONLY | SQLite::OPEN_URI);
+            peek.setBusyTimeout(5000);
+            const int v = peek.execAndGet("PRAGMA user_version").getInt();
+            older = v > 0 && v < kSchemaVersion;
+        } catch (const SQLite::Exception&) {
+            // openReadOnly() says what is wrong with the file
+        }
+    }
+    if (older) return open(path, std::move(clock), catalogue);
+    return openReadOnly(path, std::move(clock), catalogue);
+}
+
 void StudyStore::writeFailed(const std::string& what, const std::exception& e) const {
+    if (readOnly_)
+        throw StoreError(fmt::format("{}: {} refused: the study was opened read-only (by a "
+                                     "command that only reads it); nothing was written",
+                                     path_, what));
     const auto* sq = dynamic_cast<const SQLite::Exception*>(&e);
     const int code = sq ? (sq->getErrorCode() & 0xff) : -1;
     const std::string folder = std::filesystem::absolute(path_).parent_path().string();
@@ -944,6 +1054,10 @@ void StudyStore::dropParticipant(const std::string& code, const std::string& rea
 }
 
 int StudyStore::startSession(const std::string& code, const SessionSettings& settings) {
+    if (readOnly_)
+        throw StoreError(fmt::format("{}: participant '{}': a session cannot start on a study "
+                                     "opened read-only; open it for writing",
+                                     path_, code));
     try {
         SQLite::Transaction tx(*db_, SQLite::TransactionBehavior::IMMEDIATE);
         const ParticipantInfo p = participant(code);

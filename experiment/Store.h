@@ -234,6 +234,23 @@ class StudyStore {
     /// Opens an existing study (migrating an older schema; refusing a newer one).
     static StudyStore open(const std::string& path, Clock clock = {},
                            const Catalogue& catalogue = defaultCatalogue());
+    /// Opens an existing study read-only (issue #16: an archived study, read-only as a file or
+    /// as a folder for this user, still exports and analyzes): no write, no lease, no migration,
+    /// no -wal/-shm created where they cannot be. The integrity check (quick_check) still runs.
+    /// A study of an older schema is refused, saying that it needs a migration (a write). When
+    /// the file or its folder is not writable and no committed data waits in `<file>-wal`, the
+    /// file is opened as immutable (no locks: archived files are not written meanwhile);
+    /// otherwise as a read-only SQLite connection that shares the writers' locks. Every write
+    /// through this store is refused with the file name.
+    static StudyStore openReadOnly(const std::string& path, Clock clock = {},
+                                   const Catalogue& catalogue = defaultCatalogue());
+    /// The open of the commands that only read (export, analyze, study info/participants/...):
+    /// openReadOnly(), except that a study of an older schema that this user may write is
+    /// opened with open() and migrated, as before.
+    static StudyStore openForReading(const std::string& path, Clock clock = {},
+                                     const Catalogue& catalogue = defaultCatalogue());
+    /// True when opened with openReadOnly().
+    bool readOnly() const { return readOnly_; }
 
     StudyStore(StudyStore&&) noexcept;
     StudyStore& operator=(StudyStore&&) noexcept;
@@ -358,6 +375,7 @@ class StudyStore {
     Clock clock_;
     std::unique_ptr<Protocol> protocol_;
     std::string leaseToken_; ///< identifies this store's session leases
+    bool readOnly_ = false;  ///< opened with openReadOnly(): every write is refused
 };
 
 /// Minimal JSON object writer for journal details: {"k":"v",...} with escaping.

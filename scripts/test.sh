@@ -7,7 +7,7 @@
 #   UNDERFOOT_SKIP_FUZZ=1 bash scripts/test.sh       # without the short fuzz pass
 # The fuzz pass (a third, small build with clang: only the reader libraries and the libFuzzer
 # targets of tests/fuzz) replays every regression input and fuzzes each target for
-# UNDERFOOT_FUZZ_SECONDS (15 s); it runs when no extra ctest arguments are given.
+# UNDERFOOT_FUZZ_SECONDS (20 s); it runs when no extra ctest arguments are given.
 # Long soaks carry the ctest label `soak` and run with: ctest --test-dir build -L soak
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -40,9 +40,9 @@ if [ "${UNDERFOOT_SKIP_FUZZ:-0}" != "1" ] && [ $# -eq 0 ]; then
         -DCMAKE_C_COMPILER=clang-14 -DCMAKE_CXX_COMPILER=clang++-14 -DUNDERFOOT_FUZZ=ON \
         -DUNDERFOOT_BUILD_BENCHMARKS=OFF -DUNDERFOOT_BUILD_GUI=OFF
     fi
-    cmake -S . -B build-fuzz -DUNDERFOOT_FUZZ_SECONDS="${UNDERFOOT_FUZZ_SECONDS:-15}" > /dev/null
+    cmake -S . -B build-fuzz -DUNDERFOOT_FUZZ_SECONDS="${UNDERFOOT_FUZZ_SECONDS:-20}" > /dev/null
     cmake --build build-fuzz --parallel "$jobs" --target underfoot_fuzz
-    echo "== fuzz pass (libFuzzer + address + undefined sanitizers, regression inputs + ${UNDERFOOT_FUZZ_SECONDS:-15} s per target)"
+    echo "== fuzz pass (libFuzzer + address + undefined sanitizers, regression inputs + ${UNDERFOOT_FUZZ_SECONDS:-20} s per target)"
     ctest --test-dir build-fuzz --output-on-failure -j "$jobs" -L fuzz
   fi
 fi

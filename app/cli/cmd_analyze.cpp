@@ -82,7 +82,7 @@ int analyzeRatings(const AnalyzeOptions& o, analysis::ReportFormat format) {
     analysis::RatingData data;
     try {
         if (!o.study.empty()) {
-            const auto store = experiment::StudyStore::open(o.study);
+            const auto store = experiment::StudyStore::openForReading(o.study);
             std::ostringstream ratings, participants, scales;
             const auto rows = simulatedRows(o, store);
             experiment::writeRatingsCsv(store, ratings, experiment::ExportScope::Answered, rows);
@@ -126,7 +126,7 @@ int analyze(const AnalyzeOptions& o) {
     if (o.form == "auto" && !o.study.empty()) {
         // A protocol that only rates (no surface question) is analysed in the paper's form.
         try {
-            const auto store = experiment::StudyStore::open(o.study);
+            const auto store = experiment::StudyStore::openForReading(o.study);
             const auto& q = store.protocol().questions;
             ratingsForm = !q.asksSurface() && !q.scales.empty();
         } catch (const std::runtime_error& e) {
@@ -189,7 +189,7 @@ int analyze(const AnalyzeOptions& o) {
         if (!o.study.empty()) {
             // Straight from the study store: its trials, exported in the long format the
             // analysis reads, with the protocol's answer-list order unless --answers says else.
-            const auto store = experiment::StudyStore::open(o.study);
+            const auto store = experiment::StudyStore::openForReading(o.study);
             const auto dir = std::filesystem::temp_directory_path() /
                              fmt::format("underfoot_analyze_{}", ::getpid());
             std::filesystem::create_directories(dir);

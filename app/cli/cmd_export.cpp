@@ -43,7 +43,7 @@ const underfoot::cli::CommandRegistrar registrar{
         cmd->add_flag("--all-trials", o.all, "also write planned trials not answered yet");
         cmd->callback([&exitCode, &o] {
             try {
-                StudyStore store = StudyStore::open(o.study);
+                StudyStore store = StudyStore::openForReading(o.study);
                 std::filesystem::create_directories(o.outDir);
                 const std::filesystem::path dir(o.outDir);
                 const ExportScope scope = o.all ? ExportScope::All : ExportScope::Answered;

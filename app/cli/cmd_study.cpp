@@ -79,7 +79,7 @@ const underfoot::cli::CommandRegistrar registrar{
         info->add_option("--study", o.study, "study file")->required();
         info->callback([&exitCode, &o] {
             guarded([&] {
-                StudyStore store = StudyStore::open(o.study);
+                StudyStore store = StudyStore::openForReading(o.study);
                 const StudyInfo i = store.info();
                 fmt::print("study {} (site {}), seed {}, created {}\n", i.code, i.site, i.seed,
                            i.createdAt);
@@ -196,7 +196,7 @@ const underfoot::cli::CommandRegistrar registrar{
             ->check(CLI::PositiveNumber);
         trial->callback([&exitCode, &o] {
             guarded([&] {
-                StudyStore store = StudyStore::open(o.study);
+                StudyStore store = StudyStore::openForReading(o.study);
                 const ReplayInfo r = store.trialForReplay(o.participant, o.trial - 1);
                 fmt::print("study {} protocol sha256 {}\nparticipant {} trial {} (stored index "
                            "{})\nrender seed {}\n"
@@ -218,7 +218,7 @@ const underfoot::cli::CommandRegistrar registrar{
         table->add_option("--scales", o.reason, "also write the scales CSV to this file");
         table->callback([&exitCode, &o] {
             guarded([&] {
-                StudyStore store = StudyStore::open(o.study);
+                StudyStore store = StudyStore::openForReading(o.study);
                 auto write = [&](const std::string& path, auto&& writer) {
                     if (path.empty() || path == "-") {
                         writer(std::cout);
@@ -249,7 +249,7 @@ const underfoot::cli::CommandRegistrar registrar{
         events->add_option("--study", o.study, "study file")->required();
         events->callback([&exitCode, &o] {
             guarded([&] {
-                StudyStore store = StudyStore::open(o.study);
+                StudyStore store = StudyStore::openForReading(o.study);
                 for (const auto& e : store.events())
                     fmt::print("{} {:>6} {:<24} {:<8} {:>4} {}\n", e.at, e.id, e.kind,
                                e.participant,

@@ -385,3 +385,97 @@ TEST(StoreFaults, ReadOnlyFileAndFolderNameTheFileAndTheCause) {
     StudyStore s = StudyStore::open(path);
     EXPECT_EQ(answersOf(s, "P1"), expectedAnswers(2));
 }
+
+// ---- Read-only open mode (issue #16): an archived study still exports and analyzes. ---------
+
+#include "experiment/Export.h"
+
+TEST(StoreFaults, ReadOnlyArchivedStudyExportsWithoutWritingAndRefusesASession) {
+    TempDir dir;
+    const std::string folder = dir.file("archive");
+    std::filesystem::create_directories(folder);
+    const std::string path = folder + "/archived.db";
+    {
+        StudyStore s = StudyStore::create(path, miniStudyProtocol(), {"A", "lab", 1, "t"});
+        s.registerParticipant({"P1", {}, "", "", "", {}, ""});
+        const int session = s.startSession("P1", {});
+        EXPECT_EQ(answerNext(s, "P1", session, 3), 3);
+        s.endSession("P1", session, false);
+    }
+    std::error_code ec;
+    std::filesystem::remove(path + "-wal", ec); // closed cleanly: nothing waits in the -wal
+    std::filesystem::remove(path + "-shm", ec);
+    const std::string before = readAll(path);
+    // file mode, folder mode: read-only file in a read-only folder, read-only file in a
+    // writable folder, writable file in a read-only folder.
+    for (const auto& [fileMode, folderMode] :
+         {std::pair{0444, 0555}, std::pair{0444, 0777}, std::pair{0666, 0555}}) {
+        ::chmod(path.c_str(), static_cast<mode_t>(fileMode));
+        ::chmod(folder.c_str(), static_cast<mode_t>(folderMode));
+        const std::string report = fmt::format("/tmp/underfoot_ro_open_{}_{:o}_{:o}.txt",
+                                               ::getpid(), fileMode, folderMode);
+        const int status = inChild([&] {
+            if (::geteuid() == 0 && (::setgid(65534) != 0 || ::setuid(65534) != 0)) return 20;
+            std::ofstream out(report);
+            StudyStore s = StudyStore::openReadOnly(path);
+            out << "readOnly " << s.readOnly() << "\n";
+            for (const auto& a : answersOf(s, "P1")) out << "answer " << a << "\n";
+            out << "participants " << s.participants().size() << "\n";
+            out << "info " << s.info().code << "\n";
+            std::ostringstream trials, participants;
+            out << "trialRows " << writeTrialsCsv(s, trials, ExportScope::Answered) << "\n";
+            out << "participantRows " << writeParticipantsCsv(s, participants) << "\n";
+            try {
+                (void)s.startSession("P1", {});
+                out << "session started\n";
+            } catch (const StoreError& e) {
+                out << "session refused: " << e.what() << "\n";
+            }
+            // The reading commands' open (export, analyze, study info/participants).
+            StudyStore r = StudyStore::openForReading(path);
+            out << "forReading " << answersOf(r, "P1").size() << "\n";
+            return 0;
+        });
+        if (status == 20) GTEST_SKIP() << "cannot drop privileges to test a read-only study";
+        ::chmod(folder.c_str(), 0755);
+        const std::string got = readAll(report);
+        std::filesystem::remove(report);
+        const std::string where = fmt::format("file {:o} folder {:o}: ", fileMode, folderMode);
+        ASSERT_EQ(status, 0) << where << got;
+        std::string expected = "readOnly 1\n";
+        for (const auto& a : expectedAnswers(3)) expected += "answer " + a + "\n";
+        expected += "participants 1\ninfo A\ntrialRows 3\nparticipantRows 1\n";
+        EXPECT_EQ(got.substr(0, expected.size()), expected) << where << got;
+        const std::string refusal =
+            "session refused: " + path + ": participant 'P1': a session cannot start";
+        EXPECT_NE(got.find(refusal), std::string::npos) << where << got;
+        EXPECT_NE(got.find("read-only"), std::string::npos) << where << got;
+        EXPECT_NE(got.find("forReading 3\n"), std::string::npos) << where << got;
+        EXPECT_EQ(readAll(path), before) << where << "the study file changed";
+        if (folderMode == 0555) { // nothing could be created next to it
+            EXPECT_FALSE(std::filesystem::exists(path + "-shm")) << where;
+        }
+    }
+    ::chmod(path.c_str(), 0644);
+    StudyStore s = StudyStore::open(path);
+    EXPECT_EQ(answersOf(s, "P1"), expectedAnswers(3));
+}
+
+TEST(StoreFaults, ReadOnlyOpenOfAnOlderSchemaSaysAMigrationIsNeeded) {
+    TempDir dir;
+    const std::string path = dir.file("old.db");
+    { StudyStore::create(path, miniStudyProtocol(), {"O", "lab", 1, "t"}); }
+    setUserVersion(path, kSchemaVersion - 1); // as an older Underfoot left it
+    const std::string before = readAll(path);
+    std::string msg;
+    try {
+        (void)StudyStore::openReadOnly(path);
+    } catch (const StoreError& e) {
+        msg = e.what();
+    }
+    EXPECT_NE(msg.find(path), std::string::npos) << msg;
+    EXPECT_NE(msg.find(fmt::format("schema version {}", kSchemaVersion - 1)), std::string::npos)
+        << msg;
+    EXPECT_NE(msg.find("migrate"), std::string::npos) << msg;
+    EXPECT_EQ(readAll(path), before);
+}

@@ -12,6 +12,8 @@
 #include <cstring>
 #include <mutex>
 #include <thread>
+#include <utility>
+#include <vector>
 
 namespace underfoot::engine {
 
@@ -181,6 +183,87 @@ struct OscGyroReceiver::Impl {
         if (!queue.push(s)) monitor.framesDropped(1);
     }
 
+    /// A datagram that is not an OSC message or bundle (the hook's counterpart of onError).
+    void rejectDatagram(std::size_t size, const std::string& why) {
+        ++packets;
+        monitor.lineRejected(
+            sensorClockSeconds(),
+            fmt::format("packet {} ({} bytes): expected an OSC message, {}", packets, size, why));
+    }
+
+    /// Collects the messages of a bundle (recursively, at most kMaxBundleDepth deep) into
+    /// `messages`; false (with `why`) when the bundle is malformed.
+    static constexpr int kMaxBundleDepth = 8;
+    static bool isBundle(const unsigned char* data, std::size_t size) {
+        return size >= 8 && std::memcmp(data, "#bundle", 8) == 0;
+    }
+    static bool collectBundle(const unsigned char* data, std::size_t size, int depth,
+                              std::vector<std::pair<const unsigned char*, std::size_t>>& messages,
+                              std::string& why) {
+        if (depth > kMaxBundleDepth) {
+            why = fmt::format("a bundle nested at most {} deep", kMaxBundleDepth);
+            return false;
+        }
+        if (size < 16) {
+            why = "a bundle with an 8-byte time tag";
+            return false;
+        }
+        std::size_t pos = 16;
+        while (pos < size) {
+            if (size - pos < 4) {
+                why = fmt::format("a 4-byte element size at byte {} of the bundle", pos);
+                return false;
+            }
+            const std::uint32_t n = (std::uint32_t{data[pos]} << 24) |
+                                    (std::uint32_t{data[pos + 1]} << 16) |
+                                    (std::uint32_t{data[pos + 2]} << 8) | data[pos + 3];
+            pos += 4;
+            if (n == 0 || n % 4 != 0 || n > size - pos) {
+                why = fmt::format("a bundle element of a positive multiple of 4 bytes within the "
+                                  "datagram at byte {}, got a size of {}",
+                                  pos - 4, n);
+                return false;
+            }
+            if (isBundle(data + pos, n)) {
+                if (!collectBundle(data + pos, n, depth + 1, messages, why)) return false;
+            } else {
+                messages.emplace_back(data + pos, n);
+            }
+            pos += n;
+        }
+        return true;
+    }
+
+    void handleMessageBytes(const unsigned char* data, std::size_t size) {
+        int result = 0;
+        // liblo copies what it decodes and does not write to `data`.
+        void* bytes = const_cast<unsigned char*>(data);
+        lo_message m = lo_message_deserialise(bytes, size, &result);
+        if (!m) {
+            rejectDatagram(size, fmt::format("liblo error {} decoding it", result));
+            return;
+        }
+        const char* path = lo_get_path(bytes, static_cast<ssize_t>(size));
+        const char* types = lo_message_get_types(m);
+        handle(path ? path : "", types ? types : "", lo_message_get_argv(m),
+               lo_message_get_argc(m));
+        lo_message_free(m);
+    }
+
+    void handlePacket(const unsigned char* data, std::size_t size) {
+        if (!isBundle(data, size)) {
+            handleMessageBytes(data, size);
+            return;
+        }
+        std::vector<std::pair<const unsigned char*, std::size_t>> messages;
+        std::string why;
+        if (!collectBundle(data, size, 1, messages, why)) {
+            rejectDatagram(size, "an invalid OSC bundle: expected " + why);
+            return;
+        }
+        for (const auto& [bytes, n] : messages) handleMessageBytes(bytes, n);
+    }
+
     void checkLimbs(double nowS) {
         std::string message;
         {
@@ -269,6 +352,9 @@ SensorStatus OscGyroReceiver::status() const {
 }
 SensorState OscGyroReceiver::state() const noexcept {
     return impl_->monitor.state();
+}
+void OscGyroReceiver::handlePacket(const void* data, std::size_t size) {
+    impl_->handlePacket(static_cast<const unsigned char*>(data), size);
 }
 LimbCounters OscGyroReceiver::limbCounters(Limb limb) const {
     std::lock_guard lock(impl_->limbMutex);

@@ -80,6 +80,15 @@ class OscGyroReceiver {
     /// Counters of one limb.
     LimbCounters limbCounters(Limb limb) const;
 
+    /// Decodes one raw UDP payload (an OSC message, or a bundle of them) with liblo's decoder
+    /// and handles it as a datagram arriving on the port: the same address and type checks,
+    /// counters, faults, queue and callback. No socket is involved; this is the hook of the
+    /// tests and of the fuzz target (tests/fuzz/fuzz_osc_packet.cpp). Call it from one thread,
+    /// and not while the receiver thread runs (between construction and start(), or after
+    /// stop()). Bundle elements are handled at once (their time tags are not scheduled), and an
+    /// invalid bundle is rejected as a whole, as liblo does.
+    void handlePacket(const void* data, std::size_t size);
+
   private:
     struct Impl;
     std::unique_ptr<Impl> impl_;

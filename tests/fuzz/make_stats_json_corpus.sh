@@ -1,0 +1,53 @@
+#!/usr/bin/env bash
+# Writes the seed corpus of fuzz_stats_json (tests/fuzz/corpus/stats_json/): valid requests of
+# every `underfoot stats` test, each file "<test>\n<json>" (the target reads the test's name from
+# the first line). Add seeds here when a test or an option is added, then run this script.
+set -euo pipefail
+d="$(cd "$(dirname "$0")" && pwd)/corpus/stats_json"
+rm -rf "$d" && mkdir -p "$d"
+w() { printf '%s\n%s' "$1" "$3" > "$d/$1_$2"; }
+w binom 1 '{"x": 7, "n": 20, "p": 0.3, "alternative": "two.sided"}'
+w binom 2 '{"x": 682, "n": 925, "p": 0.75, "conf_level": 0.9, "alternative": "greater"}'
+w chisq 1 '{"table": [[8, 12], [18, 2]], "correct": false}'
+w chisq 2 '{"table": [[8,12,5],[18,2,7],[3,4,9]]}'
+w chisq_gof 1 '{"x": [10, 20, 30], "p": [0.2, 0.3, 0.5]}'
+w chisq_gof 2 '{"x": [89,37,30,28,2]}'
+w fisher 1 '{"table": [[3, 1], [1, 3]], "alternative": "greater", "conf_level": 0.9}'
+w fisher 2 '{"table": [[8,12],[18,2]]}'
+w fisher rxc1 '{"table": [[3,1,2],[1,3,0],[2,2,4]]}'
+w fisher rxc2 '{"table": [[2,7],[8,2],[4,4]], "alternative": "two.sided"}'
+w friedman 1 '{"y": [[1,2,3],[2,3,1],[3,1,2],[1,3,2]]}'
+w friedman 2 '{"y": [[5,4,7],[6,6,8],[3,5,4],[7,6,9],[4,4,6],[5,7,7],[6,5,8]]}'
+w glmm 1 '{"y": [0,1,1,1,0,0,1,1,0,1,1,1,1,0,1,1,0,0,0,1,1,0,1,1], "condition": ["a","a","a","b","b","b","a","a","a","b","b","b","a","a","a","b","b","b","a","a","a","b","b","b"], "participant": [1,1,1,1,1,1,2,2,2,2,2,2,3,3,3,3,3,3,4,4,4,4,4,4], "nAGQ": 1}'
+w glmm 2 '{"y": [0,1,1,0,1,1,1,0,1,1,0,0,1,1,1,1], "condition": ["x","y","x","y","x","y","x","y","x","y","x","y","x","y","x","y"], "participant": ["p1","p1","p1","p1","p2","p2","p2","p2","p3","p3","p3","p3","p4","p4","p4","p4"], "nAGQ": 5}'
+w lmm 1 '{"y": [1,2,3,4,5,6,7,9], "condition": [2,2,10,10,2,2,10,10], "participant": ["a","a","a","a","b","b","b","b"]}'
+w lmm 2 '{"y": [3.1,4.2,2.9,5.0,3.8,4.9,2.5,3.9,3.3,4.4,3.0,4.1], "condition": ["a","b","a","b","a","b","a","b","a","b","a","b"], "participant": [1,1,1,1,2,2,2,2,3,3,3,3]}'
+w kendall 1 '{"x": [44.4,45.9,41.9,53.3,44.7,44.1,50.7,45.2,60.1], "y": [2.6,3.1,2.5,5.0,3.6,4.0,5.2,2.8,3.8]}'
+w kendall 2 '{"x": [1,2,2,3,4,5], "y": [2,1,3,3,5,4], "alternative": "greater", "exact": false, "continuity": true}'
+w kruskal 1 '{"groups": [[2.9,3.0,2.5,2.6,3.2],[3.8,2.7,4.0,2.4],[2.8,3.4,3.7,2.2,2.0]]}'
+w levene 1 '{"groups": [[1,2,3],[2,4,6,8]], "center": "mean"}'
+w levene 2 '{"groups": [[2.9,3.0,2.5,2.6,3.2],[3.8,2.7,4.0,2.4],[2.8,3.4,3.7,2.2,2.0]]}'
+w p_adjust 1 '{"p": [0.01, 0.02, null, 0.5], "method": "BH"}'
+w p_adjust 2 '{"p": [0.01, 0.04, 0.03, 0.2], "method": "hochberg"}'
+w pairwise_wilcoxon 1 '{"groups": [[1,2,3,4],[2,3,4,5],[5,6,7,8]], "method": "holm"}'
+w pairwise_wilcoxon 2 '{"groups": [[1,2,3,4],[2,3,4,6],[5,6,7,8]], "paired": true, "exact": false, "correct": false, "method": "bonferroni"}'
+w pearson 1 '{"x": [44.4,45.9,41.9,53.3,44.7,44.1,50.7,45.2,60.1], "y": [2.6,3.1,2.5,5.0,3.6,4.0,5.2,2.8,3.8]}'
+w pearson 2 '{"x": [1,2,3,4,5,6], "y": [2,1,4,3,6,5], "alternative": "greater", "conf_level": 0.9}'
+w prop 1 '{"x": [15, 25], "n": [50, 50], "correct": true}'
+w prop 2 '{"x": [83,90,129,70], "n": [86,93,136,82]}'
+w prop 3 '{"x": [15], "n": [50], "p": [0.5], "alternative": "less", "conf_level": 0.9}'
+w shapiro 1 '{"x": [2.1, 3.4, 1.9, 5.6, 4.4, 3.3, 2.8]}'
+w spearman 1 '{"x": [1,2,3,4,5], "y": [5,6,7,8,7], "alternative": "less"}'
+w spearman 2 '{"x": [4.1,2.3,5.6,3.3,1.9,6.2,2.8], "y": [3.0,2.1,4.4,3.9,1.2,5.1,2.2], "exact": true}'
+w t 1 '{"x": [0.7,-1.6,-0.2,-1.2,-0.1,3.4], "y": [1.9,0.8,1.1,0.1,-0.1,4.4], "paired": true}'
+w t 2 '{"x": [0.7,-1.6,-0.2,-1.2,-0.1,3.4,3.7,0.8,0.0,2.0], "mu": 0.5, "alternative": "greater", "conf_level": 0.9}'
+w t 3 '{"x": [1,2,3,4,5], "y": [3,4,5,6,9], "var_equal": true}'
+w wilcoxon 1 '{"x": [1.83,0.50,1.62,2.48,1.68], "y": [0.878,0.647,0.598,2.05,1.06], "paired": true, "exact": true}'
+w wilcoxon 2 '{"x": [0.8,0.83,1.89,1.04,1.45,1.38,1.91,1.64,0.73,1.46], "y": [1.15,0.88,0.90,0.74,1.21], "alternative": "greater"}'
+w wilcoxon ci1 '{"x": [1.83,0.50,1.62,2.48,1.68,1.88,1.55,3.06,1.30], "y": [0.878,0.647,0.598,2.05,1.06,1.29,1.06,3.14,1.29], "paired": true, "conf_int": true, "conf_level": 0.9}'
+w wilcoxon ci2 '{"x": [0.8,0.83,1.89,1.04,1.45,1.38,1.91,1.64,0.73,1.46], "y": [1.15,0.88,0.90,0.74,1.21], "conf_int": true, "exact": false, "correct": true}'
+w wilcoxon ci3 '{"x": [1.1,2.2,3.3,4.4,0.5,-0.7,2.9], "mu": 1, "conf_int": true}'
+w wilson 1 '{"x": 7, "n": 20, "conf_level": 0.9, "correct": true}'
+w wilson 2 '{"x": 8, "n": 20}'
+# A refusal: an unknown test.
+w unknown 1 '{"x": [1,2,3]}'
