@@ -97,6 +97,7 @@ int writeParticipantsCsv(const StudyStore& store, std::ostream& out, SimulatedRo
     std::vector<std::string> header{"participant", "group", "status", "age",
                                     "gender",      "shoes", "hearing"};
     for (const auto& f : protocol.participantFields) header.push_back(f.id);
+    header.push_back("simulated");
     writeRow(out, header);
     int rows = 0;
     for (const auto& p : store.participants()) {
@@ -108,6 +109,7 @@ int writeParticipantsCsv(const StudyStore& store, std::ostream& out, SimulatedRo
             const auto it = p.fields.find(f.id);
             row.push_back(it == p.fields.end() ? "" : it->second);
         }
+        row.push_back(p.simulated ? "1" : "0");
         writeRow(out, row);
         ++rows;
     }
@@ -182,6 +184,7 @@ int writeRatingsCsv(const StudyStore& store, std::ostream& out, ExportScope scop
     header.insert(header.end(), factorNames.begin(), factorNames.end());
     header.push_back("scale");
     header.push_back("value");
+    header.push_back("simulated");
     writeRow(out, header);
     int rows = 0;
     for (const auto& p : store.participants()) {
@@ -203,6 +206,7 @@ int writeRatingsCsv(const StudyStore& store, std::ostream& out, ExportScope scop
                 }
                 row.push_back(scale);
                 row.push_back(std::to_string(value));
+                row.push_back(p.simulated ? "1" : "0");
                 writeRow(out, row);
                 ++rows;
             }
@@ -268,8 +272,14 @@ void writeCodebook(const StudyStore& store, std::ostream& out) {
     out << "\n## ratings.csv — one row per rating\n\n"
            "Columns: study, participant, group, trial_index, stimulus_id, practice, excluded, "
            "one column per factor of the protocol's [[factorial]] stimuli (their level; empty "
-           "for other stimuli), scale, value. Every scale of the protocol, including those "
-           "without a column in trials.csv.\n";
+           "for other stimuli), scale, value, simulated (0/1, as in trials.csv: 1 for a "
+           "synthetic participant of `underfoot session --simulate`). Every scale of the "
+           "protocol, including those without a column in trials.csv.\n"
+           "\n## participants.csv — one row per participant\n\n"
+           "Columns: participant, group, status, age, gender, shoes, hearing, one column per "
+           "participant field of the protocol, simulated (0/1: 1 for a synthetic participant of "
+           "`underfoot session --simulate`, not a person; left out of `underfoot analyze` unless "
+           "--include-simulated).\n";
     if (!p.questions.scales.empty()) {
         out << "\n## Scales\n\n| id | range | anchors | prompt |\n|---|---|---|---|\n";
         for (const auto& s : p.questions.scales)
