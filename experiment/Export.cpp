@@ -94,22 +94,27 @@ int writeTrialsCsv(const StudyStore& store, std::ostream& out, ExportScope scope
 
 int writeParticipantsCsv(const StudyStore& store, std::ostream& out, SimulatedRows simulated) {
     const Protocol& protocol = store.protocol();
-    std::vector<std::string> header{"participant", "group", "status", "age",
-                                    "gender",      "shoes", "hearing"};
+    // `simulated` before `hearing`: readers take the columns after `hearing` as the protocol's
+    // participant fields (analysis/ratings/RatingData.cpp).
+    std::vector<std::string> header{"participant", "group",  "status", "simulated",
+                                    "age",         "gender", "shoes",  "hearing"};
     for (const auto& f : protocol.participantFields) header.push_back(f.id);
-    header.push_back("simulated");
     writeRow(out, header);
     int rows = 0;
     for (const auto& p : store.participants()) {
         if (p.simulated && simulated == SimulatedRows::Exclude) continue;
-        std::vector<std::string> row{
-            p.code,   p.groupId, toString(p.status), p.age ? std::to_string(*p.age) : "",
-            p.gender, p.shoes,   p.hearing};
+        std::vector<std::string> row{p.code,
+                                     p.groupId,
+                                     toString(p.status),
+                                     p.simulated ? "1" : "0",
+                                     p.age ? std::to_string(*p.age) : "",
+                                     p.gender,
+                                     p.shoes,
+                                     p.hearing};
         for (const auto& f : protocol.participantFields) {
             const auto it = p.fields.find(f.id);
             row.push_back(it == p.fields.end() ? "" : it->second);
         }
-        row.push_back(p.simulated ? "1" : "0");
         writeRow(out, row);
         ++rows;
     }
@@ -276,10 +281,10 @@ void writeCodebook(const StudyStore& store, std::ostream& out) {
            "synthetic participant of `underfoot session --simulate`). Every scale of the "
            "protocol, including those without a column in trials.csv.\n"
            "\n## participants.csv — one row per participant\n\n"
-           "Columns: participant, group, status, age, gender, shoes, hearing, one column per "
-           "participant field of the protocol, simulated (0/1: 1 for a synthetic participant of "
-           "`underfoot session --simulate`, not a person; left out of `underfoot analyze` unless "
-           "--include-simulated).\n";
+           "Columns: participant, group, status, simulated (0/1: 1 for a synthetic participant "
+           "of `underfoot session --simulate`, not a person; left out of `underfoot analyze` "
+           "unless --include-simulated), age, gender, shoes, hearing, then one column per "
+           "participant field of the protocol.\n";
     if (!p.questions.scales.empty()) {
         out << "\n## Scales\n\n| id | range | anchors | prompt |\n|---|---|---|---|\n";
         for (const auto& s : p.questions.scales)
