@@ -94,16 +94,23 @@ int writeTrialsCsv(const StudyStore& store, std::ostream& out, ExportScope scope
 
 int writeParticipantsCsv(const StudyStore& store, std::ostream& out, SimulatedRows simulated) {
     const Protocol& protocol = store.protocol();
-    std::vector<std::string> header{"participant", "group", "status", "age",
-                                    "gender",      "shoes", "hearing"};
+    // `simulated` before `hearing`: readers take the columns after `hearing` as the protocol's
+    // participant fields (analysis/ratings/RatingData.cpp).
+    std::vector<std::string> header{"participant", "group",  "status", "simulated",
+                                    "age",         "gender", "shoes",  "hearing"};
     for (const auto& f : protocol.participantFields) header.push_back(f.id);
     writeRow(out, header);
     int rows = 0;
     for (const auto& p : store.participants()) {
         if (p.simulated && simulated == SimulatedRows::Exclude) continue;
-        std::vector<std::string> row{
-            p.code,   p.groupId, toString(p.status), p.age ? std::to_string(*p.age) : "",
-            p.gender, p.shoes,   p.hearing};
+        std::vector<std::string> row{p.code,
+                                     p.groupId,
+                                     toString(p.status),
+                                     p.simulated ? "1" : "0",
+                                     p.age ? std::to_string(*p.age) : "",
+                                     p.gender,
+                                     p.shoes,
+                                     p.hearing};
         for (const auto& f : protocol.participantFields) {
             const auto it = p.fields.find(f.id);
             row.push_back(it == p.fields.end() ? "" : it->second);
@@ -182,6 +189,7 @@ int writeRatingsCsv(const StudyStore& store, std::ostream& out, ExportScope scop
     header.insert(header.end(), factorNames.begin(), factorNames.end());
     header.push_back("scale");
     header.push_back("value");
+    header.push_back("simulated");
     writeRow(out, header);
     int rows = 0;
     for (const auto& p : store.participants()) {
@@ -203,6 +211,7 @@ int writeRatingsCsv(const StudyStore& store, std::ostream& out, ExportScope scop
                 }
                 row.push_back(scale);
                 row.push_back(std::to_string(value));
+                row.push_back(p.simulated ? "1" : "0");
                 writeRow(out, row);
                 ++rows;
             }
@@ -268,8 +277,14 @@ void writeCodebook(const StudyStore& store, std::ostream& out) {
     out << "\n## ratings.csv — one row per rating\n\n"
            "Columns: study, participant, group, trial_index, stimulus_id, practice, excluded, "
            "one column per factor of the protocol's [[factorial]] stimuli (their level; empty "
-           "for other stimuli), scale, value. Every scale of the protocol, including those "
-           "without a column in trials.csv.\n";
+           "for other stimuli), scale, value, simulated (0/1, as in trials.csv: 1 for a "
+           "synthetic participant of `underfoot session --simulate`). Every scale of the "
+           "protocol, including those without a column in trials.csv.\n"
+           "\n## participants.csv — one row per participant\n\n"
+           "Columns: participant, group, status, simulated (0/1: 1 for a synthetic participant "
+           "of `underfoot session --simulate`, not a person; left out of `underfoot analyze` "
+           "unless --include-simulated), age, gender, shoes, hearing, then one column per "
+           "participant field of the protocol.\n";
     if (!p.questions.scales.empty()) {
         out << "\n## Scales\n\n| id | range | anchors | prompt |\n|---|---|---|---|\n";
         for (const auto& s : p.questions.scales)

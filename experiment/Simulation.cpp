@@ -2,12 +2,15 @@
 #include "experiment/Simulation.h"
 
 #include <fmt/format.h>
+#include <toml++/toml.h>
 
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <sstream>
+#include <stdexcept>
 
 namespace underfoot::experiment {
 
@@ -278,7 +281,8 @@ namespace {
 /// seed the clip was rendered with), and the planned seed otherwise.
 class SimulationPlayer final : public StimulusPlayer {
   public:
-    explicit SimulationPlayer(const Protocol& protocol) : protocol_(protocol) {}
+    SimulationPlayer(const Protocol& protocol, std::string walker)
+        : protocol_(protocol), walker_(std::move(walker)) {}
     StimulusStart start(const Stimulus& stimulus, std::uint64_t plannedSeed) override {
         if (protocol_.clips.enabled) return {clipSeed(protocol_, stimulus), std::nullopt};
         // A sensor stimulus (microphones, shoes, gyroscopes) has no person walking: the
@@ -287,14 +291,14 @@ class SimulationPlayer final : public StimulusPlayer {
         // Water stimuli replay from the virtual gait of their wading parameters already.
         if (stimulus.input.kind == InputKind::Sensor && stimulus.wading.empty() &&
             stimulus.surface != "water")
-            return {plannedSeed,
-                    fmt::format("{}{}", kSimulatedWalkerPrefix, protocol_.timing.trialS)};
+            return {plannedSeed, walker_};
         return {plannedSeed, std::nullopt};
     }
     void stop() override {}
 
   private:
     const Protocol& protocol_;
+    std::string walker_; ///< formatSimulatedWalker() of this participant's feet
 };
 } // namespace
 
@@ -323,7 +327,11 @@ int runSimulatedSession(StudyStore& store, const std::string& code, const Confus
     const double replayProbability =
         settings.ratingModel ? settings.ratingModel->replayProbability : 0.2;
     double simulatedTimeS = 0.0;
-    SimulationPlayer player(store.protocol());
+    // The participant's own gait (the same in every session of the participant).
+    SimulationPlayer player(store.protocol(),
+                            formatSimulatedWalker(drawSimulatedWalker(
+                                deriveSeed(seed, {static_cast<std::uint64_t>(info.index), 0x3A1C}),
+                                store.protocol().timing.trialS)));
     Session session(store, code, player,
                     SessionSettings{"simulation", "none (simulated)", "none (simulated)",
                                     UNDERFOOT_VERSION, false},
@@ -453,6 +461,88 @@ MatrixByGroup defaultMatrices(const Protocol& protocol, const std::string& proto
     for (const auto& [group, file] : protocol.simulation.confusion)
         out[group] = loadConfusionMatrix(findProtocolFile(protocol, file, protocolFile));
     return out;
+}
+
+} // namespace underfoot::experiment
+
+namespace underfoot::experiment {
+
+SimulatedWalker drawSimulatedWalker(std::uint64_t seed, double seconds) {
+    Rng rng(seed);
+    const auto draw = [&](double lo, double hi, double step) {
+        return std::round((lo + (hi - lo) * rng.uniform()) / step) * step;
+    };
+    SimulatedWalker w;
+    w.seconds = seconds;
+    // Rounded through text so that the stored digits are exactly the values used.
+    const auto exact = [](double v, int decimals) {
+        return std::stod(fmt::format("{:.{}f}", v, decimals));
+    };
+    w.walker["cadence"] = exact(draw(90, 120, 0.1), 1);
+    w.walker["mass"] = exact(draw(55, 95, 0.1), 1);
+    w.walker["shoe"] = exact(draw(0.2, 0.8, 0.01), 2);
+    w.walker["variability"] = exact(draw(0.02, 0.05, 0.001), 3);
+    return w;
+}
+
+std::string formatSimulatedWalker(const SimulatedWalker& w) {
+    std::string text = fmt::format("{}{{ seconds = {}", kSimulatedWalkerTablePrefix, w.seconds);
+    for (const auto& [key, value] : w.walker)
+        if (const double* v = std::get_if<double>(&value))
+            text += fmt::format(", {} = {}", key, *v);
+    return text + " }";
+}
+
+std::optional<SimulatedWalker> parseSimulatedWalker(const std::string& reference) {
+    SimulatedWalker w;
+    const auto checkSeconds = [&](double s) {
+        if (!(s > 0 && s <= 3600))
+            throw std::invalid_argument(fmt::format(
+                "stored control stream '{}': seconds = {}; expected 0 < seconds <= 3600", reference,
+                s));
+    };
+    if (reference.rfind(kSimulatedWalkerPrefix, 0) == 0) {
+        const std::string value = reference.substr(kSimulatedWalkerPrefix.size());
+        std::size_t used = 0;
+        try {
+            w.seconds = std::stod(value, &used);
+        } catch (const std::exception&) {
+            used = 0;
+        }
+        if (used == 0 || used != value.size())
+            throw std::invalid_argument(
+                fmt::format("stored control stream '{}': expected {}SECONDS", reference,
+                            kSimulatedWalkerPrefix));
+        checkSeconds(w.seconds);
+        return w;
+    }
+    if (reference.rfind(kSimulatedWalkerTablePrefix, 0) != 0) return std::nullopt;
+    toml::table doc;
+    try {
+        doc = toml::parse("walker = " + reference.substr(kSimulatedWalkerTablePrefix.size()));
+    } catch (const toml::parse_error& e) {
+        throw std::invalid_argument(fmt::format(
+            "stored control stream '{}': expected {}{{ seconds = S, cadence = ..., mass = ..., "
+            "shoe = ..., variability = ... }} ({})",
+            reference, kSimulatedWalkerTablePrefix, e.description()));
+    }
+    const toml::table* t = doc["walker"].as_table();
+    if (!t)
+        throw std::invalid_argument(
+            fmt::format("stored control stream '{}': expected an inline table", reference));
+    for (const auto& [key, node] : *t) {
+        const auto v = node.value<double>();
+        if (!v || !std::isfinite(*v))
+            throw std::invalid_argument(
+                fmt::format("stored control stream '{}': `{}`: expected a finite number", reference,
+                            key.str()));
+        if (key.str() == "seconds")
+            w.seconds = *v;
+        else
+            w.walker[std::string(key.str())] = *v;
+    }
+    checkSeconds(w.seconds);
+    return w;
 }
 
 } // namespace underfoot::experiment

@@ -10,6 +10,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -86,11 +87,36 @@ class SimulatedParticipant {
 
 namespace underfoot::experiment {
 
-/// Prefix of the control-stream reference a simulated participant's sensor trial stores in
-/// place of a GRF recording: "virtual-walker:seconds=S" means that the participant's feet were
-/// the stimulus's virtual walker (the engine's default walker for sensor stimuli) for S seconds
-/// from the trial's render seed, which `underfoot replay` regenerates exactly.
+/// Prefix of the control-stream reference a simulated participant's sensor trial stored in
+/// place of a GRF recording before the walker's parameters were stored (studies made then):
+/// "virtual-walker:seconds=S" means that the participant's feet were the engine's default
+/// virtual walker for S seconds from the trial's render seed.
 inline constexpr std::string_view kSimulatedWalkerPrefix = "virtual-walker:seconds=";
+/// Prefix of the readable control-stream reference of a simulated participant's sensor trial:
+/// "virtual-walker: { seconds = 50, cadence = 104.3, mass = 71.2, shoe = 0.43, variability =
+/// 0.031 }" — a TOML inline table with the virtual walker's parameters (the engine's names:
+/// steps/min, kg, 0 soft .. 1 hard, relative std) that walked for this participant, for
+/// `seconds`, from the trial's render seed. `underfoot replay` regenerates it from this text;
+/// `underfoot export` shows it in audio.csv's grf_recording column.
+inline constexpr std::string_view kSimulatedWalkerTablePrefix = "virtual-walker: ";
+
+/// The feet of a simulated participant in sensor trials.
+struct SimulatedWalker {
+    double seconds = 0;
+    /// cadence, mass, shoe, variability (numbers); empty: the engine's default walker (studies
+    /// stored with the older "virtual-walker:seconds=S" reference).
+    Parameters walker;
+};
+
+/// The walker of one simulated participant, drawn from `seed` (uniform: cadence 90–120
+/// steps/min, mass 55–95 kg, shoe 0.2–0.8, variability 0.02–0.05; rounded to the digits the
+/// stored text shows, so the text is exactly what walked), walking `seconds` per trial.
+SimulatedWalker drawSimulatedWalker(std::uint64_t seed, double seconds);
+/// The stored reference (kSimulatedWalkerTablePrefix + TOML inline table).
+std::string formatSimulatedWalker(const SimulatedWalker& walker);
+/// Reads a stored reference: nullopt when it is not a simulated walker's (a recording path);
+/// throws std::invalid_argument naming what was expected for a malformed one.
+std::optional<SimulatedWalker> parseSimulatedWalker(const std::string& reference);
 
 /// Confusion matrices by group id; the entry "" is used for groups without their own.
 using MatrixByGroup = std::map<std::string, ConfusionMatrix>;

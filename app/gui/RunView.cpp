@@ -147,11 +147,10 @@ class ConsolePlayer final : public exp::StimulusPlayer {
         started.renderSeed = plannedSeed;
         if (injected_) started = injected_->start(stimulus, plannedSeed);
 #ifdef UNDERFOOT_HAVE_WIRING
-        // Silent baseline laps: the scene is submitted only when the sound comes on.
-        if (live_ && muted_)
-            deferred_ = {stimulus, plannedSeed};
-        else if (live_)
-            started = live_->start(stimulus, plannedSeed);
+        // Silent baseline laps: the live player reserves the recording now and submits the
+        // scene only when the sound comes on (LivePlayer::setMuted), so the recording reference
+        // stored with the trial is the one replay needs.
+        if (live_) started = live_->start(stimulus, plannedSeed);
 #endif
         meters_.start(stimulus, started.renderSeed);
         return started;
@@ -163,7 +162,6 @@ class ConsolePlayer final : public exp::StimulusPlayer {
         }
         if (injected_) injected_->stop();
 #ifdef UNDERFOOT_HAVE_WIRING
-        deferred_.reset();
         if (live_) live_->stop();
 #endif
         meters_.stop();
@@ -199,11 +197,9 @@ class ConsolePlayer final : public exp::StimulusPlayer {
     void setMuted(bool muted) override {
         muted_ = muted;
 #ifdef UNDERFOOT_HAVE_WIRING
-        if (!muted && deferred_ && live_) {
-            const auto [stimulus, seed] = *deferred_;
-            deferred_.reset();
+        if (live_) {
             try {
-                live_->start(stimulus, seed);
+                live_->setMuted(muted);
                 soundError_.clear();
             } catch (const std::exception& e) {
                 soundError_ = e.what(); // the lap is stored; the view shows why nothing is heard
@@ -274,7 +270,6 @@ class ConsolePlayer final : public exp::StimulusPlayer {
     std::shared_ptr<engine::OscGyroReceiver> gyros_;
     std::unique_ptr<wiring::LivePlayer> live_;
     std::unique_ptr<wiring::ClipAudio> clipAudio_;
-    std::optional<std::pair<exp::Stimulus, std::uint64_t>> deferred_;
 #endif
 };
 

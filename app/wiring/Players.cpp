@@ -115,9 +115,61 @@ std::string safeName(const std::string& id) {
 }
 } // namespace
 
+std::string LivePlayer::reference(const std::string& path) const {
+    std::string ref = path;
+    if (!options_.studyFolder.empty()) {
+        const auto rel = fs::path(path).lexically_relative(options_.studyFolder);
+        if (!rel.empty() && *rel.begin() != "..") ref = rel.string();
+    }
+    return ref;
+}
+
+std::string LivePlayer::reservePath(const exp::Stimulus& stimulus, std::uint64_t plannedSeed) {
+    if (options_.recordingFolder.empty()) return {};
+    const bool wading = isWadingStimulus(stimulus);
+    fs::create_directories(options_.recordingFolder);
+    std::string path;
+    for (int attempt = 0;; ++attempt) {
+        path = (fs::path(options_.recordingFolder) /
+                fmt::format("{}_{}_{:03d}_seed{}{}.{}", wading ? "gait" : "grf",
+                            safeName(stimulus.id), ++counter_, plannedSeed,
+                            attempt ? fmt::format("_{}", attempt) : "", wading ? "csv" : "wav"))
+                   .string();
+        if (!fs::exists(path)) break;
+    }
+    return path;
+}
+
+void LivePlayer::setMuted(bool muted) {
+    muted_ = muted;
+    if (muted || !deferred_) return;
+    const Deferred d = std::move(*deferred_);
+    deferred_.reset();
+    begin(d.stimulus, d.seed, d.path);
+}
+
 exp::StimulusStart LivePlayer::start(const exp::Stimulus& stimulus, std::uint64_t plannedSeed) {
     if (!engine_.isOpen()) throw std::runtime_error("live player: the audio engine is not open");
     stop();
+    // Fail now, not when the sound comes on, for a stimulus that cannot be described.
+    if (muted_) (void)describeStimulus(stimulus, plannedSeed, options_.scene);
+    const std::string path = reservePath(stimulus, plannedSeed);
+    if (!muted_) return begin(stimulus, plannedSeed, path);
+    // Silent baseline laps: the scene starts when the sound comes on (setMuted(false)); the
+    // recording then holds what was heard, under the name reserved now.
+    deferred_ = Deferred{stimulus, plannedSeed, path};
+    exp::StimulusStart result;
+    result.renderSeed = plannedSeed;
+    if (!path.empty()) result.grfRecording = reference(path);
+    sensor_ = stimulus.input.kind == exp::InputKind::Sensor &&
+                      stimulus.input.sensor == exp::SensorKind::Gyro && options_.scene.gyroReceiver
+                  ? TrialSensor::Gyro
+                  : TrialSensor::None;
+    return result;
+}
+
+exp::StimulusStart LivePlayer::begin(const exp::Stimulus& stimulus, std::uint64_t plannedSeed,
+                                     const std::string& path) {
     auto d = describeStimulus(stimulus, plannedSeed, options_.scene);
     const bool wading = d.wading != nullptr;
     const int grfChannels = wading                                  ? 0
@@ -127,21 +179,8 @@ exp::StimulusStart LivePlayer::start(const exp::Stimulus& stimulus, std::uint64_
                                 : d.external->channelCount();
     exp::StimulusStart result;
     result.renderSeed = plannedSeed;
-    std::string path;
-    if (!options_.recordingFolder.empty()) {
-        fs::create_directories(options_.recordingFolder);
-        for (int attempt = 0;; ++attempt) {
-            path = (fs::path(options_.recordingFolder) /
-                    fmt::format("{}_{}_{:03d}_seed{}{}.{}", wading ? "gait" : "grf",
-                                safeName(stimulus.id), ++counter_, plannedSeed,
-                                attempt ? fmt::format("_{}", attempt) : "", wading ? "csv" : "wav"))
-                       .string();
-            if (!fs::exists(path)) break;
-        }
-        if (!wading)
-            d.grfRecorder =
-                eng::makeGrfRecorder(path, grfChannels, engine_.processSpec().sampleRateHz);
-    }
+    if (!path.empty() && !wading)
+        d.grfRecorder = eng::makeGrfRecorder(path, grfChannels, engine_.processSpec().sampleRateHz);
     auto recorder = d.grfRecorder;
     std::unique_ptr<eng::LiveScene> scene;
     try {
@@ -171,14 +210,6 @@ exp::StimulusStart LivePlayer::start(const exp::Stimulus& stimulus, std::uint64_
     wading_ = wading;
     engine_.resetPeaks();
     startMeters_ = engine_.meters();
-    const auto reference = [this](const std::string& p) {
-        std::string ref = p;
-        if (!options_.studyFolder.empty()) {
-            const auto rel = fs::path(p).lexically_relative(options_.studyFolder);
-            if (!rel.empty() && *rel.begin() != "..") ref = rel.string();
-        }
-        return ref;
-    };
     if (!path.empty()) result.grfRecording = reference(path);
     TrialSensor sensor = TrialSensor::None;
     if (stimulus.input.kind == exp::InputKind::Sensor &&
@@ -262,6 +293,7 @@ std::optional<std::string> LivePlayer::sensorFault() const {
 }
 
 void LivePlayer::stop() {
+    deferred_.reset(); // a trial stopped during its silent laps: nothing was heard or recorded
     if (!playing_) return;
     playing_ = false; // sensor_ stays: the session asks whether that sensor came back
     engine_.submit(nullptr);

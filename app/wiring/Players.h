@@ -89,6 +89,11 @@ class LivePlayer final : public experiment::StimulusPlayer {
     experiment::StimulusStart start(const experiment::Stimulus& stimulus,
                                     std::uint64_t plannedSeed) override;
     void stop() override;
+    /// Silent baseline laps ([laps]): while muted, start() reserves the recording's name (and
+    /// returns it) but submits no scene; unmuting starts the scene then, so that its recording
+    /// holds exactly what was heard and `underfoot replay` reproduces it. Unmuting throws as
+    /// start() does when the scene cannot be built.
+    void setMuted(bool muted) override;
 
     bool playing() const noexcept { return playing_; }
     /// The running (or last) scene's one-line summary.
@@ -116,6 +121,15 @@ class LivePlayer final : public experiment::StimulusPlayer {
 
   private:
     enum class TrialSensor { None, Shoes, Gyro };
+    struct Deferred {
+        experiment::Stimulus stimulus;
+        std::uint64_t seed = 0;
+        std::string path;
+    };
+    experiment::StimulusStart begin(const experiment::Stimulus& stimulus, std::uint64_t plannedSeed,
+                                    const std::string& path);
+    std::string reservePath(const experiment::Stimulus& stimulus, std::uint64_t plannedSeed);
+    std::string reference(const std::string& path) const;
     void startSensorLog(const std::string& path);
     void stopSensorLog();
 
@@ -131,6 +145,8 @@ class LivePlayer final : public experiment::StimulusPlayer {
     bool playing_ = false;
     bool stopped_ = false; ///< a trial was stopped (stats_ is valid)
     bool wading_ = false;  ///< the running trial is a water scene (gait recorded at stop)
+    bool muted_ = false;   ///< silent baseline laps: scenes wait for setMuted(false)
+    std::optional<Deferred> deferred_;
     std::atomic<TrialSensor> sensor_{TrialSensor::None}; ///< what the running trial depends on
     std::string sensorLogPath_, sensorLogError_;
     std::size_t sensorLogRows_ = 0;

@@ -62,22 +62,17 @@ ReplayRender renderTrialReplay(const ReplayRequest& q) {
             q.trial + 1, q.participant, *stimulus.clip));
     std::optional<fs::path> recording;
     LiveRun live;
-    // A simulated participant's sensor trial: its feet were the virtual walker (issue #17).
-    std::optional<double> simulatedWalkerSeconds;
-    if (info.grfRecording && info.grfRecording->rfind(exp::kSimulatedWalkerPrefix, 0) == 0) {
-        const std::string value = info.grfRecording->substr(exp::kSimulatedWalkerPrefix.size());
+    // A simulated participant's sensor trial: its feet were a virtual walker whose parameters
+    // the trial stores as text (issue #17).
+    std::optional<exp::SimulatedWalker> simulatedWalker;
+    if (info.grfRecording) {
         try {
-            std::size_t used = 0;
-            const double seconds = std::stod(value, &used);
-            if (used != value.size() || !(seconds > 0 && seconds <= 3600)) throw 0;
-            simulatedWalkerSeconds = seconds;
-        } catch (...) {
-            throw ReplayError(fmt::format("trial {} of {}: stored control stream '{}': expected "
-                                          "{}SECONDS with 0 < SECONDS <= 3600",
-                                          q.trial + 1, q.participant, *info.grfRecording,
-                                          exp::kSimulatedWalkerPrefix));
+            simulatedWalker = exp::parseSimulatedWalker(*info.grfRecording);
+        } catch (const std::invalid_argument& e) {
+            throw ReplayError(
+                fmt::format("trial {} of {}: {}", q.trial + 1, q.participant, e.what()));
         }
-        info.grfRecording.reset();
+        if (simulatedWalker) info.grfRecording.reset();
     }
     if (info.grfRecording) {
         recording = fs::path(*info.grfRecording);
@@ -126,9 +121,9 @@ ReplayRender renderTrialReplay(const ReplayRequest& q) {
                 throw ReplayError(std::string("the trial's GRF recording: ") + e.what());
             }
             source = "recorded GRF " + recording->string();
-        } else if (simulatedWalkerSeconds) {
-            const auto walker = walkerFromStimulus(stimulus.input.walker);
-            grf = eng::walkerGrf(walker, *simulatedWalkerSeconds, rate, info.renderSeed);
+        } else if (simulatedWalker) {
+            const auto walker = walkerFromStimulus(simulatedWalker->walker);
+            grf = eng::walkerGrf(walker, simulatedWalker->seconds, rate, info.renderSeed);
             source = "the simulated participant's virtual walker " + walker.toString();
         } else if (stimulus.input.kind == exp::InputKind::Walker) {
             const auto walker = walkerFromStimulus(stimulus.input.walker);

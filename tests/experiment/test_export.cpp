@@ -193,7 +193,7 @@ TEST(ExperimentExport, RatingsCarryFactorLevels) {
     const auto rows = readCsv(out.str());
     EXPECT_EQ(rows[0], (std::vector<std::string>{"study", "participant", "group", "trial_index",
                                                  "stimulus_id", "practice", "excluded", "cadence",
-                                                 "depth", "scale", "value"}));
+                                                 "depth", "scale", "value", "simulated"}));
     for (std::size_t r = 1; r < rows.size(); ++r) {
         const auto& row = rows[r];
         if (row[4] == "practice_normal") {
@@ -204,5 +204,6 @@ TEST(ExperimentExport, RatingsCarryFactorLevels) {
         const int value = std::stoi(row[10]);
         EXPECT_GE(value, row[9] == "realism" ? 1 : 0);
         EXPECT_LE(value, row[9] == "realism" ? 7 : 10);
+        EXPECT_EQ(row[11], "1") << "every participant of simulateStudy is simulated";
     }
 }

@@ -133,6 +133,22 @@ TEST(Honest, ExportFlagsSimulatedRowsAndNumbersTrialsFromOne) {
     EXPECT_EQ(writeTrialsCsv(store, real, ExportScope::Answered, SimulatedRows::Exclude), 1);
     std::ostringstream participants;
     EXPECT_EQ(writeParticipantsCsv(store, participants, SimulatedRows::Exclude), 1);
+    {
+        // participants.csv and ratings.csv carry the flag too (issue #17).
+        std::ostringstream everyone;
+        EXPECT_EQ(writeParticipantsCsv(store, everyone, SimulatedRows::Include), 2);
+        const auto p = csvRows(everyone.str());
+        const std::size_t ps = column(p[0], "simulated"), pc = column(p[0], "participant");
+        for (std::size_t r = 1; r < p.size(); ++r)
+            EXPECT_EQ(p[r][ps], p[r][pc] == "P01" ? "0" : "1") << p[r][pc];
+        std::ostringstream ratings;
+        writeRatingsCsv(store, ratings, ExportScope::Answered, SimulatedRows::Include);
+        const auto q = csvRows(ratings.str());
+        const std::size_t qs = column(q[0], "simulated"), qc = column(q[0], "participant");
+        // (This protocol has no scales: the header only; test_export checks rated rows.)
+        for (std::size_t r = 1; r < q.size(); ++r)
+            EXPECT_EQ(q[r][qs], q[r][qc] == "P01" ? "0" : "1") << q[r][qc];
+    }
 
     std::ostringstream codebook;
     writeCodebook(store, codebook);
@@ -302,9 +318,49 @@ TEST(Honest, ASimulatedSensorTrialRecordsItsControlStream) {
         dir.file("s.db"), loadProtocol(shipped("tvcg2011_exp1.toml")), {"H", "ci", 2, "t"});
     simulateStudy(store, matricesFor(store.protocol()), 1, {});
     const auto code = store.participants().front().code;
+    std::optional<std::string> first;
     for (const auto& t : store.trials(code)) {
         ASSERT_TRUE(t.grfRecording.has_value()) << t.index;
-        EXPECT_EQ(*t.grfRecording, std::string(kSimulatedWalkerPrefix) + "50") << t.index;
+        // Readable text with the walker's parameters, the same for all of the participant's
+        // trials, that reads back to what walked.
+        if (!first) first = *t.grfRecording;
+        EXPECT_EQ(*t.grfRecording, *first) << t.index;
+        const auto walker = parseSimulatedWalker(*t.grfRecording);
+        ASSERT_TRUE(walker.has_value()) << *t.grfRecording;
+        EXPECT_EQ(walker->seconds, 50.0);
+        for (const char* key : {"cadence", "mass", "shoe", "variability"})
+            EXPECT_EQ(walker->walker.count(key), 1u) << key << " in " << *t.grfRecording;
+        EXPECT_EQ(formatSimulatedWalker(*walker), *t.grfRecording);
         EXPECT_EQ(store.trialForReplay(code, t.index).renderSeed, t.plannedSeed);
+    }
+    ASSERT_TRUE(first.has_value());
+    EXPECT_EQ(first->rfind(kSimulatedWalkerTablePrefix, 0), 0u) << *first;
+    std::printf("stored control stream: %s\n", first->c_str());
+}
+
+TEST(Honest, SimulatedWalkerReferencesParseOrSayWhatWasExpected) {
+    const auto w = drawSimulatedWalker(7, 12.5);
+    const auto cadence = std::get<double>(w.walker.at("cadence"));
+    EXPECT_GE(cadence, 90.0);
+    EXPECT_LE(cadence, 120.0);
+    const auto back = parseSimulatedWalker(formatSimulatedWalker(w));
+    ASSERT_TRUE(back.has_value());
+    EXPECT_EQ(back->seconds, 12.5);
+    EXPECT_EQ(back->walker, w.walker);
+    // Studies stored before the parameters were: the default walker.
+    const auto old = parseSimulatedWalker(std::string(kSimulatedWalkerPrefix) + "50");
+    ASSERT_TRUE(old.has_value());
+    EXPECT_EQ(old->seconds, 50.0);
+    EXPECT_TRUE(old->walker.empty());
+    EXPECT_FALSE(parseSimulatedWalker("recordings/grf_GL_001_seed3.wav").has_value());
+    for (const std::string bad :
+         {"virtual-walker: { seconds = 0 }", "virtual-walker: { seconds = 5, cadence = \"x\" }",
+          "virtual-walker: seconds", "virtual-walker:seconds=abc", "virtual-walker: { }"}) {
+        try {
+            (void)parseSimulatedWalker(bad);
+            ADD_FAILURE() << bad;
+        } catch (const std::invalid_argument& e) {
+            EXPECT_NE(std::string(e.what()).find("expected"), std::string::npos) << e.what();
+        }
     }
 }

@@ -57,15 +57,21 @@ class JackDummyServer {
     /// Starts the server as `JACK_DEFAULT_SERVER=<prefix>_<pid>` (also set for this process,
     /// with JACK_NO_START_SERVER=1) and waits up to 10 s for the dummy driver's ports. Its
     /// output goes to `logPath`. Nothing happens when jackd is not installed (installed() false).
+    /// `synchronous`: `jackd -S` (the server waits for every client to finish each cycle, so
+    /// that a client reading another's outputs never sees a half-written or skipped period,
+    /// even when the cycle overruns).
     JackDummyServer(const std::string& prefix, const std::filesystem::path& logPath,
-                    int period = 64) {
+                    int period = 64, bool synchronous = false) {
         jackd_ = findProgram("jackd");
         if (jackd_.empty()) return;
         name_ = prefix + "_" + std::to_string(getpid());
         setenv("JACK_DEFAULT_SERVER", name_.c_str(), 1);
         setenv("JACK_NO_START_SERVER", "1", 1);
-        std::vector<std::string> args{jackd_, "--no-realtime",        "-d", "dummy", "-r", "48000",
-                                      "-p",   std::to_string(period), "-C", "4",     "-P", "6"};
+        std::vector<std::string> args{jackd_, "--no-realtime"};
+        if (synchronous) args.push_back("-S");
+        for (std::string a : {"-d", "dummy", "-r", "48000", "-p"}) args.push_back(a);
+        args.push_back(std::to_string(period));
+        for (std::string a : {"-C", "4", "-P", "6"}) args.push_back(a);
         std::vector<char*> argv;
         for (auto& a : args) argv.push_back(a.data());
         argv.push_back(nullptr);

@@ -199,9 +199,9 @@ TEST(WadingListeningMode, ParticipantFieldsAreValidatedStoredAndExported) {
     EXPECT_EQ(store.participant("P1").fields.at("audio_expertise"), "professional");
     std::ostringstream out;
     writeParticipantsCsv(store, out);
-    EXPECT_EQ(out.str(), "participant,group,status,age,gender,shoes,hearing,music_expertise,"
-                         "audio_expertise,listening_device\r\n"
-                         "P1,all,registered,44,m,,,none,professional,laptop_speakers\r\n");
+    EXPECT_EQ(out.str(), "participant,group,status,simulated,age,gender,shoes,hearing,"
+                         "music_expertise,audio_expertise,listening_device\r\n"
+                         "P1,all,registered,0,44,m,,,none,professional,laptop_speakers\r\n");
 }
 
 TEST(WadingListeningMode, VersionOneStudyFilesAreMigrated) {
