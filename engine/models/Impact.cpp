@@ -26,6 +26,8 @@ void HuntCrossleyImpactT<Real>::configure(const ImpactParams& params, std::vecto
     if (params.contactSubsteps != 1 && params.contactSubsteps != 2 && params.contactSubsteps != 4 &&
         params.contactSubsteps != 8 && params.contactSubsteps != 16)
         throw std::invalid_argument("contact sub-steps must be 1, 2, 4, 8 or 16");
+    if (!(std::isfinite(params.substepForceChange) && params.substepForceChange >= 0.0))
+        throw std::invalid_argument("sub-step force change must be finite and >= 0");
     params_ = params;
     resonator_.configure(std::move(modes), std::move(gains));
     if (listen < 0 || listen >= resonator_.pickupCount())
@@ -139,7 +141,6 @@ double HuntCrossleyImpactT<Real>::solveForce(double ch, double dh) noexcept {
 template <typename Real>
 bool HuntCrossleyImpactT<Real>::step(double fextNow, double fextNext, bool abortOnContact,
                                      double& y) noexcept {
-    if (abortOnContact && lastForce_ > 0.0) return false;
     const double M = params_.exciterMassKg, T = T_;
     const double aNextExt = fextNext / M;
 
@@ -175,7 +176,14 @@ bool HuntCrossleyImpactT<Real>::step(double fextNow, double fextNext, bool abort
     };
 
     Trial t = trial(1.0, 1.0);
-    if (abortOnContact && t.force > 0.0) return false; // nothing committed yet
+    if (abortOnContact && (t.force > 0.0 || lastForce_ > 0.0)) {
+        // A transient (the contact opens, closes or its force changes fast) is sub-stepped:
+        // return before anything is committed.
+        const double change = std::fabs(t.force - lastForce_);
+        if (t.force == 0.0 || lastForce_ == 0.0 ||
+            change > params_.substepForceChange * std::max(t.force, lastForce_))
+            return false;
+    }
     double held = 1.0;
     double absorbed = 0.0;
     if (t.force > 0.0 || lastForce_ > 0.0) {

@@ -43,6 +43,10 @@ struct ImpactParams {
     /// samples of free flight stay single steps. A contact lasts ~10-20 samples per strike, so
     /// this costs ~1 % while matching the 8x oversampled reference (issue #18).
     int contactSubsteps = 8;
+    /// A sample in contact is sub-stepped only while the contact is a transient: it opens or
+    /// closes in the sample, or the single step's force differs from the previous one by more
+    /// than this fraction of the larger. A sole resting on the floor stays single-stepped.
+    double substepForceChange = 0.02;
 };
 
 /// Statistics of the last strikes, for tests and the accuracy benchmark.
