@@ -136,6 +136,7 @@ void ModalResonatorT<Real>::prepare(double sampleRateHz, int fineSubsteps) {
     qh_.assign(n, Real(0));
     vh_.assign(n, Real(0));
     u_.assign(n, Real(0));
+    heldZero_ = true;
 }
 
 template <typename Real>
@@ -145,7 +146,8 @@ void ModalResonatorT<Real>::reset() noexcept {
     std::fill(qh_.begin(), qh_.end(), Real(0));
     std::fill(vh_.begin(), vh_.end(), Real(0));
     std::fill(u_.begin(), u_.end(), Real(0));
-    x0_ = v0_ = outputVelocity_ = predictedX0_ = predictedV0_ = 0.0;
+    x0_ = v0_ = outputVelocity_ = predictedX0_ = predictedV0_ = predictedVo_ = 0.0;
+    heldZero_ = true;
 }
 
 template <typename Real>
@@ -153,20 +155,37 @@ void ModalResonatorT<Real>::predict(double heldScale) noexcept {
     const std::size_t n = q_.size();
     const Real h = static_cast<Real>(heldScale);
     const double* g0 = gains_.front().data();
+    const double* go = outGain_.data();
     const ModeCoefficients* cs = active();
-    double x0 = 0.0, v0 = 0.0;
-    for (std::size_t i = 0; i < n; ++i) {
-        const auto& c = cs[i];
-        const Real q = q_[i], v = v_[i], u = h * u_[i];
-        qh_[i] = static_cast<Real>(c.a00) * q + static_cast<Real>(c.a01) * v +
-                 static_cast<Real>(c.b0x) * u;
-        vh_[i] = static_cast<Real>(c.a10) * q + static_cast<Real>(c.a11) * v +
-                 static_cast<Real>(c.b0v) * u;
-        x0 += g0[i] * double(qh_[i]);
-        v0 += g0[i] * double(vh_[i]);
+    double x0 = 0.0, v0 = 0.0, vo = 0.0;
+    if (heldZero_ || heldScale == 0.0) {
+        // Free ringing (no force held from the last sample): the same values without the
+        // force terms (they would add exactly zero).
+        for (std::size_t i = 0; i < n; ++i) {
+            const auto& c = cs[i];
+            const Real q = q_[i], v = v_[i];
+            qh_[i] = static_cast<Real>(c.a00) * q + static_cast<Real>(c.a01) * v;
+            vh_[i] = static_cast<Real>(c.a10) * q + static_cast<Real>(c.a11) * v;
+            x0 += g0[i] * double(qh_[i]);
+            v0 += g0[i] * double(vh_[i]);
+            vo += go[i] * double(vh_[i]);
+        }
+    } else {
+        for (std::size_t i = 0; i < n; ++i) {
+            const auto& c = cs[i];
+            const Real q = q_[i], v = v_[i], u = h * u_[i];
+            qh_[i] = static_cast<Real>(c.a00) * q + static_cast<Real>(c.a01) * v +
+                     static_cast<Real>(c.b0x) * u;
+            vh_[i] = static_cast<Real>(c.a10) * q + static_cast<Real>(c.a11) * v +
+                     static_cast<Real>(c.b0v) * u;
+            x0 += g0[i] * double(qh_[i]);
+            v0 += g0[i] * double(vh_[i]);
+            vo += go[i] * double(vh_[i]);
+        }
     }
     predictedX0_ = x0;
     predictedV0_ = v0;
+    predictedVo_ = vo;
 }
 
 template <typename Real>
@@ -189,6 +208,19 @@ double ModalResonatorT<Real>::predictedVelocity(int p) const noexcept {
 
 template <typename Real>
 void ModalResonatorT<Real>::commit(int p, double forceN) noexcept {
+    if (forceN == 0.0) {
+        // No new force: the state is the prediction (swapping the buffers does not allocate),
+        // and so are the pickup sums predict() computed in the same order.
+        q_.swap(qh_);
+        v_.swap(vh_);
+        if (!heldZero_) std::fill(u_.begin(), u_.end(), Real(0));
+        heldZero_ = true;
+        x0_ = predictedX0_;
+        v0_ = predictedV0_;
+        outputVelocity_ = predictedVo_;
+        return;
+    }
+    heldZero_ = false;
     const std::size_t n = q_.size(), off = static_cast<std::size_t>(p) * n;
     const Real f = static_cast<Real>(forceN);
     const double* g0 = gains_.front().data();

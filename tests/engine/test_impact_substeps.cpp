@@ -185,3 +185,33 @@ TEST(ImpactContactSubsteps, RejectsUnsupportedSubstepCounts) {
         EXPECT_THROW(impact.configure(p, kModes, {{1.0, 1.0, 1.0}}), std::invalid_argument) << bad;
     }
 }
+
+TEST(ModalResonatorFastPath, FreeRingingEqualsTheGeneralRecursion) {
+    // predict()/commit() skip the force terms and swap buffers when no force acts (issue #18);
+    // the result must equal the general recursion s[n+1] = A s[n] + B0 u[n] + B1 u[n+1] computed
+    // here independently, for a force that switches on and off (bit-exact up to rounding order,
+    // which is the same: tolerance 1e-15 relative).
+    const std::vector<Mode> modes = {{180.0, 0.15, 2.0}, {620.0, 0.08, 0.8}, {30000.0, 0.04, 0.5}};
+    const std::vector<double> g = {1.0, -0.7, 0.4};
+    ModalResonator r;
+    r.configure(modes, {g});
+    r.prepare(kFs);
+    std::vector<ModeCoefficients> c;
+    for (const auto& m : modes) c.push_back(computeModeCoefficients(m, kFs));
+    std::vector<double> q(3, 0.0), v(3, 0.0), u(3, 0.0);
+    for (int n = 0; n < 4000; ++n) {
+        const double f = (n % 500 < 20) ? 10.0 * std::sin(0.3 * n) : 0.0;
+        const double y = r.processSample(0, f, 0);
+        double ref = 0.0;
+        for (std::size_t i = 0; i < 3; ++i) {
+            const double un = g[i] / modes[i].massKg * f;
+            const double qn = c[i].a00 * q[i] + c[i].a01 * v[i] + c[i].b0x * u[i] + c[i].b1x * un;
+            const double vn = c[i].a10 * q[i] + c[i].a11 * v[i] + c[i].b0v * u[i] + c[i].b1v * un;
+            q[i] = qn;
+            v[i] = vn;
+            u[i] = un;
+            if (!c[i].quasiStatic) ref += g[i] * vn;
+        }
+        ASSERT_NEAR(y, ref, 1e-15 * (1.0 + std::fabs(ref)) + 1e-300) << n;
+    }
+}
