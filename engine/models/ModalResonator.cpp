@@ -158,7 +158,8 @@ void ModalResonatorT<Real>::predict(double heldScale) noexcept {
     const double* go = outGain_.data();
     const ModeCoefficients* cs = active();
     double x0 = 0.0, v0 = 0.0, vo = 0.0;
-    if (heldZero_ || heldScale == 0.0) {
+    const bool free = heldZero_ || heldScale == 0.0;
+    if (free) {
         // Free ringing (no force held from the last sample): the same values without the
         // force terms (they would add exactly zero).
         for (std::size_t i = 0; i < n; ++i) {
@@ -180,12 +181,12 @@ void ModalResonatorT<Real>::predict(double heldScale) noexcept {
                      static_cast<Real>(c.b0v) * u;
             x0 += g0[i] * double(qh_[i]);
             v0 += g0[i] * double(vh_[i]);
-            vo += go[i] * double(vh_[i]);
         }
     }
     predictedX0_ = x0;
     predictedV0_ = v0;
     predictedVo_ = vo;
+    predictedVoValid_ = free;
 }
 
 template <typename Real>
@@ -217,6 +218,12 @@ void ModalResonatorT<Real>::commit(int p, double forceN) noexcept {
         heldZero_ = true;
         x0_ = predictedX0_;
         v0_ = predictedV0_;
+        if (!predictedVoValid_) { // a held force was predicted (a contact just ended)
+            const double* go = outGain_.data();
+            double vo = 0.0;
+            for (std::size_t i = 0; i < v_.size(); ++i) vo += go[i] * double(v_[i]);
+            predictedVo_ = vo;
+        }
         outputVelocity_ = predictedVo_;
         return;
     }

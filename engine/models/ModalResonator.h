@@ -132,7 +132,8 @@ class ModalResonatorT {
     std::vector<double> w0sq_;              // undamped angular frequency squared, per mode
     double sampleRateHz_ = 0.0;
     double predictedX0_ = 0.0, predictedV0_ = 0.0; // pickup 0, computed by predict()
-    double predictedVo_ = 0.0;                     // output pickup, computed by predict()
+    double predictedVo_ = 0.0; // output pickup, computed by predict() when ringing freely
+    bool predictedVoValid_ = false;
     bool heldZero_ = true; // every u_ is zero (free ringing): predict/commit skip the force terms
     double x0_ = 0.0, v0_ = 0.0, outputVelocity_ = 0.0; // computed by commit()
     int outputPickup_ = 0;
