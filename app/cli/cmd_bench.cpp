@@ -6,6 +6,8 @@
 #include <fmt/core.h>
 
 #include <memory>
+#include <string>
+#include <vector>
 
 namespace underfoot::cli {
 namespace {
@@ -14,12 +16,44 @@ namespace eng = underfoot::engine;
 struct BenchArgs {
     std::string only = "all";
     double seconds = 5.0;
+    int repeats = 5;
 };
 
+bool isScenario(const std::string& id) {
+    for (const auto& s : eng::scenarioIds())
+        if (s == id) return true;
+    return false;
+}
+
 int runBench(const BenchArgs& a) {
+    if (isScenario(a.only) && a.repeats == 1) {
+        // One plain run, for instruction counting under callgrind (`--repeats 1`).
+        const auto m = eng::measureScenario(a.only, a.seconds, 1);
+        fmt::print("{}: {:.1f} ns/sample over {:.1f} s (checksum {:.6g})\n", m.id, m.nsPerSample,
+                   a.seconds, m.checksum);
+        return 0;
+    }
+    if (a.only == "all" || a.only == "scenarios" || isScenario(a.only)) {
+        fmt::print("### Model scenarios (issue #18), 48 kHz, 64-frame blocks, per-block minimum "
+                   "of {} runs\n\n",
+                   a.repeats);
+        fmt::print("| scenario | ns/sample | median block | p99 block | worst block | worst block "
+                   "/ 1333 us budget |\n|---|---:|---:|---:|---:|---:|\n");
+        for (const auto& id : eng::scenarioIds()) {
+            if (a.only != "all" && a.only != "scenarios" && a.only != id) continue;
+            const auto m = eng::measureScenario(id, a.seconds, a.repeats);
+            fmt::print("| {} | {:.1f} | {:.2f} us | {:.2f} us | {:.2f} us | {:.2f} % |\n", id,
+                       m.nsPerSample, m.medianBlockNs / 1e3, m.p99BlockNs / 1e3, m.maxBlockNs / 1e3,
+                       100.0 * m.budgetShare);
+        }
+        fmt::print("\n");
+    }
     if (a.only == "impact-default") {
         // For instruction counting under callgrind: the default impact alone.
-        const auto m = eng::measureImpact(eng::defaultImpactSettings()[5], a.seconds);
+        eng::ImpactSetting def;
+        for (const auto& s : eng::defaultImpactSettings())
+            if (s.name.ends_with("(default)")) def = s;
+        const auto m = eng::measureImpact(def, a.seconds);
         fmt::print("{:.1f} ns/sample over {:.1f} s of strikes\n", m.nsPerSample, a.seconds);
         return 0;
     }
@@ -62,9 +96,19 @@ CommandRegistrar reg("bench", [](CLI::App& app, int& exitCode) {
     auto args = std::make_shared<BenchArgs>();
     auto* cmd = app.add_subcommand(
         "bench", "Measure what accuracy costs: error against a reference and CPU time per setting");
+    std::vector<std::string> choices = {"all",      "impact",         "knobs",
+                                        "surfaces", "impact-default", "scenarios"};
+    for (const auto& id : eng::scenarioIds()) choices.push_back(id);
     cmd->add_option("--only", args->only,
-                    "all, impact, knobs, surfaces, or impact-default (for callgrind)")
-        ->check(CLI::IsMember({"all", "impact", "knobs", "surfaces", "impact-default"}))
+                    "all, impact, knobs, surfaces, scenarios, impact-default (for callgrind), or "
+                    "one scenario: impact-strikes, impact-pressed, impact-metal, friction-creak, "
+                    "aggregate-gravel, bubbles")
+        ->check(CLI::IsMember(choices))
+        ->capture_default_str();
+    cmd->add_option("--repeats", args->repeats,
+                    "runs per scenario (per-block minimum); 1 = one plain run of --only's "
+                    "scenario, for callgrind")
+        ->check(CLI::Range(1, 50))
         ->capture_default_str();
     cmd->add_option("--seconds", args->seconds, "audio seconds per measurement")
         ->check(CLI::Range(0.5, 600.0))

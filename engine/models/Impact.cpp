@@ -23,6 +23,11 @@ void HuntCrossleyImpactT<Real>::configure(const ImpactParams& params, std::vecto
     if (params.oversampling != 1 && params.oversampling != 2 && params.oversampling != 4 &&
         params.oversampling != 8)
         throw std::invalid_argument("oversampling must be 1, 2, 4 or 8");
+    if (params.contactSubsteps != 1 && params.contactSubsteps != 2 && params.contactSubsteps != 4 &&
+        params.contactSubsteps != 8 && params.contactSubsteps != 16)
+        throw std::invalid_argument("contact sub-steps must be 1, 2, 4, 8 or 16");
+    if (!(std::isfinite(params.substepForceChange) && params.substepForceChange >= 0.0))
+        throw std::invalid_argument("sub-step force change must be finite and >= 0");
     params_ = params;
     resonator_.configure(std::move(modes), std::move(gains));
     if (listen < 0 || listen >= resonator_.pickupCount())
@@ -35,18 +40,34 @@ void HuntCrossleyImpactT<Real>::prepare(const ProcessSpec& spec) {
     fs_ = spec.sampleRateHz;
     internalFs_ = fs_ * params_.oversampling;
     T_ = 1.0 / internalFs_;
-    resonator_.prepare(internalFs_);
+    const int sub = params_.contactSubsteps;
+    resonator_.prepare(internalFs_, sub);
     resonator_.setOutputPickup(listen_);
     const double M = params_.exciterMassKg;
-    kc_ = T_ * T_ / (6.0 * M) + resonator_.compliance(0); // exact for a linear force ramp
-    kd_ = T_ / (2.0 * M) + resonator_.mobility(0);
+    coarseT_ = T_;
+    coarseKc_ = T_ * T_ / (6.0 * M) + resonator_.compliance(0); // exact for a linear force ramp
+    coarseKd_ = T_ / (2.0 * M) + resonator_.mobility(0);
+    fineT_ = T_ / sub;
+    resonator_.setFineRate(true);
+    fineKc_ = fineT_ * fineT_ / (6.0 * M) + resonator_.compliance(0);
+    fineKd_ = fineT_ / (2.0 * M) + resonator_.mobility(0);
+    setFineRate(false);
     if (params_.oversampling > 1)
         decimator_.design(FilterType::Lowpass, 8, internalFs_, 0.45 * fs_);
     reset();
 }
 
 template <typename Real>
+void HuntCrossleyImpactT<Real>::setFineRate(bool fine) noexcept {
+    resonator_.setFineRate(fine);
+    T_ = fine ? fineT_ : coarseT_;
+    kc_ = fine ? fineKc_ : coarseKc_;
+    kd_ = fine ? fineKd_ : coarseKd_;
+}
+
+template <typename Real>
 void HuntCrossleyImpactT<Real>::reset() noexcept {
+    setFineRate(false);
     resonator_.reset();
     decimator_.reset();
     exciterX_ = exciterV_ = lastForce_ = lastExternal_ = contactEnergy_ = 0;
@@ -118,7 +139,8 @@ double HuntCrossleyImpactT<Real>::solveForce(double ch, double dh) noexcept {
 }
 
 template <typename Real>
-double HuntCrossleyImpactT<Real>::step(double fextNow, double fextNext) noexcept {
+bool HuntCrossleyImpactT<Real>::step(double fextNow, double fextNext, bool abortOnContact,
+                                     double& y) noexcept {
     const double M = params_.exciterMassKg, T = T_;
     const double aNextExt = fextNext / M;
 
@@ -154,6 +176,14 @@ double HuntCrossleyImpactT<Real>::step(double fextNow, double fextNext) noexcept
     };
 
     Trial t = trial(1.0, 1.0);
+    if (abortOnContact && (t.force > 0.0 || lastForce_ > 0.0)) {
+        // A transient (the contact opens, closes or its force changes fast) is sub-stepped:
+        // return before anything is committed.
+        const double change = std::fabs(t.force - lastForce_);
+        if (t.force == 0.0 || lastForce_ == 0.0 ||
+            change > params_.substepForceChange * std::max(t.force, lastForce_))
+            return false;
+    }
     double held = 1.0;
     double absorbed = 0.0;
     if (t.force > 0.0 || lastForce_ > 0.0) {
@@ -234,7 +264,8 @@ double HuntCrossleyImpactT<Real>::step(double fextNow, double fextNext) noexcept
         stats_.outgoingVelocity = exciterV_ - resonator_.contactVelocity();
     }
     inContact_ = contactNow;
-    return resonator_.velocity(listen_);
+    y = resonator_.velocity(listen_);
+    return true;
 }
 
 template <typename Real>
@@ -248,6 +279,7 @@ void HuntCrossleyImpactT<Real>::process(const float* fext, float* out, int n) no
     }
     awake_ = true;
     const int os = params_.oversampling;
+    const int sub = params_.contactSubsteps;
     double peak = 0.0;
     for (int i = 0; i < n; ++i) {
         const double fNext = fext ? double(fext[i]) : 0.0;
@@ -256,7 +288,14 @@ void HuntCrossleyImpactT<Real>::process(const float* fext, float* out, int n) no
             // Linear interpolation of the external force inside the sample.
             const double f1 = lastExternal_ + (fNext - lastExternal_) * double(k + 1) / os;
             const double f0 = lastExternal_ + (fNext - lastExternal_) * double(k) / os;
-            y = step(f0, f1);
+            if (!step(f0, f1, sub > 1, y)) {
+                // The bodies touch in this sample: resolve it in `sub` exact sub-steps.
+                setFineRate(true);
+                for (int j = 0; j < sub; ++j)
+                    step(f0 + (f1 - f0) * double(j) / sub, f0 + (f1 - f0) * double(j + 1) / sub,
+                         false, y);
+                setFineRate(false);
+            }
             if (os > 1) y = decimator_.processSample(y);
         }
         lastExternal_ = fNext;

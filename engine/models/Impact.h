@@ -38,6 +38,15 @@ struct ImpactParams {
     ImpactSolver solver = ImpactSolver::Newton;
     int newtonIterations = 6; ///< iteration cap (bounded work per sample)
     int oversampling = 1;     ///< 1, 2, 4 or 8: the contact runs at this multiple of the rate
+    /// 1, 2, 4, 8 or 16: a sample in which the bodies touch is computed as this many sub-steps
+    /// (the exact modal discretisation at the finer step, the force linear in each sub-step);
+    /// samples of free flight stay single steps. A contact lasts ~10-20 samples per strike, so
+    /// this costs ~1 % while matching the 8x oversampled reference (issue #18).
+    int contactSubsteps = 8;
+    /// A sample in contact is sub-stepped only while the contact is a transient: it opens or
+    /// closes in the sample, or the single step's force differs from the previous one by more
+    /// than this fraction of the larger. A sole resting on the floor stays single-stepped.
+    double substepForceChange = 0.02;
 };
 
 /// Statistics of the last strikes, for tests and the accuracy benchmark.
@@ -93,8 +102,11 @@ class HuntCrossleyImpactT {
 
   private:
     double contactForce(double c, double cdot) const noexcept;
-    double step(double fextNow, double fextNext) noexcept; // one internal sample, returns output
-    double solveForce(double ch, double dh) noexcept;      // contact force at n+1
+    // One internal step. With `abortOnContact`, returns false and commits nothing when the step
+    // would touch (the caller then sub-steps it); otherwise commits and writes the output to y.
+    bool step(double fextNow, double fextNext, bool abortOnContact, double& y) noexcept;
+    void setFineRate(bool fine) noexcept;
+    double solveForce(double ch, double dh) noexcept; // contact force at n+1
 
     ImpactParams params_;
     ModalResonatorT<Real> resonator_;
@@ -106,6 +118,7 @@ class HuntCrossleyImpactT {
     int quietSamples_ = 0;
     double sleepVelocity_ = 1e-10;
     double kc_ = 0, kd_ = 0; // instantaneous compliance and mobility of the compression
+    double coarseT_ = 0, coarseKc_ = 0, coarseKd_ = 0, fineT_ = 0, fineKc_ = 0, fineKd_ = 0;
     Butterworth decimator_;
     ContactStats stats_;
     double contactStart_ = 0, time_ = 0;

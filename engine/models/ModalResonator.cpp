@@ -22,13 +22,13 @@ constexpr std::array<double, 10> kGlWeights = {
 
 } // namespace
 
-ModeCoefficients computeModeCoefficients(const Mode& mode, double fs) {
+ModeCoefficients computeModeCoefficients(const Mode& mode, double fs, double quasiStaticFromHz) {
     const double T = 1.0 / fs;
     const double s = std::log(1000.0) / mode.t60Seconds; // decay rate, 1/s
     const double wd = kTwoPi * mode.frequencyHz;         // damped angular frequency
     const double w0sq = wd * wd + s * s;
     ModeCoefficients c{};
-    if (mode.frequencyHz >= 0.5 * fs) {
+    if (mode.frequencyHz >= (quasiStaticFromHz > 0.0 ? quasiStaticFromHz : 0.5 * fs)) {
         // Quasi-static: q[n+1] = u[n+1] / w0^2, v = (q[n+1] - q[n]) / T.
         c.quasiStatic = true;
         c.a00 = 0, c.a01 = 0, c.a10 = -1.0 / T, c.a11 = 0;
@@ -92,8 +92,9 @@ void ModalResonatorT<Real>::configure(std::vector<Mode> modes,
 }
 
 template <typename Real>
-void ModalResonatorT<Real>::prepare(double sampleRateHz) {
+void ModalResonatorT<Real>::prepare(double sampleRateHz, int fineSubsteps) {
     sampleRateHz_ = sampleRateHz;
+    fine_ = false;
     const std::size_t n = modes_.size(), np = gains_.size();
     coefficients_.resize(n);
     quasiStaticCount_ = 0;
@@ -105,15 +106,28 @@ void ModalResonatorT<Real>::prepare(double sampleRateHz) {
         coefficients_[i] = computeModeCoefficients(modes_[i], sampleRateHz);
         quasiStaticCount_ += coefficients_[i].quasiStatic ? 1 : 0;
     }
+    fineCoefficients_.clear();
+    if (fineSubsteps > 1) {
+        fineCoefficients_.resize(n);
+        for (std::size_t i = 0; i < n; ++i)
+            fineCoefficients_[i] =
+                computeModeCoefficients(modes_[i], sampleRateHz * fineSubsteps, 0.5 * sampleRateHz);
+    }
     gainOverMass_.assign(np * n, Real(0));
     kx_.assign(np, 0.0);
     kv_.assign(np, 0.0);
+    kxFine_.assign(np, 0.0);
+    kvFine_.assign(np, 0.0);
     for (std::size_t p = 0; p < np; ++p) {
         for (std::size_t i = 0; i < n; ++i) {
             const double g = gains_[p][i];
             gainOverMass_[p * n + i] = static_cast<Real>(g / modes_[i].massKg);
             kx_[p] += g * g / modes_[i].massKg * coefficients_[i].b1x;
             kv_[p] += g * g / modes_[i].massKg * coefficients_[i].b1v;
+            if (!fineCoefficients_.empty()) {
+                kxFine_[p] += g * g / modes_[i].massKg * fineCoefficients_[i].b1x;
+                kvFine_[p] += g * g / modes_[i].massKg * fineCoefficients_[i].b1v;
+            }
         }
     }
     setOutputPickup(std::min(outputPickup_, static_cast<int>(np) - 1));
@@ -122,6 +136,7 @@ void ModalResonatorT<Real>::prepare(double sampleRateHz) {
     qh_.assign(n, Real(0));
     vh_.assign(n, Real(0));
     u_.assign(n, Real(0));
+    heldZero_ = true;
 }
 
 template <typename Real>
@@ -131,7 +146,8 @@ void ModalResonatorT<Real>::reset() noexcept {
     std::fill(qh_.begin(), qh_.end(), Real(0));
     std::fill(vh_.begin(), vh_.end(), Real(0));
     std::fill(u_.begin(), u_.end(), Real(0));
-    x0_ = v0_ = outputVelocity_ = predictedX0_ = predictedV0_ = 0.0;
+    x0_ = v0_ = outputVelocity_ = predictedX0_ = predictedV0_ = predictedVo_ = 0.0;
+    heldZero_ = true;
 }
 
 template <typename Real>
@@ -139,19 +155,38 @@ void ModalResonatorT<Real>::predict(double heldScale) noexcept {
     const std::size_t n = q_.size();
     const Real h = static_cast<Real>(heldScale);
     const double* g0 = gains_.front().data();
-    double x0 = 0.0, v0 = 0.0;
-    for (std::size_t i = 0; i < n; ++i) {
-        const auto& c = coefficients_[i];
-        const Real q = q_[i], v = v_[i], u = h * u_[i];
-        qh_[i] = static_cast<Real>(c.a00) * q + static_cast<Real>(c.a01) * v +
-                 static_cast<Real>(c.b0x) * u;
-        vh_[i] = static_cast<Real>(c.a10) * q + static_cast<Real>(c.a11) * v +
-                 static_cast<Real>(c.b0v) * u;
-        x0 += g0[i] * double(qh_[i]);
-        v0 += g0[i] * double(vh_[i]);
+    const double* go = outGain_.data();
+    const ModeCoefficients* cs = active();
+    double x0 = 0.0, v0 = 0.0, vo = 0.0;
+    const bool free = heldZero_ || heldScale == 0.0;
+    if (free) {
+        // Free ringing (no force held from the last sample): the same values without the
+        // force terms (they would add exactly zero).
+        for (std::size_t i = 0; i < n; ++i) {
+            const auto& c = cs[i];
+            const Real q = q_[i], v = v_[i];
+            qh_[i] = static_cast<Real>(c.a00) * q + static_cast<Real>(c.a01) * v;
+            vh_[i] = static_cast<Real>(c.a10) * q + static_cast<Real>(c.a11) * v;
+            x0 += g0[i] * double(qh_[i]);
+            v0 += g0[i] * double(vh_[i]);
+            vo += go[i] * double(vh_[i]);
+        }
+    } else {
+        for (std::size_t i = 0; i < n; ++i) {
+            const auto& c = cs[i];
+            const Real q = q_[i], v = v_[i], u = h * u_[i];
+            qh_[i] = static_cast<Real>(c.a00) * q + static_cast<Real>(c.a01) * v +
+                     static_cast<Real>(c.b0x) * u;
+            vh_[i] = static_cast<Real>(c.a10) * q + static_cast<Real>(c.a11) * v +
+                     static_cast<Real>(c.b0v) * u;
+            x0 += g0[i] * double(qh_[i]);
+            v0 += g0[i] * double(vh_[i]);
+        }
     }
     predictedX0_ = x0;
     predictedV0_ = v0;
+    predictedVo_ = vo;
+    predictedVoValid_ = free;
 }
 
 template <typename Real>
@@ -174,13 +209,33 @@ double ModalResonatorT<Real>::predictedVelocity(int p) const noexcept {
 
 template <typename Real>
 void ModalResonatorT<Real>::commit(int p, double forceN) noexcept {
+    if (forceN == 0.0) {
+        // No new force: the state is the prediction (swapping the buffers does not allocate),
+        // and so are the pickup sums predict() computed in the same order.
+        q_.swap(qh_);
+        v_.swap(vh_);
+        if (!heldZero_) std::fill(u_.begin(), u_.end(), Real(0));
+        heldZero_ = true;
+        x0_ = predictedX0_;
+        v0_ = predictedV0_;
+        if (!predictedVoValid_) { // a held force was predicted (a contact just ended)
+            const double* go = outGain_.data();
+            double vo = 0.0;
+            for (std::size_t i = 0; i < v_.size(); ++i) vo += go[i] * double(v_[i]);
+            predictedVo_ = vo;
+        }
+        outputVelocity_ = predictedVo_;
+        return;
+    }
+    heldZero_ = false;
     const std::size_t n = q_.size(), off = static_cast<std::size_t>(p) * n;
     const Real f = static_cast<Real>(forceN);
     const double* g0 = gains_.front().data();
     const double* go = outGain_.data();
+    const ModeCoefficients* cs = active();
     double x0 = 0.0, v0 = 0.0, vo = 0.0;
     for (std::size_t i = 0; i < n; ++i) {
-        const auto& c = coefficients_[i];
+        const auto& c = cs[i];
         const Real u = gainOverMass_[off + i] * f;
         q_[i] = qh_[i] + static_cast<Real>(c.b1x) * u;
         v_[i] = vh_[i] + static_cast<Real>(c.b1v) * u;
@@ -198,8 +253,9 @@ template <typename Real>
 double ModalResonatorT<Real>::energyIfCommitted(int p, double forceN) const noexcept {
     const std::size_t n = q_.size(), off = static_cast<std::size_t>(p) * n;
     double e = 0;
+    const ModeCoefficients* cs = active();
     for (std::size_t i = 0; i < n; ++i) {
-        const auto& c = coefficients_[i];
+        const auto& c = cs[i];
         const double u = double(gainOverMass_[off + i]) * forceN;
         const double q = double(qh_[i]) + c.b1x * u;
         const double v = c.quasiStatic ? 0.0 : double(vh_[i]) + c.b1v * u;

@@ -44,7 +44,10 @@ struct ModeCoefficients {
 };
 
 /// Computes the exact discretisation of one mode at a sample rate (per unit of u = F g / m).
-ModeCoefficients computeModeCoefficients(const Mode& mode, double sampleRateHz);
+/// The mode is kept quasi-static when its frequency is at or above `quasiStaticFromHz`
+/// (default, <= 0: the Nyquist frequency of `sampleRateHz`).
+ModeCoefficients computeModeCoefficients(const Mode& mode, double sampleRateHz,
+                                         double quasiStaticFromHz = 0.0);
 
 template <typename Real>
 class ModalResonatorT {
@@ -52,8 +55,15 @@ class ModalResonatorT {
     /// Sets modes and pickup gains `gains[p][i]` (allocates). Throws std::invalid_argument for
     /// non-finite or non-positive frequencies, decays or masses.
     void configure(std::vector<Mode> modes, std::vector<std::vector<double>> gains);
-    /// Computes coefficients for a sample rate (allocates).
-    void prepare(double sampleRateHz);
+    /// Computes coefficients for a sample rate (allocates). With `fineSubsteps` > 1 a second
+    /// set is computed for steps of 1/(fineSubsteps * sampleRateHz), selectable per step with
+    /// setFineRate(): the impact sub-steps only the samples in contact. Both sets are exact
+    /// discretisations of the same oscillators, so the state carries over between them; a mode
+    /// is quasi-static in both when it is at or above the coarse rate's Nyquist frequency.
+    void prepare(double sampleRateHz, int fineSubsteps = 1);
+    /// Selects the fine (true) or coarse (false) coefficient set for the following steps.
+    void setFineRate(bool fine) noexcept { fine_ = fine && !fineCoefficients_.empty(); }
+    bool fineRate() const noexcept { return fine_; }
     void reset() noexcept;
 
     int modeCount() const noexcept { return static_cast<int>(modes_.size()); }
@@ -71,8 +81,12 @@ class ModalResonatorT {
     double predictedPosition(int p) const noexcept;
     double predictedVelocity(int p) const noexcept;
     /// Instantaneous displacement / velocity at pickup p per newton applied at pickup p at n+1.
-    double compliance(int p) const noexcept { return kx_[static_cast<std::size_t>(p)]; }
-    double mobility(int p) const noexcept { return kv_[static_cast<std::size_t>(p)]; }
+    double compliance(int p) const noexcept {
+        return (fine_ ? kxFine_ : kx_)[static_cast<std::size_t>(p)];
+    }
+    double mobility(int p) const noexcept {
+        return (fine_ ? kvFine_ : kv_)[static_cast<std::size_t>(p)];
+    }
     /// Energy the modes would hold after commit(p, forceN), without committing.
     double energyIfCommitted(int p, double forceN) const noexcept;
     /// Completes the sample with force `forceN` acting at pickup p (at n+1).
@@ -106,12 +120,21 @@ class ModalResonatorT {
     std::vector<Mode> modes_;
     std::vector<std::vector<double>> gains_; // [pickup][mode]
     std::vector<ModeCoefficients> coefficients_;
+    std::vector<ModeCoefficients> fineCoefficients_; // empty unless prepared with sub-steps
+    bool fine_ = false;
+    const ModeCoefficients* active() const noexcept {
+        return fine_ ? fineCoefficients_.data() : coefficients_.data();
+    }
     std::vector<Real> gainOverMass_;        // [pickup * modes + mode] = g[p][i] / m_i
     std::vector<Real> q_, v_, qh_, vh_, u_; // state, prediction, last generalized force
     std::vector<double> kx_, kv_;           // per pickup
+    std::vector<double> kxFine_, kvFine_;   // per pickup, fine rate
     std::vector<double> w0sq_;              // undamped angular frequency squared, per mode
     double sampleRateHz_ = 0.0;
-    double predictedX0_ = 0.0, predictedV0_ = 0.0;      // pickup 0, computed by predict()
+    double predictedX0_ = 0.0, predictedV0_ = 0.0; // pickup 0, computed by predict()
+    double predictedVo_ = 0.0; // output pickup, computed by predict() when ringing freely
+    bool predictedVoValid_ = false;
+    bool heldZero_ = true; // every u_ is zero (free ringing): predict/commit skip the force terms
     double x0_ = 0.0, v0_ = 0.0, outputVelocity_ = 0.0; // computed by commit()
     int outputPickup_ = 0;
     std::vector<double> outGain_; // output pickup's gains, 0 for non-radiating modes

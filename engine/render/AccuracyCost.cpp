@@ -2,6 +2,9 @@
 #include "engine/render/AccuracyCost.h"
 
 #include "engine/dsp/Denormals.h"
+#include "engine/models/Aggregate.h"
+#include "engine/models/Bubbles.h"
+#include "engine/models/Friction.h"
 #include "engine/render/Renderer.h"
 
 #include <fftw3.h>
@@ -9,6 +12,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
+#include <memory>
+#include <stdexcept>
 
 namespace underfoot::engine {
 namespace {
@@ -31,6 +37,7 @@ ImpactParams benchParams(const ImpactSetting& s) {
     p.solver = s.solver;
     p.newtonIterations = s.iterations;
     p.oversampling = s.oversampling;
+    p.contactSubsteps = s.contactSubsteps;
     return p;
 }
 
@@ -130,21 +137,25 @@ double spectralDistanceDb(const std::vector<float>& a, const std::vector<float>&
 
 std::vector<ImpactSetting> defaultImpactSettings() {
     return {
-        {"explicit, 1x", ImpactSolver::Explicit, 1, 1, false},
-        {"explicit, 4x", ImpactSolver::Explicit, 1, 4, false},
-        {"Newton 1 it, 1x", ImpactSolver::Newton, 1, 1, false},
-        {"Newton 2 it, 1x", ImpactSolver::Newton, 2, 1, false},
-        {"Newton 4 it, 1x", ImpactSolver::Newton, 4, 1, false},
-        {"Newton 6 it, 1x (default)", ImpactSolver::Newton, 6, 1, false},
-        {"Newton 6 it, 2x", ImpactSolver::Newton, 6, 2, false},
-        {"Newton 6 it, 4x", ImpactSolver::Newton, 6, 4, false},
-        {"Newton 6 it, 1x, float state", ImpactSolver::Newton, 6, 1, true},
+        {"explicit, 1x", ImpactSolver::Explicit, 1, 1, false, 1},
+        {"explicit, 4x", ImpactSolver::Explicit, 1, 4, false, 1},
+        {"Newton 1 it, 1x", ImpactSolver::Newton, 1, 1, false, 1},
+        {"Newton 2 it, 1x", ImpactSolver::Newton, 2, 1, false, 1},
+        {"Newton 4 it, 1x", ImpactSolver::Newton, 4, 1, false, 1},
+        {"Newton 6 it, 1x (old default)", ImpactSolver::Newton, 6, 1, false, 1},
+        {"Newton 6 it, 2x", ImpactSolver::Newton, 6, 2, false, 1},
+        {"Newton 6 it, 4x", ImpactSolver::Newton, 6, 4, false, 1},
+        {"Newton 6 it, 1x, float state", ImpactSolver::Newton, 6, 1, true, 1},
+        {"Newton 6 it, 1x, contact sub-steps 2", ImpactSolver::Newton, 6, 1, false, 2},
+        {"Newton 6 it, 1x, contact sub-steps 4", ImpactSolver::Newton, 6, 1, false, 4},
+        {"Newton 6 it, 1x, contact sub-steps 8 (default)", ImpactSolver::Newton, 6, 1, false, 8},
+        {"Newton 6 it, 1x, contact sub-steps 16", ImpactSolver::Newton, 6, 1, false, 16},
     };
 }
 
 ImpactMeasurement measureImpact(const ImpactSetting& setting, double seconds) {
     static const StrikeResult reference =
-        strikeOnce<double>({"reference", ImpactSolver::Newton, 50, 8, false});
+        strikeOnce<double>({"reference", ImpactSolver::Newton, 50, 8, false, 1});
     ImpactMeasurement m;
     m.setting = setting;
     const StrikeResult r =
@@ -229,6 +240,174 @@ std::vector<KnobMeasurement> measureKnobs(double seconds) {
         }
     }
     return out;
+}
+
+namespace {
+
+// One scenario: a block function that adds 64 samples into `out` given the block index.
+using BlockFn = std::function<void(int block, float* out)>;
+
+ImpactParams scenarioImpact() {
+    ImpactParams p; // shipped defaults (solver, iterations, contact sub-steps)
+    p.stiffness = 2e9;
+    p.alpha = 1.5;
+    p.dissipation = 0.6;
+    p.exciterMassKg = 0.1;
+    return p;
+}
+
+// Metal preset (engine/data/surfaces/metal.toml at the time of issue #18): 14 modes.
+const std::vector<Mode>& metalModes() {
+    static const std::vector<Mode> m = {
+        {187, 0.235173, 8.0},   {467, 0.205776, 4.0},   {748, 0.17638, 3.0},
+        {935, 0.161681, 2.5},   {1216, 0.139634, 2.0},  {1683, 0.117586, 2.0},
+        {1870, 0.110237, 2.0},  {2431, 0.0881898, 2.0}, {2992, 0.0734915, 2.0},
+        {3553, 0.0617329, 2.0}, {4395, 0.0514441, 2.0}, {5236, 0.0440949, 2.0},
+        {6545, 0.0323363, 2.0}, {8040, 0.0235173, 2.5}};
+    return m;
+}
+const std::vector<double>& metalGains() {
+    static const std::vector<double> g = {1.79504,  1.17389,  0.940628, 0.818982, 0.74723,
+                                          0.625424, 0.562659, 0.476764, 0.409332, 0.353383,
+                                          0.298281, 0.252543, 0.207667, 0.144962};
+    return g;
+}
+
+struct Scenario {
+    std::shared_ptr<void> state;
+    BlockFn block;
+};
+
+Scenario makeScenario(const std::string& id) {
+    const int strikeEvery = static_cast<int>(0.25 * kRate / kBlock);
+    if (id == "impact-strikes" || id == "impact-pressed" || id == "impact-metal") {
+        auto impact = std::make_shared<HuntCrossleyImpact>();
+        ImpactParams p = scenarioImpact();
+        double v = 0.5;
+        if (id == "impact-metal") {
+            p.stiffness = 50885308640.155411;
+            p.dissipation = 0.3;
+            v = 0.45;
+            impact->configure(p, metalModes(), {metalGains()});
+        } else {
+            impact->configure(p, benchModes(), {{1.0, 1.0, 1.0}});
+        }
+        impact->prepare({kRate, kBlock});
+        const bool pressed = id == "impact-pressed";
+        auto force = std::make_shared<std::vector<float>>(kBlock, pressed ? 300.0f : 0.0f);
+        return {impact, [impact, force, pressed, v, strikeEvery](int b, float* out) {
+                    if (pressed ? b == 0 : b % strikeEvery == 0) impact->strike(v);
+                    impact->process(pressed ? force->data() : nullptr, out, kBlock);
+                }};
+    }
+    if (id == "friction-creak") {
+        // Creaking-wood friction layer (engine/data/surfaces/creaking_wood.toml).
+        FrictionParams p;
+        p.sigma0 = 2e5;
+        p.sigma1 = 150.0;
+        p.sigma2 = 0.2;
+        p.sigma3 = 0.05;
+        p.staticCoefficient = 0.55;
+        p.dynamicCoefficient = 0.25;
+        p.stribeckVelocity = 0.02;
+        p.breakAway = 0.6;
+        p.exciterMassKg = 0.02;
+        p.driveStiffness = 5e5;
+        p.driveDamping = 2.0;
+        auto f = std::make_shared<ElastoPlasticFriction>();
+        f->configure(p,
+                     {{310, 0.06, 0.05},
+                      {690, 0.05, 0.04},
+                      {1130, 0.04, 0.04},
+                      {1870, 0.03, 0.05},
+                      {2650, 0.02, 0.06}},
+                     {{1.0, 0.8, 0.7, 0.5, 0.3}});
+        f->prepare(kRate);
+        f->reset(7);
+        auto anchor = std::make_shared<double>(0.0);
+        return {f, [f, anchor](int, float* out) {
+                    for (int i = 0; i < kBlock; ++i) {
+                        *anchor += 0.05 / kRate;
+                        out[i] += static_cast<float>(f->processSample(105.0, 0.0, *anchor, 0.05));
+                    }
+                    f->resonator().flushTinyState();
+                }};
+    }
+    if (id == "aggregate-gravel") {
+        AggregateParameters p; // gravel.toml, first ("sharp clicks") grains layer
+        p.gamma = -1.6;
+        p.energyMin = 0.001;
+        p.resonances = 2;
+        p.freqMinHz = 1690.95;
+        p.freqMaxHz = 7609.26;
+        p.qMin = 9.8455;
+        p.qMax = 41.0229;
+        p.voices = 48;
+        p.burstEvents = 1.0;
+        p.burstMs = 1.5;
+        auto a = std::make_shared<AggregateModel>();
+        a->configure(p);
+        a->prepare(kRate, 4000);
+        a->reset(7);
+        auto rate = std::make_shared<std::vector<float>>(kBlock, 1000.0f);
+        auto scale = std::make_shared<std::vector<float>>(kBlock, 1.0f);
+        return {a, [a, rate, scale](int, float* out) {
+                    a->process(rate->data(), scale->data(), out, kBlock);
+                }};
+    }
+    if (id == "bubbles") {
+        BubbleStreamParameters p;
+        p.voices = 48;
+        auto s = std::make_shared<BubbleStream>();
+        s->configure(p);
+        s->prepare(kRate, 4000);
+        s->reset(7);
+        auto rate = std::make_shared<std::vector<float>>(kBlock, 500.0f);
+        auto scale = std::make_shared<std::vector<float>>(kBlock, 1.0f);
+        return {s, [s, rate, scale](int, float* out) {
+                    s->process(rate->data(), scale->data(), out, kBlock);
+                }};
+    }
+    throw std::invalid_argument("unknown bench scenario '" + id + "'");
+}
+} // namespace
+
+const std::vector<std::string>& scenarioIds() {
+    static const std::vector<std::string> ids = {"impact-strikes",   "impact-pressed",
+                                                 "impact-metal",     "friction-creak",
+                                                 "aggregate-gravel", "bubbles"};
+    return ids;
+}
+
+ScenarioMeasurement measureScenario(const std::string& id, double seconds, int repeats) {
+    const int blocks = static_cast<int>(seconds * kRate / kBlock);
+    std::vector<double> best(static_cast<std::size_t>(blocks), 1e300);
+    std::vector<float> out(kBlock);
+    ScenarioMeasurement m;
+    m.id = id;
+    ScopedFlushDenormals ftz;
+    for (int rep = 0; rep < std::max(1, repeats); ++rep) {
+        Scenario sc = makeScenario(id);
+        double checksum = 0;
+        for (int b = 0; b < blocks; ++b) {
+            std::fill(out.begin(), out.end(), 0.0f);
+            const auto s0 = Clock::now();
+            sc.block(b, out.data());
+            const double ns = std::chrono::duration<double, std::nano>(Clock::now() - s0).count();
+            best[static_cast<std::size_t>(b)] = std::min(best[static_cast<std::size_t>(b)], ns);
+            for (float y : out) checksum += std::fabs(double(y));
+        }
+        m.checksum = checksum;
+    }
+    double total = 0;
+    for (double ns : best) total += ns;
+    m.nsPerSample = total / (double(blocks) * kBlock);
+    std::sort(best.begin(), best.end());
+    m.medianBlockNs = best[best.size() / 2];
+    m.p99BlockNs = best[best.size() * 99 / 100];
+    m.maxBlockNs = best.back();
+    m.budgetShare = m.maxBlockNs / (1e9 * kBlock / kRate);
+    return m;
 }
 
 } // namespace underfoot::engine

@@ -24,6 +24,7 @@ struct ImpactSetting {
     int iterations = 6;
     int oversampling = 1;
     bool floatState = false;
+    int contactSubsteps = 1; ///< sub-steps of the samples in contact (ImpactParams)
 };
 
 struct ImpactMeasurement {
@@ -50,7 +51,8 @@ struct KnobMeasurement {
     double nsPerSample = 0;
 };
 
-/// The default settings compared (explicit, Newton 1/2/4/6 at 1x, Newton 6 at 2x/4x, float).
+/// The settings compared (explicit, Newton 1/2/4/6 at 1x, Newton 6 at 2x/4x, float, and contact
+/// sub-steps 2/4/8/16; the shipped default is Newton 6 at 1x with 8 contact sub-steps).
 std::vector<ImpactSetting> defaultImpactSettings();
 
 /// The benchmark's impact: a 0.1 kg sole, k = 2e9 N/m^1.5, mu = 0.6 s/m, 3 floor modes
@@ -67,5 +69,28 @@ std::vector<SurfaceCost> measureSurfaceCosts(double seconds = 10.0);
 
 /// Mode-count and event-cap knobs on bundled surfaces.
 std::vector<KnobMeasurement> measureKnobs(double seconds = 4.0);
+
+/// The six model scenarios of issue #18, each the model alone at 48 kHz in 64-sample blocks
+/// (parameters in docs/performance.md, mapped there onto the Sound Design Toolkit's API):
+///   impact-strikes  3 modes (the bench impact), a 0.5 m/s strike every 0.25 s;
+///   impact-pressed  the same with 300 N pressing the sole: the contact never opens;
+///   impact-metal    the metal preset's 14 modes, k and mu, a 0.45 m/s strike every 0.25 s;
+///   friction-creak  the creaking-wood friction layer (5 modes), 105 N normal force, its drive
+///                   spring's anchor moving at 0.05 m/s;
+///   aggregate-gravel the gravel preset's sharp grains layer at 1000 events/s;
+///   bubbles         a bubble stream at 500 bubbles/s with 48 voices (default radii 0.5-5 mm).
+const std::vector<std::string>& scenarioIds();
+
+struct ScenarioMeasurement {
+    std::string id;
+    double nsPerSample = 0; ///< per-block minimum over the repeats, summed
+    double medianBlockNs = 0, p99BlockNs = 0, maxBlockNs = 0;
+    double budgetShare = 0; ///< worst block / 1333 us (64 frames at 48 kHz)
+    double checksum = 0;    ///< sum of |output|, so that the work cannot be optimised away
+};
+
+/// Runs scenario `id` for `seconds` of audio, `repeats` times (per-block minimum). Throws
+/// std::invalid_argument for an unknown id.
+ScenarioMeasurement measureScenario(const std::string& id, double seconds, int repeats = 5);
 
 } // namespace underfoot::engine

@@ -1,0 +1,217 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Impact with contact sub-steps (the shipped default since issue #18): the samples in contact are
+// computed as ImpactParams::contactSubsteps exact sub-steps, free flight as single steps.
+// Accuracy against the 8x oversampled reference, the stability matrix, passivity, determinism,
+// block-size independence and no allocation on the audio path.
+#include "engine/models/Impact.h"
+#include "engine/render/AccuracyCost.h"
+#include "tests/common/AllocationTrap.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+using namespace underfoot::engine;
+
+namespace {
+constexpr double kFs = 48000.0;
+
+// The benchmark's impact (AccuracyCost.h): 0.1 kg sole, k = 2e9, alpha 1.5, mu 0.6, 3 modes.
+ImpactParams benchImpact(int substeps, int oversampling = 1, int iterations = 6) {
+    ImpactParams p;
+    p.stiffness = 2e9;
+    p.alpha = 1.5;
+    p.dissipation = 0.6;
+    p.exciterMassKg = 0.1;
+    p.newtonIterations = iterations;
+    p.oversampling = oversampling;
+    p.contactSubsteps = substeps;
+    return p;
+}
+
+const std::vector<Mode> kModes = {{180.0, 0.15, 2.0}, {620.0, 0.08, 0.8}, {1900.0, 0.04, 0.5}};
+
+struct Strike {
+    std::vector<float> out;
+    double restitution = 0, contactTime = 0;
+};
+
+Strike strike(const ImpactParams& p, int block = 64, double seconds = 0.25) {
+    HuntCrossleyImpact impact;
+    impact.configure(p, kModes, {{1.0, 1.0, 1.0}});
+    impact.prepare({kFs, 64});
+    impact.strike(0.5);
+    Strike s;
+    s.out.assign(static_cast<std::size_t>(seconds * kFs), 0.0f);
+    for (std::size_t i = 0; i < s.out.size(); i += static_cast<std::size_t>(block))
+        impact.process(nullptr, s.out.data() + i,
+                       static_cast<int>(std::min<std::size_t>(static_cast<std::size_t>(block),
+                                                              s.out.size() - i)));
+    s.restitution = -impact.stats().outgoingVelocity / impact.stats().incomingVelocity;
+    s.contactTime = impact.stats().contactTimeSeconds;
+    return s;
+}
+} // namespace
+
+TEST(ImpactContactSubsteps, DefaultIsSubsteppedAndMatchesTheReferenceRestitution) {
+    EXPECT_EQ(ImpactParams{}.contactSubsteps, 8);
+    const Strike ref = strike(benchImpact(1, 8, 50)); // the bench's 8x oversampled reference
+    const Strike def = strike(ImpactParams{benchImpact(ImpactParams{}.contactSubsteps)});
+    const Strike old = strike(benchImpact(1)); // the single-step solver (the old default)
+    ASSERT_GT(ref.restitution, 0.5);
+    EXPECT_NEAR(def.restitution, ref.restitution, 0.01 * ref.restitution);
+    // The sub-steps are what brings it there: the single step is several percent off.
+    EXPECT_GT(std::fabs(old.restitution - ref.restitution), 0.03 * ref.restitution);
+    EXPECT_NEAR(def.contactTime, ref.contactTime, 0.01 * ref.contactTime);
+    EXPECT_LE(spectralDistanceDb(def.out, ref.out, kFs), 0.1);
+    EXPECT_GT(spectralDistanceDb(old.out, ref.out, kFs), 0.3);
+}
+
+TEST(ImpactContactSubsteps, MoreSubstepsConvergeTowardsTheReference) {
+    const Strike ref = strike(benchImpact(1, 8, 50));
+    double previous = 1e9;
+    for (int sub : {1, 2, 4, 8}) {
+        const double err = std::fabs(strike(benchImpact(sub)).restitution - ref.restitution);
+        EXPECT_LT(err, previous) << sub;
+        previous = err;
+    }
+}
+
+TEST(ImpactContactSubsteps, BlockSizeIndependentAndDeterministic) {
+    const Strike a = strike(benchImpact(8), 64);
+    const Strike b = strike(benchImpact(8), 1);
+    const Strike c = strike(benchImpact(8), 37);
+    const Strike d = strike(benchImpact(8), 64);
+    ASSERT_EQ(a.out.size(), b.out.size());
+    for (std::size_t i = 0; i < a.out.size(); ++i) {
+        ASSERT_EQ(a.out[i], b.out[i]) << i;
+        ASSERT_EQ(a.out[i], c.out[i]) << i;
+        ASSERT_EQ(a.out[i], d.out[i]) << i;
+    }
+}
+
+TEST(ImpactContactSubsteps, StabilityMatrixStaysFiniteAndPassive) {
+    // Stiffness 1e5..1e11, alpha up to 3, up to 10 m/s, soles down to 1 mg, with and without
+    // sub-steps, a pressing force and strikes: finite, the exciter never leaves faster than it came
+    // and the total energy never exceeds what was put in.
+    int cases = 0;
+    for (int sub : {1, 8, 16}) {
+        for (double k : {1e5, 1e8, 1e11}) {
+            for (double alpha : {1.0, 1.5, 3.0}) {
+                for (double m : {1e-6, 1e-3, 1.0}) {
+                    for (double v : {0.01, 10.0}) {
+                        ImpactParams p;
+                        p.stiffness = k;
+                        p.alpha = alpha;
+                        p.dissipation = 0.3;
+                        p.exciterMassKg = m;
+                        p.contactSubsteps = sub;
+                        HuntCrossleyImpact impact;
+                        impact.configure(
+                            p, {{150.0, 0.3, 1.0}, {1200.0, 0.1, 0.3}, {30000.0, 0.02, 0.1}},
+                            {{1.0, 1.0, 1.0}});
+                        impact.prepare({kFs, 64});
+                        impact.strike(v);
+                        const double e0 = impact.totalEnergy();
+                        std::vector<float> out(64);
+                        bool ok = true;
+                        for (int b = 0; b < 200 && ok; ++b) {
+                            impact.process(nullptr, out.data(), 64);
+                            for (float y : out) ok &= std::isfinite(y);
+                            ok &= impact.totalEnergy() <= e0 * (1 + 1e-6);
+                        }
+                        EXPECT_TRUE(ok) << "sub=" << sub << " k=" << k << " a=" << alpha
+                                        << " m=" << m << " v=" << v;
+                        EXPECT_LE(std::fabs(impact.exciterVelocity()), v * (1 + 1e-6))
+                            << "sub=" << sub << " k=" << k << " a=" << alpha << " m=" << m;
+                        ++cases;
+                    }
+                }
+            }
+        }
+    }
+    EXPECT_EQ(cases, 162);
+}
+
+TEST(ImpactContactSubsteps, PressedSoleStaysFiniteAndDoesNotAllocate) {
+    // A sole pressed on the floor (the contact never opens): every sample is sub-stepped.
+    ImpactParams p = benchImpact(8);
+    HuntCrossleyImpact impact;
+    impact.configure(p, kModes, {{1.0, 1.0, 1.0}});
+    impact.prepare({kFs, 64});
+    impact.strike(0.5);
+    std::vector<float> force(64, 300.0f), out(64);
+    long allocations = 0;
+    {
+        underfoot::test::AllocationTrap trap;
+        for (int b = 0; b < 750; ++b) impact.process(force.data(), out.data(), 64);
+        allocations = trap.count();
+    }
+    EXPECT_EQ(allocations, 0);
+    for (float y : out) EXPECT_TRUE(std::isfinite(y));
+    // Static equilibrium: the contact force carries the pressing force.
+    EXPECT_NEAR(impact.lastContactForce(), 300.0, 3.0);
+    // Once the strike's transient has died out, the resting contact is single-stepped: far fewer
+    // solved steps than 8 per sample.
+    EXPECT_GE(impact.stats().solvedSamples, 750 * 64);
+    EXPECT_LT(impact.stats().solvedSamples, 750 * 64 * 2);
+}
+
+TEST(ImpactContactSubsteps, PressedSoleMatchesTheFullySubsteppedSolution) {
+    // The transient criterion (sub-step only while the force changes by more than
+    // substepForceChange per sample) against sub-stepping every sample in contact.
+    auto run = [](double threshold) {
+        ImpactParams p = benchImpact(8);
+        p.substepForceChange = threshold;
+        HuntCrossleyImpact impact;
+        impact.configure(p, kModes, {{1.0, 1.0, 1.0}});
+        impact.prepare({kFs, 64});
+        impact.strike(0.5);
+        std::vector<float> force(64, 300.0f), out(12032);
+        for (std::size_t i = 0; i < out.size(); i += 64)
+            impact.process(force.data(), out.data() + i, 64);
+        return out;
+    };
+    const auto all = run(0.0), shipped = run(ImpactParams{}.substepForceChange);
+    EXPECT_LE(spectralDistanceDb(shipped, all, kFs), 0.1);
+}
+
+TEST(ImpactContactSubsteps, RejectsUnsupportedSubstepCounts) {
+    for (int bad : {0, 3, 5, 32, -1}) {
+        ImpactParams p;
+        p.contactSubsteps = bad;
+        HuntCrossleyImpact impact;
+        EXPECT_THROW(impact.configure(p, kModes, {{1.0, 1.0, 1.0}}), std::invalid_argument) << bad;
+    }
+}
+
+TEST(ModalResonatorFastPath, FreeRingingEqualsTheGeneralRecursion) {
+    // predict()/commit() skip the force terms and swap buffers when no force acts (issue #18);
+    // the result must equal the general recursion s[n+1] = A s[n] + B0 u[n] + B1 u[n+1] computed
+    // here independently, for a force that switches on and off (bit-exact up to rounding order,
+    // which is the same: tolerance 1e-15 relative).
+    const std::vector<Mode> modes = {{180.0, 0.15, 2.0}, {620.0, 0.08, 0.8}, {30000.0, 0.04, 0.5}};
+    const std::vector<double> g = {1.0, -0.7, 0.4};
+    ModalResonator r;
+    r.configure(modes, {g});
+    r.prepare(kFs);
+    std::vector<ModeCoefficients> c;
+    for (const auto& m : modes) c.push_back(computeModeCoefficients(m, kFs));
+    std::vector<double> q(3, 0.0), v(3, 0.0), u(3, 0.0);
+    for (int n = 0; n < 4000; ++n) {
+        const double f = (n % 500 < 20) ? 10.0 * std::sin(0.3 * n) : 0.0;
+        const double y = r.processSample(0, f, 0);
+        double ref = 0.0;
+        for (std::size_t i = 0; i < 3; ++i) {
+            const double un = g[i] / modes[i].massKg * f;
+            const double qn = c[i].a00 * q[i] + c[i].a01 * v[i] + c[i].b0x * u[i] + c[i].b1x * un;
+            const double vn = c[i].a10 * q[i] + c[i].a11 * v[i] + c[i].b0v * u[i] + c[i].b1v * un;
+            q[i] = qn;
+            v[i] = vn;
+            u[i] = un;
+            if (!c[i].quasiStatic) ref += g[i] * vn;
+        }
+        ASSERT_NEAR(y, ref, 1e-15 * (1.0 + std::fabs(ref)) + 1e-300) << n;
+    }
+}
