@@ -12,10 +12,10 @@
 #include <mutex>
 #include <stdexcept>
 
-#if defined(__SSE__) || defined(__x86_64__)
-#include <xmmintrin.h>
-#define UNDERFOOT_CONV_SSE 1
+#if !defined(__x86_64__)
+#error "Convolver.cpp uses SSE/AVX intrinsics (x86-64)"
 #endif
+#include <immintrin.h>
 
 namespace underfoot::engine {
 
@@ -52,7 +52,131 @@ struct Plan {
     }
 };
 
-constexpr int kLanes = 4; // bins per SIMD vector; the spectra are padded to a multiple of it
+constexpr int kLanes = 8; // bins per AVX vector; the spectra are padded to a multiple of it
+
+/// Pointers of one multiply-add step: the spectra X0 (and X1) of two partitions' inputs and,
+/// per output channel c, their filter spectra H0[c] (H1[c]) and the accumulator.
+struct MacPtrs {
+    const float* x[4];    // x0 re, x0 im, x1 re, x1 im
+    const float* h[2][4]; // [c]: h0 re, h0 im, h1 re, h1 im
+    float* acc[2][2];     // [c]: re, im
+};
+
+// acc[c] = (acc[c] + X0 H0[c]) + X1 H1[c], bin by bin, for c < C. The SSE and AVX versions do
+// the same IEEE operations per bin in the same order (no FMA): identical results, so the output
+// does not depend on which one the CPU runs.
+#define UNDERFOOT_MAC_KERNEL(NAME, ATTR, V, W, LOAD, STORE, ADD, SUB, MUL)                         \
+    template <int C, bool Two>                                                                     \
+    ATTR void NAME(const MacPtrs& p, int stride) noexcept {                                        \
+        for (int b = 0; b < stride; b += W) {                                                      \
+            const V x0r = LOAD(p.x[0] + b), x0i = LOAD(p.x[1] + b);                                \
+            V x1r = x0r, x1i = x0i;                                                                \
+            if constexpr (Two) {                                                                   \
+                x1r = LOAD(p.x[2] + b);                                                            \
+                x1i = LOAD(p.x[3] + b);                                                            \
+            }                                                                                      \
+            for (int c = 0; c < C; ++c) {                                                          \
+                V sr = LOAD(p.acc[c][0] + b), si = LOAD(p.acc[c][1] + b);                          \
+                const V hr = LOAD(p.h[c][0] + b), hi = LOAD(p.h[c][1] + b);                        \
+                sr = ADD(sr, SUB(MUL(x0r, hr), MUL(x0i, hi)));                                     \
+                si = ADD(si, ADD(MUL(x0r, hi), MUL(x0i, hr)));                                     \
+                if constexpr (Two) {                                                               \
+                    const V gr = LOAD(p.h[c][2] + b), gi = LOAD(p.h[c][3] + b);                    \
+                    sr = ADD(sr, SUB(MUL(x1r, gr), MUL(x1i, gi)));                                 \
+                    si = ADD(si, ADD(MUL(x1r, gi), MUL(x1i, gr)));                                 \
+                }                                                                                  \
+                STORE(p.acc[c][0] + b, sr);                                                        \
+                STORE(p.acc[c][1] + b, si);                                                        \
+            }                                                                                      \
+        }                                                                                          \
+    }
+
+UNDERFOOT_MAC_KERNEL(macSse, , __m128, 4, _mm_loadu_ps, _mm_storeu_ps, _mm_add_ps, _mm_sub_ps,
+                     _mm_mul_ps)
+UNDERFOOT_MAC_KERNEL(macAvx, __attribute__((target("avx"))), __m256, 8, _mm256_loadu_ps,
+                     _mm256_storeu_ps, _mm256_add_ps, _mm256_sub_ps, _mm256_mul_ps)
+#undef UNDERFOOT_MAC_KERNEL
+
+template <int C, bool Two>
+void mac(bool avx, const MacPtrs& p, int stride) noexcept {
+    if (avx)
+        macAvx<C, Two>(p, stride);
+    else
+        macSse<C, Two>(p, stride);
+}
+
+/// The direct-form head over a run of m <= kTick outputs: y[t] = sum over k of h[k] x[t - k],
+/// with line[kHeadLength - 1 + t] = x[t] (the 63 inputs before the run in front). Vectorised
+/// across outputs: every output is the same float sum in the same order (k = 0, 1, ...) in the
+/// AVX, SSE and scalar code, whatever m and wherever the run starts.
+inline void headScalar(const float* hl, const float* hr, const float* line, int t0, int m,
+                       float* yl, float* yr) noexcept {
+    constexpr int q = Convolver::kHeadLength;
+    for (int t = t0; t < m; ++t) {
+        float l = 0.0f, r = 0.0f;
+        for (int k = 0; k < q; ++k) {
+            const float x = line[q - 1 + t - k];
+            l = l + hl[k] * x;
+            r = r + hr[k] * x;
+        }
+        yl[t] = l;
+        yr[t] = r;
+    }
+}
+
+void headSse(const float* hl, const float* hr, const float* line, int m, float* yl,
+             float* yr) noexcept {
+    constexpr int q = Convolver::kHeadLength;
+    int t = 0;
+    for (; t + 4 <= m; t += 4) {
+        __m128 l = _mm_setzero_ps(), r = l;
+        for (int k = 0; k < q; ++k) {
+            const __m128 x = _mm_loadu_ps(line + q - 1 + t - k);
+            l = _mm_add_ps(l, _mm_mul_ps(_mm_set1_ps(hl[k]), x));
+            r = _mm_add_ps(r, _mm_mul_ps(_mm_set1_ps(hr[k]), x));
+        }
+        _mm_storeu_ps(yl + t, l);
+        _mm_storeu_ps(yr + t, r);
+    }
+    headScalar(hl, hr, line, t, m, yl, yr);
+}
+
+__attribute__((target("avx"))) void headAvx(const float* hl, const float* hr, const float* line,
+                                            int m, float* yl, float* yr) noexcept {
+    constexpr int q = Convolver::kHeadLength;
+    int t = 0;
+    for (; t + 16 <= m; t += 16) { // two vectors of outputs share the tap broadcasts
+        __m256 l0 = _mm256_setzero_ps(), l1 = l0, r0 = l0, r1 = l0;
+        for (int k = 0; k < q; ++k) {
+            const __m256 x0 = _mm256_loadu_ps(line + q - 1 + t - k);
+            const __m256 x1 = _mm256_loadu_ps(line + q - 1 + t + 8 - k);
+            const __m256 a = _mm256_broadcast_ss(hl + k), b = _mm256_broadcast_ss(hr + k);
+            l0 = _mm256_add_ps(l0, _mm256_mul_ps(a, x0));
+            l1 = _mm256_add_ps(l1, _mm256_mul_ps(a, x1));
+            r0 = _mm256_add_ps(r0, _mm256_mul_ps(b, x0));
+            r1 = _mm256_add_ps(r1, _mm256_mul_ps(b, x1));
+        }
+        _mm256_storeu_ps(yl + t, l0);
+        _mm256_storeu_ps(yl + t + 8, l1);
+        _mm256_storeu_ps(yr + t, r0);
+        _mm256_storeu_ps(yr + t + 8, r1);
+    }
+    for (; t + 8 <= m; t += 8) {
+        __m256 l = _mm256_setzero_ps(), r = l;
+        for (int k = 0; k < q; ++k) {
+            const __m256 x = _mm256_loadu_ps(line + q - 1 + t - k);
+            l = _mm256_add_ps(l, _mm256_mul_ps(_mm256_broadcast_ss(hl + k), x));
+            r = _mm256_add_ps(r, _mm256_mul_ps(_mm256_broadcast_ss(hr + k), x));
+        }
+        _mm256_storeu_ps(yl + t, l);
+        _mm256_storeu_ps(yr + t, r);
+    }
+    headScalar(hl, hr, line, t, m, yl, yr);
+}
+
+bool cpuHasAvx() noexcept {
+    return __builtin_cpu_supports("avx") != 0;
+}
 
 } // namespace
 
@@ -77,7 +201,7 @@ struct Convolver::Stage {
     std::vector<float> xRe, xIm;     // [slot][stride], ring of the last N input spectra
     std::vector<float> accRe, accIm; // [channel][stride]
     std::vector<float> out;          // [channel][2][P]: playing and being computed
-    std::vector<int> offsets;        // N: per partition, the ring offset of its spectrum
+    bool avx = false;                // run the AVX kernels (same results as SSE)
     std::vector<Item> items;
     std::vector<int> sliceBegin; // P / kTick + 1 indices into items
     int play = 0;                // which half of out is playing
@@ -119,45 +243,38 @@ struct Convolver::Stage {
         }
     }
 
-    /// acc[c] (+)= sum over j in [j0, j1) of X[block - j] * H[c][j], bin by bin.
+    /// acc[c] (+)= sum over j in [j0, j1) of X[block - j] * H[c][j], bin by bin, partitions in
+    /// pairs (one pass over the accumulators per pair).
     void runMac(int j0, int j1, bool first) noexcept {
-        for (int j = j0; j < j1; ++j)
-            offsets[static_cast<std::size_t>(j)] = slot(block - j) * stride;
-        const float* xr = xRe.data();
-        const float* xi = xIm.data();
+        if (first) {
+            std::fill(accRe.begin(), accRe.end(), 0.0f);
+            std::fill(accIm.begin(), accIm.end(), 0.0f);
+        }
+        const auto st = static_cast<std::size_t>(stride);
+        MacPtrs p{};
         for (int c = 0; c < channels; ++c) {
-            float* ar = accRe.data() + static_cast<std::size_t>(c) * stride;
-            float* ai = accIm.data() + static_cast<std::size_t>(c) * stride;
-            const float* hr = hRe.data() + static_cast<std::size_t>(c) * N * stride;
-            const float* hi = hIm.data() + static_cast<std::size_t>(c) * N * stride;
-            for (int b = 0; b < stride; b += kLanes) {
-#ifdef UNDERFOOT_CONV_SSE
-                __m128 sr = first ? _mm_setzero_ps() : _mm_loadu_ps(ar + b);
-                __m128 si = first ? _mm_setzero_ps() : _mm_loadu_ps(ai + b);
-                for (int j = j0; j < j1; ++j) {
-                    const int o = offsets[static_cast<std::size_t>(j)] + b;
-                    const std::size_t h = static_cast<std::size_t>(j) * stride + b;
-                    const __m128 a = _mm_loadu_ps(xr + o), bb = _mm_loadu_ps(xi + o);
-                    const __m128 c1 = _mm_loadu_ps(hr + h), d = _mm_loadu_ps(hi + h);
-                    sr = _mm_add_ps(sr, _mm_sub_ps(_mm_mul_ps(a, c1), _mm_mul_ps(bb, d)));
-                    si = _mm_add_ps(si, _mm_add_ps(_mm_mul_ps(a, d), _mm_mul_ps(bb, c1)));
+            p.acc[c][0] = accRe.data() + static_cast<std::size_t>(c) * st;
+            p.acc[c][1] = accIm.data() + static_cast<std::size_t>(c) * st;
+        }
+        for (int j = j0; j < j1; j += 2) {
+            const bool two = j + 1 < j1;
+            for (int k = 0; k < (two ? 2 : 1); ++k) {
+                const std::size_t o = static_cast<std::size_t>(slot(block - j - k)) * st;
+                p.x[2 * k] = xRe.data() + o;
+                p.x[2 * k + 1] = xIm.data() + o;
+                for (int c = 0; c < channels; ++c) {
+                    const std::size_t h =
+                        (static_cast<std::size_t>(c) * static_cast<std::size_t>(N) +
+                         static_cast<std::size_t>(j + k)) *
+                        st;
+                    p.h[c][2 * k] = hRe.data() + h;
+                    p.h[c][2 * k + 1] = hIm.data() + h;
                 }
-                _mm_storeu_ps(ar + b, sr);
-                _mm_storeu_ps(ai + b, si);
-#else
-                for (int l = 0; l < kLanes; ++l) {
-                    float sr = first ? 0.0f : ar[b + l], si = first ? 0.0f : ai[b + l];
-                    for (int j = j0; j < j1; ++j) {
-                        const int o = offsets[static_cast<std::size_t>(j)] + b + l;
-                        const std::size_t h = static_cast<std::size_t>(j) * stride + b + l;
-                        sr += xr[o] * hr[h] - xi[o] * hi[h];
-                        si += xr[o] * hi[h] + xi[o] * hr[h];
-                    }
-                    ar[b + l] = sr;
-                    ai[b + l] = si;
-                }
-#endif
             }
+            if (channels == 2)
+                two ? mac<2, true>(avx, p, stride) : mac<2, false>(avx, p, stride);
+            else
+                two ? mac<1, true>(avx, p, stride) : mac<1, false>(avx, p, stride);
         }
     }
 
@@ -219,7 +336,10 @@ struct Convolver::Stage {
             double cost;
         };
         std::vector<Atom> atoms;
-        for (int j = 1; j < N; ++j) atoms.push_back({{Kind::Mac, j, j + 1, false, 0}, macCost});
+        for (int j = 1; j < N; j += 2) { // products in pairs (one pass over the accumulators)
+            const int j1 = std::min(j + 2, N);
+            atoms.push_back({{Kind::Mac, j, j1, false, 0}, macCost * (j1 - j)});
+        }
         atoms.push_back({{Kind::Forward}, fftCost});
         atoms.push_back({{Kind::Mac, 0, 1, false, 0}, macCost});
         for (auto& a : atoms) // the first product of the period clears the accumulators
@@ -294,6 +414,7 @@ void Convolver::prepare(const AudioBuffer& impulseResponse, double sampleRateHz,
         if (!std::isfinite(v))
             throw std::invalid_argument("Convolver: impulse response holds non-finite samples");
     release();
+    avx_ = cpuHasAvx();
 
     // Resample; keep the frequency response: taps scale with 1/rate.
     AudioBuffer ir = impulseResponse;
@@ -317,16 +438,15 @@ void Convolver::prepare(const AudioBuffer& impulseResponse, double sampleRateHz,
         ir_.samples[2 * i] = left[i], ir_.samples[2 * i + 1] = right[i];
     irLength_ = len;
 
-    // Direct-form head, reversed.
+    // Direct-form head.
     constexpr auto q = static_cast<std::size_t>(kHeadLength);
     headL_.assign(q, 0.0f);
     headR_.assign(q, 0.0f);
     for (std::size_t k = 0; k < std::min(len, q); ++k) {
-        headL_[q - 1 - k] = left[k];
-        headR_[q - 1 - k] = right[k];
+        headL_[k] = left[k];
+        headR_[k] = right[k];
     }
-    history_.assign(2 * q, 0.0f);
-    historyPos_ = 0;
+    line_.assign(q - 1 + static_cast<std::size_t>(kTick), 0.0f);
     phase_ = 0;
 
     // FFT stages.
@@ -372,7 +492,7 @@ void Convolver::prepare(const AudioBuffer& impulseResponse, double sampleRateHz,
         s->accRe.assign(ch * stride, 0.0f);
         s->accIm.assign(ch * stride, 0.0f);
         s->out.assign(ch * 2 * static_cast<std::size_t>(P), 0.0f);
-        s->offsets.assign(N, 0);
+        s->avx = avx_;
         // Partition spectra: taps [begin + jP, begin + (j+1)P) zero-padded to 2P, scaled by
         // 1 / 2P (FFTW's inverse is unnormalised).
         const float scale = 1.0f / static_cast<float>(P2);
@@ -400,8 +520,7 @@ void Convolver::prepare(const AudioBuffer& impulseResponse, double sampleRateHz,
 }
 
 void Convolver::reset() {
-    std::fill(history_.begin(), history_.end(), 0.0f);
-    historyPos_ = 0;
+    std::fill(line_.begin(), line_.end(), 0.0f);
     phase_ = 0;
     for (auto& s : stages_) s->clear();
 }
@@ -417,35 +536,21 @@ void Convolver::process(const float* in, float* outL, float* outR, int n) noexce
     }
     ScopedFlushDenormals flush;
     constexpr int q = kHeadLength;
+    float* line = line_.data();
     int i = 0;
     while (i < n) {
         // Up to the next tick: the same operations per sample whatever the host block.
         const int m = std::min(n - i, kTick - phase_);
-        float x[kTick];
-        double yl[kTick], yr[kTick];
-        std::memcpy(x, in + i, sizeof(float) * static_cast<std::size_t>(m)); // in may alias out
-        for (int t = 0; t < m; ++t) {
-            history_[static_cast<std::size_t>(historyPos_)] = x[t];
-            history_[static_cast<std::size_t>(historyPos_ + q)] = x[t];
-            const float* window = history_.data() + historyPos_ + 1;
-            // Float products summed in 8 independent lanes (vectorisable).
-            float accL[8] = {}, accR[8] = {};
-            const float* hl = headL_.data();
-            const float* hr = headR_.data();
-            for (int k = 0; k < q; k += 8)
-                for (int j = 0; j < 8; ++j) {
-                    accL[j] += hl[k + j] * window[k + j];
-                    accR[j] += hr[k + j] * window[k + j];
-                }
-            double l = 0.0, r = 0.0;
-            for (int j = 0; j < 8; ++j) l += accL[j], r += accR[j];
-            yl[t] = l;
-            yr[t] = r;
-            historyPos_ = (historyPos_ + 1) % q;
-        }
+        const auto bytes = sizeof(float) * static_cast<std::size_t>(m);
+        float yl[kTick], yr[kTick];
+        std::memcpy(line + q - 1, in + i, bytes); // before any output: in may alias out
+        if (avx_)
+            headAvx(headL_.data(), headR_.data(), line, m, yl, yr);
+        else
+            headSse(headL_.data(), headR_.data(), line, m, yl, yr);
         for (auto& sp : stages_) {
             Stage& s = *sp;
-            std::memcpy(s.cur.data() + s.pos, x, sizeof(float) * static_cast<std::size_t>(m));
+            std::memcpy(s.cur.data() + s.pos, line + q - 1, bytes);
             const float* pl = s.outBuf(0, s.play) + s.pos;
             const float* pr = s.outBuf(s.channels - 1, s.play) + s.pos;
             for (int t = 0; t < m; ++t) {
@@ -454,10 +559,9 @@ void Convolver::process(const float* in, float* outL, float* outR, int n) noexce
             }
             s.pos += m;
         }
-        for (int t = 0; t < m; ++t) {
-            outL[i + t] = static_cast<float>(yl[t]);
-            outR[i + t] = static_cast<float>(yr[t]);
-        }
+        std::memcpy(outL + i, yl, bytes);
+        std::memcpy(outR + i, yr, bytes);
+        std::memmove(line, line + m, sizeof(float) * (q - 1)); // keep the last 63 inputs
         phase_ += m;
         i += m;
         if (phase_ == kTick) {

@@ -71,10 +71,10 @@ class Convolver {
     AudioBuffer ir_;
     std::size_t irLength_ = 0;
     bool stereoIr_ = false;
-    std::vector<float> headL_, headR_; ///< first taps, reversed for the dot product
-    std::vector<float> history_;       ///< last kHeadLength inputs, stored twice (no wrap)
-    int historyPos_ = 0;
-    int phase_ = 0; ///< input samples since the last tick, 0 .. kTick - 1
+    bool avx_ = false;                 ///< AVX kernels (bit-identical to the SSE ones)
+    std::vector<float> headL_, headR_; ///< the first kHeadLength taps
+    std::vector<float> line_;          ///< the 63 previous inputs, then the current run
+    int phase_ = 0;                    ///< input samples since the last tick, 0 .. kTick - 1
     std::vector<std::unique_ptr<Stage>> stages_;
 };
 
