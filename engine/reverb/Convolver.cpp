@@ -1,42 +1,383 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "engine/reverb/Convolver.h"
 
+#include "engine/dsp/Denormals.h"
+
+#include <fftw3.h>
 #include <fmt/format.h>
-#include <zita-convolver.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <mutex>
 #include <stdexcept>
 
-#include <sched.h>
-#include <unistd.h>
-
-#if ZITA_CONVOLVER_MAJOR_VERSION != 4
-#error "Convolver.cpp is written against the zita-convolver 4.x API"
+#if !defined(__x86_64__)
+#error "Convolver.cpp uses SSE/AVX intrinsics (x86-64)"
 #endif
+#include <immintrin.h>
 
 namespace underfoot::engine {
 
-/// One uniformly partitioned FFT stage (a threadless zita-convolver instance).
-struct Convolver::Stage {
-    Convproc zita;
-    int partition = 0;
-    int fill = 0;                  // samples of the current block already consumed
-    std::vector<float> outL, outR; // this stage's output for the current block
+namespace {
 
-    ~Stage() {
-        if (zita.state() == Convproc::ST_PROC) zita.stop_process();
-        while (!zita.check_stop()) usleep(100); // no thread: returns at once
-        zita.cleanup();
+/// FFTW's planner is not thread-safe (fftwf_execute is): every plan is made and destroyed
+/// under this lock, outside the audio thread.
+std::mutex& plannerMutex() {
+    static std::mutex m;
+    return m;
+}
+
+/// An FFTW-allocated (SIMD-aligned) float array.
+struct FftwFloats {
+    float* p = nullptr;
+    FftwFloats() = default;
+    void allocate(std::size_t n) {
+        fftwf_free(p);
+        p = fftwf_alloc_real(n);
+        if (p == nullptr) throw std::bad_alloc();
+        std::memset(p, 0, n * sizeof(float));
     }
-    void start() {
-        // quantum == minpart: start_process() starts no thread.
-        if (zita.start_process(0, SCHED_OTHER) != 0)
-            throw std::runtime_error("Convolver: zita-convolver could not start processing");
-        std::fill(outL.begin(), outL.end(), 0.0f);
-        std::fill(outR.begin(), outR.end(), 0.0f);
-        fill = 0;
+    FftwFloats(const FftwFloats&) = delete;
+    FftwFloats& operator=(const FftwFloats&) = delete;
+    ~FftwFloats() { fftwf_free(p); }
+};
+
+struct Plan {
+    fftwf_plan p = nullptr;
+    ~Plan() {
+        if (p == nullptr) return;
+        std::lock_guard<std::mutex> lock(plannerMutex());
+        fftwf_destroy_plan(p);
+    }
+};
+
+constexpr int kLanes = 8; // bins per AVX vector; the spectra are padded to a multiple of it
+
+/// Pointers of one multiply-add step: the spectra X0 (and X1) of two partitions' inputs and,
+/// per output channel c, their filter spectra H0[c] (H1[c]) and the accumulator.
+struct MacPtrs {
+    const float* x[4];    // x0 re, x0 im, x1 re, x1 im
+    const float* h[2][4]; // [c]: h0 re, h0 im, h1 re, h1 im
+    float* acc[2][2];     // [c]: re, im
+};
+
+// acc[c] = (acc[c] + X0 H0[c]) + X1 H1[c], bin by bin, for c < C. The SSE and AVX versions do
+// the same IEEE operations per bin in the same order (no FMA): identical results, so the output
+// does not depend on which one the CPU runs.
+#define UNDERFOOT_MAC_KERNEL(NAME, ATTR, V, W, LOAD, STORE, ADD, SUB, MUL)                         \
+    template <int C, bool Two>                                                                     \
+    ATTR void NAME(const MacPtrs& p, int stride) noexcept {                                        \
+        for (int b = 0; b < stride; b += W) {                                                      \
+            const V x0r = LOAD(p.x[0] + b), x0i = LOAD(p.x[1] + b);                                \
+            V x1r = x0r, x1i = x0i;                                                                \
+            if constexpr (Two) {                                                                   \
+                x1r = LOAD(p.x[2] + b);                                                            \
+                x1i = LOAD(p.x[3] + b);                                                            \
+            }                                                                                      \
+            for (int c = 0; c < C; ++c) {                                                          \
+                V sr = LOAD(p.acc[c][0] + b), si = LOAD(p.acc[c][1] + b);                          \
+                const V hr = LOAD(p.h[c][0] + b), hi = LOAD(p.h[c][1] + b);                        \
+                sr = ADD(sr, SUB(MUL(x0r, hr), MUL(x0i, hi)));                                     \
+                si = ADD(si, ADD(MUL(x0r, hi), MUL(x0i, hr)));                                     \
+                if constexpr (Two) {                                                               \
+                    const V gr = LOAD(p.h[c][2] + b), gi = LOAD(p.h[c][3] + b);                    \
+                    sr = ADD(sr, SUB(MUL(x1r, gr), MUL(x1i, gi)));                                 \
+                    si = ADD(si, ADD(MUL(x1r, gi), MUL(x1i, gr)));                                 \
+                }                                                                                  \
+                STORE(p.acc[c][0] + b, sr);                                                        \
+                STORE(p.acc[c][1] + b, si);                                                        \
+            }                                                                                      \
+        }                                                                                          \
+    }
+
+UNDERFOOT_MAC_KERNEL(macSse, , __m128, 4, _mm_loadu_ps, _mm_storeu_ps, _mm_add_ps, _mm_sub_ps,
+                     _mm_mul_ps)
+UNDERFOOT_MAC_KERNEL(macAvx, __attribute__((target("avx"))), __m256, 8, _mm256_loadu_ps,
+                     _mm256_storeu_ps, _mm256_add_ps, _mm256_sub_ps, _mm256_mul_ps)
+#undef UNDERFOOT_MAC_KERNEL
+
+template <int C, bool Two>
+void mac(bool avx, const MacPtrs& p, int stride) noexcept {
+    if (avx)
+        macAvx<C, Two>(p, stride);
+    else
+        macSse<C, Two>(p, stride);
+}
+
+/// The direct-form head over a run of m <= kTick outputs: y[t] = sum over k of h[k] x[t - k],
+/// with line[kHeadLength - 1 + t] = x[t] (the 63 inputs before the run in front). Vectorised
+/// across outputs: every output is the same float sum in the same order (k = 0, 1, ...) in the
+/// AVX, SSE and scalar code, whatever m and wherever the run starts.
+inline void headScalar(const float* hl, const float* hr, const float* line, int t0, int m,
+                       float* yl, float* yr) noexcept {
+    constexpr int q = Convolver::kHeadLength;
+    for (int t = t0; t < m; ++t) {
+        float l = 0.0f, r = 0.0f;
+        for (int k = 0; k < q; ++k) {
+            const float x = line[q - 1 + t - k];
+            l = l + hl[k] * x;
+            r = r + hr[k] * x;
+        }
+        yl[t] = l;
+        yr[t] = r;
+    }
+}
+
+void headSse(const float* hl, const float* hr, const float* line, int m, float* yl,
+             float* yr) noexcept {
+    constexpr int q = Convolver::kHeadLength;
+    int t = 0;
+    for (; t + 4 <= m; t += 4) {
+        __m128 l = _mm_setzero_ps(), r = l;
+        for (int k = 0; k < q; ++k) {
+            const __m128 x = _mm_loadu_ps(line + q - 1 + t - k);
+            l = _mm_add_ps(l, _mm_mul_ps(_mm_set1_ps(hl[k]), x));
+            r = _mm_add_ps(r, _mm_mul_ps(_mm_set1_ps(hr[k]), x));
+        }
+        _mm_storeu_ps(yl + t, l);
+        _mm_storeu_ps(yr + t, r);
+    }
+    headScalar(hl, hr, line, t, m, yl, yr);
+}
+
+__attribute__((target("avx"))) void headAvx(const float* hl, const float* hr, const float* line,
+                                            int m, float* yl, float* yr) noexcept {
+    constexpr int q = Convolver::kHeadLength;
+    int t = 0;
+    for (; t + 16 <= m; t += 16) { // two vectors of outputs share the tap broadcasts
+        __m256 l0 = _mm256_setzero_ps(), l1 = l0, r0 = l0, r1 = l0;
+        for (int k = 0; k < q; ++k) {
+            const __m256 x0 = _mm256_loadu_ps(line + q - 1 + t - k);
+            const __m256 x1 = _mm256_loadu_ps(line + q - 1 + t + 8 - k);
+            const __m256 a = _mm256_broadcast_ss(hl + k), b = _mm256_broadcast_ss(hr + k);
+            l0 = _mm256_add_ps(l0, _mm256_mul_ps(a, x0));
+            l1 = _mm256_add_ps(l1, _mm256_mul_ps(a, x1));
+            r0 = _mm256_add_ps(r0, _mm256_mul_ps(b, x0));
+            r1 = _mm256_add_ps(r1, _mm256_mul_ps(b, x1));
+        }
+        _mm256_storeu_ps(yl + t, l0);
+        _mm256_storeu_ps(yl + t + 8, l1);
+        _mm256_storeu_ps(yr + t, r0);
+        _mm256_storeu_ps(yr + t + 8, r1);
+    }
+    for (; t + 8 <= m; t += 8) {
+        __m256 l = _mm256_setzero_ps(), r = l;
+        for (int k = 0; k < q; ++k) {
+            const __m256 x = _mm256_loadu_ps(line + q - 1 + t - k);
+            l = _mm256_add_ps(l, _mm256_mul_ps(_mm256_broadcast_ss(hl + k), x));
+            r = _mm256_add_ps(r, _mm256_mul_ps(_mm256_broadcast_ss(hr + k), x));
+        }
+        _mm256_storeu_ps(yl + t, l);
+        _mm256_storeu_ps(yr + t, r);
+    }
+    headScalar(hl, hr, line, t, m, yl, yr);
+}
+
+bool cpuHasAvx() noexcept {
+    return __builtin_cpu_supports("avx") != 0;
+}
+
+} // namespace
+
+/// One uniformly partitioned overlap-save stage: partition P, N partitions, taps [T, T + N P).
+struct Convolver::Stage {
+    enum class Kind { Mac, Forward, Inverse };
+    struct Item {
+        Kind kind;
+        int j0 = 0, j1 = 0; // Mac: partitions [j0, j1)
+        bool first = false; // Mac: the first product of the period (clears the accumulators)
+        int channel = 0;    // Inverse
+    };
+
+    int P = 0, N = 0, T = 0, channels = 1, bins = 0, stride = 0;
+    bool slack = false;  // T == 2P: the work of a block may take the whole next period
+    FftwFloats frame;    // 2P: previous and current input block (the forward FFT's input)
+    FftwFloats spectrum; // 2 (P + 1): interleaved complex, FFT output / inverse input
+    FftwFloats time;     // 2P: inverse FFT output
+    Plan forward, inverse;
+    std::vector<float> cur;          // P: the input block being filled
+    std::vector<float> hRe, hIm;     // [channel][partition][stride], scaled by 1 / 2P
+    std::vector<float> xRe, xIm;     // [slot][stride], ring of the last N input spectra
+    std::vector<float> accRe, accIm; // [channel][stride]
+    std::vector<float> out;          // [channel][2][P]: playing and being computed
+    bool avx = false;                // run the AVX kernels (same results as SSE)
+    std::vector<Item> items;
+    std::vector<int> sliceBegin; // P / kTick + 1 indices into items
+    int play = 0;                // which half of out is playing
+    int pos = 0;                 // samples of the current period, 0 .. P
+    long long block = -1;        // index of the block whose work the slices do (-1: none yet)
+
+    float* outBuf(int c, int which) {
+        return out.data() + (static_cast<std::size_t>(c) * 2 + static_cast<std::size_t>(which)) *
+                                static_cast<std::size_t>(P);
+    }
+
+    void clear() {
+        std::fill(frame.p, frame.p + 2 * P, 0.0f);
+        std::fill(cur.begin(), cur.end(), 0.0f);
+        std::fill(xRe.begin(), xRe.end(), 0.0f);
+        std::fill(xIm.begin(), xIm.end(), 0.0f);
+        std::fill(accRe.begin(), accRe.end(), 0.0f);
+        std::fill(accIm.begin(), accIm.end(), 0.0f);
+        std::fill(out.begin(), out.end(), 0.0f);
+        play = 0;
+        pos = 0;
+        block = -1;
+    }
+
+    int slot(long long k) const {
+        const long long s = k % N;
+        return static_cast<int>(s < 0 ? s + N : s);
+    }
+
+    void runForward() noexcept {
+        fftwf_execute(forward.p);
+        const std::size_t base = static_cast<std::size_t>(slot(block)) * stride;
+        float* re = xRe.data() + base;
+        float* im = xIm.data() + base;
+        const float* z = spectrum.p;
+        for (int b = 0; b < bins; ++b) {
+            re[b] = z[2 * b];
+            im[b] = z[2 * b + 1];
+        }
+    }
+
+    /// acc[c] (+)= sum over j in [j0, j1) of X[block - j] * H[c][j], bin by bin, partitions in
+    /// pairs (one pass over the accumulators per pair).
+    void runMac(int j0, int j1, bool first) noexcept {
+        if (first) {
+            std::fill(accRe.begin(), accRe.end(), 0.0f);
+            std::fill(accIm.begin(), accIm.end(), 0.0f);
+        }
+        const auto st = static_cast<std::size_t>(stride);
+        MacPtrs p{};
+        for (int c = 0; c < channels; ++c) {
+            p.acc[c][0] = accRe.data() + static_cast<std::size_t>(c) * st;
+            p.acc[c][1] = accIm.data() + static_cast<std::size_t>(c) * st;
+        }
+        for (int j = j0; j < j1; j += 2) {
+            const bool two = j + 1 < j1;
+            for (int k = 0; k < (two ? 2 : 1); ++k) {
+                const std::size_t o = static_cast<std::size_t>(slot(block - j - k)) * st;
+                p.x[2 * k] = xRe.data() + o;
+                p.x[2 * k + 1] = xIm.data() + o;
+                for (int c = 0; c < channels; ++c) {
+                    const std::size_t h =
+                        (static_cast<std::size_t>(c) * static_cast<std::size_t>(N) +
+                         static_cast<std::size_t>(j + k)) *
+                        st;
+                    p.h[c][2 * k] = hRe.data() + h;
+                    p.h[c][2 * k + 1] = hIm.data() + h;
+                }
+            }
+            if (channels == 2)
+                two ? mac<2, true>(avx, p, stride) : mac<2, false>(avx, p, stride);
+            else
+                two ? mac<1, true>(avx, p, stride) : mac<1, false>(avx, p, stride);
+        }
+    }
+
+    void runInverse(int c) noexcept {
+        const float* ar = accRe.data() + static_cast<std::size_t>(c) * stride;
+        const float* ai = accIm.data() + static_cast<std::size_t>(c) * stride;
+        float* z = spectrum.p;
+        for (int b = 0; b < bins; ++b) {
+            z[2 * b] = ar[b];
+            z[2 * b + 1] = ai[b];
+        }
+        fftwf_execute(inverse.p);
+        std::memcpy(outBuf(c, 1 - play), time.p + P, sizeof(float) * static_cast<std::size_t>(P));
+    }
+
+    void runSlice(int s) noexcept {
+        if (block < 0) return; // no block complete yet: nothing to compute
+        for (int i = sliceBegin[static_cast<std::size_t>(s)];
+             i < sliceBegin[static_cast<std::size_t>(s) + 1]; ++i) {
+            const Item& it = items[static_cast<std::size_t>(i)];
+            switch (it.kind) {
+            case Kind::Forward:
+                runForward();
+                break;
+            case Kind::Mac:
+                runMac(it.j0, it.j1, it.first);
+                break;
+            case Kind::Inverse:
+                runInverse(it.channel);
+                break;
+            }
+        }
+    }
+
+    /// Called every kTick input samples, after they were stored.
+    void tick() noexcept {
+        if (pos == P) {                 // block complete
+            if (slack) play = 1 - play; // the previous block's output starts now
+            std::memcpy(frame.p, frame.p + P, sizeof(float) * static_cast<std::size_t>(P));
+            std::memcpy(frame.p + P, cur.data(), sizeof(float) * static_cast<std::size_t>(P));
+            pos = 0;
+            ++block;
+            runSlice(0);
+            if (!slack) play = 1 - play; // computed at once, heard at once
+        } else {
+            runSlice(pos / kTick);
+        }
+    }
+
+    /// Cuts the work of one block into P / kTick slices of about equal estimated cost,
+    /// keeping the order: older products, forward FFT, newest product, inverse FFTs.
+    void schedule() {
+        const int slices = slack ? P / kTick : 1;
+        const double n = 2.0 * P;
+        const double fftCost = 0.6 * n * std::log2(n) + n; // FFT plus (de)interleaving
+        const double macCost = 3.0 * channels * stride;    // per partition
+        struct Atom {
+            Item item;
+            double cost;
+        };
+        std::vector<Atom> atoms;
+        for (int j = 1; j < N; j += 2) { // products in pairs (one pass over the accumulators)
+            const int j1 = std::min(j + 2, N);
+            atoms.push_back({{Kind::Mac, j, j1, false, 0}, macCost * (j1 - j)});
+        }
+        atoms.push_back({{Kind::Forward}, fftCost});
+        atoms.push_back({{Kind::Mac, 0, 1, false, 0}, macCost});
+        for (auto& a : atoms) // the first product of the period clears the accumulators
+            if (a.item.kind == Kind::Mac) {
+                a.item.first = true;
+                break;
+            }
+        for (int c = 0; c < channels; ++c)
+            atoms.push_back({{Kind::Inverse, 0, 0, false, c}, fftCost});
+        double total = 0;
+        for (const auto& a : atoms) total += a.cost;
+        const double share = total / slices;
+        items.clear();
+        sliceBegin.assign(static_cast<std::size_t>(slices) + 1, 0);
+        std::vector<int> sliceOf;
+        double cum = 0;
+        int last = 0;
+        for (const auto& a : atoms) {
+            int s = static_cast<int>((cum + 0.5 * a.cost) / share);
+            s = std::clamp(s, last, slices - 1); // monotone: the order is kept
+            cum += a.cost;
+            // Merge a product with the previous one when both fall in the same slice.
+            if (!items.empty() && s == last && a.item.kind == Kind::Mac &&
+                items.back().kind == Kind::Mac && items.back().j1 == a.item.j0 && !a.item.first) {
+                items.back().j1 = a.item.j1;
+            } else {
+                items.push_back(a.item);
+                sliceOf.push_back(s);
+            }
+            last = s;
+        }
+        // sliceBegin[s] = first item of slice s.
+        std::size_t i = 0;
+        for (int s = 0; s <= slices; ++s) {
+            while (i < sliceOf.size() && sliceOf[i] < s) ++i;
+            sliceBegin[static_cast<std::size_t>(s)] = static_cast<int>(i);
+        }
+        sliceBegin.back() = static_cast<int>(items.size());
     }
 };
 
@@ -52,7 +393,7 @@ void Convolver::release() noexcept {
 
 std::vector<int> Convolver::partitionSizes() const {
     std::vector<int> sizes;
-    for (const auto& s : stages_) sizes.push_back(s->partition);
+    for (const auto& s : stages_) sizes.push_back(s->P);
     return sizes;
 }
 
@@ -73,6 +414,7 @@ void Convolver::prepare(const AudioBuffer& impulseResponse, double sampleRateHz,
         if (!std::isfinite(v))
             throw std::invalid_argument("Convolver: impulse response holds non-finite samples");
     release();
+    avx_ = cpuHasAvx();
 
     // Resample; keep the frequency response: taps scale with 1/rate.
     AudioBuffer ir = impulseResponse;
@@ -88,6 +430,7 @@ void Convolver::prepare(const AudioBuffer& impulseResponse, double sampleRateHz,
     const std::size_t len = ir.frames();
     std::vector<float> left = ir.channel(0);
     std::vector<float> right = ir.channels == 2 ? ir.channel(1) : left;
+    stereoIr_ = ir.channels == 2;
     ir_.sampleRateHz = sampleRateHz;
     ir_.channels = 2;
     ir_.samples.resize(2 * len);
@@ -95,70 +438,95 @@ void Convolver::prepare(const AudioBuffer& impulseResponse, double sampleRateHz,
         ir_.samples[2 * i] = left[i], ir_.samples[2 * i + 1] = right[i];
     irLength_ = len;
 
-    // Direct-form head, reversed.
+    // Direct-form head.
     constexpr auto q = static_cast<std::size_t>(kHeadLength);
     headL_.assign(q, 0.0f);
     headR_.assign(q, 0.0f);
     for (std::size_t k = 0; k < std::min(len, q); ++k) {
-        headL_[q - 1 - k] = left[k];
-        headR_[q - 1 - k] = right[k];
+        headL_[k] = left[k];
+        headR_[k] = right[k];
     }
-    history_.assign(2 * q, 0.0f);
-    historyPos_ = 0;
+    line_.assign(q - 1 + static_cast<std::size_t>(kTick), 0.0f);
+    phase_ = 0;
 
-    // FFT stages: [64, 1024) with partition 64, [1024, end) with partition 1024.
-    struct Range {
-        std::size_t begin, end;
-        int partition;
-    };
-    std::vector<Range> ranges;
-    if (len > q) ranges.push_back({q, std::min<std::size_t>(len, kLongPartition), kHeadLength});
-    if (len > static_cast<std::size_t>(kLongPartition))
-        ranges.push_back({static_cast<std::size_t>(kLongPartition), len, kLongPartition});
-    for (const auto& r : ranges) {
-        auto stage = std::make_unique<Stage>();
-        stage->partition = r.partition;
-        const auto p = static_cast<std::size_t>(r.partition);
-        // Taps [begin, end) are loaded at positions [begin - P, end - P).
-        const auto first = static_cast<int>(r.begin - p), last = static_cast<int>(r.end - p);
-        stage->zita.set_options(Convproc::OPT_VECTOR_MODE); // SIMD multiply-add when built in
-        int err = stage->zita.configure(
-            1, 2, static_cast<std::uint32_t>(last), static_cast<std::uint32_t>(p),
-            static_cast<std::uint32_t>(p), static_cast<std::uint32_t>(p), 0.0f);
-        if (err != 0)
-            throw std::runtime_error(fmt::format(
-                "Convolver: zita-convolver configure failed ({}) for an IR of {} samples", err,
-                len));
-        std::vector<float> taps(left.begin() + static_cast<long>(r.begin),
-                                left.begin() + static_cast<long>(r.end));
-        err = stage->zita.impdata_create(0, 0, 1, taps.data(), first, last);
-        if (err == 0) {
-            if (ir.channels == 2) {
-                taps.assign(right.begin() + static_cast<long>(r.begin),
-                            right.begin() + static_cast<long>(r.end));
-                err = stage->zita.impdata_create(0, 1, 1, taps.data(), first, last);
-            } else {
-                err = stage->zita.impdata_link(0, 0, 0, 1);
+    // FFT stages.
+    constexpr int stageCount = static_cast<int>(std::size(kPartitions));
+    for (int i = 0; i < stageCount; ++i) {
+        const int P = kPartitions[i];
+        const std::size_t begin = i == 0 ? q : 2 * static_cast<std::size_t>(P);
+        if (len <= begin) break;
+        const std::size_t end =
+            i + 1 < stageCount ? std::min(len, 2 * static_cast<std::size_t>(kPartitions[i + 1]))
+                               : len;
+        auto s = std::make_unique<Stage>();
+        s->P = P;
+        s->T = static_cast<int>(begin);
+        s->slack = begin == 2 * static_cast<std::size_t>(P);
+        s->N = static_cast<int>((end - begin + static_cast<std::size_t>(P) - 1) /
+                                static_cast<std::size_t>(P));
+        s->channels = stereoIr_ ? 2 : 1;
+        s->bins = P + 1;
+        s->stride = (s->bins + kLanes - 1) / kLanes * kLanes;
+        const auto P2 = 2 * static_cast<std::size_t>(P);
+        const auto stride = static_cast<std::size_t>(s->stride);
+        const auto N = static_cast<std::size_t>(s->N);
+        const auto ch = static_cast<std::size_t>(s->channels);
+        s->frame.allocate(P2);
+        s->spectrum.allocate(2 * static_cast<std::size_t>(s->bins));
+        s->time.allocate(P2);
+        {
+            std::lock_guard<std::mutex> lock(plannerMutex());
+            s->forward.p = fftwf_plan_dft_r2c_1d(
+                2 * P, s->frame.p, reinterpret_cast<fftwf_complex*>(s->spectrum.p), FFTW_ESTIMATE);
+            s->inverse.p = fftwf_plan_dft_c2r_1d(
+                2 * P, reinterpret_cast<fftwf_complex*>(s->spectrum.p), s->time.p, FFTW_ESTIMATE);
+        }
+        if (s->forward.p == nullptr || s->inverse.p == nullptr)
+            throw std::runtime_error(
+                fmt::format("Convolver: FFTW could not plan a {}-point transform", 2 * P));
+        s->cur.assign(static_cast<std::size_t>(P), 0.0f);
+        s->hRe.assign(ch * N * stride, 0.0f);
+        s->hIm.assign(ch * N * stride, 0.0f);
+        s->xRe.assign(N * stride, 0.0f);
+        s->xIm.assign(N * stride, 0.0f);
+        s->accRe.assign(ch * stride, 0.0f);
+        s->accIm.assign(ch * stride, 0.0f);
+        s->out.assign(ch * 2 * static_cast<std::size_t>(P), 0.0f);
+        s->avx = avx_;
+        // Partition spectra: taps [begin + jP, begin + (j+1)P) zero-padded to 2P, scaled by
+        // 1 / 2P (FFTW's inverse is unnormalised).
+        const float scale = 1.0f / static_cast<float>(P2);
+        for (std::size_t c = 0; c < ch; ++c) {
+            const std::vector<float>& taps = c == 0 ? left : right;
+            for (std::size_t j = 0; j < N; ++j) {
+                std::fill(s->frame.p, s->frame.p + P2, 0.0f);
+                for (std::size_t k = 0; k < static_cast<std::size_t>(P); ++k) {
+                    const std::size_t t = begin + j * static_cast<std::size_t>(P) + k;
+                    if (t < end) s->frame.p[k] = taps[t] * scale;
+                }
+                fftwf_execute(s->forward.p);
+                float* re = s->hRe.data() + (c * N + j) * stride;
+                float* im = s->hIm.data() + (c * N + j) * stride;
+                for (int b = 0; b < s->bins; ++b) {
+                    re[b] = s->spectrum.p[2 * b];
+                    im[b] = s->spectrum.p[2 * b + 1];
+                }
             }
         }
-        if (err != 0)
-            throw std::runtime_error(
-                fmt::format("Convolver: zita-convolver could not load the IR ({})", err));
-        stage->outL.assign(p, 0.0f);
-        stage->outR.assign(p, 0.0f);
-        stage->start();
-        stages_.push_back(std::move(stage));
+        s->schedule();
+        s->clear();
+        stages_.push_back(std::move(s));
     }
 }
 
 void Convolver::reset() {
-    std::fill(history_.begin(), history_.end(), 0.0f);
-    historyPos_ = 0;
-    for (auto& s : stages_) {
-        if (s->zita.state() == Convproc::ST_PROC) s->zita.stop_process();
-        while (!s->zita.check_stop()) usleep(100);
-        s->start(); // start_process() clears zita's buffers
-    }
+    std::fill(line_.begin(), line_.end(), 0.0f);
+    phase_ = 0;
+    for (auto& s : stages_) s->clear();
+}
+
+void Convolver::tick() noexcept {
+    for (auto& s : stages_) s->tick();
 }
 
 void Convolver::process(const float* in, float* outL, float* outR, int n) noexcept {
@@ -166,39 +534,40 @@ void Convolver::process(const float* in, float* outL, float* outR, int n) noexce
         for (int i = 0; i < n; ++i) outL[i] = outR[i] = 0.0f;
         return;
     }
+    ScopedFlushDenormals flush;
     constexpr int q = kHeadLength;
-    for (int i = 0; i < n; ++i) {
-        const float x = in[i];
-        history_[static_cast<std::size_t>(historyPos_)] = x;
-        history_[static_cast<std::size_t>(historyPos_ + q)] = x;
-        const float* window = history_.data() + historyPos_ + 1;
-        // Float products summed in 8 independent lanes (vectorisable).
-        float accL[8] = {}, accR[8] = {};
-        const float* hl = headL_.data();
-        const float* hr = headR_.data();
-        for (int k = 0; k < q; k += 8)
-            for (int j = 0; j < 8; ++j) {
-                accL[j] += hl[k + j] * window[k + j];
-                accR[j] += hr[k + j] * window[k + j];
-            }
-        double yl = 0.0, yr = 0.0;
-        for (int j = 0; j < 8; ++j) yl += accL[j], yr += accR[j];
-        historyPos_ = (historyPos_ + 1) % q;
+    float* line = line_.data();
+    int i = 0;
+    while (i < n) {
+        // Up to the next tick: the same operations per sample whatever the host block.
+        const int m = std::min(n - i, kTick - phase_);
+        const auto bytes = sizeof(float) * static_cast<std::size_t>(m);
+        float yl[kTick], yr[kTick];
+        std::memcpy(line + q - 1, in + i, bytes); // before any output: in may alias out
+        if (avx_)
+            headAvx(headL_.data(), headR_.data(), line, m, yl, yr);
+        else
+            headSse(headL_.data(), headR_.data(), line, m, yl, yr);
         for (auto& sp : stages_) {
             Stage& s = *sp;
-            const auto f = static_cast<std::size_t>(s.fill);
-            yl += s.outL[f];
-            yr += s.outR[f];
-            s.zita.inpdata(0)[f] = x;
-            if (++s.fill == s.partition) {
-                s.fill = 0;
-                s.zita.process(true); // inline: no level has a thread
-                std::memcpy(s.outL.data(), s.zita.outdata(0), sizeof(float) * s.outL.size());
-                std::memcpy(s.outR.data(), s.zita.outdata(1), sizeof(float) * s.outR.size());
+            std::memcpy(s.cur.data() + s.pos, line + q - 1, bytes);
+            const float* pl = s.outBuf(0, s.play) + s.pos;
+            const float* pr = s.outBuf(s.channels - 1, s.play) + s.pos;
+            for (int t = 0; t < m; ++t) {
+                yl[t] += pl[t];
+                yr[t] += pr[t];
             }
+            s.pos += m;
         }
-        outL[i] = static_cast<float>(yl);
-        outR[i] = static_cast<float>(yr);
+        std::memcpy(outL + i, yl, bytes);
+        std::memcpy(outR + i, yr, bytes);
+        std::memmove(line, line + m, sizeof(float) * (q - 1)); // keep the last 63 inputs
+        phase_ += m;
+        i += m;
+        if (phase_ == kTick) {
+            phase_ = 0;
+            tick();
+        }
     }
 }
 

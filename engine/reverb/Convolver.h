@@ -2,37 +2,42 @@
 #pragma once
 /// Zero-latency convolution reverb: mono in, stereo out (a mono IR feeds both sides).
 ///
-/// Structure (Gardner 1995, "Efficient convolution without input-output delay", JAES 43(3)):
+/// A non-uniformly partitioned convolution whose FFT work is spread in time, deterministically,
+/// on the calling (audio) thread (Gardner 1995, "Efficient convolution without input-output
+/// delay", JAES 43(3); Garcia 2002, "Optimal filter partition for efficient convolution with
+/// short input/output delay", AES 113th conv. 5660; Wefers 2015, "Partitioned convolution
+/// algorithms for real-time auralization", ch. 5, time-distributed FFTs):
 ///  - taps [0, 64) run as a direct-form FIR, sample by sample, so an impulse at input sample 0
 ///    is heard at output sample 0 whatever the block size;
-///  - taps [64, 1024) run in a zita-convolver instance (Fons Adriaensen, API 4.x) with quantum =
-///    partition = 64, and taps [1024, end) in a second one with quantum = partition = 1024.
-///    A stage with partition P is given its taps shifted P earlier, so its output for input
-///    block k is exactly those taps' contribution to block k + 1, which is buffered and added
-///    during the next P samples: no added latency. (A stage may start at tap T only if T >= P.)
-/// Why one partition size per zita instance: zita-convolver computes its larger partitions in
-/// worker threads, and a level whose thread is not running yet (or could not be created, e.g.
-/// SCHED_FIFO without privileges) is computed inline one partition too early, silently giving
-/// wrong output; the thread start is a race its API does not let us observe. With quantum =
-/// minpart = maxpart zita runs no thread at all (Convproc::start_process skips level 0), so every
-/// sample is computed on the calling thread: deterministic, identical for every host block size,
-/// no locks, no waiting, no allocation in process(). (The thread policy passed is SCHED_OTHER.)
-/// Cost: the 1024-sample stage does its work once every 1024 samples (a burst of about three
-/// 2048-point FFTs plus one complex multiply-add per bin and partition).
+///  - taps [64, 512) run in a uniformly partitioned overlap-save stage with partition P = 64,
+///    computed at once each time 64 input samples are complete (it starts at tap T = P);
+///  - taps [512, 4096) run in a stage with P = 256 and taps [4096, end) in one with P = 2048.
+///    Such a stage starts at tap T = 2P: the output of input block k (samples [kP, (k+1)P)) is
+///    first needed at sample kP + T = (k+2)P, so its work (one forward FFT of 2P points, one
+///    complex multiply-add per bin, partition and channel, one inverse FFT per channel) may take
+///    the whole next period. It is cut into P / 64 slices (a schedule fixed in prepare() by
+///    estimated cost; order: the products of the older spectra, the forward FFT, the newest
+///    product, the inverse FFTs), and one slice runs every 64 input samples.
+/// Work is tied to the count of input samples only (a "tick" every 64 samples), never to the
+/// host block: the output is bit-identical for every block size (replay relies on it).
+/// FFTs: FFTW single precision, FFTW_ESTIMATE plans (deterministic; planned under a lock).
+/// process() allocates nothing, takes no lock, does not wait and flushes denormals.
 #include "engine/io/AudioFile.h"
 #include "engine/reverb/ImpulseResponses.h" // findImpulseResponse(), for users of the convolver
 
+#include <cstdint>
 #include <memory>
 #include <vector>
-
-class Convproc;
 
 namespace underfoot::engine {
 
 class Convolver {
   public:
-    static constexpr int kHeadLength = 64;      ///< direct-form taps
-    static constexpr int kLongPartition = 1024; ///< partition of the late stage
+    static constexpr int kHeadLength = 64; ///< direct-form taps
+    static constexpr int kTick = 64;       ///< samples between two slices of FFT work
+    /// Partition sizes of the FFT stages, in order. Stage 0 starts at tap kHeadLength; stage
+    /// i > 0 starts at tap 2 x its partition (2 x 256 = 512, 2 x 2048 = 4096).
+    static constexpr int kPartitions[3] = {64, 256, 2048};
 
     Convolver();
     ~Convolver();
@@ -42,9 +47,9 @@ class Convolver {
     /// Allocates and loads the IR (1 or 2 channels), resampled with libsamplerate when its rate
     /// differs from sampleRateHz (and scaled by the rate ratio so that the filter's frequency
     /// response, not its sum of taps, is kept). Throws std::invalid_argument for an empty IR,
-    /// more than two channels, non-finite taps or a bad rate, std::runtime_error when
-    /// zita-convolver refuses the configuration. `blockSize` is the largest n passed to
-    /// process() (any n up to it works; the output does not depend on it).
+    /// more than two channels, non-finite taps or a bad rate, std::runtime_error when FFTW
+    /// cannot plan. `blockSize` is the largest n passed to process() (any n works; the output
+    /// does not depend on it).
     void prepare(const AudioBuffer& impulseResponse, double sampleRateHz, int blockSize);
     /// Clears the signal history (not for the audio thread).
     void reset();
@@ -61,12 +66,15 @@ class Convolver {
   private:
     struct Stage;
     void release() noexcept;
+    void tick() noexcept;
 
     AudioBuffer ir_;
     std::size_t irLength_ = 0;
-    std::vector<float> headL_, headR_; ///< first taps, reversed for the dot product
-    std::vector<float> history_;       ///< last kHeadLength inputs, stored twice (no wrap)
-    int historyPos_ = 0;
+    bool stereoIr_ = false;
+    bool avx_ = false;                 ///< AVX kernels (bit-identical to the SSE ones)
+    std::vector<float> headL_, headR_; ///< the first kHeadLength taps
+    std::vector<float> line_;          ///< the 63 previous inputs, then the current run
+    int phase_ = 0;                    ///< input samples since the last tick, 0 .. kTick - 1
     std::vector<std::unique_ptr<Stage>> stages_;
 };
 

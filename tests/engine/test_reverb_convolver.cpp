@@ -215,9 +215,15 @@ TEST(Convolver, OfflineHelperReturnsTheFullTail) {
 }
 
 TEST(Convolver, StagesFollowTheIrLength) {
-    // Direct head [0, 64), partition 64 for [64, 1024), partition 1024 from 1024 on.
-    const std::pair<std::size_t, std::vector<int>> cases[] = {
-        {10, {}}, {64, {}}, {65, {64}}, {1024, {64}}, {1025, {64, 1024}}, {100000, {64, 1024}}};
+    // Direct head [0, 64), partition 64 for [64, 512), 256 for [512, 4096), 2048 from 4096 on.
+    const std::pair<std::size_t, std::vector<int>> cases[] = {{10, {}},
+                                                              {64, {}},
+                                                              {65, {64}},
+                                                              {512, {64}},
+                                                              {513, {64, 256}},
+                                                              {4096, {64, 256}},
+                                                              {4097, {64, 256, 2048}},
+                                                              {100000, {64, 256, 2048}}};
     for (const auto& [len, sizes] : cases) {
         Convolver c;
         c.prepare(noiseIr(len, 1, 1), 48000, 512);
