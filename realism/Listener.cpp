@@ -31,6 +31,26 @@ std::vector<double> fileFeatures(const std::vector<StepDescriptors>& steps) {
     return f;
 }
 
+void centreBySource(std::vector<Example>& ex) {
+    std::set<std::string> sources;
+    for (const auto& e : ex) sources.insert(e.source);
+    for (const auto& s : sources) {
+        std::size_t n = 0;
+        for (const auto& e : ex)
+            if (e.source == s) n = std::max(n, e.features.size());
+        std::vector<double> med(n);
+        for (std::size_t k = 0; k < n; ++k) {
+            std::vector<double> v;
+            for (const auto& e : ex)
+                if (e.source == s && k < e.features.size()) v.push_back(e.features[k]);
+            med[k] = quantile(v, 0.5);
+        }
+        for (auto& e : ex)
+            if (e.source == s)
+                for (std::size_t k = 0; k < e.features.size(); ++k) e.features[k] -= med[k];
+    }
+}
+
 void Listener::train(const std::vector<Example>& ex) {
     if (ex.empty()) throw std::invalid_argument("the listener needs at least one example");
     const std::size_t n = ex.front().features.size();
@@ -49,21 +69,29 @@ void Listener::train(const std::vector<Example>& ex) {
         const double floor = k < kDescriptorCount ? descriptorInfo(int(k)).floor : 1.0;
         scale_[k] = std::max((quantile(v, 0.75) - quantile(v, 0.25)) / 1.349, floor);
         if (k >= kDescriptorCount && bands > 0)
-            weight_[k] = std::sqrt(double(kDescriptorCount) / double(bands));
+            weight_[k] =
+                opt_.scalarsOnly ? 0.0 : std::sqrt(double(kDescriptorCount) / double(bands));
     }
     std::set<std::string> mats;
-    for (const auto& e : ex) mats.insert(e.material);
+    std::set<std::pair<std::string, std::string>> groups; // (material, source)
+    for (const auto& e : ex) {
+        mats.insert(e.material);
+        groups.insert({e.material, opt_.centroidPerSource ? e.source : std::string()});
+    }
     materials_.assign(mats.begin(), mats.end());
     centroids_.clear();
-    for (const auto& m : materials_) {
+    centroidMaterial_.clear();
+    for (const auto& [m, src] : groups) {
         std::vector<double> c(n);
         for (std::size_t k = 0; k < n; ++k) {
             std::vector<double> v;
             for (const auto& e : ex)
-                if (e.material == m) v.push_back((e.features[k] - centre_[k]) / scale_[k]);
+                if (e.material == m && (src.empty() || e.source == src))
+                    v.push_back((e.features[k] - centre_[k]) / scale_[k]);
             c[k] = quantile(v, 0.5);
         }
         centroids_.push_back(std::move(c));
+        centroidMaterial_.push_back(m);
     }
 }
 
@@ -72,16 +100,19 @@ Listener::distances(const std::vector<double>& f) const {
     if (f.size() != centre_.size())
         throw std::invalid_argument(fmt::format(
             "features of length {}, the listener was trained on {}", f.size(), centre_.size()));
-    std::vector<std::pair<std::string, double>> out;
-    for (std::size_t m = 0; m < materials_.size(); ++m) {
+    std::map<std::string, double> best; // material -> distance to its nearest centroid
+    for (std::size_t m = 0; m < centroids_.size(); ++m) {
         double d2 = 0;
         for (std::size_t k = 0; k < f.size(); ++k) {
             const double z = ((f[k] - centre_[k]) / scale_[k] - centroids_[m][k]) * weight_[k];
             d2 += z * z;
         }
-        out.emplace_back(materials_[m], std::sqrt(d2));
+        const double d = std::sqrt(d2);
+        auto [it, fresh] = best.emplace(centroidMaterial_[m], d);
+        if (!fresh) it->second = std::min(it->second, d);
     }
-    std::sort(out.begin(), out.end(), [](auto& a, auto& b) { return a.second < b.second; });
+    std::vector<std::pair<std::string, double>> out(best.begin(), best.end());
+    std::stable_sort(out.begin(), out.end(), [](auto& a, auto& b) { return a.second < b.second; });
     return out;
 }
 
@@ -90,7 +121,9 @@ std::string Listener::classify(const std::vector<double>& f) const {
     return distances(f).front().first;
 }
 
-LosoResult leaveOneSourceOut(const std::vector<Example>& ex) {
+LosoResult leaveOneSourceOut(const std::vector<Example>& input, ListenerOptions o) {
+    std::vector<Example> ex = input;
+    if (o.centrePerSource) centreBySource(ex);
     std::set<std::string> sources;
     for (const auto& e : ex) sources.insert(e.source);
     if (sources.size() < 2)
@@ -101,7 +134,7 @@ LosoResult leaveOneSourceOut(const std::vector<Example>& ex) {
         std::vector<Example> train;
         for (const auto& e : ex)
             if (e.source != held) train.push_back(e);
-        Listener l;
+        Listener l(o);
         l.train(train);
         const auto& mats = l.materials();
         for (const auto& e : ex) {

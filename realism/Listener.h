@@ -10,6 +10,13 @@
 /// centroid (per-dimension median of its training files) is nearest in Euclidean distance; its
 /// category follows from the material. It is evaluated leave-one-source-out: trained on every
 /// source but one, tested on the held-out source's files.
+///
+/// ListenerOptions (defaults = the configuration docs/realism.md reports): each source's files
+/// are first centred on that source's own per-feature median (a source's microphone, room and
+/// processing shift all its files alike; the held-out source, and the renders as a source of
+/// their own, are centred on their own median, which needs no labels), only the scalar
+/// descriptors are used, and there is one centroid per (source, material) rather than per
+/// material, so two sources that recorded a material differently each keep their own.
 #include "realism/Descriptors.h"
 
 #include <map>
@@ -27,10 +34,22 @@ struct Example {
 /// Throws std::invalid_argument when there are no steps.
 std::vector<double> fileFeatures(const std::vector<StepDescriptors>& steps);
 
+struct ListenerOptions {
+    bool centrePerSource = true;   ///< subtract each source's per-feature median first
+    bool scalarsOnly = true;       ///< leave the third-octave envelope out
+    bool centroidPerSource = true; ///< one centroid per (source, material)
+};
+
+/// Subtracts from every example its source's per-feature median (examples of one source with
+/// no label, e.g. the renders, are centred the same way).
+void centreBySource(std::vector<Example>& examples);
+
 class Listener {
   public:
+    explicit Listener(ListenerOptions o = {}) : opt_(o) {}
     /// Trains on labelled examples (at least one; all of the same length). Throws
-    /// std::invalid_argument otherwise.
+    /// std::invalid_argument otherwise. Centring by source is the caller's (centreBySource);
+    /// leaveOneSourceOut does it.
     void train(const std::vector<Example>& examples);
     /// The nearest material.
     std::string classify(const std::vector<double>& features) const;
@@ -39,8 +58,10 @@ class Listener {
     const std::vector<std::string>& materials() const { return materials_; }
 
   private:
+    ListenerOptions opt_;
     std::vector<double> centre_, scale_, weight_;
     std::vector<std::string> materials_;
+    std::vector<std::string> centroidMaterial_; ///< material of each centroid
     std::vector<std::vector<double>> centroids_;
 };
 
@@ -54,7 +75,8 @@ struct LosoResult {
     std::map<std::string, std::pair<int, int>> perSource; ///< source -> (material ok, files)
 };
 
-/// Leave-one-source-out evaluation over labelled examples of two or more sources.
-LosoResult leaveOneSourceOut(const std::vector<Example>& examples);
+/// Leave-one-source-out evaluation over labelled examples of two or more sources (centred by
+/// source first when the options say so).
+LosoResult leaveOneSourceOut(const std::vector<Example>& examples, ListenerOptions o = {});
 
 } // namespace underfoot::realism

@@ -114,7 +114,7 @@ std::string materialOfSurface(const std::string& surfaceId) {
         {"wood_reverb", "wood"},  {"creaking_wood_reverb", "wood"},
         {"metal", "metal"},       {"metal_reverb", "metal"},
         {"concrete", "hard"},     {"puddles", "water"},
-        {"water", "water"},
+        {"water", "water"},       {"carpet", "carpet"},
     };
     auto it = m.find(fs::path(surfaceId).stem().string());
     return it == m.end() ? std::string() : it->second;
@@ -122,12 +122,13 @@ std::string materialOfSurface(const std::string& surfaceId) {
 
 const std::vector<std::string>& knownMaterials() {
     static const std::vector<std::string> m = {"wood", "metal", "hard", "ice",   "gravel",
-                                               "sand", "snow",  "dirt", "grass", "water"};
+                                               "sand", "snow",  "dirt", "grass", "water", "carpet"};
     return m;
 }
 
 std::string categoryOfMaterial(const std::string& material) {
-    if (material == "wood" || material == "metal" || material == "hard" || material == "ice")
+    if (material == "wood" || material == "metal" || material == "hard" || material == "ice" ||
+        material == "carpet")
         return "solid";
     if (material == "gravel" || material == "sand" || material == "snow" || material == "dirt" ||
         material == "grass")

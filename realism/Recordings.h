@@ -32,7 +32,7 @@ std::vector<Recording> loadManifest(const std::string& dir);
 std::vector<Recording> collectRecordings(const std::vector<std::string>& paths);
 
 /// The recorded material a bundled surface is compared with ("" when none was recorded, e.g.
-/// carpet, dry leaves, underbrush).
+/// dry leaves, underbrush).
 std::string materialOfSurface(const std::string& surfaceId);
 
 /// "solid", "aggregate" or "liquid" for a recorded material; throws for an unknown one.

@@ -11,11 +11,16 @@
 # The audio is not shipped in the repository: it stays under its own licence (named per file in
 # the manifest, from each package's copyright file) and is fetched on demand.
 #
-# Sources (two independent packages, different microphones, rooms and processing):
+# Sources (four independent packages, different microphones, rooms and processing; about
+# 110 MB downloaded in all):
 #   minetest-data  minetest_game's default_*_footstep*.ogg (CC0-1.0 / CC-BY-3.0 / CC-BY-SA-3.0,
 #                  per file in mods/default/README.txt; freesound.org recordists)
 #   openarena-data baseoa/pak0.pk3 sound/player/footsteps/ (GPL-2+): boot (hard floor),
 #                  clank (metal), splash (water)
+#   ufoai-sound    base/0snd.pk3 sound/footsteps/ (CC-BY-SA-3.0; sand.ogg, sand2.ogg GPL-2;
+#                  metal1, metal3 GPL-2+; per file in its copyright file): carpet, dirt, grass,
+#                  gravel, sand, snow, splash (water), stone and tile (hard floor), wood, metal
+#   lugaru-data    Sounds/FootStep{Grass,Snow,Stone}[12].ogg (CC-BY-SA-3.0, Wolfire Games)
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 cache="${1:-${UNDERFOOT_RECORDINGS:-$root/build/recordings}}"
@@ -89,6 +94,60 @@ metal clank
 water splash
 LIST
 cp "$work/openarena/usr/share/doc/openarena-data/copyright" "$cache/licences/openarena-data.copyright"
+
+# ---- ufoai-sound ---------------------------------------------------------------------------
+deb="$(download ufoai-sound)"
+ver="$(dpkg-deb -f "$deb" Version)"
+dpkg-deb -x "$deb" "$work/ufoai"
+python3 - "$work/ufoai/usr/share/games/ufoai/base/0snd.pk3" "$work/ufo" <<'PY' 2>/dev/null ||
+import sys, zipfile
+z = zipfile.ZipFile(sys.argv[1])
+for n in z.namelist():
+    if n.startswith("sound/footsteps/"):
+        z.extract(n, sys.argv[2])
+PY
+    unzip -q -o "$work/ufoai/usr/share/games/ufoai/base/0snd.pk3" 'sound/footsteps/*' -d "$work/ufo"
+# material  files  licence (debian/copyright of ufoai-sound)  recordist
+while read -r material files licence recordist; do
+    mkdir -p "$cache/ufoai/$material"
+    for name in ${files//,/ }; do
+        f="$work/ufo/sound/footsteps/$name.ogg"
+        [ -f "$f" ] || continue
+        cp "$f" "$cache/ufoai/$material/"
+        echo "ufoai/$material/$name.ogg,ufoai,ufoai-sound,$ver,$licence,$material,${recordist//_/ }" >>"$manifest.tmp"
+    done
+done <<'LIST'
+carpet carpet1,carpet2,carpet3,carpet4 CC-BY-SA-3.0 UFO:AI_team
+dirt dirt1,dirt2,dirt3,dirt4 CC-BY-SA-3.0 UFO:AI_team
+grass grass1,grass2,grass3,grass4 CC-BY-SA-3.0 UFO:AI_team
+gravel gravel1,gravel2,gravel3,gravel4 CC-BY-SA-3.0 UFO:AI_team
+sand sand1 CC-BY-SA-3.0 UFO:AI_team
+sand sand,sand2 GPL-2 UFO:AI_team_(OpenArena/Nexuiz_GPL_data)
+snow snow1,snow2,snow3,snow4 CC-BY-SA-3.0 UFO:AI_team
+water splash1,splash2,splash3,splash4 CC-BY-SA-3.0 UFO:AI_team
+hard stone1,stone2,stone3,stone4,tile1,tile2,tile3,tile4 CC-BY-SA-3.0 UFO:AI_team
+wood wood1,wood2,wood3,wood4 CC-BY-SA-3.0 UFO:AI_team
+metal metal1,metal3 GPL-2+ UFO:AI_team_(Nexuiz_GPL_data)
+LIST
+cp "$work/ufoai/usr/share/doc/ufoai-sound/copyright" "$cache/licences/ufoai-sound.copyright"
+
+# ---- lugaru-data ---------------------------------------------------------------------------
+deb="$(download lugaru-data)"
+ver="$(dpkg-deb -f "$deb" Version)"
+dpkg-deb -x "$deb" "$work/lugaru"
+while read -r material prefix; do
+    mkdir -p "$cache/lugaru/$material"
+    for f in "$work"/lugaru/usr/share/games/lugaru/Sounds/FootStep"$prefix"[0-9].ogg; do
+        [ -f "$f" ] || continue
+        cp "$f" "$cache/lugaru/$material/"
+        echo "lugaru/$material/$(basename "$f"),lugaru,lugaru-data,$ver,CC-BY-SA-3.0,$material,Wolfire Games" >>"$manifest.tmp"
+    done
+done <<'LIST'
+grass Grass
+snow Snow
+hard Stone
+LIST
+cp "$work/lugaru/usr/share/doc/lugaru-data/copyright" "$cache/licences/lugaru-data.copyright"
 
 mv "$manifest.tmp" "$manifest"
 n=$(($(wc -l <"$manifest") - 1))

@@ -32,8 +32,18 @@ struct CompareArgs {
     bool all = false;
     bool listener = false;
     std::string output;
+    std::string features;         ///< --features: CSV of every file's listener features
+    bool classicListener = false; ///< --classic-listener: no centring, bands, one centroid
     rl::RenderSpec spec;
 };
+
+// One CSV line of listener features (names carry no commas: manifest paths and surface ids).
+std::string featureLine(const rl::Example& e) {
+    std::string s =
+        fmt::format("{},{},{}", e.name, e.source, e.material.empty() ? "-" : e.material);
+    for (double v : e.features) s += fmt::format(",{:.6g}", v);
+    return s + "\n";
+}
 
 std::vector<rl::Recording> manifest(const CompareArgs& a) {
     const auto dir = a.recordings.empty() ? rl::defaultRecordingsDir() : a.recordings;
@@ -206,11 +216,30 @@ int runListener(const CompareArgs& a) {
         }
         ex.push_back({r.file, r.source, r.material, rl::fileFeatures(steps)});
     }
-    const auto loso = rl::leaveOneSourceOut(ex);
+    std::ofstream csv;
+    if (!a.features.empty()) {
+        csv.open(a.features);
+        if (!csv) throw UserError(fmt::format("--features {}: cannot write this file", a.features));
+        csv << "name,source,material";
+        for (int d = 0; d < rl::kDescriptorCount; ++d) csv << "," << rl::descriptorInfo(d).key;
+        for (double c : rl::thirdOctaveCentres(o.maxHz)) csv << fmt::format(",to{:.0f}", c);
+        csv << "\n";
+        for (const auto& e : ex) csv << featureLine(e);
+    }
+    rl::ListenerOptions lo;
+    if (a.classicListener) lo = {false, false, false};
+    const auto loso = rl::leaveOneSourceOut(ex, lo);
     std::string body = fmt::format(
-        "<p>Nearest-centroid listener on {} descriptors and {} third-octave bands (band "
-        "{:.0f}-{:.0f} Hz), trained on recordings only.</p>",
-        int(rl::kDescriptorCount), rl::thirdOctaveCentres(o.maxHz).size(), o.minHz, o.maxHz);
+        "<p>Nearest-centroid listener on {} descriptors{} (band {:.0f}-{:.0f} Hz), {}, trained on "
+        "recordings only.</p>",
+        int(rl::kDescriptorCount),
+        lo.scalarsOnly
+            ? std::string()
+            : fmt::format(" and {} third-octave bands", rl::thirdOctaveCentres(o.maxHz).size()),
+        o.minHz, o.maxHz,
+        lo.centrePerSource ? "every source centred on its own median, one centroid per source "
+                             "and material"
+                           : "one centroid per material");
     fmt::print("listener, leave-one-source-out over {} recordings: material {}/{} ({:.0f} %), "
                "category {}/{} ({:.0f} %); {} held-out files of a material no other source has "
                "were not scored\n",
@@ -243,19 +272,32 @@ int runListener(const CompareArgs& a) {
         body += "</tr>";
     }
     body += "</table>";
-    rl::Listener l;
-    l.train(ex);
+    rl::Listener l(lo);
+    auto trainSet = ex;
+    if (lo.centrePerSource) rl::centreBySource(trainSet);
+    l.train(trainSet);
     fmt::print("\n{:<22} {:<9} {:<9} {:<9} {:<9} {}\n", "surface", "category", "heard cat",
                "material", "heard", "verdict");
     body += "<h2>Verdict on every surface (listener trained on all recordings)</h2><table><tr><th>"
             "surface</th><th>category</th><th>heard category</th><th>material</th><th>heard as</th>"
             "</tr>\n";
     int catOk = 0, matOk = 0, matN = 0, n = 0;
+    // The renders are one more source: described first, centred on their own median.
+    std::vector<rl::Example> synth;
+    std::vector<eng::SurfaceInfo> infos;
     for (const auto& info : eng::listSurfaces()) {
         const auto audio = rl::renderForComparison(info.id, a.spec);
         const auto steps = rl::describeSteps(audio, o);
         if (steps.empty()) continue;
-        const auto heard = l.classify(rl::fileFeatures(steps));
+        synth.push_back(
+            {info.id, "synthetic", rl::materialOfSurface(info.id), rl::fileFeatures(steps)});
+        infos.push_back(info);
+        if (csv.is_open()) csv << featureLine(synth.back());
+    }
+    if (lo.centrePerSource) rl::centreBySource(synth);
+    for (std::size_t i = 0; i < infos.size(); ++i) {
+        const auto& info = infos[i];
+        const auto heard = l.classify(synth[i].features);
         const auto cat = std::string(eng::toString(info.category));
         const auto heardCat = rl::categoryOfMaterial(heard);
         const auto mat = rl::materialOfSurface(info.id);
@@ -323,6 +365,12 @@ CommandRegistrar reg("compare", [](CLI::App& app, int& exitCode) {
         ->check(CLI::Range(1.0, 600.0));
     cmd->add_option("--seed", args->spec.seed, "seed of the render")->capture_default_str();
     cmd->add_option("-o,--output", args->output, "HTML report (SVG figures beside it)");
+    cmd->add_flag("--classic-listener", args->classicListener,
+                  "with --listener: the first listener (one centroid per material on all "
+                  "features, no centring by source), for comparison");
+    cmd->add_option("--features", args->features,
+                    "with --listener: write every recording's and render's listener features "
+                    "(CSV: name, source, material, then one column per feature)");
     cmd->callback([args, &exitCode] { exitCode = runCompare(*args); });
 });
 

@@ -1,14 +1,17 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // `underfoot fit`: fit a surface preset to recorded footsteps (analysis by synthesis, NLopt).
 //   fit --surface gravel [--real FILES_OR_DIRS...] -o gravel_fitted.toml [--evaluations 80]
+//   fit --surface wood --modes 8     modal estimate (matrix pencil) of every recorded strike
 // Without --real the recordings of the surface's material come from the cache of
 // scripts/fetch-recordings.sh. The output is a normal preset with a [provenance] table.
 #include "app/cli/CommandRegistry.h"
 #include "engine/surfaces/Surface.h"
 #include "realism/Fit.h"
+#include "realism/Modal.h"
 
 #include <fmt/core.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -25,7 +28,30 @@ struct FitArgs {
     int evaluations = 80;
     rl::FitOptions options;
     bool quiet = false;
+    int modes = 0; ///< --modes K: print K modes of every recording and stop
 };
+
+// The matrix pencil modes of every recording (strongest step, from its peak): the starting
+// point for a solid's modal parameters (frequencies, T60s, relative gains).
+int printModes(const std::vector<rl::Recording>& real, int k) {
+    rl::ModalOptions o;
+    o.modes = k;
+    for (const auto& r : real) {
+        std::vector<rl::Mode> modes;
+        try {
+            modes = rl::modesOfRecording(r.path, o);
+        } catch (const std::invalid_argument& e) {
+            fmt::print("{}: {}\n", r.file, e.what());
+            continue;
+        }
+        fmt::print("{} ({} modes, strongest first):\n", r.file, modes.size());
+        const double top = modes.empty() ? 1.0 : modes.front().amplitude;
+        for (const auto& m : modes)
+            fmt::print("  {:8.1f} Hz  T60 {:6.3f} s  gain {:6.1f} dB\n", m.frequencyHz, m.t60S,
+                       20 * std::log10(m.amplitude / top));
+    }
+    return 0;
+}
 
 std::string presetFile(const std::string& s) {
     if (s.size() > 5 && s.substr(s.size() - 5) == ".toml") return s;
@@ -34,7 +60,7 @@ std::string presetFile(const std::string& s) {
 
 int runFit(FitArgs& a) {
     if (a.surface.empty()) throw UserError("fit: --surface is required");
-    if (a.output.empty()) throw UserError("fit: -o FILE.toml is required");
+    if (a.output.empty() && a.modes == 0) throw UserError("fit: -o FILE.toml is required");
     const auto file = presetFile(a.surface);
     if (!fs::exists(file))
         throw UserError(fmt::format("fit: no preset {} (see `underfoot surfaces`)", file));
@@ -56,6 +82,13 @@ int runFit(FitArgs& a) {
         }
     } catch (const std::runtime_error& e) {
         throw UserError(e.what());
+    }
+    if (a.modes > 0) {
+        try {
+            return printModes(real, a.modes);
+        } catch (const eng::FileError& e) {
+            throw UserError(e.what());
+        }
     }
     a.options.maxEvaluations = a.evaluations;
     if (!a.quiet)
@@ -118,6 +151,10 @@ CommandRegistrar reg("fit", [](CLI::App& app, int& exitCode) {
         ->capture_default_str();
     cmd->add_option("-o,--output", args->output, "fitted preset (.toml)");
     cmd->add_flag("-q,--quiet", args->quiet, "no progress lines");
+    cmd->add_option("--modes", args->modes,
+                    "print the K strongest modes (matrix pencil: Hz, T60, gain) of every "
+                    "recording's strongest step instead of fitting")
+        ->check(CLI::Range(1, 64));
     cmd->callback([args, &exitCode] { exitCode = runFit(*args); });
 });
 

@@ -8,7 +8,9 @@
 
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <random>
+#include <set>
 
 using namespace underfoot::realism;
 namespace fs = std::filesystem;
@@ -32,6 +34,41 @@ fs::path scratch(const std::string& name) {
     return p;
 }
 } // namespace
+
+TEST(RealismListener, CentringBySourceRemovesASourceWideOffset) {
+    // Source "b" recorded everything 4 units higher (another microphone and processing): its
+    // metal sits where the others' gravel is. Centred on each source's median, it is heard right.
+    std::mt19937 g(9);
+    std::vector<Example> ex;
+    for (const char* src : {"a", "b", "c"})
+        for (int i = 0; i < 3; ++i) {
+            const double off = std::string(src) == "b" ? 4.0 : 0.0;
+            ex.push_back(example(src, "metal", 0.0 + off, g));
+            ex.push_back(example(src, "gravel", 4.0 + off, g));
+            ex.push_back(example(src, "water", 8.0 + off, g));
+        }
+    const auto plain = leaveOneSourceOut(ex, {false, false, false});
+    const auto centred = leaveOneSourceOut(ex);
+    EXPECT_EQ(centred.files, 27);
+    EXPECT_EQ(centred.materialCorrect, 27);
+    // Without centring only b's water (beyond everything) is heard right; metal and gravel not.
+    EXPECT_EQ(plain.perSource.at("b").first, 3) << "b's files without centring";
+    EXPECT_LT(plain.materialCorrect, 27);
+    // centreBySource subtracts each source's own median, unlabelled sources too.
+    std::vector<Example> s = {
+        {"x", "s", "", {1, 10}}, {"y", "s", "", {3, 30}}, {"z", "t", "", {7, 7}}};
+    centreBySource(s);
+    EXPECT_DOUBLE_EQ(s[0].features[0], -1);
+    EXPECT_DOUBLE_EQ(s[1].features[1], 10);
+    EXPECT_DOUBLE_EQ(s[2].features[0], 0);
+    // One centroid per (source, material): the material's nearest centroid counts.
+    Listener l;
+    l.train({{"1", "a", "metal", std::vector<double>(kDescriptorCount, 0.0)},
+             {"2", "b", "metal", std::vector<double>(kDescriptorCount, 10.0)},
+             {"3", "a", "water", std::vector<double>(kDescriptorCount, 4.0)}});
+    EXPECT_EQ(l.classify(std::vector<double>(kDescriptorCount, 9.0)), "metal");
+    EXPECT_EQ(l.distances(std::vector<double>(kDescriptorCount, 9.0)).size(), 2u);
+}
 
 TEST(RealismListener, NearestCentroidAndLeaveOneSourceOut) {
     std::mt19937 g(4);
@@ -83,7 +120,8 @@ TEST(RealismRecordings, ManifestErrorsNameTheFileAndLine) {
         EXPECT_NE(std::string(e.what()).find("manifest.csv:3"), std::string::npos) << e.what();
     }
     EXPECT_EQ(materialOfSurface("gravel"), "gravel");
-    EXPECT_EQ(materialOfSurface("carpet"), "");
+    EXPECT_EQ(materialOfSurface("carpet"), "carpet");
+    EXPECT_EQ(materialOfSurface("dry_leaves"), "");
     EXPECT_EQ(categoryOfMaterial("water"), "liquid");
     EXPECT_THROW(categoryOfMaterial("lava"), std::invalid_argument);
     EXPECT_THROW(collectRecordings({(dir / "nope").string()}), std::runtime_error);
@@ -107,6 +145,12 @@ class RealRecordings : public ::testing::Test {
 
 TEST_F(RealRecordings, EveryRecordingHasStepsAndTheListenerBeatsChance) {
     ASSERT_GE(recs_.size(), 20u);
+    std::set<std::string> sources;
+    for (const auto& r : recs_) sources.insert(r.source);
+    if (sources.size() < 4)
+        GTEST_SKIP()
+            << "the recordings cache at " << dir_ << " has " << sources.size()
+            << " sources, this test is for the 4 of scripts/fetch-recordings.sh: re-run it";
     AnalysisOptions o;
     o.maxHz = sharedMaxHz(recs_, 48000);
     std::vector<Example> ex;
@@ -118,9 +162,19 @@ TEST_F(RealRecordings, EveryRecordingHasStepsAndTheListenerBeatsChance) {
     }
     const auto loso = leaveOneSourceOut(ex);
     ASSERT_GT(loso.files, 0);
-    // Three materials are shared between the sources, so chance is 1/3 for the material.
-    EXPECT_GT(double(loso.materialCorrect) / loso.files, 0.4)
-        << loso.materialCorrect << "/" << loso.files;
+    // Better than always answering the commonest material (or category) of the held-out files.
+    int commonestMaterial = 0;
+    std::map<std::string, int> perCategory;
+    for (const auto& [truth, row] : loso.confusion) {
+        int n = 0;
+        for (const auto& [heard, k] : row) n += k;
+        commonestMaterial = std::max(commonestMaterial, n);
+        perCategory[categoryOfMaterial(truth)] += n;
+    }
+    int commonestCategory = 0;
+    for (const auto& [c, n] : perCategory) commonestCategory = std::max(commonestCategory, n);
+    EXPECT_GT(loso.materialCorrect, commonestMaterial) << loso.materialCorrect << "/" << loso.files;
+    EXPECT_GT(loso.categoryCorrect, commonestCategory) << loso.categoryCorrect << "/" << loso.files;
 }
 
 TEST_F(RealRecordings, RecordedMetalDecaysFasterThanTheOldRingingMetal) {

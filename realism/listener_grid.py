@@ -1,0 +1,136 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""How the listener's configuration was chosen (docs/realism.md, "The listener").
+
+    underfoot compare --listener --features features.csv
+    python3 realism/listener_grid.py features.csv
+
+Reads the per-file listener features written by `compare --features` and evaluates, leave-one-
+source-out on the recordings only, a small fixed grid: feature set (all, scalar descriptors
+only, scalars + third-octave bands from 200 Hz), centring (none, each source on its own median,
+each source standardised by its own median and spread) and classifier (one centroid per
+material, one per source and material, 3 nearest neighbours). Same scaling as realism/
+Listener.cpp (training set median and IQR / 1.349 with the descriptors' floors).
+
+Choosing the best cell of that grid on the same held-out sources flatters it, so the script
+also prints a nested estimate: for each held-out source the configuration is chosen by a
+leave-one-source-out run on the other sources only, then scored on the held-out one.
+Pure Python (no numpy), a few seconds.
+"""
+import csv
+import math
+import sys
+
+NS = 14  # scalar descriptors (realism/Descriptors.h), then third-octave bands
+FLOORS = [0.5, 0.5, 3, 3, 3, 3, 3, 3, 0.5, 3, 0.5, 0.5, 0.5, 0.5]
+CATEGORY = {"wood": "solid", "metal": "solid", "hard": "solid", "ice": "solid",
+            "carpet": "solid", "gravel": "aggregate", "sand": "aggregate",
+            "snow": "aggregate", "dirt": "aggregate", "grass": "aggregate", "water": "liquid"}
+
+
+def quantile(v, p):
+    v = sorted(v)
+    h = (len(v) - 1) * p
+    lo = math.floor(h)
+    hi = min(lo + 1, len(v) - 1)
+    return v[lo] + (h - lo) * (v[hi] - v[lo])
+
+
+def spread(v, k):
+    return max((quantile(v, .75) - quantile(v, .25)) / 1.349, FLOORS[k] if k < NS else 1.0)
+
+
+def centre(examples, mode):
+    if mode == "none":
+        return examples
+    out = []
+    for s in sorted({e[1] for e in examples}):
+        es = [e for e in examples if e[1] == s]
+        n = len(es[0][3])
+        med = [quantile([e[3][k] for e in es], .5) for k in range(n)]
+        sc = [spread([e[3][k] for e in es], k) if mode == "z" else 1.0 for k in range(n)]
+        out += [(e[0], e[1], e[2], [(e[3][k] - med[k]) / sc[k] for k in range(n)]) for e in es]
+    return out
+
+
+def scaling(train, feats):
+    n = len(train[0][3])
+    sc = [spread([e[3][k] for e in train], k) for k in range(n)]
+    nb = sum(k >= NS for k in feats)
+    ns = sum(k < NS for k in feats)
+    w = [math.sqrt(ns / nb) if (k >= NS and nb and ns) else 1.0 for k in range(n)]
+    return sc, w
+
+
+def dist(a, b, m, feats):
+    sc, w = m
+    return math.sqrt(sum(((a[k] - b[k]) / sc[k] * w[k]) ** 2 for k in feats))
+
+
+def classify(m, train, x, feats, method):
+    if method in ("centroid", "source-centroid"):
+        groups = {(e[2], e[1] if method == "source-centroid" else "") for e in train}
+        best = None
+        for mat, src in sorted(groups):
+            es = [e for e in train if e[2] == mat and (not src or e[1] == src)]
+            c = [quantile([e[3][j] for e in es], .5) for j in range(len(x))]
+            d = dist(x, c, m, feats)
+            if best is None or d < best[0]:
+                best = (d, mat)
+        return best[1]
+    near = sorted((dist(x, e[3], m, feats), e[2]) for e in train)[:3]
+    votes = {}
+    for i, (_, mat) in enumerate(near):
+        votes[mat] = votes.get(mat, 0) + 1 / (1 + 0.01 * i)
+    return max(votes, key=votes.get)
+
+
+def loso(examples, feats, mode, method, only=None):
+    ex = centre(examples, mode)
+    mc = cc = n = 0
+    for held in sorted({e[1] for e in ex}):
+        if only and held != only:
+            continue
+        train = [e for e in ex if e[1] != held]
+        m = scaling(train, feats)
+        mats = {e[2] for e in train}
+        for e in ex:
+            if e[1] != held or e[2] not in mats:
+                continue
+            p = classify(m, train, e[3], feats, method)
+            n += 1
+            mc += p == e[2]
+            cc += CATEGORY[p] == CATEGORY[e[2]]
+    return mc, cc, n
+
+
+def main():
+    rows = list(csv.reader(open(sys.argv[1])))
+    header, data = rows[0], rows[1:]
+    rec = [(r[0], r[1], r[2], [float(v) for v in r[3:]]) for r in data if r[1] != "synthetic"]
+    nf = len(rec[0][3])
+    sets = {"all": list(range(nf)), "scalars": list(range(NS)),
+            "scalars+bands>=200Hz": list(range(NS)) +
+            [k for k in range(NS, nf) if float(header[3 + k][2:]) >= 200]}
+    grid = [(f, c, m) for f in sets for c in ("none", "centre", "z")
+            for m in ("centroid", "source-centroid", "3-nn")]
+    method = {"centroid": "centroid", "source-centroid": "source-centroid", "3-nn": "knn"}
+    mode = {"none": "none", "centre": "c", "z": "z"}
+    print(f"{len(rec)} recordings from {len({e[1] for e in rec})} sources")
+    print(f"{'features':22} {'centring':8} {'classifier':16} material  category")
+    for f, c, m in grid:
+        mc, cc, n = loso(rec, sets[f], mode[c], method[m])
+        print(f"{f:22} {c:8} {m:16} {mc:3}/{n}    {cc:3}/{n}")
+    tot = [0, 0, 0]
+    for held in sorted({e[1] for e in rec}):
+        inner = [e for e in rec if e[1] != held]
+        f, c, m = max(grid, key=lambda g: loso(inner, sets[g[0]], mode[g[1]], method[g[2]])[0])
+        mc, cc, n = loso(rec, sets[f], mode[c], method[m], only=held)
+        print(f"nested: held out {held}: chose {f}/{c}/{m} on the others -> "
+              f"material {mc}/{n}, category {cc}/{n}")
+        tot = [tot[0] + mc, tot[1] + cc, tot[2] + n]
+    print(f"nested estimate: material {tot[0]}/{tot[2]}, category {tot[1]}/{tot[2]}")
+
+
+if __name__ == "__main__":
+    main()
