@@ -9,7 +9,7 @@ PACKAGES=(
   build-essential cmake ninja-build pkg-config git clang-format
   # engine / io
   libsndfile1-dev libsamplerate0-dev libfftw3-dev libzita-convolver-dev
-  librtaudio-dev libserialport-dev liblo-dev jackd2 socat
+  librtaudio-dev libserialport-dev liblo-dev jackd2 libjack-jackd2-dev socat
   # files, CLI, formatting
   libtomlplusplus-dev libcli11-dev libfmt-dev nlohmann-json3-dev
   # statistics and real-time containers
