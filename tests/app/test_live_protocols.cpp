@@ -282,12 +282,12 @@ void LiveProtocols::run(const std::string& id, Compare compare) {
         for (const auto& f : protocol.participantFields)
             fields[f.id] = f.options.empty() ? "x" : f.options.front();
         store.registerParticipant({c, 30, "", "", "", {}, ""}, fields);
-        const xp::Stimulus& s = store.trials(c).front().stimulus;
+        const xp::Stimulus s = store.trials(c).front().stimulus; // trials() returns a copy
         // Heard (not haptics only) and rendered (a lab-supplied clip is not re-rendered).
         if (s.modalities != xp::Modalities::Haptic && !s.clip) code = c;
     }
     ASSERT_FALSE(code.empty());
-    const xp::Stimulus& first = store.trials(code).front().stimulus;
+    const xp::Stimulus first = store.trials(code).front().stimulus;
     const bool clips = protocol.clips.enabled;
     const bool mics = !clips && first.input.kind == xp::InputKind::Sensor &&
                       first.input.sensor == xp::SensorKind::Microphones;
