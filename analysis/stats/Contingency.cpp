@@ -212,6 +212,14 @@ TestResult fisherTest(const CountTable& table, double confLevel, Alternative alt
     if (a != table[0][0] || b != table[0][1] || c != table[1][0] || d != table[1][1])
         r.warnings.emplace_back("'x' has been rounded to integer");
     const double m = a + c, n = b + d, k = a + b, x = a;
+    // The exact distribution is held as one value per possible first cell: bound it (a table read
+    // from outside must not make us allocate or compute without limit; R would try and stall).
+    constexpr double kMaxSupport = 1e5;
+    if (const double support = std::min(k, m) - std::max(0.0, k - n) + 1; support > kMaxSupport)
+        return failedTest(method, fmt::format("the table's margins allow {} values of the first "
+                                              "cell, more than the {} this exact test enumerates "
+                                              "(use chisqTest for counts this large)",
+                                              support, kMaxSupport));
     const NoncentralHypergeometric h(m, n, k, x);
     const double lo = h.lo(), hi = h.hi();
 
@@ -298,6 +306,9 @@ TestResult binomTest(double successes, double trials, double p, Alternative alte
     const double n = std::round(trials);
     if (!(trials >= 1) || std::fabs(trials - n) > 1e-7 || x > n)
         return failedTest(method, "'n' must be a positive integer >= 'x'");
+    // Counts beyond 2^53 are not exact in double (R's binom.test would loop for ever on them).
+    if (n > 9007199254740992.0)
+        return failedTest(method, "'n' must be at most 2^53 = 9007199254740992");
     if (!(p >= 0 && p <= 1))
         return failedTest(method, "'p' must be a single number between 0 and 1");
     if (!validLevel(confLevel))
@@ -324,17 +335,46 @@ TestResult binomTest(double successes, double trials, double p, Alternative alte
             constexpr double relErr = 1 + 1e-7;
             const double d = dbinom(x, n, p);
             const double mu = n * p;
+            const auto atMost = [&](double i) { return dbinom(i, n, p) <= d * relErr; };
+            // How many i in [lo, hi] have dbinom(i) <= d * relErr, as R counts them. The mode
+            // lies in [floor(mu), ceil(mu)], so the density only falls away from mu on each side:
+            // up to 10^6 terms are counted one by one as R does, beyond that the boundary is
+            // found by bisection on the monotone side (work O(log n) for any n, not O(n)).
+            const auto countAtMost = [&](double lo, double hi, bool rising) {
+                if (hi < lo) return 0.0;
+                if (hi - lo <= 1e6) {
+                    double y = 0;
+                    for (double i = lo; i <= hi; i += 1)
+                        if (atMost(i)) y += 1;
+                    return y;
+                }
+                if (rising) { // density non-decreasing on [lo, hi]: count the prefix
+                    if (!atMost(lo)) return 0.0;
+                    double a = lo, b = hi; // atMost(a) holds
+                    if (atMost(b)) return hi - lo + 1;
+                    while (b - a > 1) {
+                        const double m = std::floor((a + b) / 2);
+                        (atMost(m) ? a : b) = m;
+                    }
+                    return a - lo + 1;
+                }
+                // density non-increasing on [lo, hi]: count the suffix
+                if (!atMost(hi)) return 0.0;
+                double a = lo, b = hi; // atMost(b) holds
+                if (atMost(a)) return hi - lo + 1;
+                while (b - a > 1) {
+                    const double m = std::floor((a + b) / 2);
+                    (atMost(m) ? b : a) = m;
+                }
+                return hi - b + 1;
+            };
             if (x == mu) {
                 r.p = 1;
             } else if (x < mu) {
-                double y = 0;
-                for (double i = std::ceil(mu); i <= n; i += 1)
-                    if (dbinom(i, n, p) <= d * relErr) y += 1;
+                const double y = countAtMost(std::ceil(mu), n, false);
                 r.p = pbinom(x, n, p) + pbinom(n - y, n, p, false);
             } else {
-                double y = 0;
-                for (double i = 0; i <= std::floor(mu); i += 1)
-                    if (dbinom(i, n, p) <= d * relErr) y += 1;
+                const double y = countAtMost(0, std::floor(mu), true);
                 r.p = pbinom(y - 1, n, p) + pbinom(x - 1, n, p, false);
             }
             r.p = std::min(1.0, r.p);

@@ -564,6 +564,28 @@ TEST(BinomTest, ExactPValueAndClopperPearsonInterval) {
     EXPECT_EQ(binomTest(11, 10).error, "'n' must be a positive integer >= 'x'");
 }
 
+TEST(BinomTest, LargeCountsCountTheOtherTailByBisectionAndHugeOnesAreRefused) {
+    // More than 10^6 terms on the other side of the mean: counted by bisection on the monotone
+    // density instead of one by one (a fuzzed n of 7.8e98 looped for ever). R 4.2:
+    // binom.test(1498000, 3000000, 0.5), binom.test(1001700, 3333333, 0.3),
+    // binom.test(999000, 3333333, 0.3)
+    expectRel(binomTest(1498000, 3000000, 0.5).p, 0.020953349433570377, 1e-6);
+    expectRel(binomTest(1001700, 3333333, 0.3).p, 0.042164931449614557, 1e-6);
+    expectRel(binomTest(999000, 3333333, 0.3).p, 0.2322312084468296, 1e-6);
+    EXPECT_EQ(binomTest(7, 7.8e98, 0.3).error, "'n' must be at most 2^53 = 9007199254740992");
+    EXPECT_TRUE(binomTest(7, 1e15, 0.3).ok()); // bounded work at any exact count
+}
+
+TEST(FisherTest, MarginsBeyondTheEnumerationLimitAreRefusedNotEnumerated) {
+    // 4e8 counts would have held 2e8 densities in memory and run for minutes.
+    const CountTable big{{300000000, 100000000}, {100000000, 300000000}};
+    const auto r = fisherTest(big);
+    EXPECT_FALSE(r.ok());
+    EXPECT_NE(r.error.find("more than the 100000 this exact test enumerates"), std::string::npos)
+        << r.error;
+    EXPECT_TRUE(fisherTest({{40000, 10000}, {10000, 40000}}).ok());
+}
+
 TEST(PropTest, OneTwoAndKSampleTestsMatchR) {
     // R: prop.test(15, 20)
     const std::vector<double> x1{15}, n1{20};
