@@ -68,7 +68,9 @@ namespace wir = underfoot::wiring;
 std::string askLine(const std::string& prompt);
 
 /// The audio device, the sensors and the player of a live session (all optional parts stay
-/// null when not asked for). Destroyed in reverse order: player, engine, sensors.
+/// null when not asked for). Torn down sensors first (their reader threads push steps into the
+/// player's step queues: stopping them after the player was a use-after-free ASan found), then
+/// the player, then the engine.
 struct LiveRig {
     std::unique_ptr<wir::ClipAudio> clipAudio; ///< listening tests: clips through the device
     std::shared_ptr<eng::SerialSource> shoes;
@@ -77,11 +79,11 @@ struct LiveRig {
     std::unique_ptr<eng::LiveEngine> engine;
     std::unique_ptr<wir::LivePlayer> player;
     ~LiveRig() {
+        if (shoes) shoes->stop();
+        if (gyros) gyros->stop();
         clipAudio.reset();
         player.reset();
         if (engine) engine->close();
-        if (shoes) shoes->stop();
-        if (gyros) gyros->stop();
     }
 };
 
