@@ -131,10 +131,14 @@ class ConsolePlayer final : public exp::StimulusPlayer {
     /// reopened without it; a failure shows in the Setup view's status line).
     ~ConsolePlayer() override {
 #ifdef UNDERFOOT_HAVE_WIRING
+        // The shoes' reader thread pushes steps into the player's queues: stop it before the
+        // player goes (the terminal session freed the queue under a running reader; ASan).
+        if (shoes_) {
+            shoes_->stop();
+            shoes_->setFrameCallback({});
+        }
         live_.reset();
         if (!shoes_) return;
-        shoes_->stop();
-        shoes_->setFrameCallback({});
         try {
             shoes_->start();
         } catch (const std::exception&) {
