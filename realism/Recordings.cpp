@@ -121,8 +121,8 @@ std::string materialOfSurface(const std::string& surfaceId) {
 }
 
 const std::vector<std::string>& knownMaterials() {
-    static const std::vector<std::string> m = {"wood", "metal", "hard", "ice",   "gravel",
-                                               "sand", "snow",  "dirt", "grass", "water", "carpet"};
+    static const std::vector<std::string> m = {"wood", "metal", "hard",  "ice",   "gravel", "sand",
+                                               "snow", "dirt",  "grass", "water", "carpet"};
     return m;
 }
 
