@@ -348,25 +348,18 @@ TestResult binomTest(double successes, double trials, double p, Alternative alte
                         if (atMost(i)) y += 1;
                     return y;
                 }
-                if (rising) { // density non-decreasing on [lo, hi]: count the prefix
-                    if (!atMost(lo)) return 0.0;
-                    double a = lo, b = hi; // atMost(a) holds
-                    if (atMost(b)) return hi - lo + 1;
-                    while (b - a > 1) {
-                        const double m = std::floor((a + b) / 2);
-                        (atMost(m) ? a : b) = m;
-                    }
-                    return a - lo + 1;
-                }
-                // density non-increasing on [lo, hi]: count the suffix
-                if (!atMost(hi)) return 0.0;
-                double a = lo, b = hi; // atMost(b) holds
-                if (atMost(a)) return hi - lo + 1;
+                // t counts from the end farthest from mu, where the density is smallest: the
+                // condition holds on a prefix of t; bisect for its length.
+                const auto at = [&](double t) { return atMost(rising ? lo + t : hi - t); };
+                const double last = hi - lo;
+                if (!at(0)) return 0.0;
+                if (at(last)) return last + 1;
+                double a = 0, b = last; // at(a) holds, at(b) does not
                 while (b - a > 1) {
                     const double m = std::floor((a + b) / 2);
-                    (atMost(m) ? b : a) = m;
+                    (at(m) ? a : b) = m;
                 }
-                return hi - b + 1;
+                return a + 1;
             };
             if (x == mu) {
                 r.p = 1;
