@@ -126,13 +126,21 @@ void Session::answer(const TrialAnswer& answer) {
                                      "failed ({}); the session is paused",
                                      participant_.code, t.index + 1, *fault));
     }
-    store_.commitAnswer(participant_.code, t.index, answer, rt >= 0.0 ? rt : 0.0);
-    stopPlayer();
-    trials_[position_].answered = true;
-    trials_[position_].answer = answer;
-    trials_[position_].responseTimeS = rt;
-    pending_.clear();
-    advance();
+    const auto recorded = [&] {
+        stopPlayer();
+        trials_[position_].answered = true;
+        trials_[position_].answer = answer;
+        trials_[position_].responseTimeS = rt;
+        pending_.clear();
+        advance();
+    };
+    try {
+        store_.commitAnswer(participant_.code, t.index, answer, rt >= 0.0 ? rt : 0.0);
+    } catch (const AnswerSavedButNotCopied&) {
+        recorded(); // stored: move on, then let the view show the warning
+        throw;
+    }
+    recorded();
 }
 
 void Session::advance() {

@@ -3,8 +3,9 @@
 /// The session state machine: briefing -> practice -> trials (with breaks) -> end.
 ///
 /// It drives a StimulusPlayer (the app wires it to the engine; tests use a fake) and stores
-/// every step in the StudyStore: a trial's start (render seed, GRF recording reference) before
-/// the stimulus is presented, and its answer in a durable transaction before the next trial.
+/// every step in the StudyStore: a trial's start (render seed, GRF recording reference) as soon
+/// as the player has started the stimulus (which is stopped again if that write fails), and its
+/// answer in a durable transaction before the next trial.
 /// A session of a participant with answered trials resumes at the first unanswered trial.
 #include "experiment/Store.h"
 
@@ -86,10 +87,13 @@ class Session {
 
     /// Briefing -> first trial (practice if any).
     void finishBriefing();
-    /// Starts the current trial's stimulus (stored before the player starts).
+    /// Starts the current trial's stimulus and stores the start (the player reports the render
+    /// seed and recording it used); if storing fails the stimulus is stopped and the error thrown.
     void play();
     /// Commits the answer (durably), stops the stimulus and advances. Throws StoreError for an
-    /// invalid answer; the trial then stays current and keeps playing.
+    /// invalid answer; the trial then stays current and keeps playing. When the answer was
+    /// stored but the checkpoint after it failed, it advances first and then throws
+    /// AnswerSavedButNotCopied, so that the view shows the warning and never asks again.
     void answer(const TrialAnswer& answer);
     /// Break -> next trial.
     void finishBreak();

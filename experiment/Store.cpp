@@ -1233,7 +1233,7 @@ TrialRecord readTrial(SQLite::Database& db, SQLite::Statement& q) {
     } catch (const std::runtime_error& e) { // a damaged file (found by fuzz_study_db)
         throw StoreError(fmt::format("{}: participant '{}' trial {}: {}; the study file is "
                                      "damaged",
-                                     db.getFilename(), r.participant, r.index, e.what()));
+                                     db.getFilename(), r.participant, r.index + 1, e.what()));
     }
     r.repetition = q.getColumn(6).getInt();
     r.plannedSeed = fromDb(q.getColumn(7).getInt64());
@@ -1377,7 +1377,7 @@ void StudyStore::commitAnswer(const std::string& code, int trialIndex, const Tri
             throw StoreError(
                 fmt::format("participant '{}' trial {}: {} of {} laps walked; expected "
                             "every lap (baseline and feedback) before the questions",
-                            code, trialIndex, cur.getColumn(5).getInt(), laps));
+                            code, trialIndex + 1, cur.getColumn(5).getInt(), laps));
         const std::int64_t trialId = cur.getColumn(0).getInt64();
         if (cur.getColumn(1).isNull())
             throw StoreError(fmt::format("participant '{}' trial {} has not started; expected its "
@@ -1435,7 +1435,17 @@ void StudyStore::commitAnswer(const std::string& code, int trialIndex, const Tri
         writeFailed(
             fmt::format("saving the answer of participant '{}' trial {}", code, trialIndex + 1), e);
     }
-    checkpoint();
+    // Committed with synchronous=FULL: the answer is durable in the WAL from here on. A failed
+    // checkpoint must not look like a lost answer (the caller would ask for it again and store
+    // it as a change), so it is reported as what it is.
+    try {
+        checkpoint();
+    } catch (const StoreError& e) {
+        throw AnswerSavedButNotCopied(fmt::format(
+            "participant '{}' trial {}: the answer IS saved (in {}-wal; keep that file beside the "
+            "study and do not delete it), but copying it into the study file then failed: {}",
+            code, trialIndex + 1, path_, e.what()));
+    }
 }
 
 void StudyStore::recordReplay(const std::string& code, int trialIndex) {

@@ -31,6 +31,14 @@ struct StoreError : std::runtime_error {
     using std::runtime_error::runtime_error;
 };
 
+/// The answer was committed (durably, in the study's write-ahead log `<study>-wal`), but copying
+/// it into the study file failed afterwards. The answer counts: a session advances past it and
+/// must not ask for it again (asking again would store it as a changed answer). The message
+/// says so, names the file and the cause, and says to keep the -wal file beside the study.
+struct AnswerSavedButNotCopied : StoreError {
+    using StoreError::StoreError;
+};
+
 /// Current schema version written by this code.
 /// Version 2 adds clip replay counts and laps walked per trial, and participant fields
 /// (expertise, listening device...); version 3 adds per-trial audio figures (TrialAudioStats),
@@ -316,6 +324,8 @@ class StudyStore {
     /// the participant resumes at it. Throws StoreError for an answered or unknown trial.
     void markTrialInterrupted(const std::string& code, int trialIndex, const std::string& reason);
     /// Validates and commits an answer in its own durable transaction.
+    /// Throws AnswerSavedButNotCopied (a StoreError) when the answer was stored but the
+    /// checkpoint after it failed.
     void commitAnswer(const std::string& code, int trialIndex, const TrialAnswer& answer,
                       std::optional<double> responseTimeS);
     /// Counts one more replay of a started, unanswered trial's clip; journaled. Throws StoreError

@@ -282,6 +282,9 @@ FlowResult TrialFlow::commitRevision() {
     try {
         store_.commitAnswer(session_.participant().code, *revising_, draft_,
                             revisedTrial_->responseTimeS);
+    } catch (const AnswerSavedButNotCopied& e) {
+        reset(); // the change is stored; only the copy into the study file failed
+        return {Refusal::Failed, e.what()};
     } catch (const std::exception& e) {
         return {Refusal::Failed, e.what()};
     }

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
-/// The trial flow every front end shares (the console's Run view and participant window, the
-/// terminal session, the web server), on top of experiment::Session:
+/// The console's trial flow (its Run view and participant window), on top of
+/// experiment::Session, which the terminal session and the web server drive directly:
 ///
 /// - the answer being entered for the current trial: its sections (surface question, the scales
 ///   asked in this trial's block, soundscape question), the active section, letters, digits
