@@ -406,12 +406,12 @@ int WebStudy::currentTrialChecked(const Invitation& inv, Session* s, const json&
                fmt::format("{}: the headphone screening comes first", request));
     if (s->phase() != SessionPhase::Trial && s->phase() != SessionPhase::Practice)
         refuse(inv, trial, request, 409,
-               fmt::format("{}: trial {} refused; the session is in phase '{}'", request, *trial,
-                           toString(s->phase())));
+               fmt::format("{}: trial index {} refused; the session is in phase '{}'", request,
+                           *trial, toString(s->phase())));
     if (*trial != s->current().index)
         refuse(inv, trial, request, 409,
-               fmt::format("{}: trial {} refused; the current trial is {}", request, *trial,
-                           s->current().index));
+               fmt::format("{}: trial index {} refused; the current trial index is {}", request,
+                           *trial, s->current().index));
     return *trial;
 }
 
@@ -476,7 +476,7 @@ json WebStudy::answer(const std::string& token, const json& body) {
                     return j;
                 }
                 refuse(inv, *trialIndex, request, 409,
-                       fmt::format("answer: trial {} is already answered", *trialIndex));
+                       fmt::format("answer: trial index {} is already answered", *trialIndex));
             }
         }
     }
@@ -516,9 +516,9 @@ json WebStudy::answer(const std::string& token, const json& body) {
     }
     if (!s->playing()) {
         if (t.startedAt.empty())
-            refuse(
-                inv, trial, request, 409,
-                fmt::format("answer: trial {} was not presented yet; play the clip first", trial));
+            refuse(inv, trial, request, 409,
+                   fmt::format("answer: trial index {} was not presented yet; play the clip first",
+                               trial));
         // Presented before a server restart: the presentation is restored (journaled as a
         // restart of the trial by the store), then the answer is committed.
         s->play();
@@ -558,11 +558,12 @@ ClipFile WebStudy::clip(const std::string& token, int trialIndex) {
     const auto [rootEnd, fileIt] =
         std::mismatch(root.begin(), root.end(), file.begin(), file.end());
     if (ec || rootEnd != root.end() || fileIt == file.end())
-        refuse(inv, trial, "clip", 403,
-               fmt::format("clip: the clip of trial {} lies outside the clips folder", trial));
+        refuse(
+            inv, trial, "clip", 403,
+            fmt::format("clip: the clip of trial index {} lies outside the clips folder", trial));
     if (!fs::is_regular_file(file, ec))
         refuse(inv, trial, "clip", 404,
-               fmt::format("clip: the clip of trial {} is missing", trial));
+               fmt::format("clip: the clip of trial index {} is missing", trial));
     return {file.string(), contentTypeOf(file), fs::file_size(file, ec)};
 }
 

@@ -2,9 +2,9 @@
 #pragma once
 /// The sensor log of a live trial: raw shoe frames, step events (with the GRF the player chose)
 /// and gyroscope samples, one CSV file a trial references (docs/sensors.md, "Sensor log").
-/// Written on the main/sensor side (the consumer of the sources' SPSC queues), never on the
-/// audio thread. Long format, one row per record, time on the sensor clock relative to the
-/// log's start:
+/// Written by the one consumer of the sources' SPSC queues (in a live session the live player's
+/// sensor-log thread, app/wiring/Players.cpp), never on the audio thread. Long format, one row per
+/// record, time on the sensor clock relative to the log's start:
 ///
 ///     time_s,kind,device_ms,index,lh,lt,rh,rt,foot,part,strength,derivative_per_s,bank_index,
 ///     gain,start_sample,limb,angular_velocity_dps,sequence
