@@ -262,11 +262,11 @@ bool PaletteCompare::useMaterial(const QString& material) {
     }
     referenceMaterial_ = material;
     material_->setCurrentText(material);
-    startReference(std::move(chosen),
-                   tr("%1 recordings of %2 from %3 (%4)")
-                       .arg(std::count_if(all.begin(), all.end(),
-                                          [&](const auto& r) { return q(r.material) == material; }))
-                       .arg(material, sources.join(", "), QDir::toNativeSeparators(cacheDir_)));
+    const QString label =
+        tr("%1 recordings of %2 from %3 (%4)")
+            .arg(chosen.size())
+            .arg(material, sources.join(", "), QDir::toNativeSeparators(cacheDir_));
+    startReference(std::move(chosen), label);
     return true;
 }
 
@@ -488,7 +488,7 @@ void PaletteCompare::showComparison(const PaletteComparison& c) {
         syn.push_back(cmp.d[std::size_t(b)].synthetic);
     }
     const double top4 = reference_ ? reference_->options.maxHz : 16000;
-    bands_->setBands({tr("20–250 Hz"), tr("250 Hz–1 kHz"), tr("1–4 kHz"),
+    bands_->setBands({tr("20–250 Hz"), tr("0.25–1 kHz"), tr("1–4 kHz"),
                       tr("4–%1 kHz").arg(std::min(16000.0, top4) / 1000, 0, 'g', 3)},
                      rec, syn);
     if (message_->styleSheet().contains("#a00") && !fitRunning_) setMessage(QString(), false);
@@ -521,6 +521,7 @@ bool PaletteCompare::startFit(int maxEvaluations) {
     options.spec = renderSpec();
     options.maxEvaluations = maxEvaluations;
     fitBudget_ = maxEvaluations;
+    budget_->setValue(maxEvaluations);
     cancel_ = std::make_shared<std::atomic<bool>>(false);
     fitRunning_ = true;
     fit_.reset();

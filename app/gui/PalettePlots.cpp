@@ -18,7 +18,7 @@ constexpr double kMinHz = 50;
 QColor colourAt(double level) {
     static const double stops[][3] = {
         {0, 0, 4}, {87, 16, 110}, {188, 55, 84}, {249, 142, 9}, {252, 255, 164}};
-    level = std::clamp(level, 0.0, 1.0) * 4.0;
+    level = std::isfinite(level) ? std::clamp(level, 0.0, 1.0) * 4.0 : 0.0;
     const int i = std::min(3, static_cast<int>(level));
     const double t = level - i;
     return QColor::fromRgb(static_cast<int>(stops[i][0] + t * (stops[i + 1][0] - stops[i][0])),
@@ -84,7 +84,8 @@ void SpectrogramPlot::paintEvent(QPaintEvent*) {
     p.drawRect(area.adjusted(-1, -1, 0, 0));
     if (data_.empty()) return;
 
-    const double span = std::max(span_, data_.seconds);
+    const double frameSpan = static_cast<double>(data_.db.size()) * data_.hop / data_.rateHz;
+    const double span = std::max({span_, data_.seconds, frameSpan});
     const double f0 = std::log2(kMinHz), f1 = std::log2(std::max(kMinHz * 2, data_.maxHz));
     // One image pixel per screen pixel: frames along x (up to the step's end), bands along y.
     QImage image(area.width(), area.height(), QImage::Format_RGB32);

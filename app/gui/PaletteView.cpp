@@ -109,13 +109,16 @@ CostMeasurement measure(const QString& presetPath, eng::WalkerParameters walker)
     return m;
 }
 
-/// Decimals that show a value (and its range) with at least four significant digits.
+/// Decimals that show a value exactly (the spin box rounds to its decimals, and the palette
+/// must not change a parameter nobody touched): at least 4 (2 for wide ranges), at most 10.
 int decimalsFor(double value, double minValue, double maxValue) {
     int d = maxValue - minValue < 10 ? 4 : 2;
-    for (double v : {value, minValue})
-        if (v != 0 && std::isfinite(v) && std::abs(v) < 1)
-            d = std::max(d, 3 - static_cast<int>(std::floor(std::log10(std::abs(v)))));
-    return std::min(d, 10);
+    if (!std::isfinite(value) || value == 0) return d;
+    for (; d < 10; ++d) {
+        const double scale = std::pow(10.0, d);
+        if (std::abs(std::round(value * scale) / scale - value) <= 1e-12 * std::abs(value)) break;
+    }
+    return d;
 }
 } // namespace
 
@@ -197,8 +200,8 @@ PaletteView::PaletteView(const QString& dataDir, QWidget* parent)
     auto* split = new QSplitter(Qt::Vertical, this);
     split->addWidget(params_);
     split->addWidget(compareBox);
-    split->setStretchFactor(0, 2);
-    split->setStretchFactor(1, 3);
+    split->setStretchFactor(0, 1);
+    split->setStretchFactor(1, 1);
     split->setChildrenCollapsible(false);
     auto* right = new QVBoxLayout;
     right->addWidget(info_);

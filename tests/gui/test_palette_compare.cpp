@@ -95,7 +95,7 @@ class PaletteCompareTest : public QObject {
         QVERIFY(useAndCompare(c, {woodWav_}));
         const double self = c->distance();
         qInfo("wood vs its own render: %.6f", self);
-        QVERIFY2(self < 0.05, qPrintable(c->distanceText()));
+        QVERIFY2(self < 1e-9, qPrintable(c->distanceText())); // the same samples
         QVERIFY(c->distanceText().contains("Distance to the reference"));
         QVERIFY(!c->syntheticPlot()->spectrogram().empty());
         QVERIFY(!c->referencePlot()->spectrogram().empty());
@@ -277,10 +277,36 @@ class PaletteCompareTest : public QObject {
                  qPrintable(again->compareView()->message()));
     }
 
+    void settingsTheEngineRefusesGiveAMessage() {
+        auto palette = makePalette();
+        QVERIFY(palette->selectSurface("creaking_wood"));
+        auto* c = palette->compareView();
+        QVERIFY(useAndCompare(c, {woodWav_}));
+        QString dynamic;
+        const auto creaking = engine::Surface::loadById("creaking_wood");
+        for (const auto& p : creaking->parameters())
+            if (p.path.ends_with("dynamic_coefficient")) dynamic = QString::fromStdString(p.path);
+        QVERIFY(!dynamic.isEmpty());
+        // Dynamic friction above static (0.55): in range alone, refused by the friction layer.
+        QSignalSpy failed(c, &gui::PaletteCompare::compareFailed);
+        QVERIFY(palette->setParameter(dynamic, 0.9));
+        QVERIFY(failed.wait(60000));
+        QVERIFY2(c->message().contains("dynamic_coefficient"), qPrintable(c->message()));
+        QVERIFY(std::isnan(c->distance()));
+        QSignalSpy finished(c, &gui::PaletteCompare::fitFinished);
+        QVERIFY(c->startFit(4));
+        QVERIFY(finished.wait(60000));
+        QVERIFY(!finished.front().front().toBool());
+        QVERIFY2(c->message().startsWith("Fit failed") &&
+                     c->message().contains("dynamic_coefficient"),
+                 qPrintable(c->message()));
+        QVERIFY(!c->applyFit());
+    }
+
     void screenshotOfThePaletteComparingWithRecordings() {
         qputenv("XDG_CONFIG_HOME", home_.filePath("config").toUtf8());
         gui::MainWindow::Options o;
-        o.dataDir = home_.filePath("data");
+        o.dataDir = home_.filePath("screenshot_data"); // no presets saved by the other tests
         o.createDemo = false;
         o.startAudio = false;
         gui::MainWindow w(o);
@@ -297,6 +323,11 @@ class PaletteCompareTest : public QObject {
         if (!c->useMaterial("wood")) QVERIFY(c->useFiles({metalWav_}));
         QVERIFY(compared.wait(120000));
         QVERIFY(failed.isEmpty());
+        // With a short fit done: its before/after distance and the apply/save buttons.
+        QSignalSpy finished(c, &gui::PaletteCompare::fitFinished);
+        QVERIFY(c->startFit(10));
+        QVERIFY(finished.wait(120000));
+        QVERIFY2(finished.front().front().toBool(), qPrintable(c->message()));
         QApplication::processEvents();
         const QImage shot = w.grab().toImage();
         QCOMPARE(shot.size(), QSize(1280, 800));
