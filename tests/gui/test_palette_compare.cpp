@@ -215,6 +215,32 @@ class PaletteCompareTest : public QObject {
         QVERIFY(content.contains("metal.wav"));
     }
 
+    void aBasePresetIsFittedThroughItsFlatCopyAndApplied() {
+        auto palette = makePalette();
+        QVERIFY(palette->selectSurface("wood_reverb")); // base = "wood", plus a reverb
+        auto* c = palette->compareView();
+        QVERIFY(useAndCompare(c, {metalWav_}));
+        QSignalSpy finished(c, &gui::PaletteCompare::fitFinished);
+        QVERIFY(c->startFit(8));
+        QVERIFY(finished.wait(120000));
+        QVERIFY2(finished.front().front().toBool(), qPrintable(c->message()));
+        const auto& fit = *c->lastFit();
+        qInfo("fit wood_reverb to a metal render: %.3f -> %.3f", fit.result.distanceBefore,
+              fit.result.distanceAfter);
+        QVERIFY(fit.result.distanceAfter <= fit.result.distanceBefore + 1e-3);
+        QVERIFY2(c->applyFit(), qPrintable(c->message()));
+        const auto fitted = engine::loadSurfaceFromString(fit.result.presetText, "fitted");
+        QVERIFY(fitted->info().reverb.has_value());
+        const auto applied = engine::loadSurfaceFromString(
+            palette->currentPresetText("applied", "applied").toStdString(), "applied");
+        QCOMPARE(applied->parameters().size(), fitted->parameters().size());
+        for (std::size_t i = 0; i < fitted->parameters().size(); ++i) {
+            const double want = fitted->parameters()[i].value, got = applied->parameters()[i].value;
+            QVERIFY2(std::abs(got - want) <= 1e-3 * std::abs(want) + 1e-12,
+                     qPrintable(QString::fromStdString(fitted->parameters()[i].path)));
+        }
+    }
+
     void cancelStopsTheFitWithinOneEvaluation() {
         auto palette = makePalette();
         QVERIFY(palette->selectSurface("wood"));
