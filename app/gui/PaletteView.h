@@ -3,7 +3,8 @@
 /// The Sound palette: pick a surface, change its physical parameters (units, documented ranges
 /// and help from the preset reader), measure the CPU cost of the current settings by rendering
 /// a walk offline, render it to a WAV file, listen to it through the live engine, and save the
-/// settings as a new preset (TOML) in the user's data folder.
+/// settings as a new preset (TOML) in the user's data folder. Below the parameters, the
+/// "compare with a recording · fit" panel (PaletteCompare) follows every change.
 #include "engine/control/VirtualWalker.h"
 
 #include <QFutureWatcher>
