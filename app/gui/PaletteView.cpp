@@ -4,6 +4,7 @@
 #include <cstring>
 
 #include "app/gui/AudioOutput.h"
+#include "app/gui/PaletteCompare.h"
 #include "app/gui/PresetEdit.h"
 #include "engine/render/Renderer.h"
 #include "engine/surfaces/Surface.h"
@@ -22,6 +23,7 @@
 #include <QPushButton>
 #include <QRegularExpression>
 #include <QShortcut>
+#include <QSplitter>
 #include <QTableWidget>
 #include <QTemporaryDir>
 #include <QVBoxLayout>
@@ -106,6 +108,18 @@ CostMeasurement measure(const QString& presetPath, eng::WalkerParameters walker)
     }
     return m;
 }
+
+/// Decimals that show a value exactly (the spin box rounds to its decimals, and the palette
+/// must not change a parameter nobody touched): at least 4 (2 for wide ranges), at most 10.
+int decimalsFor(double value, double minValue, double maxValue) {
+    int d = maxValue - minValue < 10 ? 4 : 2;
+    if (!std::isfinite(value) || value == 0) return d;
+    for (; d < 10; ++d) {
+        const double scale = std::pow(10.0, d);
+        if (std::abs(std::round(value * scale) / scale - value) <= 1e-12 * std::abs(value)) break;
+    }
+    return d;
+}
 } // namespace
 
 PaletteView::PaletteView(const QString& dataDir, QWidget* parent)
@@ -170,9 +184,28 @@ PaletteView::PaletteView(const QString& dataDir, QWidget* parent)
     auto* buttons = new QHBoxLayout;
     for (auto* b : {costButton_, auditionButton_, wavButton, saveButton, resetButton})
         buttons->addWidget(b);
+    PaletteHooks hooks;
+    hooks.surfaceFile = [this] { return currentFile_; };
+    hooks.presetText = [this](const QString& id, const QString& name) {
+        return currentPresetText(id, name);
+    };
+    hooks.walker = [this] { return walkerParameters(); };
+    hooks.apply = [this](const QString& text) { return applyPresetText(text); };
+    hooks.presetsDir = QDir(dataDir_).filePath("presets");
+    compare_ = new PaletteCompare(std::move(hooks), this);
+    compare_->setAccessibleName(tr("Compare with a recording"));
+    auto* compareBox = new QGroupBox(tr("Compare with a recording · fit"), this);
+    auto* cl = new QVBoxLayout(compareBox);
+    cl->addWidget(compare_);
+    auto* split = new QSplitter(Qt::Vertical, this);
+    split->addWidget(params_);
+    split->addWidget(compareBox);
+    split->setStretchFactor(0, 1);
+    split->setStretchFactor(1, 1);
+    split->setChildrenCollapsible(false);
     auto* right = new QVBoxLayout;
     right->addWidget(info_);
-    right->addWidget(params_, 1);
+    right->addWidget(split, 1);
     right->addLayout(buttons);
     right->addWidget(cost_);
     right->addWidget(message_);
@@ -201,6 +234,8 @@ PaletteView::PaletteView(const QString& dataDir, QWidget* parent)
     connect(auditionButton_, &QPushButton::clicked, this, &PaletteView::audition);
     connect(wavButton, &QPushButton::clicked, this, &PaletteView::renderToWav);
     connect(resetButton, &QPushButton::clicked, this, &PaletteView::showSurface);
+    for (auto* spin : {cadence_, mass_, shoe_})
+        connect(spin, &QDoubleSpinBox::valueChanged, compare_, &PaletteCompare::settingsChanged);
     connect(saveButton, &QPushButton::clicked, this, [this] {
         bool ok = false;
         const QString id = QInputDialog::getText(
@@ -298,7 +333,7 @@ void PaletteView::showSurface() {
         name->setToolTip(tr("%1\n(preset key %2)").arg(q(p.help), q(p.path)));
         params_->setItem(row, PathCol, name);
         auto* spin = new QDoubleSpinBox(params_);
-        spin->setDecimals(p.maxValue - p.minValue < 10 ? 4 : 2);
+        spin->setDecimals(decimalsFor(p.value, p.minValue, p.maxValue));
         spin->setRange(p.minValue, p.maxValue);
         spin->setStepType(QAbstractSpinBox::AdaptiveDecimalStepType);
         spin->setValue(p.value);
@@ -306,6 +341,7 @@ void PaletteView::showSurface() {
         spin->setAccessibleDescription(q(p.help));
         spin->setToolTip(q(p.help));
         params_->setCellWidget(row, ValueCol, spin);
+        connect(spin, &QDoubleSpinBox::valueChanged, compare_, &PaletteCompare::settingsChanged);
         params_->setItem(row, UnitCol, new QTableWidgetItem(q(p.unit)));
         params_->setItem(row, RangeCol,
                          new QTableWidgetItem(QString("%1 … %2%3")
@@ -316,6 +352,55 @@ void PaletteView::showSurface() {
     params_->resizeColumnsToContents();
     cost_->setText(tr("CPU cost: not measured yet (Ctrl+M)"));
     message_->clear();
+    compare_->surfaceChanged();
+}
+
+eng::WalkerParameters PaletteView::walkerParameters() const {
+    eng::WalkerParameters w;
+    w.cadenceStepsPerMin = cadence_->value();
+    w.massKg = mass_->value();
+    w.shoeHardness = shoe_->value();
+    return w;
+}
+
+QString PaletteView::applyPresetText(const QString& text) {
+    std::unique_ptr<eng::Surface> surface;
+    try {
+        surface = eng::loadSurfaceFromString(text.toStdString(), "fitted preset");
+    } catch (const std::exception& e) {
+        return q(e.what());
+    }
+    // The fit is of the palette's own (self-contained) preset: the same parameters in the same
+    // order; a base preset's prefix ("wood:.") and layer numbering may differ, the key may not.
+    const auto& ps = surface->parameters();
+    if (static_cast<int>(ps.size()) != params_->rowCount())
+        return tr("the preset has %1 parameters, the palette %2: not the same surface layout")
+            .arg(ps.size())
+            .arg(params_->rowCount());
+    const auto key = [](const std::string& path) { return path.substr(path.rfind('.') + 1); };
+    for (int r = 0; r < params_->rowCount(); ++r) {
+        const std::string path =
+            params_->item(r, PathCol)->data(Qt::UserRole).toString().toStdString();
+        const auto& p = ps[static_cast<std::size_t>(r)];
+        auto* spin = static_cast<QDoubleSpinBox*>(params_->cellWidget(r, ValueCol));
+        if (key(path) != key(p.path))
+            return tr("parameter %1 of the preset is %2 in the palette: not the same layout")
+                .arg(r + 1)
+                .arg(q(path));
+        if (p.value < spin->minimum() || p.value > spin->maximum())
+            return tr("%1 = %2 is outside its range %3 … %4")
+                .arg(q(path))
+                .arg(p.value)
+                .arg(spin->minimum())
+                .arg(spin->maximum());
+    }
+    for (int r = 0; r < params_->rowCount(); ++r) {
+        const auto& p = ps[static_cast<std::size_t>(r)];
+        auto* spin = static_cast<QDoubleSpinBox*>(params_->cellWidget(r, ValueCol));
+        spin->setDecimals(std::max(spin->decimals(), decimalsFor(p.value, 0, 0)));
+        spin->setValue(p.value); // each change restarts the comparison's debounce: one compare
+    }
+    return {};
 }
 
 bool PaletteView::setParameter(const QString& path, double value) {

@@ -3,7 +3,10 @@
 /// The Sound palette: pick a surface, change its physical parameters (units, documented ranges
 /// and help from the preset reader), measure the CPU cost of the current settings by rendering
 /// a walk offline, render it to a WAV file, listen to it through the live engine, and save the
-/// settings as a new preset (TOML) in the user's data folder.
+/// settings as a new preset (TOML) in the user's data folder. Below the parameters, the
+/// "compare with a recording · fit" panel (PaletteCompare) follows every change.
+#include "engine/control/VirtualWalker.h"
+
 #include <QFutureWatcher>
 #include <QWidget>
 
@@ -19,6 +22,7 @@ class QPushButton;
 namespace underfoot::gui {
 
 class AudioOutput;
+class PaletteCompare;
 
 /// Offline cost of one surface setting.
 struct CostMeasurement {
@@ -49,6 +53,13 @@ class PaletteView : public QWidget {
     QString costText() const;
     QString message() const;
     QTableWidget* parameterTable() const { return params_; }
+    /// The "compare with a recording / fit" panel (PaletteCompare.h).
+    PaletteCompare* compareView() const { return compare_; }
+    /// Puts the parameter values of a preset of the same layout (e.g. the fit of the current
+    /// settings) into the table; returns "" or the problem (nothing is changed then).
+    QString applyPresetText(const QString& text);
+    /// The virtual walker set in the view.
+    engine::WalkerParameters walkerParameters() const;
 
   signals:
     void costMeasured(const QString& text);
@@ -76,6 +87,7 @@ class PaletteView : public QWidget {
     std::map<std::string, double> original_;
     QFutureWatcher<CostMeasurement>* costWatcher_;
     AudioOutput* audio_ = nullptr;
+    PaletteCompare* compare_ = nullptr;
 };
 
 } // namespace underfoot::gui
