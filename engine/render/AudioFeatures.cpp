@@ -2,8 +2,7 @@
 #include "engine/render/AudioFeatures.h"
 
 #include "engine/dsp/ProcessSpec.h"
-
-#include <fftw3.h>
+#include "engine/dsp/RealFft.h"
 
 #include <algorithm>
 #include <cmath>
@@ -25,9 +24,9 @@ std::vector<float> monoMix(const AudioBuffer& a) {
 std::vector<std::vector<double>> powerFrames(const std::vector<float>& x, int n, int hop) {
     std::vector<std::vector<double>> frames;
     if (x.size() < static_cast<std::size_t>(n)) return frames;
-    double* in = fftw_alloc_real(static_cast<std::size_t>(n));
-    fftw_complex* out = fftw_alloc_complex(static_cast<std::size_t>(n / 2 + 1));
-    fftw_plan plan = fftw_plan_dft_r2c_1d(n, in, out, FFTW_ESTIMATE);
+    RealFft fft(n);
+    double* in = fft.time();
+    const fftw_complex* out = fft.spectrum();
     std::vector<double> window(static_cast<std::size_t>(n));
     for (int i = 0; i < n; ++i)
         window[static_cast<std::size_t>(i)] = 0.5 - 0.5 * std::cos(kTwoPi * i / n);
@@ -35,15 +34,12 @@ std::vector<std::vector<double>> powerFrames(const std::vector<float>& x, int n,
          start += static_cast<std::size_t>(hop)) {
         for (int i = 0; i < n; ++i)
             in[i] = x[start + static_cast<std::size_t>(i)] * window[static_cast<std::size_t>(i)];
-        fftw_execute(plan);
+        fft.forward();
         std::vector<double> p(static_cast<std::size_t>(n / 2 + 1));
         for (int k = 0; k <= n / 2; ++k)
             p[static_cast<std::size_t>(k)] = out[k][0] * out[k][0] + out[k][1] * out[k][1];
         frames.push_back(std::move(p));
     }
-    fftw_destroy_plan(plan);
-    fftw_free(in);
-    fftw_free(out);
     return frames;
 }
 } // namespace
