@@ -46,6 +46,8 @@ void AggregateParameters::validate() const {
             "a mean count in [0, 64]", burstEvents);
     require(finite(burstMs) && burstMs > 0, "burstMs", "a positive time", burstMs);
     require(finite(maxRateHz) && maxRateHz > 0, "maxRateHz", "a positive rate", maxRateHz);
+    require(finite(amplitudeCap) && amplitudeCap >= 0, "amplitudeCap",
+            "a non-negative amplitude (0: no bound)", amplitudeCap);
 }
 
 void AggregateModel::configure(const AggregateParameters& parameters) {
@@ -92,6 +94,8 @@ void AggregateModel::reset(std::uint64_t seed) noexcept {
     sample_ = 0;
     eventCount_ = 0;
     stolen_ = 0;
+    capped_ = 0;
+    peakSummed_ = 0.0;
 }
 
 void AggregateModel::trigger(double energy) noexcept {
@@ -101,24 +105,45 @@ void AggregateModel::trigger(double energy) noexcept {
 void AggregateModel::spawn(double energy, bool burst) noexcept {
     ++eventCount_;
     if (observer_) observer_(observerUser_, {sample_, energy, burst});
-    const double amplitude = std::sqrt(energy);
+    double amplitude = std::sqrt(energy);
     if (!(amplitude > silenceAmplitude_) || c1_.empty()) return; // inaudible: no voice
-    int v;
-    if (activeVoices_ < params_.voices) {
-        v = activeVoices_++;
-    } else { // pool full: replace the quietest voice
-        v = 0;
-        double quietest = HUGE_VAL;
+    // Current envelope of every ringing voice: their sum (for the energy bound) and the quietest
+    // (replaced when the pool is full). The loop runs only when one of them is needed.
+    const bool full = activeVoices_ >= params_.voices;
+    const double cap = params_.amplitudeCap;
+    int quietestVoice = 0;
+    double quietest = HUGE_VAL, summed = 0.0;
+    if (full || cap > 0) {
         for (int i = 0; i < activeVoices_; ++i) {
             const auto u = static_cast<std::size_t>(i);
             const double a =
                 startAmplitude_[u] *
                 std::exp(logDecay_[u] * static_cast<double>(sample_ - startSample_[u]));
+            summed += a;
             if (a < quietest) {
                 quietest = a;
-                v = i;
+                quietestVoice = i;
             }
         }
+    }
+    if (cap > 0) {
+        if (full) summed -= quietest; // that voice is replaced
+        const double room = cap - summed;
+        if (amplitude > room) {
+            ++capped_;
+            amplitude = room;
+            if (!(amplitude > silenceAmplitude_)) {
+                peakSummed_ = std::max(peakSummed_, summed);
+                return; // the bed is at its bound: this break releases nothing audible
+            }
+        }
+        peakSummed_ = std::max(peakSummed_, summed + amplitude);
+    }
+    int v;
+    if (!full) {
+        v = activeVoices_++;
+    } else { // pool full: replace the quietest voice
+        v = quietestVoice;
         ++stolen_;
     }
     const double nyquistGuard = 0.45 * sampleRateHz_; // resonances stay below Nyquist

@@ -31,6 +31,15 @@
 ///  - Bursts (crumpling cascades): each event may be followed by a geometric number of
 ///    micro-events (mean burstEvents), each after its own exponential delay (mean burstMs), with
 ///    the same energy scale: a crunch is a quick cascade of breaks.
+///  - Energy bound (amplitudeCap > 0): a bed of grains under a sole holds only so many grains
+///    in contact, so it can release only so much energy at once, however hard it is loaded. The
+///    model keeps the summed amplitude of the grains ringing at once, S(t) = sum_i sqrt(E_i)
+///    exp(-(t - t_i) / tau_i) with tau_i the slowest decay of grain i, at or below the cap: a new
+///    event of amplitude a starts with min(a, cap - S) (nothing when S >= cap). Since every
+///    grain's output is at most sqrt(resonances) x its envelope, the layer's output never exceeds
+///    sqrt(resonances) x cap: the bound holds for any load, cadence and seed. S is evaluated at
+///    each event from the voices' own decays (exact, no extra per-sample work), so it is
+///    deterministic and independent of the block size. Below the cap nothing changes.
 ///  - Voices: a pool allocated in prepare(); a voice frees itself when its slowest resonance has
 ///    decayed 80 dB below the loudest possible event (computed at spawn, so no per-sample test);
 ///    when the pool is full the quietest voice is replaced. process() never allocates.
@@ -55,6 +64,9 @@ struct AggregateParameters {
     double burstEvents = 0.0;  ///< mean number of follow-up micro-events per event
     double burstMs = 2.0;      ///< mean delay of a burst's micro-events after their event
     double maxRateHz = 4000.0; ///< the layer's own cap on the event rate
+    /// Bound on the summed amplitude of the grains ringing at once, in units of the amplitude of
+    /// the largest event at unit energy scale (1 kN of load, no rise); 0: no bound.
+    double amplitudeCap = 0.0;
     /// Throws std::invalid_argument naming the parameter when a value is not finite or out of its
     /// meaningful domain (positive energies, frequencies, Q; resonances 1..4; voices >= 1).
     void validate() const;
@@ -121,6 +133,11 @@ class AggregateModel {
     std::uint64_t eventCount() const noexcept { return eventCount_; }
     /// Events that found the pool full and replaced the quietest voice.
     std::uint64_t stolenVoices() const noexcept { return stolen_; }
+    /// Events whose amplitude the energy bound (amplitudeCap) reduced or suppressed.
+    std::uint64_t cappedEvents() const noexcept { return capped_; }
+    /// Largest summed amplitude of the ringing grains seen at an event since reset (after the
+    /// bound: never above amplitudeCap when it is set).
+    double peakSummedAmplitude() const noexcept { return peakSummed_; }
     /// Effective cap on the rate: min(maxRateHz, maxEventsPerSecond).
     double rateCapHz() const noexcept { return rateCapHz_; }
     /// Reports every event (from process(), on the audio thread: the observer must be cheap).
@@ -158,6 +175,8 @@ class AggregateModel {
     std::int64_t sample_ = 0;
     std::uint64_t eventCount_ = 0;
     std::uint64_t stolen_ = 0;
+    std::uint64_t capped_ = 0;
+    double peakSummed_ = 0.0;
     EventObserver observer_ = nullptr;
     void* observerUser_ = nullptr;
 };

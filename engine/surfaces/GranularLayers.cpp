@@ -108,8 +108,10 @@ void GrainsLayer::processChunk(const float* grf, float* out, int n) noexcept {
                                 : control_.loadExponent == 0.0
                                     ? 1.0
                                     : std::pow(kn, control_.loadExponent);
-            scale_[u] = static_cast<float>(
-                load * (1.0 + control_.riseEnergy * rise / kDerivativeRefKnPerS));
+            double scale = load * (1.0 + control_.riseEnergy * rise / kDerivativeRefKnPerS);
+            if (control_.energySaturation > 0) // soft saturation: linear below, bounded above
+                scale = control_.energySaturation * std::tanh(scale / control_.energySaturation);
+            scale_[u] = static_cast<float>(scale);
             if (onsetArmed_ && f >= control_.onsetForceN) {
                 onsetArmed_ = false;
                 if (control_.onsetEnergy > 0)
@@ -165,6 +167,10 @@ std::unique_ptr<SurfaceLayer> makeGrainsLayer(PresetReader& r, const AccuracyOpt
     c.riseEnergy =
         r.number("rise_energy", 0.0, 0.0, 20.0, "per 10 kN/s",
                  "extra energy while the load rises: x (1 + rise_energy dF/dt / 10 kN/s)");
+    c.energySaturation = r.number(
+        "energy_saturation", 0.0, 0.0, 1000.0, "x energy scale at 1 kN",
+        "event energies saturate with load and load change: scale -> S tanh(scale / S), so no "
+        "single break exceeds S times the largest one under a 1 kN load (0: linear)");
     c.onsetEnergy = r.number("onset_energy", 0.0, 0.0, 10.0, "relative",
                              "energy of one event when the heel loads (0: none)");
     c.onsetForceN = r.number("onset_force_n", 200.0, 1.0, 2000.0, "N",
@@ -183,6 +189,10 @@ std::unique_ptr<SurfaceLayer> makeGrainsLayer(PresetReader& r, const AccuracyOpt
     m.burstMs = r.number("burst_ms", 2.0, 0.1, 100.0, "ms",
                          "mean delay of a burst's micro-events after their event", true);
     m.voices = r.integer("voices", 32, 1, 256, "simultaneous events");
+    m.amplitudeCap = r.number(
+        "amplitude_cap", 0.0, 0.0, 100.0, "x largest grain at 1 kN",
+        "bound on the summed amplitude of the grains ringing at once, in amplitudes of the largest "
+        "event under a 1 kN load: the bed releases only so much energy at a time (0: none)");
     c.derivativeMs =
         r.number("derivative_ms", 5.0, 0.5, 50.0, "ms", "smoothing time constant of dF/dt", true);
     c.contactThresholdN = r.number("contact_threshold_n", 5.0, 0.5, 100.0, "N",

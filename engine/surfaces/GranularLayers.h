@@ -10,12 +10,19 @@
 ///   (grains settle under a standing load; they crunch while the load builds up and shifts, and
 ///   some spring back on release: the two derivative terms are "events per kN of load change")
 ///   scale   = F^load_exponent x (1 + rise_energy x max(dF/dt, 0) / 10)   (energy multiplier)
+///           with energy_saturation S > 0 the scale saturates softly: scale -> S tanh(scale / S)
+///           (unchanged for light loads, never above S: a grain can only break so hard)
 ///   onset   = one event of energy onset_energy x clamp(dF/dt / 10, 0.1, 3) when the load first
 ///             crosses onset_force_n in a step (the heel lands: a thump or a crunch).
 /// A load that appears from no contact by more than 100 N within one sample (a GRF file or the
 /// walker starting mid-stance) is taken as already there: no landing event, no rise.
 /// Everything is zero while F <= contact_threshold_n; when the voices have rung out and the load
 /// stays below the threshold the layer sleeps (a block then costs one scan of the GRF).
+/// Energy bound: amplitude_cap (in amplitudes of the largest event under a 1 kN load) bounds the
+/// summed amplitude of the grains ringing at once (engine/models/Aggregate.h): a heavy or fast
+/// walker makes more and stronger breaks, but the bed under the sole releases only so much
+/// energy at a time, so the layer's output stays below sqrt(resonances) x cap x gain for any
+/// load. 0 (the default): no bound.
 /// The sum of the voices goes through an optional 2nd-order Butterworth high-pass and low-pass
 /// (tone) and the layer gain.
 #include "engine/dsp/Biquad.h"
@@ -31,6 +38,7 @@ struct GrainsControl {
     double eventsPerKnFall = 0.0;
     double loadExponent = 1.0;
     double riseEnergy = 0.0;
+    double energySaturation = 0.0; ///< S of scale -> S tanh(scale / S); 0: linear
     double onsetEnergy = 0.0;
     double onsetForceN = 200.0;
     double derivativeMs = 5.0;

@@ -50,24 +50,11 @@ inline std::map<std::string, WorstPeak> worstPeaks(const std::vector<std::string
     return worst;
 }
 
-// Surfaces whose 200 kg peaks cannot be brought 1 dB below the limiter by their gain alone
-// without leaving the -12 +- 2 dBFS calibration of a 70 kg walker (test_granular_surfaces.cpp):
-// their grain energy grows faster with load than that span allows (docs/realism.md, Levels).
-// Each has a cap, its measured worst peak (48 renders: 200 kg at 150 and 120 steps/min, soft,
-// medium and hard shoes, 120 kg hard, seeds 1-12) plus 1 dB, so that it does not get worse;
-// above -0.3 dBFS the safety limiter catches them and says so.
-inline double peakLimitDb(const std::string& id) {
-    static const std::map<std::string, double> known = {
-        {"beach_sand", 0.9},        // measured -0.08
-        {"deep_snow", -0.4},        // measured -1.39 (just inside; no margin for other seeds)
-        {"dirt_pebbles", -0.1},     // measured -1.11
-        {"dry_leaves", 3.9},        // measured 2.89
-        {"forest_underbrush", 5.9}, // measured 4.93
-        {"frozen_snow", 4.4},       // measured 3.43
-        {"gravel", -0.1},           // measured -1.12
-    };
-    auto it = known.find(id);
-    return it == known.end() ? kLimitDb : it->second;
+// Every surface has the same limit: 1 dB below the limiter's ceiling. The aggregates' grains are
+// held there for heavy walkers by their energy bound (energy_saturation, amplitude_cap:
+// engine/surfaces/GranularLayers.h, docs/realism.md "Levels"), not by exceptions.
+inline double peakLimitDb(const std::string&) {
+    return kLimitDb;
 }
 
 inline void printPeaks(const std::map<std::string, WorstPeak>& worst) {
