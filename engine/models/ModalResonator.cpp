@@ -161,6 +161,18 @@ void ModalResonatorT<Real>::fillBank(Bank& b, const std::vector<ModeCoefficients
             b.dv0[p] += g0[i] * (gamma * double(b.b1v[i]));
             b.dvo[p] += outGain_[i] * (gamma * double(b.b1v[i]));
         }
+    b.pairs.assign(n2 / 2, PairCoefficients{});
+    pairGains_.assign(n2 / 2, PairGains{});
+    for (std::size_t i = 0; i < n2; ++i) {
+        auto& c = b.pairs[i / 2];
+        const std::size_t l = i % 2;
+        c.a00[l] = b.a00[i], c.a01[l] = b.a01[i], c.a10[l] = b.a10[i], c.a11[l] = b.a11[i];
+        c.b0x[l] = b.b0x[i], c.b0v[l] = b.b0v[i], c.b1x[l] = b.b1x[i], c.b1v[l] = b.b1v[i];
+        c.lv[l] = b.lv[i], c.lx[l] = b.lx[i];
+        auto& gg = pairGains_[i / 2];
+        gg.g0[l] = contactGain_[i], gg.go[l] = outGain_[i];
+        gg.kin[l] = kinetic_[i], gg.pot[l] = potential_[i];
+    }
 }
 
 template <typename Real>
@@ -237,87 +249,69 @@ void ModalResonatorT<Real>::reset() noexcept {
 template <typename Real>
 void ModalResonatorT<Real>::predict(double heldScale) noexcept {
     using V = V2<Real>;
-    const std::size_t n2 = q_.size();
-    const Bank& b = bank();
-    const Real *a00 = b.a00.data(), *a01 = b.a01.data(), *a10 = b.a10.data(), *a11 = b.a11.data();
+    const std::size_t pairs = q_.size() / 2;
+    const PairCoefficients* c = bank().pairs.data();
+    const PairGains* gg = pairGains_.data();
     const Real *q = q_.data(), *v = v_.data();
     Real *qh = qh_.data(), *vh = vh_.data();
-    const double *g0 = contactGain_.data(), *go = outGain_.data();
     D2 x0 = {0.0, 0.0}, v0 = {0.0, 0.0}, vo = {0.0, 0.0};
     predictedEnergyValid_ = false;
     if (heldZero_ || heldScale == 0.0) {
         // Free ringing (no force held from the last sample): the same values without the
         // force terms (they would add exactly zero).
-        for (std::size_t i = 0; i < n2; i += 2) {
+        for (std::size_t k = 0; k < pairs; ++k) {
+            const std::size_t i = 2 * k;
             const V qi = load2<Real, V>(q + i), vi = load2<Real, V>(v + i);
-            const V x = load2<Real, V>(a00 + i) * qi + load2<Real, V>(a01 + i) * vi;
-            const V y = load2<Real, V>(a10 + i) * qi + load2<Real, V>(a11 + i) * vi;
+            const V x = load2<Real, V>(c[k].a00) * qi + load2<Real, V>(c[k].a01) * vi;
+            const V y = load2<Real, V>(c[k].a10) * qi + load2<Real, V>(c[k].a11) * vi;
             store2(qh + i, x);
             store2(vh + i, y);
             const D2 xd = __builtin_convertvector(x, D2), yd = __builtin_convertvector(y, D2);
-            x0 += load2<double, D2>(g0 + i) * xd;
-            v0 += load2<double, D2>(g0 + i) * yd;
-            vo += load2<double, D2>(go + i) * yd;
+            const D2 g0 = load2<double, D2>(gg[k].g0);
+            x0 += g0 * xd;
+            v0 += g0 * yd;
+            vo += load2<double, D2>(gg[k].go) * yd;
         }
     } else {
         const Real h = static_cast<Real>(heldScale);
-        const Real *b0x = b.b0x.data(), *b0v = b.b0v.data(), *u = u_.data();
+        const Real* u = u_.data();
         D2 e = {0.0, 0.0}, slope = {0.0, 0.0};
-        const double *kin = kinetic_.data(), *pot = potential_.data();
-        const double *lv = b.lv.data(), *lx = b.lx.data();
         auto run = [&](auto withEnergy) {
-            for (std::size_t i = 0; i < n2; i += 2) {
+            for (std::size_t k = 0; k < pairs; ++k) {
+                const std::size_t i = 2 * k;
                 const V qi = load2<Real, V>(q + i), vi = load2<Real, V>(v + i);
                 const V ui = h * load2<Real, V>(u + i);
-                const V x = load2<Real, V>(a00 + i) * qi + load2<Real, V>(a01 + i) * vi +
-                            load2<Real, V>(b0x + i) * ui;
-                const V y = load2<Real, V>(a10 + i) * qi + load2<Real, V>(a11 + i) * vi +
-                            load2<Real, V>(b0v + i) * ui;
+                const V x = load2<Real, V>(c[k].a00) * qi + load2<Real, V>(c[k].a01) * vi +
+                            load2<Real, V>(c[k].b0x) * ui;
+                const V y = load2<Real, V>(c[k].a10) * qi + load2<Real, V>(c[k].a11) * vi +
+                            load2<Real, V>(c[k].b0v) * ui;
                 store2(qh + i, x);
                 store2(vh + i, y);
                 const D2 xd = __builtin_convertvector(x, D2), yd = __builtin_convertvector(y, D2);
-                x0 += load2<double, D2>(g0 + i) * xd;
-                v0 += load2<double, D2>(g0 + i) * yd;
-                vo += load2<double, D2>(go + i) * yd;
+                const D2 g0 = load2<double, D2>(gg[k].g0);
+                x0 += g0 * xd;
+                v0 += g0 * yd;
+                vo += load2<double, D2>(gg[k].go) * yd;
                 if constexpr (decltype(withEnergy)::value) {
                     // The prediction's energy and the slope of E(F) (energyIfCommitted).
-                    e += load2<double, D2>(kin + i) * (yd * yd) +
-                         load2<double, D2>(pot + i) * (xd * xd);
-                    slope += load2<double, D2>(lv + i) * yd + load2<double, D2>(lx + i) * xd;
+                    e += load2<double, D2>(gg[k].kin) * (yd * yd) +
+                         load2<double, D2>(gg[k].pot) * (xd * xd);
+                    slope += load2<double, D2>(c[k].lv) * yd + load2<double, D2>(c[k].lx) * xd;
                 }
             }
         };
-        if (trackEnergy_)
-            run(std::true_type{});
-        else
-            run(std::false_type{});
         if (trackEnergy_) {
+            run(std::true_type{});
             predictedEnergy_ = e[0] + e[1];
             predictedEnergySlope_ = slope[0] + slope[1];
             predictedEnergyValid_ = true;
+        } else {
+            run(std::false_type{});
         }
     }
     predictedX0_ = x0[0] + x0[1];
     predictedV0_ = v0[0] + v0[1];
     predictedVo_ = vo[0] + vo[1];
-}
-
-template <typename Real>
-double ModalResonatorT<Real>::predictedPosition(int p) const noexcept {
-    if (p == 0) return predictedX0_;
-    double x = 0;
-    for (std::size_t i = 0; i < modes_.size(); ++i)
-        x += gains_[static_cast<std::size_t>(p)][i] * qh_[i];
-    return x;
-}
-
-template <typename Real>
-double ModalResonatorT<Real>::predictedVelocity(int p) const noexcept {
-    if (p == 0) return predictedV0_;
-    double v = 0;
-    for (std::size_t i = 0; i < modes_.size(); ++i)
-        v += gains_[static_cast<std::size_t>(p)][i] * vh_[i];
-    return v;
 }
 
 template <typename Real>
@@ -343,12 +337,14 @@ void ModalResonatorT<Real>::commit(int p, double forceN) noexcept {
     const Real f = static_cast<Real>(forceN);
     const Bank& b = bank();
     const Real* gm = gainOverMass_.data() + pp * n2;
-    const Real *b1x = b.b1x.data(), *b1v = b.b1v.data(), *qh = qh_.data(), *vh = vh_.data();
+    const PairCoefficients* c = b.pairs.data();
+    const Real *qh = qh_.data(), *vh = vh_.data();
     Real *q = q_.data(), *v = v_.data(), *u = u_.data();
     for (std::size_t i = 0; i < n2; i += 2) {
+        const PairCoefficients& ci = c[i / 2];
         const V ui = load2<Real, V>(gm + i) * f;
-        store2(q + i, load2<Real, V>(qh + i) + load2<Real, V>(b1x + i) * ui);
-        store2(v + i, load2<Real, V>(vh + i) + load2<Real, V>(b1v + i) * ui);
+        store2(q + i, load2<Real, V>(qh + i) + load2<Real, V>(ci.b1x) * ui);
+        store2(v + i, load2<Real, V>(vh + i) + load2<Real, V>(ci.b1v) * ui);
         store2(u + i, ui);
     }
     // The pickup sums are linear in the force: the prediction's plus the force times the sums
@@ -364,7 +360,7 @@ void ModalResonatorT<Real>::commit(int p, double forceN) noexcept {
 }
 
 template <typename Real>
-double ModalResonatorT<Real>::energyIfCommitted(int p, double forceN) const noexcept {
+double ModalResonatorT<Real>::energyIfCommittedSlow(int p, double forceN) const noexcept {
     const std::size_t n = modes_.size();
     if (p == 0) {
         const Bank& b = bank();
@@ -409,22 +405,13 @@ void ModalResonatorT<Real>::setOutputPickup(int p) {
 }
 
 template <typename Real>
-double ModalResonatorT<Real>::position(int p) const noexcept {
-    if (p == 0) return x0_;
-    double x = 0;
+double ModalResonatorT<Real>::pickupSum(const std::vector<Real>& x, int p,
+                                        bool radiatingOnly) const noexcept {
+    double sum = 0;
+    const auto& g = gains_[static_cast<std::size_t>(p)];
     for (std::size_t i = 0; i < modes_.size(); ++i)
-        x += gains_[static_cast<std::size_t>(p)][i] * q_[i];
-    return x;
-}
-
-template <typename Real>
-double ModalResonatorT<Real>::velocity(int p) const noexcept {
-    // Quasi-static modes do not radiate (their "velocity" is a finite difference of a compliance).
-    if (p == outputPickup_) return outputVelocity_;
-    double v = 0;
-    for (std::size_t i = 0; i < modes_.size(); ++i)
-        if (!coefficients_[i].quasiStatic) v += gains_[static_cast<std::size_t>(p)][i] * v_[i];
-    return v;
+        if (!radiatingOnly || !coefficients_[i].quasiStatic) sum += g[i] * double(x[i]);
+    return sum;
 }
 
 template <typename Real>
@@ -435,12 +422,6 @@ double ModalResonatorT<Real>::energyLoop() const noexcept {
         e += 0.5 * modes_[i].massKg * (v * v + w0sq_[i] * q * q);
     }
     return e;
-}
-
-template <typename Real>
-double ModalResonatorT<Real>::energy() const noexcept {
-    // Known in O(1) after a commit whose prediction tracked the energy (setEnergyTracking).
-    return energyValid_ ? committedEnergy_ : energyLoop();
 }
 
 template <typename Real>
