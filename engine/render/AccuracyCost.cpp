@@ -363,7 +363,7 @@ Scenario makeScenario(const std::string& id) {
                     f->resonator().flushTinyState();
                 }};
     }
-    if (id == "aggregate-gravel") {
+    if (id == "aggregate-gravel" || id == "aggregate-gravel-1voice") {
         AggregateParameters p; // gravel.toml, first ("sharp clicks") grains layer
         p.gamma = -1.6;
         p.energyMin = 0.001;
@@ -375,6 +375,12 @@ Scenario makeScenario(const std::string& id) {
         p.voices = 48;
         p.burstEvents = 1.0;
         p.burstMs = 1.5;
+        if (id == "aggregate-gravel-1voice") {
+            // Like for like with SDT's crumpling patch: one grain resonator, retriggered by each
+            // event (the new grain cuts the last one off), no follow-up bursts.
+            p.voices = 1;
+            p.burstEvents = 0.0;
+        }
         auto a = std::make_shared<AggregateModel>();
         a->configure(p);
         a->prepare(kRate, 4000);
@@ -403,9 +409,9 @@ Scenario makeScenario(const std::string& id) {
 } // namespace
 
 const std::vector<std::string>& scenarioIds() {
-    static const std::vector<std::string> ids = {"impact-strikes",   "impact-pressed",
-                                                 "impact-metal",     "friction-creak",
-                                                 "aggregate-gravel", "bubbles"};
+    static const std::vector<std::string> ids = {
+        "impact-strikes",   "impact-pressed", "impact-metal",           "friction-creak",
+        "aggregate-gravel", "bubbles",        "aggregate-gravel-1voice"};
     return ids;
 }
 
@@ -433,6 +439,75 @@ ScenarioMeasurement measureScenario(const std::string& id, double seconds, int r
     m.maxBlockNs = t.maxBlockNs;
     m.budgetShare = m.maxBlockNs / (1e9 * kBlock / kRate);
     return m;
+}
+
+std::vector<ScalingPoint> measureScaling(double seconds, int repeats) {
+    const int blocks = static_cast<int>(seconds * kRate / kBlock);
+    const int strikeEvery = static_cast<int>(0.25 * kRate / kBlock);
+    auto out = std::make_shared<std::vector<float>>(kBlock);
+    std::vector<ScalingPoint> points;
+    auto timeRuns = [&](const std::function<TimedRun()>& make) {
+        return timeBlocks(blocks, repeats, make).nsPerSample;
+    };
+    // Simultaneous impact voices (the impact-strikes scenario's voice), strikes staggered.
+    for (int voices : {1, 2, 4, 8, 16, 32, 64, 128, 256}) {
+        const double ns = timeRuns([&] {
+            auto pool =
+                std::make_shared<std::vector<HuntCrossleyImpact>>(static_cast<std::size_t>(voices));
+            for (auto& v : *pool) {
+                v.configure(scenarioImpact(), benchModes(), {{1.0, 1.0, 1.0}});
+                v.prepare({kRate, kBlock});
+            }
+            TimedRun run;
+            run.block = [pool, out, strikeEvery](int b) {
+                for (std::size_t v = 0; v < pool->size(); ++v) {
+                    auto& voice = (*pool)[v];
+                    if ((b + static_cast<int>(v) * 7) % strikeEvery == 0) voice.strike(0.5);
+                    voice.process(nullptr, out->data(), kBlock);
+                }
+            };
+            return run;
+        });
+        points.push_back({"voices", voices, ns, ns / voices});
+    }
+    // Modes per voice: one impact voice, modes spread over 100 Hz..19 kHz.
+    for (int modes : {3, 6, 12, 24, 48, 64}) {
+        std::vector<Mode> m;
+        for (int i = 0; i < modes; ++i)
+            m.push_back({100.0 + 18900.0 * i / std::max(1, modes - 1), 0.2 / (1 + 0.1 * i), 1.0});
+        const std::vector<double> g(static_cast<std::size_t>(modes), 1.0);
+        const double ns = timeRuns([&] {
+            auto impact = std::make_shared<HuntCrossleyImpact>();
+            impact->configure(scenarioImpact(), m, {g});
+            impact->prepare({kRate, kBlock});
+            TimedRun run;
+            run.block = [impact, out, strikeEvery](int b) {
+                if (b % strikeEvery == 0) impact->strike(0.5);
+                impact->process(nullptr, out->data(), kBlock);
+            };
+            return run;
+        });
+        points.push_back({"modes per voice", modes, ns, ns / modes});
+    }
+    // Grain rate: the aggregate-gravel scenario's grains layer at 250..16000 events/s.
+    for (int rate : {250, 500, 1000, 2000, 4000, 8000, 16000}) {
+        const double ns = timeRuns([&] {
+            Scenario sc = makeScenario("aggregate-gravel");
+            auto a = std::static_pointer_cast<AggregateModel>(sc.state);
+            a->prepare(kRate, 16000);
+            a->reset(7);
+            auto rates = std::make_shared<std::vector<float>>(kBlock, float(rate));
+            auto scale = std::make_shared<std::vector<float>>(kBlock, 1.0f);
+            TimedRun run;
+            run.prepare = [out](int) { std::fill(out->begin(), out->end(), 0.0f); };
+            run.block = [a, rates, scale, out](int) {
+                a->process(rates->data(), scale->data(), out->data(), kBlock);
+            };
+            return run;
+        });
+        points.push_back({"grain events/s", rate, ns, ns / (rate / 1000.0)});
+    }
+    return points;
 }
 
 } // namespace underfoot::engine
