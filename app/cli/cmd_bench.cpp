@@ -48,6 +48,17 @@ int runBench(const BenchArgs& a) {
         }
         fmt::print("\n");
     }
+    if (a.only == "scaling") {
+        fmt::print("### Scaling (issue #18): ns per output sample, 48 kHz, 64-frame blocks, "
+                   "per-block minimum of {} runs of {:.1f} s\n\n",
+                   a.repeats, a.seconds);
+        fmt::print("| axis | value | ns/sample | per unit |\n|---|---:|---:|---:|\n");
+        for (const auto& p : eng::measureScaling(a.seconds, a.repeats))
+            fmt::print("| {} | {} | {:.1f} | {:.2f} |\n", p.axis, p.value, p.nsPerSample,
+                       p.perUnit);
+        fmt::print("\n");
+        return 0;
+    }
     if (a.only == "impact-default") {
         // For instruction counting under callgrind: the default impact alone.
         eng::ImpactSetting def;
@@ -96,13 +107,15 @@ CommandRegistrar reg("bench", [](CLI::App& app, int& exitCode) {
     auto args = std::make_shared<BenchArgs>();
     auto* cmd = app.add_subcommand(
         "bench", "Measure what accuracy costs: error against a reference and CPU time per setting");
-    std::vector<std::string> choices = {"all",      "impact",         "knobs",
-                                        "surfaces", "impact-default", "scenarios"};
+    std::vector<std::string> choices = {
+        "all", "impact", "knobs", "surfaces", "impact-default", "scenarios", "scaling"};
     for (const auto& id : eng::scenarioIds()) choices.push_back(id);
-    cmd->add_option("--only", args->only,
-                    "all, impact, knobs, surfaces, scenarios, impact-default (for callgrind), or "
-                    "one scenario: impact-strikes, impact-pressed, impact-metal, friction-creak, "
-                    "aggregate-gravel, bubbles")
+    cmd->add_option(
+           "--only", args->only,
+           "all, impact, knobs, surfaces, scenarios, scaling (not in all), impact-default (for "
+           "callgrind), or "
+           "one scenario: impact-strikes, impact-pressed, impact-metal, friction-creak, "
+           "aggregate-gravel, bubbles, aggregate-gravel-1voice")
         ->check(CLI::IsMember(choices))
         ->capture_default_str();
     cmd->add_option("--repeats", args->repeats,

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 
 namespace underfoot::engine {
@@ -21,6 +22,15 @@ void require(bool ok, const char* name, const char* expected, double value) {
     if (!ok)
         throw std::invalid_argument(
             fmt::format("bubble parameter {}: expected {}, got {:g}", name, expected, value));
+}
+typedef double D2 __attribute__((vector_size(16)));
+inline D2 load2(const double* p) noexcept {
+    D2 v;
+    std::memcpy(&v, p, sizeof v);
+    return v;
+}
+inline void store2(double* p, D2 v) noexcept {
+    std::memcpy(p, &v, sizeof v);
 }
 int roundUpLanes(int v) {
     return (v + kLanes - 1) / kLanes * kLanes;
@@ -184,22 +194,24 @@ void BubbleStream::process(const float* rateHz, const float* amplitudeScale, flo
         }
         if (sample_ >= nextDeath_) retireDeadVoices();
         const int slots = roundUpLanes(activeVoices_);
-        double acc[kLanes] = {};
+        // Four lanes as two pairs of doubles (SSE2 on x86-64: each lane computes exactly what
+        // the scalar expression computes; the lane sums are added in the same order as before).
+        D2 accLo = {0.0, 0.0}, accHi = {0.0, 0.0};
         for (int j = 0; j < slots; j += kLanes) {
-            for (int l = 0; l < kLanes; ++l) {
-                const int k = j + l;
-                acc[l] += zi[k];
+            for (int h = 0; h < kLanes; h += 2) {
+                const int k = j + h;
+                const D2 zrk = load2(zr + k), zik = load2(zi + k), wrk = load2(wr + k),
+                         wik = load2(wi + k), urk = load2(ur + k), uik = load2(ui + k),
+                         gk = load2(g + k);
+                (h == 0 ? accLo : accHi) += zik;
                 // z <- z w g, then w <- w u (the rotation of the next sample)
-                const double nr = (zr[k] * wr[k] - zi[k] * wi[k]) * g[k];
-                const double ni = (zr[k] * wi[k] + zi[k] * wr[k]) * g[k];
-                zr[k] = nr;
-                zi[k] = ni;
-                const double vr = wr[k] * ur[k] - wi[k] * ui[k];
-                const double vi = wr[k] * ui[k] + wi[k] * ur[k];
-                wr[k] = vr;
-                wi[k] = vi;
+                store2(zr + k, (zrk * wrk - zik * wik) * gk);
+                store2(zi + k, (zrk * wik + zik * wrk) * gk);
+                store2(wr + k, wrk * urk - wik * uik);
+                store2(wi + k, wrk * uik + wik * urk);
             }
         }
+        const double acc[kLanes] = {accLo[0], accLo[1], accHi[0], accHi[1]};
         out[i] += static_cast<float>(acc[0] + acc[1] + acc[2] + acc[3]);
         ++sample_;
     }

@@ -43,6 +43,7 @@ void HuntCrossleyImpactT<Real>::prepare(const ProcessSpec& spec) {
     const int sub = params_.contactSubsteps;
     resonator_.prepare(internalFs_, sub);
     resonator_.setOutputPickup(listen_);
+    resonator_.setEnergyTracking(true); // the passivity guard's energies in O(1) per trial
     const double M = params_.exciterMassKg;
     coarseT_ = T_;
     coarseKc_ = T_ * T_ / (6.0 * M) + resonator_.compliance(0); // exact for a linear force ramp
@@ -92,7 +93,7 @@ void HuntCrossleyImpactT<Real>::strike(double velocity) noexcept {
 }
 
 template <typename Real>
-double HuntCrossleyImpactT<Real>::contactForce(double c, double cdot) const noexcept {
+inline double HuntCrossleyImpactT<Real>::contactForce(double c, double cdot) const noexcept {
     if (c <= 0.0) return 0.0;
     const double a = params_.alpha;
     const double ca = (a == 1.0)   ? c
@@ -284,10 +285,9 @@ void HuntCrossleyImpactT<Real>::process(const float* fext, float* out, int n) no
     for (int i = 0; i < n; ++i) {
         const double fNext = fext ? double(fext[i]) : 0.0;
         double y = 0.0;
-        for (int k = 0; k < os; ++k) {
-            // Linear interpolation of the external force inside the sample.
-            const double f1 = lastExternal_ + (fNext - lastExternal_) * double(k + 1) / os;
-            const double f0 = lastExternal_ + (fNext - lastExternal_) * double(k) / os;
+        if (os == 1) {
+            // (the same force values as the general interpolation below gives for os = 1)
+            const double f0 = lastExternal_, f1 = lastExternal_ + (fNext - lastExternal_);
             if (!step(f0, f1, sub > 1, y)) {
                 // The bodies touch in this sample: resolve it in `sub` exact sub-steps.
                 setFineRate(true);
@@ -296,7 +296,19 @@ void HuntCrossleyImpactT<Real>::process(const float* fext, float* out, int n) no
                          false, y);
                 setFineRate(false);
             }
-            if (os > 1) y = decimator_.processSample(y);
+        }
+        for (int k = 0; k < os && os > 1; ++k) {
+            // Linear interpolation of the external force inside the sample.
+            const double f1 = lastExternal_ + (fNext - lastExternal_) * double(k + 1) / os;
+            const double f0 = lastExternal_ + (fNext - lastExternal_) * double(k) / os;
+            if (!step(f0, f1, sub > 1, y)) {
+                setFineRate(true);
+                for (int j = 0; j < sub; ++j)
+                    step(f0 + (f1 - f0) * double(j) / sub, f0 + (f1 - f0) * double(j + 1) / sub,
+                         false, y);
+                setFineRate(false);
+            }
+            y = decimator_.processSample(y);
         }
         lastExternal_ = fNext;
         out[i] = static_cast<float>(y);

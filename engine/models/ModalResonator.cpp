@@ -4,11 +4,40 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 
 namespace underfoot::engine {
 namespace {
+
+// Two modes per step: the per-mode loops below work on pairs of lanes with GCC/Clang vector
+// extensions (SSE2 on x86-64: every operation is the IEEE operation of each lane, as in scalar
+// code, so results do not depend on the machine), over arrays padded to an even length with
+// modes whose coefficients are all zero. The pickup sums keep one partial sum per lane (even and
+// odd modes) added at the end: a fixed order, so the output is bit-for-bit reproducible.
+template <typename Real>
+struct Pair {
+    typedef Real type __attribute__((vector_size(2 * sizeof(Real))));
+};
+template <typename Real>
+using V2 = typename Pair<Real>::type;
+typedef double D2 __attribute__((vector_size(16)));
+
+template <typename T, typename V>
+inline V load2(const T* p) noexcept {
+    V v;
+    std::memcpy(&v, p, sizeof v);
+    return v;
+}
+template <typename T, typename V>
+inline void store2(T* p, V v) noexcept {
+    std::memcpy(p, &v, sizeof v);
+}
+inline std::size_t padded(std::size_t n) noexcept {
+    return (n + 1) & ~std::size_t(1);
+}
 
 // 20-point Gauss–Legendre nodes/weights on [-1, 1] (Abramowitz & Stegun, Table 25.4).
 constexpr std::array<double, 10> kGlNodes = {
@@ -92,19 +121,78 @@ void ModalResonatorT<Real>::configure(std::vector<Mode> modes,
 }
 
 template <typename Real>
+void ModalResonatorT<Real>::Bank::assign(std::size_t n2, std::size_t np) {
+    for (auto* a : {&a00, &a01, &a10, &a11, &b0x, &b0v, &b1x, &b1v}) a->assign(n2, Real(0));
+    lv.assign(n2, 0.0);
+    lx.assign(n2, 0.0);
+    c2 = 0.0;
+    dx0.assign(np, 0.0);
+    dv0.assign(np, 0.0);
+    dvo.assign(np, 0.0);
+}
+
+template <typename Real>
+void ModalResonatorT<Real>::fillBank(Bank& b, const std::vector<ModeCoefficients>& cs) {
+    const std::size_t n = modes_.size(), np = gains_.size(), n2 = padded(n);
+    b.assign(n2, np);
+    for (std::size_t i = 0; i < n; ++i) {
+        const auto& c = cs[i];
+        b.a00[i] = static_cast<Real>(c.a00);
+        b.a01[i] = static_cast<Real>(c.a01);
+        b.a10[i] = static_cast<Real>(c.a10);
+        b.a11[i] = static_cast<Real>(c.a11);
+        b.b0x[i] = static_cast<Real>(c.b0x);
+        b.b0v[i] = static_cast<Real>(c.b0v);
+        b.b1x[i] = static_cast<Real>(c.b1x);
+        b.b1v[i] = static_cast<Real>(c.b1v);
+        // E(F) around the prediction for a force at pickup 0 (u_i = gamma_i F):
+        // sum kin_i (vh_i + gamma_i b1v_i F)^2 + pot_i (qh_i + gamma_i b1x_i F)^2.
+        const double gamma = double(gainOverMass_[i]);
+        const double bv = gamma * c.b1v, bx = gamma * c.b1x;
+        b.lv[i] = 2.0 * kinetic_[i] * bv;
+        b.lx[i] = 2.0 * potential_[i] * bx;
+        b.c2 += kinetic_[i] * bv * bv + potential_[i] * bx * bx;
+    }
+    const double* g0 = gains_.front().data();
+    for (std::size_t p = 0; p < np; ++p)
+        for (std::size_t i = 0; i < n; ++i) {
+            const double gamma = double(gainOverMass_[p * n2 + i]);
+            b.dx0[p] += g0[i] * (gamma * double(b.b1x[i]));
+            b.dv0[p] += g0[i] * (gamma * double(b.b1v[i]));
+            b.dvo[p] += outGain_[i] * (gamma * double(b.b1v[i]));
+        }
+    b.pairs.assign(n2 / 2, PairCoefficients{});
+    pairGains_.assign(n2 / 2, PairGains{});
+    for (std::size_t i = 0; i < n2; ++i) {
+        auto& c = b.pairs[i / 2];
+        const std::size_t l = i % 2;
+        c.a00[l] = b.a00[i], c.a01[l] = b.a01[i], c.a10[l] = b.a10[i], c.a11[l] = b.a11[i];
+        c.b0x[l] = b.b0x[i], c.b0v[l] = b.b0v[i], c.b1x[l] = b.b1x[i], c.b1v[l] = b.b1v[i];
+        c.lv[l] = b.lv[i], c.lx[l] = b.lx[i];
+        auto& gg = pairGains_[i / 2];
+        gg.g0[l] = contactGain_[i], gg.go[l] = outGain_[i];
+        gg.kin[l] = kinetic_[i], gg.pot[l] = potential_[i];
+    }
+}
+
+template <typename Real>
 void ModalResonatorT<Real>::prepare(double sampleRateHz, int fineSubsteps) {
     sampleRateHz_ = sampleRateHz;
     fine_ = false;
-    const std::size_t n = modes_.size(), np = gains_.size();
+    const std::size_t n = modes_.size(), np = gains_.size(), n2 = padded(n);
     coefficients_.resize(n);
     quasiStaticCount_ = 0;
     w0sq_.resize(n);
+    kinetic_.assign(n2, 0.0);
+    potential_.assign(n2, 0.0);
     for (std::size_t i = 0; i < n; ++i) {
         const double s = std::log(1000.0) / modes_[i].t60Seconds;
         const double wd = kTwoPi * modes_[i].frequencyHz;
         w0sq_[i] = wd * wd + s * s;
         coefficients_[i] = computeModeCoefficients(modes_[i], sampleRateHz);
         quasiStaticCount_ += coefficients_[i].quasiStatic ? 1 : 0;
+        kinetic_[i] = coefficients_[i].quasiStatic ? 0.0 : 0.5 * modes_[i].massKg;
+        potential_[i] = 0.5 * modes_[i].massKg * w0sq_[i];
     }
     fineCoefficients_.clear();
     if (fineSubsteps > 1) {
@@ -113,7 +201,9 @@ void ModalResonatorT<Real>::prepare(double sampleRateHz, int fineSubsteps) {
             fineCoefficients_[i] =
                 computeModeCoefficients(modes_[i], sampleRateHz * fineSubsteps, 0.5 * sampleRateHz);
     }
-    gainOverMass_.assign(np * n, Real(0));
+    gainOverMass_.assign(np * n2, Real(0));
+    contactGain_.assign(n2, 0.0);
+    for (std::size_t i = 0; i < n; ++i) contactGain_[i] = gains_.front()[i];
     kx_.assign(np, 0.0);
     kv_.assign(np, 0.0);
     kxFine_.assign(np, 0.0);
@@ -121,7 +211,7 @@ void ModalResonatorT<Real>::prepare(double sampleRateHz, int fineSubsteps) {
     for (std::size_t p = 0; p < np; ++p) {
         for (std::size_t i = 0; i < n; ++i) {
             const double g = gains_[p][i];
-            gainOverMass_[p * n + i] = static_cast<Real>(g / modes_[i].massKg);
+            gainOverMass_[p * n2 + i] = static_cast<Real>(g / modes_[i].massKg);
             kx_[p] += g * g / modes_[i].massKg * coefficients_[i].b1x;
             kv_[p] += g * g / modes_[i].massKg * coefficients_[i].b1v;
             if (!fineCoefficients_.empty()) {
@@ -130,13 +220,16 @@ void ModalResonatorT<Real>::prepare(double sampleRateHz, int fineSubsteps) {
             }
         }
     }
-    setOutputPickup(std::min(outputPickup_, static_cast<int>(np) - 1));
-    q_.assign(n, Real(0));
-    v_.assign(n, Real(0));
-    qh_.assign(n, Real(0));
-    vh_.assign(n, Real(0));
-    u_.assign(n, Real(0));
+    setOutputPickup(std::min(outputPickup_, static_cast<int>(np) - 1)); // fills the banks
+    q_.assign(n2, Real(0));
+    v_.assign(n2, Real(0));
+    qh_.assign(n2, Real(0));
+    vh_.assign(n2, Real(0));
+    u_.assign(n2, Real(0));
     heldZero_ = true;
+    predictedEnergyValid_ = false;
+    energyValid_ = true;
+    committedEnergy_ = 0.0;
 }
 
 template <typename Real>
@@ -148,112 +241,145 @@ void ModalResonatorT<Real>::reset() noexcept {
     std::fill(u_.begin(), u_.end(), Real(0));
     x0_ = v0_ = outputVelocity_ = predictedX0_ = predictedV0_ = predictedVo_ = 0.0;
     heldZero_ = true;
+    predictedEnergyValid_ = false;
+    energyValid_ = true;
+    committedEnergy_ = 0.0;
 }
 
 template <typename Real>
 void ModalResonatorT<Real>::predict(double heldScale) noexcept {
-    const std::size_t n = q_.size();
-    const Real h = static_cast<Real>(heldScale);
-    const double* g0 = gains_.front().data();
-    const double* go = outGain_.data();
-    const ModeCoefficients* cs = active();
-    double x0 = 0.0, v0 = 0.0, vo = 0.0;
-    const bool free = heldZero_ || heldScale == 0.0;
-    if (free) {
+    using V = V2<Real>;
+    const std::size_t pairs = q_.size() / 2;
+    const PairCoefficients* c = bank().pairs.data();
+    const PairGains* gg = pairGains_.data();
+    const Real *q = q_.data(), *v = v_.data();
+    Real *qh = qh_.data(), *vh = vh_.data();
+    D2 x0 = {0.0, 0.0}, v0 = {0.0, 0.0}, vo = {0.0, 0.0};
+    predictedEnergyValid_ = false;
+    if (heldZero_ || heldScale == 0.0) {
         // Free ringing (no force held from the last sample): the same values without the
         // force terms (they would add exactly zero).
-        for (std::size_t i = 0; i < n; ++i) {
-            const auto& c = cs[i];
-            const Real q = q_[i], v = v_[i];
-            qh_[i] = static_cast<Real>(c.a00) * q + static_cast<Real>(c.a01) * v;
-            vh_[i] = static_cast<Real>(c.a10) * q + static_cast<Real>(c.a11) * v;
-            x0 += g0[i] * double(qh_[i]);
-            v0 += g0[i] * double(vh_[i]);
-            vo += go[i] * double(vh_[i]);
+        for (std::size_t k = 0; k < pairs; ++k) {
+            const std::size_t i = 2 * k;
+            const V qi = load2<Real, V>(q + i), vi = load2<Real, V>(v + i);
+            const V x = load2<Real, V>(c[k].a00) * qi + load2<Real, V>(c[k].a01) * vi;
+            const V y = load2<Real, V>(c[k].a10) * qi + load2<Real, V>(c[k].a11) * vi;
+            store2(qh + i, x);
+            store2(vh + i, y);
+            const D2 xd = __builtin_convertvector(x, D2), yd = __builtin_convertvector(y, D2);
+            const D2 g0 = load2<double, D2>(gg[k].g0);
+            x0 += g0 * xd;
+            v0 += g0 * yd;
+            vo += load2<double, D2>(gg[k].go) * yd;
         }
     } else {
-        for (std::size_t i = 0; i < n; ++i) {
-            const auto& c = cs[i];
-            const Real q = q_[i], v = v_[i], u = h * u_[i];
-            qh_[i] = static_cast<Real>(c.a00) * q + static_cast<Real>(c.a01) * v +
-                     static_cast<Real>(c.b0x) * u;
-            vh_[i] = static_cast<Real>(c.a10) * q + static_cast<Real>(c.a11) * v +
-                     static_cast<Real>(c.b0v) * u;
-            x0 += g0[i] * double(qh_[i]);
-            v0 += g0[i] * double(vh_[i]);
+        const Real h = static_cast<Real>(heldScale);
+        const Real* u = u_.data();
+        D2 e = {0.0, 0.0}, slope = {0.0, 0.0};
+        auto run = [&](auto withEnergy) {
+            for (std::size_t k = 0; k < pairs; ++k) {
+                const std::size_t i = 2 * k;
+                const V qi = load2<Real, V>(q + i), vi = load2<Real, V>(v + i);
+                const V ui = h * load2<Real, V>(u + i);
+                const V x = load2<Real, V>(c[k].a00) * qi + load2<Real, V>(c[k].a01) * vi +
+                            load2<Real, V>(c[k].b0x) * ui;
+                const V y = load2<Real, V>(c[k].a10) * qi + load2<Real, V>(c[k].a11) * vi +
+                            load2<Real, V>(c[k].b0v) * ui;
+                store2(qh + i, x);
+                store2(vh + i, y);
+                const D2 xd = __builtin_convertvector(x, D2), yd = __builtin_convertvector(y, D2);
+                const D2 g0 = load2<double, D2>(gg[k].g0);
+                x0 += g0 * xd;
+                v0 += g0 * yd;
+                vo += load2<double, D2>(gg[k].go) * yd;
+                if constexpr (decltype(withEnergy)::value) {
+                    // The prediction's energy and the slope of E(F) (energyIfCommitted).
+                    e += load2<double, D2>(gg[k].kin) * (yd * yd) +
+                         load2<double, D2>(gg[k].pot) * (xd * xd);
+                    slope += load2<double, D2>(c[k].lv) * yd + load2<double, D2>(c[k].lx) * xd;
+                }
+            }
+        };
+        if (trackEnergy_) {
+            run(std::true_type{});
+            predictedEnergy_ = e[0] + e[1];
+            predictedEnergySlope_ = slope[0] + slope[1];
+            predictedEnergyValid_ = true;
+        } else {
+            run(std::false_type{});
         }
     }
-    predictedX0_ = x0;
-    predictedV0_ = v0;
-    predictedVo_ = vo;
-    predictedVoValid_ = free;
-}
-
-template <typename Real>
-double ModalResonatorT<Real>::predictedPosition(int p) const noexcept {
-    if (p == 0) return predictedX0_;
-    double x = 0;
-    for (std::size_t i = 0; i < q_.size(); ++i)
-        x += gains_[static_cast<std::size_t>(p)][i] * qh_[i];
-    return x;
-}
-
-template <typename Real>
-double ModalResonatorT<Real>::predictedVelocity(int p) const noexcept {
-    if (p == 0) return predictedV0_;
-    const std::size_t n = q_.size();
-    double v = 0;
-    for (std::size_t i = 0; i < n; ++i) v += gains_[static_cast<std::size_t>(p)][i] * vh_[i];
-    return v;
+    predictedX0_ = x0[0] + x0[1];
+    predictedV0_ = v0[0] + v0[1];
+    predictedVo_ = vo[0] + vo[1];
 }
 
 template <typename Real>
 void ModalResonatorT<Real>::commit(int p, double forceN) noexcept {
     if (forceN == 0.0) {
         // No new force: the state is the prediction (swapping the buffers does not allocate),
-        // and so are the pickup sums predict() computed in the same order.
+        // and so are the pickup sums predict() computed.
         q_.swap(qh_);
         v_.swap(vh_);
         if (!heldZero_) std::fill(u_.begin(), u_.end(), Real(0));
         heldZero_ = true;
         x0_ = predictedX0_;
         v0_ = predictedV0_;
-        if (!predictedVoValid_) { // a held force was predicted (a contact just ended)
-            const double* go = outGain_.data();
-            double vo = 0.0;
-            for (std::size_t i = 0; i < v_.size(); ++i) vo += go[i] * double(v_[i]);
-            predictedVo_ = vo;
-        }
         outputVelocity_ = predictedVo_;
+        energyValid_ = predictedEnergyValid_;
+        committedEnergy_ = predictedEnergy_;
+        predictedEnergyValid_ = false;
         return;
     }
+    using V = V2<Real>;
     heldZero_ = false;
-    const std::size_t n = q_.size(), off = static_cast<std::size_t>(p) * n;
+    const std::size_t n2 = q_.size(), pp = static_cast<std::size_t>(p);
     const Real f = static_cast<Real>(forceN);
-    const double* g0 = gains_.front().data();
-    const double* go = outGain_.data();
-    const ModeCoefficients* cs = active();
-    double x0 = 0.0, v0 = 0.0, vo = 0.0;
-    for (std::size_t i = 0; i < n; ++i) {
-        const auto& c = cs[i];
-        const Real u = gainOverMass_[off + i] * f;
-        q_[i] = qh_[i] + static_cast<Real>(c.b1x) * u;
-        v_[i] = vh_[i] + static_cast<Real>(c.b1v) * u;
-        u_[i] = u;
-        x0 += g0[i] * double(q_[i]);
-        v0 += g0[i] * double(v_[i]);
-        vo += go[i] * double(v_[i]);
+    const Bank& b = bank();
+    const Real* gm = gainOverMass_.data() + pp * n2;
+    const PairCoefficients* c = b.pairs.data();
+    const Real *qh = qh_.data(), *vh = vh_.data();
+    Real *q = q_.data(), *v = v_.data(), *u = u_.data();
+    for (std::size_t i = 0; i < n2; i += 2) {
+        const PairCoefficients& ci = c[i / 2];
+        const V ui = load2<Real, V>(gm + i) * f;
+        store2(q + i, load2<Real, V>(qh + i) + load2<Real, V>(ci.b1x) * ui);
+        store2(v + i, load2<Real, V>(vh + i) + load2<Real, V>(ci.b1v) * ui);
+        store2(u + i, ui);
     }
-    x0_ = x0;
-    v0_ = v0;
-    outputVelocity_ = vo;
+    // The pickup sums are linear in the force: the prediction's plus the force times the sums
+    // of the instantaneous responses (no second pass over the modes).
+    x0_ = predictedX0_ + forceN * b.dx0[pp];
+    v0_ = predictedV0_ + forceN * b.dv0[pp];
+    outputVelocity_ = predictedVo_ + forceN * b.dvo[pp];
+    energyValid_ = p == 0 && predictedEnergyValid_;
+    if (energyValid_)
+        committedEnergy_ =
+            predictedEnergy_ + forceN * predictedEnergySlope_ + forceN * forceN * b.c2;
+    predictedEnergyValid_ = false;
 }
 
 template <typename Real>
-double ModalResonatorT<Real>::energyIfCommitted(int p, double forceN) const noexcept {
-    const std::size_t n = q_.size(), off = static_cast<std::size_t>(p) * n;
+double ModalResonatorT<Real>::energyIfCommittedSlow(int p, double forceN) const noexcept {
+    const std::size_t n = modes_.size();
+    if (p == 0) {
+        const Bank& b = bank();
+        if (!predictedEnergyValid_) {
+            double e = 0.0, slope = 0.0;
+            for (std::size_t i = 0; i < n; ++i) {
+                const double x = double(qh_[i]), y = double(vh_[i]);
+                e += kinetic_[i] * (y * y) + potential_[i] * (x * x);
+                slope += b.lv[i] * y + b.lx[i] * x;
+            }
+            predictedEnergy_ = e;
+            predictedEnergySlope_ = slope;
+            predictedEnergyValid_ = true;
+        }
+        return predictedEnergy_ + forceN * predictedEnergySlope_ + forceN * forceN * b.c2;
+    }
+    const std::size_t off = static_cast<std::size_t>(p) * q_.size();
     double e = 0;
-    const ModeCoefficients* cs = active();
+    const ModeCoefficients* cs = fine_ ? fineCoefficients_.data() : coefficients_.data();
     for (std::size_t i = 0; i < n; ++i) {
         const auto& c = cs[i];
         const double u = double(gainOverMass_[off + i]) * forceN;
@@ -267,34 +393,31 @@ double ModalResonatorT<Real>::energyIfCommitted(int p, double forceN) const noex
 template <typename Real>
 void ModalResonatorT<Real>::setOutputPickup(int p) {
     outputPickup_ = p;
-    outGain_.assign(modes_.size(), 0.0);
+    outGain_.assign(padded(modes_.size()), 0.0);
     for (std::size_t i = 0; i < modes_.size(); ++i)
         if (i < coefficients_.size() && !coefficients_[i].quasiStatic)
             outGain_[i] = gains_.at(static_cast<std::size_t>(p))[i];
+    if (coefficients_.size() == modes_.size() && !gainOverMass_.empty()) {
+        fillBank(coarseBank_, coefficients_);
+        if (!fineCoefficients_.empty()) fillBank(fineBank_, fineCoefficients_);
+    }
+    predictedEnergyValid_ = false;
 }
 
 template <typename Real>
-double ModalResonatorT<Real>::position(int p) const noexcept {
-    if (p == 0) return x0_;
-    double x = 0;
-    for (std::size_t i = 0; i < q_.size(); ++i) x += gains_[static_cast<std::size_t>(p)][i] * q_[i];
-    return x;
+double ModalResonatorT<Real>::pickupSum(const std::vector<Real>& x, int p,
+                                        bool radiatingOnly) const noexcept {
+    double sum = 0;
+    const auto& g = gains_[static_cast<std::size_t>(p)];
+    for (std::size_t i = 0; i < modes_.size(); ++i)
+        if (!radiatingOnly || !coefficients_[i].quasiStatic) sum += g[i] * double(x[i]);
+    return sum;
 }
 
 template <typename Real>
-double ModalResonatorT<Real>::velocity(int p) const noexcept {
-    // Quasi-static modes do not radiate (their "velocity" is a finite difference of a compliance).
-    if (p == outputPickup_) return outputVelocity_;
-    double v = 0;
-    for (std::size_t i = 0; i < v_.size(); ++i)
-        if (!coefficients_[i].quasiStatic) v += gains_[static_cast<std::size_t>(p)][i] * v_[i];
-    return v;
-}
-
-template <typename Real>
-double ModalResonatorT<Real>::energy() const noexcept {
+double ModalResonatorT<Real>::energyLoop() const noexcept {
     double e = 0;
-    for (std::size_t i = 0; i < q_.size(); ++i) {
+    for (std::size_t i = 0; i < modes_.size(); ++i) {
         const double q = q_[i], v = coefficients_[i].quasiStatic ? 0.0 : double(v_[i]);
         e += 0.5 * modes_[i].massKg * (v * v + w0sq_[i] * q * q);
     }
@@ -308,12 +431,14 @@ void ModalResonatorT<Real>::flushTinyState() noexcept {
         v_[i] = static_cast<Real>(snapToZero(v_[i]));
         u_[i] = static_cast<Real>(snapToZero(u_[i]));
     }
+    energyValid_ = false; // the next energy() sums the modes again
+    predictedEnergyValid_ = false;
 }
 
 template <typename Real>
 double ModalResonatorT<Real>::peakModalVelocity() const noexcept {
     double m = 0;
-    for (std::size_t i = 0; i < v_.size(); ++i) {
+    for (std::size_t i = 0; i < modes_.size(); ++i) {
         const double wd = kTwoPi * modes_[i].frequencyHz;
         // Amplitude of the modal velocity including the part stored as displacement.
         m = std::max(m, std::fabs(double(v_[i])) + wd * std::fabs(double(q_[i])));

@@ -62,7 +62,15 @@ class ModalResonatorT {
     /// is quasi-static in both when it is at or above the coarse rate's Nyquist frequency.
     void prepare(double sampleRateHz, int fineSubsteps = 1);
     /// Selects the fine (true) or coarse (false) coefficient set for the following steps.
-    void setFineRate(bool fine) noexcept { fine_ = fine && !fineCoefficients_.empty(); }
+    void setFineRate(bool fine) noexcept {
+        const bool f = fine && !fineCoefficients_.empty();
+        if (f != fine_) predictedEnergyValid_ = false;
+        fine_ = f;
+    }
+    /// With tracking on, predict() also computes the prediction's energy terms while a force is
+    /// held, so that energyIfCommitted(0, F) and the energy() after commit(0, F) cost O(1) (the
+    /// impact's passivity guard in sustained contact). Off by default (friction does not need it).
+    void setEnergyTracking(bool on) noexcept { trackEnergy_ = on; }
     bool fineRate() const noexcept { return fine_; }
     void reset() noexcept;
 
@@ -78,8 +86,12 @@ class ModalResonatorT {
     /// `heldScale` scales the force held from the previous sample (1 = as committed); the
     /// impact's passivity guard uses smaller values.
     void predict(double heldScale = 1.0) noexcept;
-    double predictedPosition(int p) const noexcept;
-    double predictedVelocity(int p) const noexcept;
+    double predictedPosition(int p) const noexcept {
+        return p == 0 ? predictedX0_ : predictedSum(qh_, p);
+    }
+    double predictedVelocity(int p) const noexcept {
+        return p == 0 ? predictedV0_ : predictedSum(vh_, p);
+    }
     /// Instantaneous displacement / velocity at pickup p per newton applied at pickup p at n+1.
     double compliance(int p) const noexcept {
         return (fine_ ? kxFine_ : kx_)[static_cast<std::size_t>(p)];
@@ -87,8 +99,13 @@ class ModalResonatorT {
     double mobility(int p) const noexcept {
         return (fine_ ? kvFine_ : kv_)[static_cast<std::size_t>(p)];
     }
-    /// Energy the modes would hold after commit(p, forceN), without committing.
-    double energyIfCommitted(int p, double forceN) const noexcept;
+    /// Energy the modes would hold after commit(p, forceN), without committing (for p = 0 one pass
+    /// over the modes per prediction, then O(1) per force).
+    double energyIfCommitted(int p, double forceN) const noexcept {
+        if (p == 0 && predictedEnergyValid_)
+            return predictedEnergy_ + forceN * predictedEnergySlope_ + forceN * forceN * bank().c2;
+        return energyIfCommittedSlow(p, forceN);
+    }
     /// Completes the sample with force `forceN` acting at pickup p (at n+1).
     void commit(int p, double forceN) noexcept;
 
@@ -96,12 +113,18 @@ class ModalResonatorT {
     void setOutputPickup(int p);
 
     // ---- after commit ----
-    double position(int p) const noexcept;
+    double position(int p) const noexcept { return p == 0 ? x0_ : pickupSum(q_, p, false); }
     /// Velocity of the contact point (pickup 0), all modes included (computed by commit()).
     double contactVelocity() const noexcept { return v0_; }
-    double velocity(int p) const noexcept;
+    double velocity(int p) const noexcept {
+        // Quasi-static modes do not radiate (their "velocity" is a finite difference).
+        return p == outputPickup_ ? outputVelocity_ : pickupSum(v_, p, true);
+    }
     /// Mechanical energy stored in the modes (kinetic + potential), joules.
-    double energy() const noexcept;
+    double energy() const noexcept {
+        // Known in O(1) after a commit whose prediction tracked the energy (setEnergyTracking).
+        return energyValid_ ? committedEnergy_ : energyLoop();
+    }
 
     /// Convenience: one full sample with an external force at pickup `p`; returns velocity at
     /// pickup `listen`.
@@ -117,27 +140,69 @@ class ModalResonatorT {
     double peakModalVelocity() const noexcept;
 
   private:
+    // Coefficients of one rate as structure of arrays (contiguous per coefficient, so that the
+    // per-mode loops are plain multiply-adds over arrays), stored in Real as the loops use them.
+    // The hot loops read two modes at a time from one aligned record per pair (few pointers, so
+    // the loop keeps everything in registers, and aligned SIMD operands).
+    struct alignas(16) PairCoefficients {
+        Real a00[2], a01[2], a10[2], a11[2], b0x[2], b0v[2], b1x[2], b1v[2];
+        double lv[2], lx[2];
+    };
+    struct alignas(16) PairGains {
+        double g0[2], go[2], kin[2], pot[2]; // pickup 0, output pickup, 0.5 m, 0.5 m w0^2
+    };
+    struct Bank {
+        std::vector<Real> a00, a01, a10, a11, b0x, b0v, b1x, b1v;
+        std::vector<PairCoefficients> pairs; // the same values, two modes per record
+        // Energy of the modes after commit(0, F) as a quadratic in F around the prediction:
+        // E(F) = E_h + F sum(lv vh + lx qh) + F^2 c2 (double, per mode; see energyIfCommitted).
+        std::vector<double> lv, lx;
+        double c2 = 0.0;
+        // Pickup sums of the instantaneous response to a force at pickup p (per pickup):
+        // x0 += F dx0[p], v0 += F dv0[p], output velocity += F dvo[p].
+        std::vector<double> dx0, dv0, dvo;
+        void assign(std::size_t modes, std::size_t pickups);
+    };
+    void fillBank(Bank& bank, const std::vector<ModeCoefficients>& c);
+    const Bank& bank() const noexcept { return fine_ ? fineBank_ : coarseBank_; }
+    double energyLoop() const noexcept;
+    double energyIfCommittedSlow(int p, double forceN) const noexcept;
+    double predictedSum(const std::vector<Real>& x, int p) const noexcept {
+        return pickupSum(x, p, false);
+    }
+    double pickupSum(const std::vector<Real>& x, int p, bool radiatingOnly) const noexcept;
+
     std::vector<Mode> modes_;
     std::vector<std::vector<double>> gains_; // [pickup][mode]
     std::vector<ModeCoefficients> coefficients_;
     std::vector<ModeCoefficients> fineCoefficients_; // empty unless prepared with sub-steps
+    Bank coarseBank_, fineBank_;
+    std::vector<PairGains> pairGains_;
     bool fine_ = false;
-    const ModeCoefficients* active() const noexcept {
-        return fine_ ? fineCoefficients_.data() : coefficients_.data();
-    }
-    std::vector<Real> gainOverMass_;        // [pickup * modes + mode] = g[p][i] / m_i
-    std::vector<Real> q_, v_, qh_, vh_, u_; // state, prediction, last generalized force
-    std::vector<double> kx_, kv_;           // per pickup
-    std::vector<double> kxFine_, kvFine_;   // per pickup, fine rate
-    std::vector<double> w0sq_;              // undamped angular frequency squared, per mode
+    // Per-mode arrays are padded to an even length (two modes per SIMD step, see the .cpp) with
+    // modes whose coefficients and gains are zero.
+    std::vector<Real> gainOverMass_;          // [pickup * padded modes + mode] = g[p][i] / m_i
+    std::vector<Real> q_, v_, qh_, vh_, u_;   // state, prediction, last generalized force
+    std::vector<double> kx_, kv_;             // per pickup
+    std::vector<double> kxFine_, kvFine_;     // per pickup, fine rate
+    std::vector<double> w0sq_;                // undamped angular frequency squared, per mode
+    std::vector<double> kinetic_, potential_; // 0.5 m_i (0 when quasi-static), 0.5 m_i w0_i^2
     double sampleRateHz_ = 0.0;
     double predictedX0_ = 0.0, predictedV0_ = 0.0; // pickup 0, computed by predict()
-    double predictedVo_ = 0.0; // output pickup, computed by predict() when ringing freely
-    bool predictedVoValid_ = false;
+    double predictedVo_ = 0.0;                     // output pickup, computed by predict()
     bool heldZero_ = true; // every u_ is zero (free ringing): predict/commit skip the force terms
+    // Energy bookkeeping (setEnergyTracking): predict() computes the prediction's energy E_h and
+    // the linear coefficient of E(F) when a force is held; commit(0, F) then knows the committed
+    // energy in O(1), so energy() and energyIfCommitted() need no pass over the modes.
+    bool trackEnergy_ = false;
+    mutable bool predictedEnergyValid_ = false;
+    mutable double predictedEnergy_ = 0.0, predictedEnergySlope_ = 0.0;
+    bool energyValid_ = true; // committedEnergy_ is the energy of (q_, v_)
+    double committedEnergy_ = 0.0;
     double x0_ = 0.0, v0_ = 0.0, outputVelocity_ = 0.0; // computed by commit()
     int outputPickup_ = 0;
-    std::vector<double> outGain_; // output pickup's gains, 0 for non-radiating modes
+    std::vector<double> outGain_;     // output pickup's gains, 0 for non-radiating modes
+    std::vector<double> contactGain_; // pickup 0's gains (padded like the state)
     int quasiStaticCount_ = 0;
 };
 

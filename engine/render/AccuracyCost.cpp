@@ -64,35 +64,65 @@ StrikeResult strikeOnce(const ImpactSetting& s) {
     return r;
 }
 
-// Times a deterministic train of strikes (4 per second) block by block, `repeats` times over;
-// each block's cost is the minimum over the repeats, which removes preemption by other processes
-// (this machine is shared) and keeps what the algorithm itself costs in that block.
+// What one timed run does per 64-frame block: `prepare` and `check` are not timed (clearing the
+// output, a checksum), `block` is.
+struct TimedRun {
+    std::function<void(int)> prepare, block, check;
+};
+
+struct BlockTimes {
+    double nsPerSample = 0, medianBlockNs = 0, p99BlockNs = 0, maxBlockNs = 0;
+};
+
+// Times `blocks` blocks of `repeats` fresh runs (makeRun() builds one); each block's cost is the
+// minimum over the repeats, which removes preemption by other processes (this machine is shared)
+// and keeps what the algorithm itself costs in that block. The one timing loop of the bench.
+BlockTimes timeBlocks(int blocks, int repeats, const std::function<TimedRun()>& makeRun) {
+    std::vector<double> best(static_cast<std::size_t>(blocks), 1e300);
+    ScopedFlushDenormals ftz;
+    for (int rep = 0; rep < std::max(1, repeats); ++rep) {
+        const TimedRun run = makeRun();
+        for (int b = 0; b < blocks; ++b) {
+            if (run.prepare) run.prepare(b);
+            const auto s0 = Clock::now();
+            run.block(b);
+            const double ns = std::chrono::duration<double, std::nano>(Clock::now() - s0).count();
+            best[static_cast<std::size_t>(b)] = std::min(best[static_cast<std::size_t>(b)], ns);
+            if (run.check) run.check(b);
+        }
+    }
+    BlockTimes t;
+    double total = 0;
+    for (double ns : best) total += ns;
+    t.nsPerSample = total / (double(blocks) * kBlock);
+    std::sort(best.begin(), best.end());
+    t.medianBlockNs = best[best.size() / 2];
+    t.p99BlockNs = best[best.size() * 99 / 100];
+    t.maxBlockNs = best.back();
+    return t;
+}
+
+// Times a deterministic train of strikes (4 per second) block by block.
 template <typename Real>
 void timeStrikes(const ImpactSetting& s, double seconds, ImpactMeasurement& m, int repeats = 5) {
     const int blocks = static_cast<int>(seconds * kRate / kBlock);
     const int strikeEvery = static_cast<int>(0.25 * kRate / kBlock);
-    std::vector<double> best(static_cast<std::size_t>(blocks), 1e300);
-    std::vector<float> out(kBlock);
-    ScopedFlushDenormals ftz;
-    for (int rep = 0; rep < repeats; ++rep) {
-        HuntCrossleyImpactT<Real> impact;
-        impact.configure(benchParams(s), benchModes(), {{1.0, 1.0, 1.0}});
-        impact.prepare({kRate, kBlock});
-        for (int b = 0; b < blocks; ++b) {
-            const auto s0 = Clock::now();
-            if (b % strikeEvery == 0) impact.strike(0.5);
-            impact.process(nullptr, out.data(), kBlock);
-            const double ns = std::chrono::duration<double, std::nano>(Clock::now() - s0).count();
-            best[static_cast<std::size_t>(b)] = std::min(best[static_cast<std::size_t>(b)], ns);
-        }
-    }
-    double total = 0;
-    for (double ns : best) total += ns;
-    m.nsPerSample = total / (double(blocks) * kBlock);
-    std::sort(best.begin(), best.end());
-    m.medianBlockNs = best[best.size() / 2];
-    m.p99BlockNs = best[best.size() * 99 / 100];
-    m.maxBlockNs = best.back();
+    auto out = std::make_shared<std::vector<float>>(kBlock);
+    const BlockTimes t = timeBlocks(blocks, repeats, [&] {
+        auto impact = std::make_shared<HuntCrossleyImpactT<Real>>();
+        impact->configure(benchParams(s), benchModes(), {{1.0, 1.0, 1.0}});
+        impact->prepare({kRate, kBlock});
+        TimedRun run;
+        run.block = [impact, out, strikeEvery](int b) {
+            if (b % strikeEvery == 0) impact->strike(0.5);
+            impact->process(nullptr, out->data(), kBlock);
+        };
+        return run;
+    });
+    m.nsPerSample = t.nsPerSample;
+    m.medianBlockNs = t.medianBlockNs;
+    m.p99BlockNs = t.p99BlockNs;
+    m.maxBlockNs = t.maxBlockNs;
 }
 
 std::vector<double> thirdOctaveLevels(const std::vector<float>& x, double fs) {
@@ -333,7 +363,7 @@ Scenario makeScenario(const std::string& id) {
                     f->resonator().flushTinyState();
                 }};
     }
-    if (id == "aggregate-gravel") {
+    if (id == "aggregate-gravel" || id == "aggregate-gravel-1voice") {
         AggregateParameters p; // gravel.toml, first ("sharp clicks") grains layer
         p.gamma = -1.6;
         p.energyMin = 0.001;
@@ -345,6 +375,12 @@ Scenario makeScenario(const std::string& id) {
         p.voices = 48;
         p.burstEvents = 1.0;
         p.burstMs = 1.5;
+        if (id == "aggregate-gravel-1voice") {
+            // Like for like with SDT's crumpling patch: one grain resonator, retriggered by each
+            // event (the new grain cuts the last one off), no follow-up bursts.
+            p.voices = 1;
+            p.burstEvents = 0.0;
+        }
         auto a = std::make_shared<AggregateModel>();
         a->configure(p);
         a->prepare(kRate, 4000);
@@ -373,41 +409,105 @@ Scenario makeScenario(const std::string& id) {
 } // namespace
 
 const std::vector<std::string>& scenarioIds() {
-    static const std::vector<std::string> ids = {"impact-strikes",   "impact-pressed",
-                                                 "impact-metal",     "friction-creak",
-                                                 "aggregate-gravel", "bubbles"};
+    static const std::vector<std::string> ids = {
+        "impact-strikes",   "impact-pressed", "impact-metal",           "friction-creak",
+        "aggregate-gravel", "bubbles",        "aggregate-gravel-1voice"};
     return ids;
 }
 
 ScenarioMeasurement measureScenario(const std::string& id, double seconds, int repeats) {
     const int blocks = static_cast<int>(seconds * kRate / kBlock);
-    std::vector<double> best(static_cast<std::size_t>(blocks), 1e300);
-    std::vector<float> out(kBlock);
+    auto out = std::make_shared<std::vector<float>>(kBlock);
+    auto checksum = std::make_shared<double>(0.0);
     ScenarioMeasurement m;
     m.id = id;
-    ScopedFlushDenormals ftz;
-    for (int rep = 0; rep < std::max(1, repeats); ++rep) {
-        Scenario sc = makeScenario(id);
-        double checksum = 0;
-        for (int b = 0; b < blocks; ++b) {
-            std::fill(out.begin(), out.end(), 0.0f);
-            const auto s0 = Clock::now();
-            sc.block(b, out.data());
-            const double ns = std::chrono::duration<double, std::nano>(Clock::now() - s0).count();
-            best[static_cast<std::size_t>(b)] = std::min(best[static_cast<std::size_t>(b)], ns);
-            for (float y : out) checksum += std::fabs(double(y));
-        }
-        m.checksum = checksum;
-    }
-    double total = 0;
-    for (double ns : best) total += ns;
-    m.nsPerSample = total / (double(blocks) * kBlock);
-    std::sort(best.begin(), best.end());
-    m.medianBlockNs = best[best.size() / 2];
-    m.p99BlockNs = best[best.size() * 99 / 100];
-    m.maxBlockNs = best.back();
+    const BlockTimes t = timeBlocks(blocks, repeats, [&] {
+        auto sc = std::make_shared<Scenario>(makeScenario(id));
+        *checksum = 0.0;
+        TimedRun run;
+        run.prepare = [out](int) { std::fill(out->begin(), out->end(), 0.0f); };
+        run.block = [sc, out](int b) { sc->block(b, out->data()); };
+        run.check = [out, checksum](int) {
+            for (float y : *out) *checksum += std::fabs(double(y));
+        };
+        return run;
+    });
+    m.checksum = *checksum;
+    m.nsPerSample = t.nsPerSample;
+    m.medianBlockNs = t.medianBlockNs;
+    m.p99BlockNs = t.p99BlockNs;
+    m.maxBlockNs = t.maxBlockNs;
     m.budgetShare = m.maxBlockNs / (1e9 * kBlock / kRate);
     return m;
+}
+
+std::vector<ScalingPoint> measureScaling(double seconds, int repeats) {
+    const int blocks = static_cast<int>(seconds * kRate / kBlock);
+    const int strikeEvery = static_cast<int>(0.25 * kRate / kBlock);
+    auto out = std::make_shared<std::vector<float>>(kBlock);
+    std::vector<ScalingPoint> points;
+    auto timeRuns = [&](const std::function<TimedRun()>& make) {
+        return timeBlocks(blocks, repeats, make).nsPerSample;
+    };
+    // Simultaneous impact voices (the impact-strikes scenario's voice), strikes staggered.
+    for (int voices : {1, 2, 4, 8, 16, 32, 64, 128, 256}) {
+        const double ns = timeRuns([&] {
+            auto pool =
+                std::make_shared<std::vector<HuntCrossleyImpact>>(static_cast<std::size_t>(voices));
+            for (auto& v : *pool) {
+                v.configure(scenarioImpact(), benchModes(), {{1.0, 1.0, 1.0}});
+                v.prepare({kRate, kBlock});
+            }
+            TimedRun run;
+            run.block = [pool, out, strikeEvery](int b) {
+                for (std::size_t v = 0; v < pool->size(); ++v) {
+                    auto& voice = (*pool)[v];
+                    if ((b + static_cast<int>(v) * 7) % strikeEvery == 0) voice.strike(0.5);
+                    voice.process(nullptr, out->data(), kBlock);
+                }
+            };
+            return run;
+        });
+        points.push_back({"voices", voices, ns, ns / voices});
+    }
+    // Modes per voice: one impact voice, modes spread over 100 Hz..19 kHz.
+    for (int modes : {3, 6, 12, 24, 48, 64}) {
+        std::vector<Mode> m;
+        for (int i = 0; i < modes; ++i)
+            m.push_back({100.0 + 18900.0 * i / std::max(1, modes - 1), 0.2 / (1 + 0.1 * i), 1.0});
+        const std::vector<double> g(static_cast<std::size_t>(modes), 1.0);
+        const double ns = timeRuns([&] {
+            auto impact = std::make_shared<HuntCrossleyImpact>();
+            impact->configure(scenarioImpact(), m, {g});
+            impact->prepare({kRate, kBlock});
+            TimedRun run;
+            run.block = [impact, out, strikeEvery](int b) {
+                if (b % strikeEvery == 0) impact->strike(0.5);
+                impact->process(nullptr, out->data(), kBlock);
+            };
+            return run;
+        });
+        points.push_back({"modes per voice", modes, ns, ns / modes});
+    }
+    // Grain rate: the aggregate-gravel scenario's grains layer at 250..16000 events/s.
+    for (int rate : {250, 500, 1000, 2000, 4000, 8000, 16000}) {
+        const double ns = timeRuns([&] {
+            Scenario sc = makeScenario("aggregate-gravel");
+            auto a = std::static_pointer_cast<AggregateModel>(sc.state);
+            a->prepare(kRate, 16000);
+            a->reset(7);
+            auto rates = std::make_shared<std::vector<float>>(kBlock, float(rate));
+            auto scale = std::make_shared<std::vector<float>>(kBlock, 1.0f);
+            TimedRun run;
+            run.prepare = [out](int) { std::fill(out->begin(), out->end(), 0.0f); };
+            run.block = [a, rates, scale, out](int) {
+                a->process(rates->data(), scale->data(), out->data(), kBlock);
+            };
+            return run;
+        });
+        points.push_back({"grain events/s", rate, ns, ns / (rate / 1000.0)});
+    }
+    return points;
 }
 
 } // namespace underfoot::engine

@@ -78,7 +78,9 @@ std::vector<KnobMeasurement> measureKnobs(double seconds = 4.0);
 ///   friction-creak  the creaking-wood friction layer (5 modes), 105 N normal force, its drive
 ///                   spring's anchor moving at 0.05 m/s;
 ///   aggregate-gravel the gravel preset's sharp grains layer at 1000 events/s;
-///   bubbles         a bubble stream at 500 bubbles/s with 48 voices (default radii 0.5-5 mm).
+///   bubbles         a bubble stream at 500 bubbles/s with 48 voices (default radii 0.5-5 mm);
+///   aggregate-gravel-1voice the same grains with one voice and no bursts: like for like with
+///                   SDT's crumpling patch (one resonator retriggered by every event).
 const std::vector<std::string>& scenarioIds();
 
 struct ScenarioMeasurement {
@@ -92,5 +94,16 @@ struct ScenarioMeasurement {
 /// Runs scenario `id` for `seconds` of audio, `repeats` times (per-block minimum). Throws
 /// std::invalid_argument for an unknown id.
 ScenarioMeasurement measureScenario(const std::string& id, double seconds, int repeats = 5);
+
+/// How the cost grows (issue #18): ns per output sample against simultaneous impact voices
+/// (1..256, the impact-strikes voice, strikes staggered), modes per voice (3..64, one voice) and
+/// grain events per second (250..16000, the aggregate-gravel layer). `perUnit` divides by the
+/// voices, the modes or the thousands of events per second.
+struct ScalingPoint {
+    std::string axis;
+    int value = 0;
+    double nsPerSample = 0, perUnit = 0;
+};
+std::vector<ScalingPoint> measureScaling(double seconds = 2.0, int repeats = 3);
 
 } // namespace underfoot::engine
