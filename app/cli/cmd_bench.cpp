@@ -2,6 +2,8 @@
 // `underfoot bench`: what accuracy costs in time (engine/render/AccuracyCost.h), as Markdown.
 #include "app/cli/CommandRegistry.h"
 #include "engine/render/AccuracyCost.h"
+#include "engine/render/SceneBench.h"
+#include "engine/surfaces/Surface.h"
 
 #include <fmt/core.h>
 
@@ -23,6 +25,24 @@ bool isScenario(const std::string& id) {
     for (const auto& s : eng::scenarioIds())
         if (s == id) return true;
     return false;
+}
+
+void printSceneHeader(const char* what) {
+    fmt::print(
+        "| {} | reverb taps | x real time | ns/sample | ns/sample, mean of per-block minima | "
+        "median block | p99 block | worst block | worst / median | worst / 1333 us "
+        "budget |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
+        what);
+}
+
+void printSceneRow(const std::string& name, const eng::SceneBenchResult& r) {
+    const auto& s = r.stats;
+    fmt::print(
+        "| {} | {} | {:.0f} | {:.1f} | {:.1f} | {:.2f} us | {:.2f} us | {:.2f} us | {:.2f} | "
+        "{:.2f} % |\n",
+        name, r.hasReverb ? std::to_string(r.irLength) : std::string("-"), s.realTimeFactor,
+        s.nsPerSample, s.minimaNsPerSample, s.medianUs, s.p99Us, s.worstUs, s.worstOverMedian(),
+        100.0 * s.budgetShare());
 }
 
 int runBench(const BenchArgs& a) {
@@ -84,10 +104,21 @@ int runBench(const BenchArgs& a) {
         fmt::print("\n");
     }
     if (a.only == "all" || a.only == "surfaces") {
-        fmt::print("### One voice of every surface, virtual walker at 100 steps/min, 48 kHz\n\n");
-        fmt::print("| surface | x real time | ns/sample |\n|---|---:|---:|\n");
-        for (const auto& c : eng::measureSurfaceCosts(2.0 * a.seconds))
-            fmt::print("| {} | {:.0f} | {:.1f} |\n", c.id, c.realTimeFactor, c.nsPerSample);
+        // engine/render/SceneBench: the same timing as tests/bench/bench_reverb (one harness).
+        fmt::print("### One voice of every surface, virtual walker at 100 steps/min, 48 kHz, "
+                   "64-frame blocks, {} runs\n\n",
+                   a.repeats);
+        fmt::print("x real time and ns/sample: the fastest run's thread CPU time; blocks: "
+                   "per-block minimum over the runs (steady clock).\n\n");
+        printSceneHeader("surface");
+        for (const auto& info : eng::listSurfaces()) {
+            eng::SceneBenchSpec spec;
+            spec.surface = info.id;
+            spec.seconds = 2.0 * a.seconds;
+            spec.repeats = a.repeats;
+            printSceneRow(info.id, eng::measureScene(spec));
+        }
+        fmt::print("\n");
     }
     return 0;
 }

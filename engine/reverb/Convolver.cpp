@@ -213,7 +213,7 @@ struct Convolver::Stage {
                                 static_cast<std::size_t>(P);
     }
 
-    void clear() {
+    void clear() noexcept {
         std::fill(frame.p, frame.p + 2 * P, 0.0f);
         std::fill(cur.begin(), cur.end(), 0.0f);
         std::fill(xRe.begin(), xRe.end(), 0.0f);
@@ -519,7 +519,7 @@ void Convolver::prepare(const AudioBuffer& impulseResponse, double sampleRateHz,
     }
 }
 
-void Convolver::reset() {
+void Convolver::reset() noexcept {
     std::fill(line_.begin(), line_.end(), 0.0f);
     phase_ = 0;
     for (auto& s : stages_) s->clear();

@@ -51,8 +51,8 @@ class Convolver {
     /// cannot plan. `blockSize` is the largest n passed to process() (any n works; the output
     /// does not depend on it).
     void prepare(const AudioBuffer& impulseResponse, double sampleRateHz, int blockSize);
-    /// Clears the signal history (not for the audio thread).
-    void reset();
+    /// Clears the signal history (no allocation: usable wherever process() is).
+    void reset() noexcept;
     /// Mono in, stereo out; in may alias outL or outR. No allocation, no locks, no waiting.
     void process(const float* in, float* outL, float* outR, int n) noexcept;
 
