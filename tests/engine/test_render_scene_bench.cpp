@@ -5,12 +5,30 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <stdexcept>
+#include <string>
+#include <sys/wait.h>
 #include <vector>
 
 using namespace underfoot::engine;
 
 namespace {
+struct CommandResult {
+    int exitCode;
+    std::string output;
+};
+CommandResult runUnderfoot(const std::string& args) {
+    const std::string cmd =
+        std::string(UNDERFOOT_BINARY_DIR) + "/app/cli/underfoot " + args + " 2>&1";
+    FILE* pipe = popen(cmd.c_str(), "r");
+    std::string out;
+    char buf[512];
+    while (pipe && fgets(buf, sizeof buf, pipe)) out += buf;
+    const int status = pipe ? pclose(pipe) : -1;
+    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
 std::vector<float> renderBlocks(FootstepScene& scene, const GrfSignal& grf, int block) {
     std::vector<float> out, l(static_cast<std::size_t>(block)), r(l.size());
     for (std::size_t s = 0; s + static_cast<std::size_t>(block) <= grf.frames();
@@ -92,4 +110,17 @@ TEST(SceneBench, MeasuresAReverbSurfaceAndReportsConsistentFigures) {
     EXPECT_EQ(dry.irLength, 0u);
     spec.surface = "no_such_surface";
     EXPECT_ANY_THROW(measureScene(spec));
+}
+
+// `underfoot bench --only surfaces` prints one row per surface from SceneBench, reverb presets
+// with their IR length.
+TEST(SceneBench, BenchCommandPrintsEverySurfaceWithItsBlockFigures) {
+    const auto r = runUnderfoot("bench --only surfaces --seconds 0.5 --repeats 1");
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_NE(r.output.find("| wood | - |"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("| wood_reverb | 42240 |"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("worst / median"), std::string::npos);
+    const auto bad = runUnderfoot("bench --only no_such_part");
+    EXPECT_NE(bad.exitCode, 0);
+    EXPECT_NE(bad.output.find("--only"), std::string::npos) << bad.output;
 }
