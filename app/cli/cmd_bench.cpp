@@ -2,6 +2,12 @@
 // `underfoot bench`: what accuracy costs in time (engine/render/AccuracyCost.h), as Markdown.
 #include "app/cli/CommandRegistry.h"
 #include "engine/render/AccuracyCost.h"
+#include "engine/render/SceneBench.h"
+#include "engine/scene/LiveScene.h"
+#include "engine/surfaces/Surface.h"
+#include "soundscapes/Coherence.h"
+#include "soundscapes/Library.h"
+#include "soundscapes/Renderer.h"
 
 #include <fmt/core.h>
 
@@ -23,6 +29,57 @@ bool isScenario(const std::string& id) {
     for (const auto& s : eng::scenarioIds())
         if (s == id) return true;
     return false;
+}
+
+/// A soundscape as the live scene's background (as `underfoot live --soundscape` adapts it).
+class SoundscapeAmbience final : public eng::AmbienceSource {
+  public:
+    explicit SoundscapeAmbience(const std::string& id)
+        : renderer_(underfoot::soundscapes::loadSoundscape(id)), id_(id) {}
+    void prepare(const eng::ProcessSpec& spec) override { renderer_.prepare(spec); }
+    void reset(std::uint64_t seed) noexcept override { renderer_.reset(seed); }
+    void process(float* l, float* r, int n) noexcept override { renderer_.process(l, r, n); }
+    std::string name() const override { return id_; }
+
+  private:
+    underfoot::soundscapes::SoundscapeRenderer renderer_;
+    std::string id_;
+};
+
+struct SceneRow {
+    std::string surface, impulseResponse, soundscape;
+};
+
+/// The shipped scenes: every surface with its coherent soundscape (soundscapes/data/
+/// coherence.toml), every preset with a reverb, and the live engine's heaviest reference scene
+/// (creaking wood + the hall + the forest, as tests/bench/bench_live.cpp).
+std::vector<SceneRow> shippedScenes() {
+    std::vector<SceneRow> rows;
+    const auto& coherence = underfoot::soundscapes::CoherenceTable::builtin();
+    for (const auto& info : eng::listSurfaces())
+        if (auto sc = coherence.coherentSoundscapeFor(info.id)) rows.push_back({info.id, "", *sc});
+    for (const auto& info : eng::listSurfaces())
+        if (info.reverb) rows.push_back({info.id, "", ""});
+    rows.push_back({"creaking_wood", "hall", "forest"});
+    return rows;
+}
+
+void printSceneHeader(const char* what) {
+    fmt::print(
+        "| {} | reverb taps | x real time | ns/sample | ns/sample, mean of per-block minima | "
+        "median block | p99 block | worst block | worst / median | worst / 1333 us "
+        "budget |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
+        what);
+}
+
+void printSceneRow(const std::string& name, const eng::SceneBenchResult& r) {
+    const auto& s = r.stats;
+    fmt::print(
+        "| {} | {} | {:.0f} | {:.1f} | {:.1f} | {:.2f} us | {:.2f} us | {:.2f} us | {:.2f} | "
+        "{:.2f} % |\n",
+        name, r.hasReverb ? std::to_string(r.irLength) : std::string("-"), s.realTimeFactor,
+        s.nsPerSample, s.minimaNsPerSample, s.medianUs, s.p99Us, s.worstUs, s.worstOverMedian(),
+        100.0 * s.budgetShare());
 }
 
 int runBench(const BenchArgs& a) {
@@ -94,11 +151,56 @@ int runBench(const BenchArgs& a) {
                        k.spectralDistanceDb, k.nsPerSample);
         fmt::print("\n");
     }
+    if (a.only == "all" || a.only == "scenes") {
+        fmt::print("### Shipped scenes: one walker (two voices, one per foot), the reverb, the "
+                   "soundscape (unity gain, as the live headphone mix), 48 kHz, 64-frame blocks, "
+                   "{} runs of {:.0f} s\n\n",
+                   a.repeats, 2.0 * a.seconds);
+        fmt::print("| scene | reverb taps | x real time | x real time per voice | ns/sample | "
+                   "median block | p99 block | worst block | worst / median | worst / 1333 us "
+                   "budget |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+        for (const auto& row : shippedScenes()) {
+            eng::SceneBenchSpec spec;
+            spec.surface = row.surface;
+            spec.impulseResponse = row.impulseResponse;
+            spec.voices = 2;
+            spec.seconds = 2.0 * a.seconds;
+            spec.repeats = a.repeats;
+            std::unique_ptr<SoundscapeAmbience> ambience;
+            if (!row.soundscape.empty()) {
+                ambience = std::make_unique<SoundscapeAmbience>(row.soundscape);
+                spec.ambience = ambience.get();
+            }
+            const auto r = eng::measureScene(spec);
+            std::string name = row.surface;
+            if (!row.impulseResponse.empty()) name += " + " + row.impulseResponse;
+            if (!row.soundscape.empty()) name += " + " + row.soundscape;
+            const auto& st = r.stats;
+            fmt::print("| {} | {} | {:.0f} | {:.0f} | {:.1f} | {:.2f} us | {:.2f} us | {:.2f} us | "
+                       "{:.2f} | {:.2f} % |\n",
+                       name, r.hasReverb ? std::to_string(r.irLength) : std::string("-"),
+                       st.realTimeFactor, st.realTimeFactor * spec.voices, st.nsPerSample,
+                       st.medianUs, st.p99Us, st.worstUs, st.worstOverMedian(),
+                       100.0 * st.budgetShare());
+        }
+        fmt::print("\n");
+    }
     if (a.only == "all" || a.only == "surfaces") {
-        fmt::print("### One voice of every surface, virtual walker at 100 steps/min, 48 kHz\n\n");
-        fmt::print("| surface | x real time | ns/sample |\n|---|---:|---:|\n");
-        for (const auto& c : eng::measureSurfaceCosts(2.0 * a.seconds))
-            fmt::print("| {} | {:.0f} | {:.1f} |\n", c.id, c.realTimeFactor, c.nsPerSample);
+        // engine/render/SceneBench: the same timing as tests/bench/bench_reverb (one harness).
+        fmt::print("### One voice of every surface, virtual walker at 100 steps/min, 48 kHz, "
+                   "64-frame blocks, {} runs\n\n",
+                   a.repeats);
+        fmt::print("x real time and ns/sample: the fastest run's thread CPU time; blocks: "
+                   "per-block minimum over the runs (steady clock).\n\n");
+        printSceneHeader("surface");
+        for (const auto& info : eng::listSurfaces()) {
+            eng::SceneBenchSpec spec;
+            spec.surface = info.id;
+            spec.seconds = 2.0 * a.seconds;
+            spec.repeats = a.repeats;
+            printSceneRow(info.id, eng::measureScene(spec));
+        }
+        fmt::print("\n");
     }
     return 0;
 }
@@ -107,15 +209,14 @@ CommandRegistrar reg("bench", [](CLI::App& app, int& exitCode) {
     auto args = std::make_shared<BenchArgs>();
     auto* cmd = app.add_subcommand(
         "bench", "Measure what accuracy costs: error against a reference and CPU time per setting");
-    std::vector<std::string> choices = {
-        "all", "impact", "knobs", "surfaces", "impact-default", "scenarios", "scaling"};
+    std::vector<std::string> choices = {"all",    "impact",         "knobs",     "surfaces",
+                                        "scenes", "impact-default", "scenarios", "scaling"};
     for (const auto& id : eng::scenarioIds()) choices.push_back(id);
-    cmd->add_option(
-           "--only", args->only,
-           "all, impact, knobs, surfaces, scenarios, scaling (not in all), impact-default (for "
-           "callgrind), or "
-           "one scenario: impact-strikes, impact-pressed, impact-metal, friction-creak, "
-           "aggregate-gravel, bubbles, aggregate-gravel-1voice")
+    cmd->add_option("--only", args->only,
+                    "all, impact, knobs, surfaces, scenes, scenarios, scaling (not in all), "
+                    "impact-default (for callgrind), or one scenario: impact-strikes, "
+                    "impact-pressed, impact-metal, friction-creak, aggregate-gravel, bubbles, "
+                    "aggregate-gravel-1voice")
         ->check(CLI::IsMember(choices))
         ->capture_default_str();
     cmd->add_option("--repeats", args->repeats,

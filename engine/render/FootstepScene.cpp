@@ -59,6 +59,7 @@ void FootstepScene::prepare(const ProcessSpec& spec) {
 void FootstepScene::reset(std::uint64_t seed) noexcept {
     for (std::size_t v = 0; v < voices_.size(); ++v)
         voices_[v]->reset(Random::deriveSeed(seed, 100 + v));
+    if (reverb_) reverb_->reset();
 }
 
 void FootstepScene::process(const float* const* grf, float* outL, float* outR, int n) noexcept {

@@ -45,12 +45,16 @@ class FootstepScene {
     /// PresetError / std::runtime_error with a clear message.
     void build(const std::string& surface, const SceneOptions& options = {});
     void prepare(const ProcessSpec& spec);
+    /// Restarts deterministically: the voices from `seed`, the reverb's history cleared (a reset
+    /// scene gives the samples of a freshly built one).
     void reset(std::uint64_t seed) noexcept;
     /// grf[v] is the GRF (N) of voice v (v < voices()); writes stereo output (overwrites).
     void process(const float* const* grf, float* outL, float* outR, int n) noexcept;
 
     int voices() const noexcept { return static_cast<int>(voices_.size()); }
     bool hasReverb() const noexcept { return reverb_ != nullptr; }
+    /// Taps of the reverb's IR at the processing rate (0: no reverb or not prepared).
+    std::size_t reverbLength() const noexcept { return reverb_ ? reverb_->impulseLength() : 0; }
     const Surface& surface(int v = 0) const { return *voices_.at(static_cast<std::size_t>(v)); }
     /// Measured cost per node, when `measure` is on (off by default: no clock reads).
     void setMeasureCost(bool on) noexcept { measure_ = on; }

@@ -18,6 +18,12 @@
 ///    the whole next period. It is cut into P / 64 slices (a schedule fixed in prepare() by
 ///    estimated cost; order: the products of the older spectra, the forward FFT, the newest
 ///    product, the inverse FFTs), and one slice runs every 64 input samples.
+///  - In stages with P >= 1024 no piece of that work is large against a slice (issue #18: worst
+///    64-frame block <= 2x the median on short IRs too): the 2P-point FFTs are complex
+///    "four-step" FFTs (Bailey 1990: 2P / 64 DFTs of 64 points, twiddles, 64 DFTs of 2P / 64
+///    points; FFTW plans of a few DFTs each, run one group per piece), both output channels share
+///    one inverse (left + i right), and the products are cut into bin ranges. The order of the
+///    operations per bin does not depend on the cut, so the output stays the same for any block.
 /// Work is tied to the count of input samples only (a "tick" every 64 samples), never to the
 /// host block: the output is bit-identical for every block size (replay relies on it).
 /// FFTs: FFTW single precision, FFTW_ESTIMATE plans (deterministic; planned under a lock).
@@ -51,8 +57,8 @@ class Convolver {
     /// cannot plan. `blockSize` is the largest n passed to process() (any n works; the output
     /// does not depend on it).
     void prepare(const AudioBuffer& impulseResponse, double sampleRateHz, int blockSize);
-    /// Clears the signal history (not for the audio thread).
-    void reset();
+    /// Clears the signal history (no allocation: usable wherever process() is).
+    void reset() noexcept;
     /// Mono in, stereo out; in may alias outL or outR. No allocation, no locks, no waiting.
     void process(const float* in, float* outL, float* outR, int n) noexcept;
 

@@ -20,9 +20,9 @@
 #include "engine/scene/LiveEngine.h"
 #include "soundscapes/Library.h"
 #include "soundscapes/Renderer.h"
+#include "tests/bench/BenchCommon.h"
 
 #include <benchmark/benchmark.h>
-#include <zita-convolver.h>
 
 #include <ctime>
 #include <memory>
@@ -34,16 +34,11 @@ namespace {
 constexpr int kRate = 48000;
 constexpr int kBlock = 64;
 
-double processCpuSeconds() {
-    timespec ts{};
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-    return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
-}
-
+using underfoot::bench::noise;
+using underfoot::bench::processCpuSeconds;
+using underfoot::bench::Zita;
 double threadCpu() {
-    timespec ts{};
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+    return underfoot::bench::threadCpuSeconds();
 }
 
 class Ambience final : public AmbienceSource {
@@ -97,47 +92,15 @@ struct Rig {
     std::vector<float*> outPtr;
 };
 
-/// zita-convolver used as its author intends (one instance, non-uniform partitions 64..8192
-/// computed in its own threads, one quantum of latency), mono in, stereo IR out.
-/// One instance for the whole program, never destroyed: after a run faster than real time the
-/// Debian build's stop_process()/cleanup() waits forever for its worker threads (seen with gdb:
-/// workers in Convlevel::main's sem_wait, cleanup() polling), so the program's exit ends them.
-struct Zita {
-    static Zita& hall() {
-        static Zita* instance = new Zita(readAudioFile(findImpulseResponse("hall"), kRate));
-        return *instance;
-    }
-    explicit Zita(const AudioBuffer& ir) {
-        const auto len = static_cast<unsigned>(ir.frames());
-        zita.set_options(Convproc::OPT_VECTOR_MODE); // as our Convolver's stages
-        if (zita.configure(1, 2, len, kBlock, kBlock, 8192, 0.0f) != 0)
-            throw std::runtime_error("zita configure failed");
-        for (int c = 0; c < 2; ++c) {
-            std::vector<float> h(len);
-            for (unsigned i = 0; i < len; ++i) h[i] = ir.at(i, ir.channels > 1 ? c : 0);
-            zita.impdata_create(0, static_cast<unsigned>(c), 1, h.data(), 0, static_cast<int>(len));
-        }
-        if (zita.start_process(0, SCHED_OTHER) != 0) throw std::runtime_error("zita start failed");
-    }
-    void block(const float* in, float* l, float* r) {
-        std::copy(in, in + kBlock, zita.inpdata(0));
-        // Synchronous: each call waits for the worker threads' partitions due in it, so that
-        // running faster than real time measures all of zita's work instead of letting it
-        // fall behind (zita stops itself after 5 late cycles in asynchronous mode).
-        zita.process(true);
-        std::copy(zita.outdata(0), zita.outdata(0) + kBlock, l);
-        std::copy(zita.outdata(1), zita.outdata(1) + kBlock, r);
-    }
-    Convproc zita;
-};
+/// zita-convolver on the hall, one instance for the whole program, never destroyed (see
+/// tests/bench/BenchCommon.h).
+Zita& zitaHall() {
+    static Zita* instance = new Zita(readAudioFile(findImpulseResponse("hall"), kRate), kBlock);
+    return *instance;
+}
 
 std::vector<float> noiseBlock(int n, std::uint32_t seed) {
-    std::vector<float> x(static_cast<std::size_t>(n));
-    for (auto& v : x) {
-        seed = seed * 1664525u + 1013904223u;
-        v = (static_cast<float>(seed >> 8) / 16777216.0f - 0.5f) * 0.2f;
-    }
-    return x;
+    return noise(static_cast<std::size_t>(n), seed);
 }
 
 void sceneBench(benchmark::State& state, bool heaviest) {
@@ -175,7 +138,7 @@ void reverbOurs(benchmark::State& state) {
 
 void reverbZita(benchmark::State& state) {
     ScopedFlushDenormals flush;
-    Zita& z = Zita::hall();
+    Zita& z = zitaHall();
     const auto in = noiseBlock(kBlock, 1);
     std::vector<float> l(kBlock), r(kBlock);
     std::int64_t blocks = 0;
@@ -197,7 +160,7 @@ void liveCostSummary(benchmark::State& state) {
     Rig heavy(true), dry(false);
     Convolver conv;
     conv.prepare(readAudioFile(findImpulseResponse("hall")), kRate, kBlock);
-    Zita& z = Zita::hall();
+    Zita& z = zitaHall();
     const auto in = noiseBlock(kBlock, 1);
     std::vector<float> l(kBlock), r(kBlock);
     const std::int64_t blocks = std::int64_t(20) * kRate / kBlock;

@@ -7,11 +7,10 @@
 //   - per reverb surface (one voice, the virtual walker at 100 steps/min, FootstepScene at 64
 //     frames, reverb included): median, p99 and worst block, worst / median, x real time;
 //     and the same surface dry (ReverbMode::Off) for reference.
-// Timing method: the same deterministic input is run `repeats` times (the state reset in
-// between, so block b does the same work in every repeat); each block's time is the MINIMUM
-// over the repeats (steady clock around each process() call). A shared machine only ever slows
-// a block down (preemption, another process in the cache), so the minimum is the block's own
-// cost; median / p99 / worst are taken over those per-block minima.
+// Timing method: engine/render/SceneBench's timeBlocks (the same as `underfoot bench --only
+// surfaces|scenes`): the same deterministic input runs `repeats` times, everything reset in
+// between so that block b does the same work in every repeat; x real time from the fastest
+// repeat's whole-run CPU time; median / p99 / worst over the per-block minima (steady clock).
 //
 // Instructions per sample against zita-convolver (callgrind; difference of a long and a short
 // run, so that loading, planning and start-up cancel):
@@ -24,10 +23,11 @@
 #include "engine/io/AudioFile.h"
 #include "engine/render/FootstepScene.h"
 #include "engine/render/Renderer.h"
+#include "engine/render/SceneBench.h"
 #include "engine/reverb/Convolver.h"
+#include "tests/bench/BenchCommon.h"
 
 #include <benchmark/benchmark.h>
-#include <zita-convolver.h>
 
 #include <algorithm>
 #include <chrono>
@@ -40,86 +40,26 @@
 #include <vector>
 
 using namespace underfoot::engine;
+using underfoot::bench::noise;
+using underfoot::bench::Zita;
 
 namespace {
 constexpr int kRate = 48000;
 constexpr int kBlock = 64;
 
-/// zita-convolver, mono in, stereo IR out, partitions 64..8192 with its threads (as
-/// tests/bench/bench_live.cpp). Never destroyed: the Debian build's stop_process()/cleanup()
-/// can wait forever for its worker threads after a run faster than real time.
-struct Zita {
-    explicit Zita(const AudioBuffer& ir) {
-        const auto len = static_cast<unsigned>(ir.frames());
-        zita.set_options(Convproc::OPT_VECTOR_MODE);
-        if (zita.configure(1, 2, len, kBlock, kBlock, 8192, 0.0f) != 0)
-            throw std::runtime_error("zita configure failed");
-        for (int c = 0; c < 2; ++c) {
-            std::vector<float> h(len);
-            for (unsigned i = 0; i < len; ++i) h[i] = ir.at(i, ir.channels > 1 ? c : 0);
-            zita.impdata_create(0, static_cast<unsigned>(c), 1, h.data(), 0, static_cast<int>(len));
-        }
-        if (zita.start_process(0, SCHED_OTHER) != 0) throw std::runtime_error("zita start failed");
-    }
-    void block(const float* in, float* l, float* r) {
-        std::copy(in, in + kBlock, zita.inpdata(0));
-        zita.process(true); // synchronous: waits for the worker threads' partitions due now
-        std::copy(zita.outdata(0), zita.outdata(0) + kBlock, l);
-        std::copy(zita.outdata(1), zita.outdata(1) + kBlock, r);
-    }
-    Convproc zita;
-};
-
-std::vector<float> noise(std::size_t n, std::uint32_t seed) {
-    std::vector<float> x(n);
-    for (auto& v : x) {
-        seed = seed * 1664525u + 1013904223u;
-        v = (static_cast<float>(seed >> 8) / 16777216.0f - 0.5f) * 0.2f;
-    }
-    return x;
-}
-
 AudioBuffer shippedIr(const std::string& name) {
     return readAudioFile(findImpulseResponse(name), kRate);
 }
 
-struct BlockStats {
-    double medianUs = 0, p99Us = 0, worstUs = 0, meanUs = 0;
-};
-
-/// Per-block minimum over `repeats` runs of `blocks` blocks; `reset` runs before each repeat
-/// and `block(b)` processes block b.
-BlockStats timeBlocks(std::size_t blocks, int repeats, const std::function<void()>& reset,
-                      const std::function<void(std::size_t)>& block) {
-    using Clock = std::chrono::steady_clock;
-    std::vector<double> best(blocks, 1e300);
-    for (int r = 0; r < repeats; ++r) {
-        reset();
-        for (std::size_t b = 0; b < blocks; ++b) {
-            const auto t0 = Clock::now();
-            block(b);
-            const auto t1 = Clock::now();
-            best[b] = std::min(best[b], std::chrono::duration<double, std::micro>(t1 - t0).count());
-        }
-    }
-    BlockStats s;
-    for (double v : best) s.meanUs += v;
-    s.meanUs /= double(blocks);
-    std::vector<double> sorted = best;
-    std::sort(sorted.begin(), sorted.end());
-    s.medianUs = sorted[sorted.size() / 2];
-    s.p99Us = sorted[std::min(sorted.size() - 1, sorted.size() * 99 / 100)];
-    s.worstUs = sorted.back();
-    return s;
-}
-
-void report(benchmark::State& state, const BlockStats& s) {
+void report(benchmark::State& state, const BlockCostStats& s) {
     state.counters["median_us"] = s.medianUs;
     state.counters["p99_us"] = s.p99Us;
     state.counters["worst_us"] = s.worstUs;
-    state.counters["worst_over_median"] = s.worstUs / s.medianUs;
-    state.counters["budget_pct_worst"] = 100.0 * s.worstUs / (1e6 * kBlock / kRate);
-    state.counters["x_realtime"] = (1e6 * kBlock / kRate) / s.meanUs;
+    state.counters["worst_over_median"] = s.worstOverMedian();
+    state.counters["budget_pct_worst"] = 100.0 * s.budgetShare();
+    state.counters["ns_per_sample"] = s.nsPerSample;
+    state.counters["ns_per_sample_minima"] = s.minimaNsPerSample;
+    state.counters["x_realtime"] = s.realTimeFactor;
 }
 
 constexpr double kSeconds = 20.0;
@@ -132,10 +72,10 @@ void irOurs(benchmark::State& state, const std::string& name) {
     const std::size_t blocks = static_cast<std::size_t>(kSeconds * kRate / kBlock);
     const auto in = noise(blocks * kBlock, 1);
     std::vector<float> l(kBlock), r(kBlock);
-    BlockStats s;
+    BlockCostStats s;
     for (auto _ : state)
         s = timeBlocks(
-            blocks, kRepeats, [&] { conv.reset(); },
+            blocks, kRepeats, kBlock, kRate, [&] { conv.reset(); },
             [&](std::size_t b) {
                 conv.process(in.data() + b * kBlock, l.data(), r.data(), kBlock);
                 benchmark::DoNotOptimize(l.data());
@@ -145,44 +85,35 @@ void irOurs(benchmark::State& state, const std::string& name) {
 
 void irZita(benchmark::State& state, const std::string& name) {
     ScopedFlushDenormals flush;
-    auto* z = new Zita(shippedIr(name)); // never destroyed (see Zita)
-    const std::size_t blocks = static_cast<std::size_t>(kSeconds * kRate / kBlock);
+    auto* z = new Zita(shippedIr(name), kBlock); // never destroyed (see Zita)
+    // zita has no reset: the repeats continue its stream. Its period is 8192 samples (128
+    // blocks): with a whole number of periods per repeat block b does the same work in every
+    // repeat. Process CPU time: its worker threads count.
+    const std::size_t blocks = static_cast<std::size_t>(kSeconds * kRate / kBlock) / 128 * 128;
     const auto in = noise(blocks * kBlock, 1);
     std::vector<float> l(kBlock), r(kBlock);
-    BlockStats s;
-    // zita has no reset: the repeats continue its stream (same work per block after the
-    // first IR length).
+    BlockCostStats s;
     for (auto _ : state)
         s = timeBlocks(
-            blocks, kRepeats, [] {},
+            blocks, kRepeats, kBlock, kRate, [] {},
             [&](std::size_t b) {
                 z->block(in.data() + b * kBlock, l.data(), r.data());
                 benchmark::DoNotOptimize(l.data());
-            });
+            },
+            BenchClock::Process);
     report(state, s);
 }
 
 void surface(benchmark::State& state, const std::string& id, bool withReverb) {
-    FootstepScene scene;
-    SceneOptions options;
-    options.voices = 1;
-    options.reverb = withReverb ? ReverbMode::AsPreset : ReverbMode::Off;
-    scene.build(id, options);
-    scene.prepare(ProcessSpec{double(kRate), kBlock});
-    const GrfSignal grf = walkerGrf(WalkerParameters{}, kSeconds, kRate, 1);
-    const std::size_t blocks = grf.frames() / kBlock;
-    std::vector<float> l(kBlock), r(kBlock);
-    BlockStats s;
-    for (auto _ : state)
-        s = timeBlocks(
-            blocks, kRepeats, [&] { scene.reset(1); },
-            [&](std::size_t b) {
-                const float* g = grf.channels[0].data() + b * kBlock;
-                scene.process(&g, l.data(), r.data(), kBlock);
-                benchmark::DoNotOptimize(l.data());
-            });
-    state.counters["has_reverb"] = scene.hasReverb() ? 1 : 0;
-    report(state, s);
+    SceneBenchSpec spec;
+    spec.surface = id;
+    spec.reverb = withReverb ? ReverbMode::AsPreset : ReverbMode::Off;
+    spec.seconds = kSeconds;
+    spec.repeats = kRepeats;
+    SceneBenchResult r;
+    for (auto _ : state) r = measureScene(spec);
+    state.counters["has_reverb"] = r.hasReverb ? 1 : 0;
+    report(state, r.stats);
 }
 
 /// The instruction-count driver: `--driver=ours|zita --ir=NAME --seconds=S`.
@@ -201,7 +132,7 @@ int driver(const std::string& which, const std::string& ir, double seconds) {
             sink += l[0];
         }
     } else if (which == "zita") {
-        auto* z = new Zita(h); // never destroyed (see Zita)
+        auto* z = new Zita(h, kBlock); // never destroyed (see Zita)
         for (long long b = 0; b < blocks; ++b) {
             z->block(in.data(), l.data(), r.data());
             sink += l[0];
