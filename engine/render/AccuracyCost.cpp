@@ -2,12 +2,11 @@
 #include "engine/render/AccuracyCost.h"
 
 #include "engine/dsp/Denormals.h"
+#include "engine/dsp/RealFft.h"
 #include "engine/models/Aggregate.h"
 #include "engine/models/Bubbles.h"
 #include "engine/models/Friction.h"
 #include "engine/render/Renderer.h"
-
-#include <fftw3.h>
 
 #include <algorithm>
 #include <chrono>
@@ -127,11 +126,10 @@ void timeStrikes(const ImpactSetting& s, double seconds, ImpactMeasurement& m, i
 
 std::vector<double> thirdOctaveLevels(const std::vector<float>& x, double fs) {
     const int n = static_cast<int>(x.size());
-    double* in = fftw_alloc_real(static_cast<std::size_t>(n));
-    fftw_complex* out = fftw_alloc_complex(static_cast<std::size_t>(n / 2 + 1));
-    fftw_plan plan = fftw_plan_dft_r2c_1d(n, in, out, FFTW_ESTIMATE);
-    for (int i = 0; i < n; ++i) in[i] = x[static_cast<std::size_t>(i)];
-    fftw_execute(plan);
+    RealFft fft(n);
+    for (int i = 0; i < n; ++i) fft.time()[i] = x[static_cast<std::size_t>(i)];
+    fft.forward();
+    const fftw_complex* out = fft.spectrum();
     std::vector<double> bands;
     for (double fc = 50.0; fc <= 16000.0; fc *= std::pow(2.0, 1.0 / 3.0)) {
         const double lo = fc / std::pow(2.0, 1.0 / 6.0), hi = fc * std::pow(2.0, 1.0 / 6.0);
@@ -141,9 +139,6 @@ std::vector<double> thirdOctaveLevels(const std::vector<float>& x, double fs) {
             e += out[k][0] * out[k][0] + out[k][1] * out[k][1];
         bands.push_back(10 * std::log10(e));
     }
-    fftw_destroy_plan(plan);
-    fftw_free(in);
-    fftw_free(out);
     return bands;
 }
 } // namespace
@@ -201,34 +196,6 @@ ImpactMeasurement measureImpact(const ImpactSetting& setting, double seconds) {
     else
         timeStrikes<double>(setting, seconds, m);
     return m;
-}
-
-std::vector<SurfaceCost> measureSurfaceCosts(double seconds) {
-    std::vector<SurfaceCost> out;
-    WalkerParameters w;
-    const GrfSignal grf = walkerGrf(w, seconds, kRate, 1);
-    GrfSignal left = grf;
-    left.channels.resize(1); // one voice
-    left.names.resize(1);
-    for (const auto& info : listSurfaces()) {
-        RenderOptions options;
-        options.blockSize = 256;
-        // The fastest of three identical renders: other processes on a shared machine only ever
-        // slow a run down.
-        double cpu = 1e300;
-        std::size_t frames = 0;
-        for (int repeat = 0; repeat < 3; ++repeat) {
-            const auto r = renderSurface(info.id, left, options);
-            cpu = std::min(cpu, r.cpuSeconds);
-            frames = r.audio.frames();
-        }
-        SurfaceCost c;
-        c.id = info.id;
-        c.realTimeFactor = double(frames) / kRate / cpu;
-        c.nsPerSample = 1e9 * cpu / double(frames);
-        out.push_back(c);
-    }
-    return out;
 }
 
 std::vector<KnobMeasurement> measureKnobs(double seconds) {

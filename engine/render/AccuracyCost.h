@@ -39,12 +39,6 @@ struct ImpactMeasurement {
     double contactTimeMs = 0, restitution = 0;
 };
 
-struct SurfaceCost {
-    std::string id;
-    double realTimeFactor = 0; ///< audio seconds per CPU second, one voice
-    double nsPerSample = 0;
-};
-
 struct KnobMeasurement {
     std::string knob, setting;
     double spectralDistanceDb = 0; ///< against the knob's most accurate setting
@@ -63,9 +57,6 @@ ImpactMeasurement measureImpact(const ImpactSetting& setting, double strikesSeco
 /// 80 dB of the reference's loudest band).
 double spectralDistanceDb(const std::vector<float>& a, const std::vector<float>& reference,
                           double sampleRateHz);
-
-/// One voice of each bundled surface walked by the virtual walker for `seconds`.
-std::vector<SurfaceCost> measureSurfaceCosts(double seconds = 10.0);
 
 /// Mode-count and event-cap knobs on bundled surfaces.
 std::vector<KnobMeasurement> measureKnobs(double seconds = 4.0);

@@ -2,6 +2,7 @@
 #include "engine/reverb/Convolver.h"
 
 #include "engine/dsp/Denormals.h"
+#include "engine/dsp/RealFft.h"
 
 #include <fftw3.h>
 #include <fmt/format.h>
@@ -22,10 +23,9 @@ namespace underfoot::engine {
 namespace {
 
 /// FFTW's planner is not thread-safe (fftwf_execute is): every plan is made and destroyed
-/// under this lock, outside the audio thread.
+/// under the one planner lock of both precisions, outside the audio thread.
 std::mutex& plannerMutex() {
-    static std::mutex m;
-    return m;
+    return fftwPlannerMutex();
 }
 
 /// An FFTW-allocated (SIMD-aligned) float array.

@@ -3,6 +3,7 @@
 
 #include "engine/dsp/ProcessSpec.h"
 #include "engine/dsp/Random.h"
+#include "engine/dsp/RealFft.h"
 
 #include <fftw3.h>
 #include <fmt/format.h>
@@ -17,48 +18,31 @@ namespace underfoot::engine {
 
 namespace {
 
-struct FftwFree {
-    void operator()(void* p) const noexcept { fftw_free(p); }
-};
-template <typename T>
-using FftwPtr = std::unique_ptr<T[], FftwFree>;
-
-/// Real FFT of size n with reusable buffers (offline only: planning allocates).
-class RealFft {
+/// Vector front end of RealFft (offline only: planning allocates).
+class VectorFft {
   public:
-    explicit RealFft(std::size_t n)
-        : n_(n), time_(static_cast<double*>(fftw_malloc(sizeof(double) * n))),
-          freq_(static_cast<fftw_complex*>(fftw_malloc(sizeof(fftw_complex) * (n / 2 + 1)))) {
-        if (!time_ || !freq_) throw std::bad_alloc();
-        const int size = static_cast<int>(n);
-        forward_ = fftw_plan_dft_r2c_1d(size, time_.get(), freq_.get(), FFTW_ESTIMATE);
-        inverse_ = fftw_plan_dft_c2r_1d(size, freq_.get(), time_.get(), FFTW_ESTIMATE);
-        if (!forward_ || !inverse_) throw std::runtime_error("FFTW could not plan an FFT");
-    }
-    ~RealFft() {
-        fftw_destroy_plan(forward_);
-        fftw_destroy_plan(inverse_);
-    }
-    RealFft(const RealFft&) = delete;
-    RealFft& operator=(const RealFft&) = delete;
+    explicit VectorFft(std::size_t n) : n_(n), fft_(static_cast<int>(n)) {}
 
     std::size_t bins() const { return n_ / 2 + 1; }
     std::vector<std::complex<double>> forward(const std::vector<double>& x) {
-        std::fill(time_.get(), time_.get() + n_, 0.0);
-        std::copy(x.begin(), x.begin() + static_cast<long>(std::min(x.size(), n_)), time_.get());
-        fftw_execute(forward_);
+        double* time = fft_.time();
+        std::fill(time, time + n_, 0.0);
+        std::copy(x.begin(), x.begin() + static_cast<long>(std::min(x.size(), n_)), time);
+        fft_.forward();
+        const fftw_complex* freq = fft_.spectrum();
         std::vector<std::complex<double>> out(bins());
-        for (std::size_t k = 0; k < bins(); ++k) out[k] = {freq_[k][0], freq_[k][1]};
+        for (std::size_t k = 0; k < bins(); ++k) out[k] = {freq[k][0], freq[k][1]};
         return out;
     }
     /// Inverse, normalised (forward then inverse is the identity).
     std::vector<double> inverse(const std::vector<std::complex<double>>& spectrum) {
+        fftw_complex* freq = fft_.spectrum();
         for (std::size_t k = 0; k < bins(); ++k) {
-            freq_[k][0] = spectrum[k].real();
-            freq_[k][1] = spectrum[k].imag();
+            freq[k][0] = spectrum[k].real();
+            freq[k][1] = spectrum[k].imag();
         }
-        fftw_execute(inverse_);
-        std::vector<double> out(time_.get(), time_.get() + n_);
+        fft_.inverse();
+        std::vector<double> out(fft_.time(), fft_.time() + n_);
         const double scale = 1.0 / static_cast<double>(n_);
         for (double& v : out) v *= scale;
         return out;
@@ -66,9 +50,7 @@ class RealFft {
 
   private:
     std::size_t n_;
-    FftwPtr<double> time_;
-    FftwPtr<fftw_complex> freq_;
-    fftw_plan forward_ = nullptr, inverse_ = nullptr;
+    RealFft fft_;
 };
 
 // The late tail is split finer than the octave bands: one extra band below 125 Hz and one above
@@ -234,7 +216,7 @@ AudioBuffer generateRoomImpulseResponse(const RoomSpec& room, const RoomIrOption
     const double seconds = o.lengthSeconds > 0 ? o.lengthSeconds : 1.1 * maxT60;
     const auto len = static_cast<std::size_t>(std::llround(seconds * fs));
     const std::size_t nfft = nextPow2(len + 32);
-    RealFft fft(nfft);
+    VectorFft fft(nfft);
 
     std::array<double, kOctaveBandCount> beta{};
     for (int b = 0; b < kOctaveBandCount; ++b)
