@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "app/gui/RunView.h"
 
+#include "app/gui/ScaleRow.h"
+
 #include "app/gui/AudioOutput.h"
 #include "app/gui/ParticipantWindow.h"
 #include "app/gui/StudyContext.h"
@@ -1084,26 +1086,14 @@ void RunView::rebuildAnswerSections() {
             anchorLabel->setStyleSheet("color: #404040;");
             anchorLabel->setAccessibleName(tr("Anchors of %1").arg(q(sc.id)));
             column->addWidget(anchorLabel);
-            auto* row = new QHBoxLayout;
-            column->addLayout(row);
-            for (int v = sc.min; v <= sc.max; ++v) {
-                auto* b = new QPushButton(QString::number(v), s.box);
-                b->setCheckable(true);
-                b->setFocusPolicy(Qt::NoFocus);
-                b->setMinimumSize(48, 36);
-                b->setFont(bigFont(this, 1.1));
-                b->setStyleSheet("QPushButton:checked { background: #1f6feb; color: white; "
-                                 "font-weight: bold; }");
-                b->setAccessibleName(tr("%1: %2").arg(q(sc.id)).arg(v));
-                connect(b, &QPushButton::clicked, this, [this, index, v, id = sc.id] {
-                    flow_->setRating(id, v);
-                    setActive(index);
-                    trial_->setFocus();
-                });
-                row->addWidget(b);
-                s.buttons.push_back(b);
-            }
-            row->addStretch();
+            ScaleRowStyle style;
+            style.minimumButtonSize = {48, 36};
+            style.font = bigFont(this, 1.1);
+            s.buttons = addScaleRow(column, s.box, sc, style, [this, index, id = sc.id](int v) {
+                flow_->setRating(id, v);
+                setActive(index);
+                trial_->setFocus();
+            });
         }
         layout->addWidget(s.box);
         sections_.push_back(std::move(s));
@@ -1133,9 +1123,9 @@ void RunView::renderDraft() {
                           "left: 8px; }");
         if (s.kind == SectionKind::Scale) {
             const auto it = draft.ratings.find(s.scale->id);
-            for (std::size_t b = 0; b < s.buttons.size(); ++b)
-                s.buttons[b]->setChecked(it != draft.ratings.end() &&
-                                         it->second == s.scale->min + static_cast<int>(b));
+            showScaleValue(s.buttons, *s.scale,
+                           it != draft.ratings.end() ? std::optional<int>(it->second)
+                                                     : std::nullopt);
         } else {
             const auto& options = flow_->sections()[static_cast<std::size_t>(i)].options;
             const std::string& chosen =
