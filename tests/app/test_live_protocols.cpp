@@ -43,8 +43,8 @@
 #include "experiment/Session.h"
 #include "experiment/Store.h"
 #include "tests/common/ScratchDir.h"
+#include "tests/common/SocatHelpers.h"
 #include "tests/live/audio/JackDummyServer.h"
-#include "tests/live/sensors/SocatHelpers.h"
 
 #include <gtest/gtest.h>
 #include <jack/jack.h>
@@ -166,32 +166,6 @@ class JackTap {
     std::uint64_t t_ = 0;
 };
 
-/// Writes ShoeScript lines at 1 kHz into the shoes' end of the pty pair from its own thread.
-class ShoeWriter {
-  public:
-    ShoeWriter(int fd, const eng::ShoeScript& script)
-        : thread_([this, fd, &script] {
-              underfoot::test::writeAll(fd, eng::shoeHeaderLine());
-              eng::Random noise(3);
-              const auto start = std::chrono::steady_clock::now();
-              for (std::size_t i = 0; !stop_.load(); ++i) {
-                  std::this_thread::sleep_until(start + std::chrono::milliseconds(i));
-                  if (!underfoot::test::writeAll(fd,
-                                                 eng::formatShoeLine(static_cast<std::uint32_t>(i),
-                                                                     script.sample(i, noise))))
-                      break;
-              }
-          }) {}
-    ~ShoeWriter() {
-        stop_ = true;
-        thread_.join();
-    }
-
-  private:
-    std::atomic<bool> stop_{false};
-    std::thread thread_;
-};
-
 /// Sends the four limbs at 100 Hz: a walk at 0.9 strides/s, thighs and shanks swinging in
 /// opposite phase left and right, for `seconds`.
 void sendGait(lo_address to, double seconds) {
@@ -298,7 +272,7 @@ void LiveProtocols::run(const std::string& id, Compare compare) {
     std::shared_ptr<eng::StepInput> steps;
     std::unique_ptr<eng::ShoeScript> script;
     int shoeFd = -1;
-    std::unique_ptr<ShoeWriter> writer;
+    std::unique_ptr<underfoot::test::ShoeLineWriter> writer;
     std::shared_ptr<eng::OscGyroReceiver> gyros;
     wir::LivePlayerOptions options;
     options.studyFolder = dir.string();
@@ -325,7 +299,7 @@ void LiveProtocols::run(const std::string& id, Compare compare) {
         script->walk(40);
         shoeFd = underfoot::test::openWriter(pty->shoes);
         ASSERT_GE(shoeFd, 0);
-        writer = std::make_unique<ShoeWriter>(shoeFd, *script);
+        writer = std::make_unique<underfoot::test::ShoeLineWriter>(shoeFd, *script);
         const auto until = std::chrono::steady_clock::now() + 5s;
         while (!shoes->recordable() && std::chrono::steady_clock::now() < until)
             std::this_thread::sleep_for(10ms);
