@@ -521,7 +521,10 @@ std::string confusionHeatMapSvg(const ConfusionMatrix& m) {
     const int top = axisTitle + 12 + std::min(220, static_cast<int>(longestColumn) * 5 + 16);
     const int columns = static_cast<int>(m.columns.options.size());
     const int rows = static_cast<int>(m.rows.size());
-    const int width = left + cellW * columns + right + 60, height = top + cellH * rows + 10;
+    // The last column's label reaches right by its length x cos 40 (~5 px a character).
+    const int width = left + cellW * columns +
+                      std::max(right + 60, static_cast<int>(longestColumn) * 5 + 10),
+              height = top + cellH * rows + 10;
     std::string out = fmt::format("<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{}\" "
                                   "height=\"{}\" viewBox=\"0 0 {} {}\" role=\"img\" "
                                   "font-family=\"sans-serif\" font-size=\"12\">\n",

@@ -254,6 +254,9 @@ PlotFrame plotFrame(const ScaleAnalysis& s, const RatingLabels& labels) {
     for (const auto& c : s.cells) longest = std::max(longest, labels.stimulus(c.stimulus).size());
     // ~6.5 px per character at 11 px, turned by 40 degrees (sin 40 = 0.64), then the axis title.
     f.bottom = 20 + std::min(200.0, static_cast<double>(longest) * 6.5 * 0.64) + 28;
+    // The first cell's label reaches left by its length x cos 40 = 0.77: room for it.
+    f.left = std::max(f.left, std::min(200.0, static_cast<double>(longest) * 6.5 * 0.77) -
+                                  f.cellW / 2 + 12);
     f.width =
         f.left + f.right + f.cellW * static_cast<double>(std::max<std::size_t>(1, s.cells.size()));
     f.height = f.top + f.plotH + f.bottom;

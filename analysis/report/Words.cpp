@@ -15,6 +15,7 @@ std::string pInWords(double p) {
 
 std::string statisticSymbol(const std::string& rName) {
     if (rName.find("chi-squared") != std::string::npos || rName == "X-squared") return "χ²";
+    if (rName == "F value") return "F"; // Levene (car::leveneTest's column name)
     if (rName.empty()) return "statistic";
     return rName;
 }

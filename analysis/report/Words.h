@@ -12,7 +12,7 @@ namespace underfoot::analysis {
 /// "p = 0.003", "p < 0.001", "p = NA".
 std::string pInWords(double p);
 /// The statistic's symbol: R's "X-squared", "Friedman chi-squared", "Kruskal-Wallis
-/// chi-squared" -> "χ²"; others ("t", "W", "V", "F", "Z") as R names them.
+/// chi-squared" -> "χ²", "F value" -> "F"; others ("t", "W", "V", "Z") as R names them.
 std::string statisticSymbol(const std::string& rName);
 /// "χ²(1) = 8.90, p = 0.003": the symbol, the degrees of freedom in brackets (whole numbers
 /// without decimals, others to 1 decimal), the statistic to 2 decimals, p to 3 (< 0.001 below).
