@@ -323,4 +323,29 @@ void writeCodebook(const StudyStore& store, std::ostream& out) {
     }
 }
 
+std::map<std::string, std::string> stimulusDisplayLabels(const Protocol& protocol) {
+    std::map<std::string, int> uses;
+    for (const auto& s : protocol.stimuli)
+        if (!s.label.empty()) ++uses[s.label];
+    std::map<std::string, std::string> out;
+    for (const auto& s : protocol.stimuli) {
+        if (s.label.empty()) {
+            out[s.id] = s.id;
+        } else if (uses[s.label] == 1) {
+            out[s.id] = s.label;
+        } else {
+            std::string levels;
+            for (const auto& [factor, level] : s.factors)
+                levels += (levels.empty() ? "" : ", ") + factor + " " + level;
+            out[s.id] = s.label + " (" + (levels.empty() ? s.id : levels) + ")";
+        }
+    }
+    // Levels that still do not tell two stimuli apart: add the id.
+    std::map<std::string, int> shown;
+    for (const auto& [id, label] : out) ++shown[label];
+    for (auto& [id, label] : out)
+        if (shown[label] > 1) label += " [" + id + "]";
+    return out;
+}
+
 } // namespace underfoot::experiment

@@ -7,6 +7,7 @@
 #include "experiment/Store.h"
 
 #include <array>
+#include <map>
 #include <ostream>
 #include <string_view>
 
@@ -101,5 +102,11 @@ int writeAudioCsv(const StudyStore& store, std::ostream& out,
 /// Writes the codebook (Markdown): every column, its type and meaning, and the value labels
 /// (answer options, groups, stimuli, scales) of this study's protocol.
 void writeCodebook(const StudyStore& store, std::ostream& out);
+
+/// What people read for each stimulus id of a protocol (issue #17: reports show labels, not raw
+/// ids): its label; the id when it has none; when several stimuli share a label (those of one
+/// [[factorial]]), the label with the stimulus's factor levels ("synthesized wading (algorithm
+/// v1, cadence 27)"), or with the id when the levels do not tell them apart.
+std::map<std::string, std::string> stimulusDisplayLabels(const Protocol& protocol);
 
 } // namespace underfoot::experiment

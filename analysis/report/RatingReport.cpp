@@ -2,6 +2,8 @@
 #include "analysis/report/RatingReport.h"
 
 #include "analysis/report/Markup.h"
+#include "analysis/report/Words.h"
+#include "analysis/stats/Numerics.h"
 
 #include <fmt/format.h>
 
@@ -11,6 +13,23 @@
 #include <sstream>
 
 namespace underfoot::analysis {
+
+MeanInterval cellMeanInterval(const RatingCell& cell) {
+    MeanInterval m;
+    m.n = cell.values.size();
+    if (m.n == 0) return m;
+    double sum = 0;
+    for (const auto& [who, v] : cell.values) sum += v;
+    m.mean = sum / static_cast<double>(m.n);
+    if (m.n < 2) return m;
+    double ss = 0;
+    for (const auto& [who, v] : cell.values) ss += (v - m.mean) * (v - m.mean);
+    const double se = std::sqrt(ss / static_cast<double>(m.n - 1) / static_cast<double>(m.n));
+    const double t = numerics::qt(0.975, static_cast<double>(m.n - 1));
+    m.lower = m.mean - t * se;
+    m.upper = m.mean + t * se;
+    return m;
+}
 
 const char* significanceStars(double p) {
     if (std::isnan(p)) return "";
@@ -44,12 +63,7 @@ std::string factorsText(const std::map<std::string, std::string>& factors) {
 }
 
 std::string statisticText(const TestResult& t) {
-    if (!t.ok()) return "not computed: " + t.error;
-    std::string df;
-    for (double d : t.df) df += (df.empty() ? "" : ", ") + fmt::format("{:g}", d);
-    const std::string p = pText(t.p);
-    return fmt::format("{}{} = {}, p {}", t.statisticName, df.empty() ? "" : "(" + df + ")",
-                       num(t.statistic), p.front() == '<' ? p : "= " + p);
+    return testInWords(t);
 }
 
 /// Markdown table helper.
@@ -93,34 +107,47 @@ struct Table {
     }
 };
 
-Table cellTable(const ScaleAnalysis& s) {
-    Table t{{"cell", "factors", "n", "median", "IQR (Q1-Q3)", "Shapiro-Wilk p"}, {}};
-    for (const auto& c : s.cells)
-        t.rows.push_back({c.stimulus, factorsText(c.factors), std::to_string(c.box.n),
-                          num(c.box.median, 2),
-                          fmt::format("{}-{}", num(c.box.q1, 2), num(c.box.q3, 2)),
-                          c.shapiro.ok() ? pText(c.shapiro.p) : "NA"});
+Table cellTable(const ScaleAnalysis& s, const RatingLabels& labels) {
+    Table t{{"condition", "id", "factors", "n", "mean [95% CI]", "median", "IQR (Q1-Q3)",
+             "Shapiro-Wilk p"},
+            {}};
+    for (const auto& c : s.cells) {
+        const auto m = cellMeanInterval(c);
+        t.rows.push_back(
+            {labels.stimulus(c.stimulus), c.stimulus, factorsText(c.factors),
+             std::to_string(c.box.n),
+             fmt::format("{} [{}, {}]", num(m.mean, 2), num(m.lower, 2), num(m.upper, 2)),
+             num(c.box.median, 2), fmt::format("{}-{}", num(c.box.q1, 2), num(c.box.q3, 2)),
+             c.shapiro.ok() ? pText(c.shapiro.p) : "NA"});
+    }
     return t;
 }
 
-Table pairTable(const std::vector<PairedComparison>& pairs) {
-    Table t{{"comparison", "context", "medians", "pairs", "Z", "p", "p (Holm)", ""}, {}};
+Table pairTable(const std::vector<PairedComparison>& pairs, const RatingLabels& labels) {
+    Table t{{"comparison", "context", "medians", "pairs", "Z", "p", "p (Holm)", "", "in words"},
+            {}};
     for (const auto& p : pairs)
-        t.rows.push_back({p.first + " vs " + p.second, p.context,
-                          num(p.medianFirst, 2) + " / " + num(p.medianSecond, 2),
-                          std::to_string(p.pairs), num(p.test.z), pText(p.test.p), pText(p.pHolm),
-                          significanceStars(p.pHolm)});
+        t.rows.push_back(
+            {labels.stimulus(p.first) + " vs " + labels.stimulus(p.second), p.context,
+             num(p.medianFirst, 2) + " / " + num(p.medianSecond, 2), std::to_string(p.pairs),
+             num(p.test.z), pText(p.test.p), pText(p.pHolm), significanceStars(p.pHolm),
+             statisticInWords("Z", p.test.z, p.test.p) + " (Holm: " + pInWords(p.pHolm) + ")"});
     return t;
 }
+
+struct Figure {
+    std::string caption;
+    std::string svg;
+};
 
 struct Section {
     std::string heading;
     std::string text;
     std::vector<Table> tables;
-    std::string svg;
+    std::vector<Figure> figures;
 };
 
-std::vector<Section> sections(const RatingStudyAnalysis& a) {
+std::vector<Section> sections(const RatingStudyAnalysis& a, const RatingLabels& labels) {
     std::vector<Section> out;
     for (const auto& s : a.scales) {
         Section sec;
@@ -133,8 +160,8 @@ std::vector<Section> sections(const RatingStudyAnalysis& a) {
             s.participants, statisticText(s.levene),
             s.omnibus.conditions.size() >= 3 ? "Friedman test" : "Wilcoxon signed-rank test",
             s.omnibus.participants, statisticText(s.omnibus.result));
-        sec.tables.push_back(cellTable(s));
-        if (!s.planned.empty()) sec.tables.push_back(pairTable(s.planned));
+        sec.tables.push_back(cellTable(s, labels));
+        if (!s.planned.empty()) sec.tables.push_back(pairTable(s.planned, labels));
         for (const auto& fe : s.factorEffects) {
             Table t{{"level of " + fe.factor, "n", "median", "IQR (Q1-Q3)"}, {}};
             for (std::size_t i = 0; i < fe.levels.size(); ++i)
@@ -147,7 +174,7 @@ std::vector<Section> sections(const RatingStudyAnalysis& a) {
                             "other factors; {} participants): {}.",
                             fe.factor, fe.omnibus.participants, statisticText(fe.omnibus.result));
             sec.tables.push_back(t);
-            sec.tables.push_back(pairTable(fe.pairs));
+            sec.tables.push_back(pairTable(fe.pairs, labels));
         }
         for (const auto& g : s.groups) {
             Table t{{g.field, "n", "median", "IQR (Q1-Q3)"}, {}};
@@ -159,15 +186,23 @@ std::vector<Section> sections(const RatingStudyAnalysis& a) {
                                     g.field, statisticText(g.kruskal));
             sec.tables.push_back(t);
             if (!g.pairs.empty()) {
-                Table mw{{"comparison", "W", "p", "p (Holm)", ""}, {}};
+                Table mw{{"comparison", "W", "p", "p (Holm)", "", "in words"}, {}};
                 for (const auto& p : g.pairs)
                     mw.rows.push_back({p.first + " vs " + p.second, num(p.test.statistic),
-                                       pText(p.test.p), pText(p.pHolm),
-                                       significanceStars(p.pHolm)});
+                                       pText(p.test.p), pText(p.pHolm), significanceStars(p.pHolm),
+                                       testInWords(p.test) + " (Holm: " + pInWords(p.pHolm) + ")"});
                 sec.tables.push_back(mw);
             }
         }
-        sec.svg = ratingBoxPlotSvg(s);
+        sec.figures.push_back(
+            {fmt::format("{}: mean rating per condition with its 95 % confidence interval (t), "
+                         "each participant's mean rating of the condition as a grey point",
+                         s.scale.id),
+             ratingMeansSvg(s, labels)});
+        sec.figures.push_back({fmt::format("{}: box plots (median, quartiles, Tukey whiskers; "
+                                           "outliers as circles, extremes as dots)",
+                                           s.scale.id),
+                               ratingBoxPlotSvg(s, labels)});
         out.push_back(std::move(sec));
     }
     if (!a.correlations.empty()) {
@@ -175,11 +210,14 @@ std::vector<Section> sections(const RatingStudyAnalysis& a) {
         sec.heading = "Spearman correlations between scales";
         sec.text = "Over (participant, stimulus) cells rated on both scales; R's cor.test(method "
                    "= \"spearman\") p-values, Holm-corrected across all pairs in the last column.";
-        Table t{{"scales", "n", "rho", "p", "p (Holm)", ""}, {}};
-        for (const auto& c : a.correlations)
-            t.rows.push_back({c.first + " ~ " + c.second, std::to_string(c.n),
-                              c.test.estimate.empty() ? "NA" : num(c.test.estimate[0].value),
-                              pText(c.test.p), pText(c.pHolm), significanceStars(c.test.p)});
+        Table t{{"scales", "n", "rho", "p", "p (Holm)", "", "in words"}, {}};
+        for (const auto& c : a.correlations) {
+            const double rho = c.test.estimate.empty() ? std::nan("") : c.test.estimate[0].value;
+            t.rows.push_back(
+                {c.first + " ~ " + c.second, std::to_string(c.n), num(rho), pText(c.test.p),
+                 pText(c.pHolm), significanceStars(c.test.p),
+                 statisticInWords("ρ", rho, c.test.p) + " (n = " + std::to_string(c.n) + ")"});
+        }
         sec.tables.push_back(t);
         out.push_back(std::move(sec));
     }
@@ -194,17 +232,123 @@ constexpr const char* kMethods =
     "each family (the planned comparisons of a scale; the pairs of a main effect); "
     "Kruskal-Wallis: kruskal.test; Mann-Whitney: wilcox.test(exact = FALSE, correct = FALSE) with "
     "Holm, only after a significant Kruskal-Wallis test. Significance: * p < 0.05, ** p < 0.01, "
-    "*** p < 0.001 (corrected p where given).";
+    "*** p < 0.001 (corrected p where given). Means with 95 % confidence intervals: t "
+    "intervals over the participants' cell values (mean ± qt(0.975, n - 1) SD / sqrt(n)).";
 
 } // namespace
 
-std::string ratingBoxPlotSvg(const ScaleAnalysis& s) {
-    const double cellW = 64, left = 52, right = 16, top = 34, plotH = 220, bottom = 96;
-    const double width =
-        left + right + cellW * static_cast<double>(std::max<std::size_t>(1, s.cells.size()));
-    const double height = top + plotH + bottom;
-    const double lo = s.scale.min, hi = s.scale.max > s.scale.min ? s.scale.max : s.scale.min + 1;
-    auto y = [&](double v) { return top + plotH * (1 - (v - lo) / (hi - lo)); };
+namespace {
+
+/// The frame shared by the rating figures: a value axis over the scale's range with its title,
+/// one slot per cell with the cell's label turned under it, and the x-axis title.
+struct PlotFrame {
+    double cellW = 64, left = 72, right = 16, top = 34, plotH = 220, bottom = 0;
+    double width = 0, height = 0, lo = 0, hi = 1;
+    double y(double v) const { return top + plotH * (1 - (v - lo) / (hi - lo)); }
+    double x(std::size_t cell) const { return left + cellW * (static_cast<double>(cell) + 0.5); }
+};
+
+PlotFrame plotFrame(const ScaleAnalysis& s, const RatingLabels& labels) {
+    PlotFrame f;
+    std::size_t longest = 0;
+    for (const auto& c : s.cells) longest = std::max(longest, labels.stimulus(c.stimulus).size());
+    // ~6.5 px per character at 11 px, turned by 40 degrees (sin 40 = 0.64), then the axis title.
+    f.bottom = 20 + std::min(200.0, static_cast<double>(longest) * 6.5 * 0.64) + 28;
+    // The first cell's label reaches left by its length x cos 40 = 0.77: room for it.
+    f.left = std::max(f.left, std::min(200.0, static_cast<double>(longest) * 6.5 * 0.77) -
+                                  f.cellW / 2 + 12);
+    f.width =
+        f.left + f.right + f.cellW * static_cast<double>(std::max<std::size_t>(1, s.cells.size()));
+    f.height = f.top + f.plotH + f.bottom;
+    f.lo = s.scale.min;
+    f.hi = s.scale.max > s.scale.min ? s.scale.max : s.scale.min + 1;
+    return f;
+}
+
+void openFigure(std::ostringstream& o, const PlotFrame& f, const ScaleAnalysis& s,
+                const RatingLabels& labels, const std::string& cssClass,
+                const std::string& heading) {
+    o << fmt::format("<svg xmlns=\"http://www.w3.org/2000/svg\" class=\"{}\" width=\"{:.0f}\" "
+                     "height=\"{:.0f}\" viewBox=\"0 0 {:.0f} {:.0f}\" font-family=\"sans-serif\" "
+                     "font-size=\"11\">\n",
+                     cssClass, f.width, f.height, f.width, f.height);
+    o << fmt::format("<title>{}</title>\n", xmlEscape(s.scale.id + ": " + s.scale.prompt));
+    o << fmt::format("<text x=\"{:.0f}\" y=\"16\" font-size=\"13\">{}</text>\n", f.left,
+                     xmlEscape(heading));
+    const double step = (f.hi - f.lo) > 12 ? std::ceil((f.hi - f.lo) / 10) : 1;
+    for (double v = f.lo; v <= f.hi + 1e-9; v += step) {
+        o << fmt::format("<line x1=\"{:.1f}\" x2=\"{:.1f}\" y1=\"{:.1f}\" y2=\"{:.1f}\" "
+                         "stroke=\"#e0e0e0\"/>\n",
+                         f.left, f.width - f.right, f.y(v), f.y(v));
+        o << fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\" text-anchor=\"end\">{:g}</text>\n",
+                         f.left - 6, f.y(v) + 4, v);
+    }
+    o << fmt::format("<line x1=\"{0:.1f}\" x2=\"{0:.1f}\" y1=\"{1:.1f}\" y2=\"{2:.1f}\" "
+                     "stroke=\"black\"/>\n",
+                     f.left, f.top, f.top + f.plotH);
+    o << fmt::format(
+        "<text class=\"axis-title\" transform=\"translate(18,{:.1f}) rotate(-90)\" "
+        "text-anchor=\"middle\" font-weight=\"bold\">{}</text>\n",
+        f.top + f.plotH / 2,
+        xmlEscape(fmt::format("Rating: {} ({:g} to {:g})", s.scale.id, s.scale.min, s.scale.max)));
+    o << fmt::format("<text class=\"axis-title\" x=\"{:.1f}\" y=\"{:.1f}\" "
+                     "text-anchor=\"middle\" font-weight=\"bold\">Condition</text>\n",
+                     f.left + (f.width - f.left - f.right) / 2, f.height - 8);
+    for (std::size_t i = 0; i < s.cells.size(); ++i)
+        o << fmt::format("<text class=\"cell-label\" transform=\"translate({:.1f},{:.1f}) "
+                         "rotate(-40)\" text-anchor=\"end\">{}<title>{}</title></text>\n",
+                         f.x(i) + 4, f.top + f.plotH + 14,
+                         xmlEscape(labels.stimulus(s.cells[i].stimulus)),
+                         xmlEscape(s.cells[i].stimulus));
+}
+
+} // namespace
+
+std::string ratingMeansSvg(const ScaleAnalysis& s, const RatingLabels& labels) {
+    const PlotFrame f = plotFrame(s, labels);
+    std::ostringstream o;
+    openFigure(o, f, s, labels, "rating-means", s.scale.id + ": means with 95 % CI");
+    const auto inside = [&](double v) { return std::clamp(v, f.lo, f.hi); }; // drawing only
+    for (std::size_t i = 0; i < s.cells.size(); ++i) {
+        const auto& c = s.cells[i];
+        const double cx = f.x(i);
+        // Every participant's value: spread sideways in a fixed pattern of 7 columns.
+        std::size_t k = 0;
+        for (const auto& [who, v] : c.values) {
+            const double dx = (static_cast<double>(k++ % 7) - 3.0) * 3.0;
+            o << fmt::format("<circle class=\"point\" cx=\"{:.1f}\" cy=\"{:.1f}\" r=\"2.5\" "
+                             "fill=\"#8c8c8c\" fill-opacity=\"0.6\"><title>{}: {:g}</title>"
+                             "</circle>\n",
+                             cx - 14 + dx, f.y(v), xmlEscape(who), v);
+        }
+        const auto m = cellMeanInterval(c);
+        if (m.n == 0) continue;
+        const std::string tip =
+            m.n >= 2 ? fmt::format("{}: mean {:.2f}, 95 % CI {:.2f} to {:.2f}, n {}",
+                                   labels.stimulus(c.stimulus), m.mean, m.lower, m.upper, m.n)
+                     : fmt::format("{}: mean {:.2f}, n 1 (no interval)",
+                                   labels.stimulus(c.stimulus), m.mean);
+        if (m.n >= 2) {
+            const double y1 = f.y(inside(m.upper)), y2 = f.y(inside(m.lower));
+            o << fmt::format("<line class=\"ci\" x1=\"{0:.1f}\" x2=\"{0:.1f}\" y1=\"{1:.1f}\" "
+                             "y2=\"{2:.1f}\" stroke=\"#1f4e79\" stroke-width=\"2\"/>\n",
+                             cx + 8, y1, y2);
+            for (double yy : {y1, y2})
+                o << fmt::format("<line x1=\"{:.1f}\" x2=\"{:.1f}\" y1=\"{:.1f}\" "
+                                 "y2=\"{:.1f}\" stroke=\"#1f4e79\" stroke-width=\"2\"/>\n",
+                                 cx + 3, cx + 13, yy, yy);
+        }
+        o << fmt::format("<circle class=\"mean\" cx=\"{:.1f}\" cy=\"{:.1f}\" r=\"4.5\" "
+                         "fill=\"#1f4e79\"><title>{}</title></circle>\n",
+                         cx + 8, f.y(m.mean), xmlEscape(tip));
+    }
+    o << "</svg>\n";
+    return o.str();
+}
+
+std::string ratingBoxPlotSvg(const ScaleAnalysis& s, const RatingLabels& labels) {
+    const PlotFrame f = plotFrame(s, labels);
+    const auto y = [&](double v) { return f.y(v); };
     // Colour by the first factor's level (the paper: dark / light blue by depth).
     static const char* kPalette[] = {"#1f4e79", "#8fb8de", "#4a90c2",
                                      "#c6dbef", "#2c7fb8", "#a6bddb"};
@@ -213,69 +357,49 @@ std::string ratingBoxPlotSvg(const ScaleAnalysis& s) {
                                   ? std::string()
                                   : s.cells.front().factors.begin()->first;
     std::ostringstream o;
-    o << fmt::format("<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{:.0f}\" height=\"{:.0f}\" "
-                     "viewBox=\"0 0 {:.0f} {:.0f}\" font-family=\"sans-serif\" font-size=\"11\">\n",
-                     width, height, width, height);
-    o << fmt::format("<title>{}</title>\n", xmlEscape(s.scale.id + ": " + s.scale.prompt));
-    o << fmt::format("<text x=\"{:.0f}\" y=\"16\" font-size=\"13\">{}</text>\n", left,
-                     xmlEscape(s.scale.id));
-    // Axis and grid.
-    const double step = (hi - lo) > 12 ? std::ceil((hi - lo) / 10) : 1;
-    for (double v = lo; v <= hi + 1e-9; v += step) {
-        o << fmt::format("<line x1=\"{:.1f}\" x2=\"{:.1f}\" y1=\"{:.1f}\" y2=\"{:.1f}\" "
-                         "stroke=\"#e0e0e0\"/>\n",
-                         left, width - right, y(v), y(v));
-        o << fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\" text-anchor=\"end\">{:g}</text>\n",
-                         left - 6, y(v) + 4, v);
-    }
-    o << fmt::format("<line x1=\"{:.1f}\" x2=\"{:.1f}\" y1=\"{:.1f}\" y2=\"{:.1f}\" "
-                     "stroke=\"black\"/>\n",
-                     left, left, top, top + plotH);
+    openFigure(o, f, s, labels, "rating-boxes", s.scale.id + ": box plots");
     for (std::size_t i = 0; i < s.cells.size(); ++i) {
         const auto& c = s.cells[i];
         const auto& b = c.box;
-        const double cx = left + cellW * (static_cast<double>(i) + 0.5);
+        const double cx = f.x(i);
         std::string level;
         if (!firstFactor.empty() && c.factors.count(firstFactor)) level = c.factors.at(firstFactor);
         const std::size_t colour = colourOf.try_emplace(level, colourOf.size()).first->second;
         const char* fill = kPalette[colour % 6];
-        if (b.n > 0) {
-            o << fmt::format("<line x1=\"{0:.1f}\" x2=\"{0:.1f}\" y1=\"{1:.1f}\" y2=\"{2:.1f}\" "
-                             "stroke=\"black\"/>\n",
-                             cx, y(b.whiskerHigh), y(b.q3));
-            o << fmt::format("<line x1=\"{0:.1f}\" x2=\"{0:.1f}\" y1=\"{1:.1f}\" y2=\"{2:.1f}\" "
-                             "stroke=\"black\"/>\n",
-                             cx, y(b.q1), y(b.whiskerLow));
-            for (double w : {b.whiskerLow, b.whiskerHigh})
-                o << fmt::format("<line x1=\"{:.1f}\" x2=\"{:.1f}\" y1=\"{:.1f}\" y2=\"{:.1f}\" "
-                                 "stroke=\"black\"/>\n",
-                                 cx - 8, cx + 8, y(w), y(w));
-            o << fmt::format("<rect x=\"{:.1f}\" y=\"{:.1f}\" width=\"{:.1f}\" height=\"{:.1f}\" "
-                             "fill=\"{}\" stroke=\"black\"><title>{}: median {:g}, IQR {:g}-{:g}, "
-                             "n {}</title></rect>\n",
-                             cx - 16, y(b.q3), 32.0, std::max(1.0, y(b.q1) - y(b.q3)), fill,
-                             xmlEscape(c.stimulus), b.median, b.q1, b.q3, b.n);
+        if (b.n == 0) continue;
+        o << fmt::format("<line x1=\"{0:.1f}\" x2=\"{0:.1f}\" y1=\"{1:.1f}\" y2=\"{2:.1f}\" "
+                         "stroke=\"black\"/>\n",
+                         cx, y(b.whiskerHigh), y(b.q3));
+        o << fmt::format("<line x1=\"{0:.1f}\" x2=\"{0:.1f}\" y1=\"{1:.1f}\" y2=\"{2:.1f}\" "
+                         "stroke=\"black\"/>\n",
+                         cx, y(b.q1), y(b.whiskerLow));
+        for (double w : {b.whiskerLow, b.whiskerHigh})
             o << fmt::format("<line x1=\"{:.1f}\" x2=\"{:.1f}\" y1=\"{:.1f}\" y2=\"{:.1f}\" "
-                             "stroke=\"#d62728\" stroke-width=\"2\"/>\n",
-                             cx - 16, cx + 16, y(b.median), y(b.median));
-            for (double v : b.outliers)
-                o << fmt::format("<circle cx=\"{:.1f}\" cy=\"{:.1f}\" r=\"3\" fill=\"none\" "
-                                 "stroke=\"black\"/>\n",
-                                 cx, y(v));
-            for (double v : b.extremes)
-                o << fmt::format("<circle cx=\"{:.1f}\" cy=\"{:.1f}\" r=\"2.5\" fill=\"black\"/>\n",
-                                 cx, y(v));
-        }
-        o << fmt::format("<text transform=\"translate({:.1f},{:.1f}) rotate(-40)\" "
-                         "text-anchor=\"end\">{}</text>\n",
-                         cx + 4, top + plotH + 14, xmlEscape(c.stimulus));
+                             "stroke=\"black\"/>\n",
+                             cx - 8, cx + 8, y(w), y(w));
+        o << fmt::format("<rect x=\"{:.1f}\" y=\"{:.1f}\" width=\"{:.1f}\" height=\"{:.1f}\" "
+                         "fill=\"{}\" stroke=\"black\"><title>{}: median {:g}, IQR {:g}-{:g}, "
+                         "n {}</title></rect>\n",
+                         cx - 16, y(b.q3), 32.0, std::max(1.0, y(b.q1) - y(b.q3)), fill,
+                         xmlEscape(labels.stimulus(c.stimulus)), b.median, b.q1, b.q3, b.n);
+        o << fmt::format("<line x1=\"{:.1f}\" x2=\"{:.1f}\" y1=\"{:.1f}\" y2=\"{:.1f}\" "
+                         "stroke=\"#d62728\" stroke-width=\"2\"/>\n",
+                         cx - 16, cx + 16, y(b.median), y(b.median));
+        for (double v : b.outliers)
+            o << fmt::format("<circle cx=\"{:.1f}\" cy=\"{:.1f}\" r=\"3\" fill=\"none\" "
+                             "stroke=\"black\"/>\n",
+                             cx, y(v));
+        for (double v : b.extremes)
+            o << fmt::format("<circle cx=\"{:.1f}\" cy=\"{:.1f}\" r=\"2.5\" fill=\"black\"/>\n", cx,
+                             y(v));
     }
     o << "</svg>\n";
     return o.str();
 }
 
-std::string renderRatingReport(const RatingStudyAnalysis& a, ReportFormat format) {
-    const auto secs = sections(a);
+std::string renderRatingReport(const RatingStudyAnalysis& a, ReportFormat format,
+                               const RatingLabels& labels) {
+    const auto secs = sections(a, labels);
     const std::string title = a.title.empty() ? "Rating study" : a.title;
     std::string out;
     switch (format) {
@@ -284,7 +408,7 @@ std::string renderRatingReport(const RatingStudyAnalysis& a, ReportFormat format
         for (const auto& s : secs) {
             out += fmt::format("\n## {}\n\n{}\n\n", s.heading, s.text);
             for (const auto& t : s.tables) out += t.markdown() + "\n";
-            if (!s.svg.empty()) out += s.svg + "\n";
+            for (const auto& fig : s.figures) out += fig.svg + "\n";
         }
         break;
     }
@@ -301,7 +425,9 @@ std::string renderRatingReport(const RatingStudyAnalysis& a, ReportFormat format
             for (std::size_t at; (at = text.find("\n\n")) != std::string::npos;)
                 text.replace(at, 2, "</p><p>");
             out += "<p>" + text + "</p>\n";
-            if (!s.svg.empty()) out += s.svg;
+            for (const auto& fig : s.figures)
+                out += "<figure>\n" + fig.svg + "<figcaption>" + xmlEscape(fig.caption) +
+                       "</figcaption>\n</figure>\n";
             for (const auto& t : s.tables) out += t.html();
         }
         out += "</body></html>\n";

@@ -80,6 +80,7 @@ void writeText(const std::string& output, const std::string& text) {
 /// Rating studies (the wading studies and any protocol of scales): the paper's form.
 int analyzeRatings(const AnalyzeOptions& o, analysis::ReportFormat format) {
     analysis::RatingData data;
+    analysis::RatingLabels labels;
     try {
         if (!o.study.empty()) {
             const auto store = experiment::StudyStore::openForReading(o.study);
@@ -92,6 +93,7 @@ int analyzeRatings(const AnalyzeOptions& o, analysis::ReportFormat format) {
                                              participants.str(), o.study + " (participants)",
                                              scales.str(), o.study + " (scales)");
             data.title = store.protocol().title;
+            labels.stimuli = experiment::stimulusDisplayLabels(store.protocol()); // issue #17
         } else if (!o.ratings.empty()) {
             data = analysis::readRatingData(o.ratings, o.participants, o.scales);
         } else {
@@ -108,7 +110,7 @@ int analyzeRatings(const AnalyzeOptions& o, analysis::ReportFormat format) {
                                                  "this study (fields: {})",
                                                  f, fmt::join(data.groupingFields, ", ")));
         const auto result = analysis::analyzeRatingStudy(data, options);
-        writeText(o.output, analysis::renderRatingReport(result, format));
+        writeText(o.output, analysis::renderRatingReport(result, format, labels));
     } catch (const std::runtime_error& e) {
         throw cli::UserError(e.what());
     } catch (const std::invalid_argument& e) {

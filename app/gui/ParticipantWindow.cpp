@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "app/gui/ParticipantWindow.h"
 
+#include "app/gui/ScaleRow.h"
+
 #include "experiment/TrialFlow.h"
 
 #include <QCloseEvent>
@@ -181,27 +183,16 @@ void ParticipantWindow::rebuildSections() {
             auto* anchorLabel = new QLabel(anchors.join("\n"), s.box);
             anchorLabel->setWordWrap(true);
             column->addWidget(anchorLabel);
-            auto* row = new QHBoxLayout;
-            column->addLayout(row);
-            for (int v = sc.min; v <= sc.max; ++v) {
-                auto* b = new QPushButton(QString::number(v), s.box);
-                b->setCheckable(true);
-                b->setFocusPolicy(Qt::NoFocus);
-                b->setMinimumSize(56, 48);
-                b->setStyleSheet("QPushButton:checked { background: #1f6feb; color: white; "
-                                 "font-weight: bold; }");
-                connect(b, &QPushButton::clicked, this, [this, v, id = sc.id, index] {
-                    if (flow_) {
-                        flow_->setRating(id, v);
-                        flow_->setActive(index);
-                    }
-                    emit draftChanged();
-                    setFocus();
-                });
-                row->addWidget(b);
-                s.buttons.push_back(b);
-            }
-            row->addStretch();
+            ScaleRowStyle style;
+            style.minimumButtonSize = {56, 48};
+            s.buttons = addScaleRow(column, s.box, sc, style, [this, id = sc.id, index](int v) {
+                if (flow_) {
+                    flow_->setRating(id, v);
+                    flow_->setActive(index);
+                }
+                emit draftChanged();
+                setFocus();
+            });
         }
         sectionsLayout_->addWidget(s.box);
         sections_.push_back(std::move(s));
@@ -225,9 +216,9 @@ void ParticipantWindow::renderDraft() {
                                    "subcontrol-origin: margin; left: 10px; }");
         if (sec.kind == exp::SectionKind::Scale) {
             const auto it = draft.ratings.find(sec.scale->id);
-            for (std::size_t b = 0; b < s.buttons.size(); ++b)
-                s.buttons[b]->setChecked(it != draft.ratings.end() &&
-                                         it->second == sec.scale->min + static_cast<int>(b));
+            showScaleValue(s.buttons, *sec.scale,
+                           it != draft.ratings.end() ? std::optional<int>(it->second)
+                                                     : std::nullopt);
         } else {
             const std::string& chosen =
                 sec.kind == exp::SectionKind::Surface ? draft.answer : draft.soundscapeAnswer;

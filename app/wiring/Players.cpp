@@ -300,6 +300,7 @@ void LivePlayer::stop() {
     // Crossfade plus a margin; a stopped stream hands nothing back (then nothing pushes).
     engine_.waitIdle(engine_.settings().crossfadeMs * 1e-3 + 2.0);
     std::string gaitError;
+    bool wroteGait = false;
     if (wading_) {
         // The retired water scene still holds its gait recording: write it before releasing.
         bool written = recordingPath_.empty();
@@ -307,7 +308,11 @@ void LivePlayer::stop() {
             if (scene->wading() && !written) {
                 try {
                     scene->wading()->writeRecording(recordingPath_);
+                    // What reproduces the node exactly: each frame at the sample where it took
+                    // effect (`underfoot replay` renders from it when present).
+                    scene->wading()->writeArrivals(recordingPath_ + ".arrivals.csv");
                     written = true;
+                    wroteGait = true;
                     if (scene->wading()->unrecordedFrames() > 0)
                         gaitError = fmt::format("{} gait frames did not fit the recording",
                                                 scene->wading()->unrecordedFrames());
@@ -335,11 +340,8 @@ void LivePlayer::stop() {
     stats_.maxLoadPercent = m.maxLoadPercent;
     stats_.maxBlockSeconds = m.maxBlockSeconds;
     stopped_ = true;
-    if (recorder_) {
-        recorder_->finish();
-        lastDropped_ = recorder_->droppedFrames();
-        stats_.droppedGrfFrames = lastDropped_;
-        std::ofstream side(recorder_->path() + ".meters.toml");
+    const auto writeMeters = [&](const std::string& recording) {
+        std::ofstream side(recording + ".meters.toml");
         side << fmt::format(
             "# Measured by the live engine while this trial played (docs/live.md)\n"
             "scene = \"{}\"\nsample_rate = {}\nblock_size = {}\nframes = {}\nxruns = {}\n"
@@ -348,6 +350,13 @@ void LivePlayer::stop() {
             summary_, engine_.settings().sampleRateHz, engine_.settings().blockSize, stats_.frames,
             stats_.xruns, stats_.averageLoadPercent, stats_.maxLoadPercent,
             stats_.maxBlockSeconds * 1e3, stats_.droppedGrfFrames);
+    };
+    if (wroteGait) writeMeters(recordingPath_); // the replay reads the live block size there
+    if (recorder_) {
+        recorder_->finish();
+        lastDropped_ = recorder_->droppedFrames();
+        stats_.droppedGrfFrames = lastDropped_;
+        writeMeters(recorder_->path());
         const std::string error = recorder_->error();
         recorder_.reset();
         if (!error.empty()) throw std::runtime_error("live player: GRF recording: " + error);

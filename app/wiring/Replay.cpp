@@ -4,6 +4,7 @@
 #include "app/wiring/Players.h"
 #include "engine/control/GrfFile.h"
 #include "engine/render/Renderer.h"
+#include "engine/scene/WadingNode.h"
 #include "engine/wading/Gait.h"
 #include "engine/wading/Wading.h"
 #include "experiment/Clips.h"
@@ -97,9 +98,21 @@ ReplayRender renderTrialReplay(const ReplayRequest& q) {
             options.seed = info.renderSeed;
             options.sampleRateHz = rate;
             std::string source;
-            if (recording) {
+            const fs::path arrivals =
+                recording ? fs::path(recording->string() + ".arrivals.csv") : fs::path();
+            if (recording && fs::exists(arrivals)) {
+                // Each frame at the sample where the live node applied it, at the live block
+                // size: the samples the node rendered (issue #17).
+                out.audio = eng::renderWadingArrivals(
+                    options, eng::readGaitArrivals(arrivals.string()), out.blockSize);
+                source = fmt::format("recorded gait arrivals {} (block {})", arrivals.string(),
+                                     out.blockSize);
+            } else if (recording) {
+                // An older trial (no arrivals file): the gait on its 100 Hz grid, which only
+                // approximates where the live frames took effect.
                 out.audio = eng::renderWading(options, eng::readGaitCsv(recording->string()));
-                source = "recorded gait " + recording->string();
+                source = "recorded gait " + recording->string() +
+                         " on its 100 Hz grid (no arrivals file: not sample-exact)";
             } else {
                 out.audio = eng::renderWading(options, q.walkSeconds);
                 source = fmt::format("virtual gait, {} steps/min", options.cadenceStepsPerMin);

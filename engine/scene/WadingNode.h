@@ -16,8 +16,12 @@
 /// Every frame the node hands to the scene is also appended to a preallocated gait recording
 /// (capacity fixed before the trial; frames beyond it are counted, not recorded) that the main
 /// thread writes with writeGaitCsv() after the trial, so that `underfoot wade --gait` re-renders
-/// it.
+/// it. Each frame is also recorded with the sample (counted from the node's reset) at which it
+/// took effect; writeArrivals() saves those as a gait arrivals file from which
+/// renderWadingArrivals() reproduces the node's output exactly (issue #17, `underfoot replay`).
 #include "engine/dsp/ProcessSpec.h"
+#include "engine/io/AudioFile.h"
+#include "engine/render/SafetyLimiter.h"
 #include "engine/wading/Gait.h"
 #include "engine/wading/Wading.h"
 #include "engine/wading/WadingScene.h"
@@ -94,6 +98,52 @@ class VirtualGaitSource final : public GaitSource {
     std::int64_t nextFrame_ = 0; ///< index of the next frame (not wrapped)
 };
 
+/// A gait frame as the live node applied it: the sample, counted from the node's reset, at which
+/// it took effect (block start + offset in the block).
+struct GaitArrival {
+    std::int64_t sample = 0;
+    GaitFrame frame;
+};
+
+/// Everything the node was fed during a run: its frames where they took effect, and how many
+/// samples it rendered.
+struct GaitArrivals {
+    std::vector<GaitArrival> frames; ///< sorted by sample
+    std::int64_t samples = 0;        ///< samples the node processed since its reset
+};
+
+/// Writes a gait arrivals file (CSV: '#' comments, a `# samples = N` line, then the header
+/// sample,time_s,left_thigh_dps,right_thigh_dps,left_shank_dps,right_shank_dps; numbers in
+/// shortest round-trip form, so reading back gives the same doubles). Throws GaitFileError.
+void writeGaitArrivals(const std::string& path, const GaitArrivals& arrivals);
+/// Reads it back. Throws GaitFileError naming file:line and what was expected (missing
+/// `samples` line, wrong header, a non-number, NaN/Inf, samples out of order or beyond the run,
+/// more than 10^8 frames).
+GaitArrivals readGaitArrivals(const std::string& path);
+GaitArrivals parseGaitArrivals(const std::string& text, const std::string& file);
+
+/// Recorded arrivals as a gait source: each frame at its recorded sample (replay).
+class RecordedGaitSource final : public GaitSource {
+  public:
+    explicit RecordedGaitSource(std::vector<GaitArrival> frames);
+    void prepare(const ProcessSpec&) override {}
+    void reset(std::uint64_t seed) noexcept override;
+    int pull(int n, TimedGaitFrame* frames, int capacity) noexcept override;
+    std::string name() const override { return "recorded gait arrivals"; }
+
+  private:
+    std::vector<GaitArrival> frames_;
+    std::size_t next_ = 0;
+    std::int64_t sample_ = 0;
+};
+
+/// Re-renders a live wading node's run: the same node (options, seed) fed the recorded frames at
+/// their samples, in blocks of `blockSize` (the live block size) for `arrivals.samples` samples,
+/// then the offline output stage (StereoSafetyLimiter, as renderWading). Identical to what the
+/// live node rendered when blockSize is the live one. Throws WadingOptionError / PresetError.
+AudioBuffer renderWadingArrivals(const WadingOptions& options, const GaitArrivals& arrivals,
+                                 int blockSize, LimiterReport* limiter = nullptr);
+
 /// The node: a configured WadingScene + its gait source + the gait recording.
 class WadingNode {
   public:
@@ -121,6 +171,13 @@ class WadingNode {
     /// Main thread, after the node stopped running: writes the recording as a gait CSV (the
     /// times are made relative to the first frame). Throws GaitFileError / FileError.
     void writeRecording(const std::string& path) const;
+    /// Main thread, after the node stopped running: the recorded frames with the samples at
+    /// which they took effect, and the samples processed.
+    GaitArrivals arrivals() const;
+    /// Writes arrivals() as a gait arrivals file (writeGaitArrivals).
+    void writeArrivals(const std::string& path) const;
+    /// Samples processed since reset (audio thread publishes).
+    std::int64_t samplesProcessed() const noexcept { return samples_.load(); }
     /// "deep, v2, butterworth_5hz, osc gyroscopes".
     std::string summary() const;
 
@@ -131,7 +188,9 @@ class WadingNode {
     WadingScene scene_;
     std::vector<TimedGaitFrame> frames_;
     std::vector<GaitFrame> record_;
+    std::vector<std::int64_t> recordSample_; ///< where each recorded frame took effect
     std::atomic<std::size_t> recorded_{0};
+    std::atomic<std::int64_t> samples_{0};
     std::atomic<std::uint64_t> overflow_{0}, applied_{0};
 };
 

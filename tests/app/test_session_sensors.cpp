@@ -13,7 +13,7 @@
 #include "experiment/Export.h"
 #include "experiment/Session.h"
 #include "tests/common/PacedOfflineEngine.h"
-#include "tests/live/sensors/SocatHelpers.h"
+#include "tests/common/SocatHelpers.h"
 
 #include <gtest/gtest.h>
 

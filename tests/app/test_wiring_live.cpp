@@ -6,6 +6,7 @@
 #include "app/wiring/Players.h"
 #include "engine/control/GrfFile.h"
 #include "engine/render/Renderer.h"
+#include "engine/scene/WadingNode.h"
 #include "engine/wading/Gait.h"
 #include "soundscapes/Library.h"
 #include "soundscapes/Renderer.h"
@@ -250,4 +251,15 @@ TEST(Wiring, WaterStimulusPlaysTheWadingNodeAndRecordsItsGait) {
     double swing = 0;
     for (const auto& f : gait) swing = std::max(swing, f[eng::Limb::LeftThigh]);
     EXPECT_GT(swing, 50.0) << "the recorded virtual gait swings";
+    // Beside it, what reproduces the node exactly (issue #17): the same frames with the samples
+    // at which they took effect, and the live block size for the replay.
+    const auto recording = (study / *start.grfRecording).string();
+    const auto arrivals = eng::readGaitArrivals(recording + ".arrivals.csv");
+    ASSERT_EQ(arrivals.frames.size(), gait.size());
+    EXPECT_GE(arrivals.samples, 72000);
+    for (std::size_t k = 0; k < gait.size(); ++k)
+        EXPECT_NEAR(arrivals.frames[k].frame[eng::Limb::LeftThigh], gait[k][eng::Limb::LeftThigh],
+                    1e-6)
+            << k;
+    EXPECT_TRUE(fs::exists(recording + ".meters.toml"));
 }

@@ -17,7 +17,7 @@
 #include "experiment/Protocol.h"
 #include "experiment/Store.h"
 #include "tests/common/PacedOfflineEngine.h"
-#include "tests/live/sensors/SocatHelpers.h"
+#include "tests/common/SocatHelpers.h"
 
 #include <QApplication>
 #include <QComboBox>
@@ -66,34 +66,20 @@ QPushButton* button(QWidget* root, const QString& name) {
 
 using OfflineEngine = underfoot::test::PacedOfflineEngine;
 
-/// Writes the scripted walk's lines at 1 kHz to `fd` until destroyed.
+/// The scripted walk (stand 0.5 s, then 80 steps) written at 1 kHz to `fd` until destroyed.
 class ShoeWriter {
   public:
-    explicit ShoeWriter(int fd) : script_(eng::ShoeWalkOptions{}, 8) {
-        script_.stand(500);
-        script_.walk(80);
-        thread_ = std::thread([this, fd] {
-            underfoot::test::writeAll(fd, eng::shoeHeaderLine());
-            eng::Random noise(3);
-            const auto start = std::chrono::steady_clock::now();
-            for (std::size_t i = 0; !stop_.load(); ++i) {
-                std::this_thread::sleep_until(start + std::chrono::milliseconds(i));
-                if (!underfoot::test::writeAll(fd,
-                                               eng::formatShoeLine(static_cast<std::uint32_t>(i),
-                                                                   script_.sample(i, noise))))
-                    break;
-            }
-        });
-    }
-    ~ShoeWriter() {
-        stop_ = true;
-        thread_.join();
-    }
+    explicit ShoeWriter(int fd) : script_(makeScript()), writer_(fd, script_) {}
 
   private:
+    static eng::ShoeScript makeScript() {
+        eng::ShoeScript script(eng::ShoeWalkOptions{}, 8);
+        script.stand(500);
+        script.walk(80);
+        return script;
+    }
     eng::ShoeScript script_;
-    std::atomic<bool> stop_{false};
-    std::thread thread_;
+    underfoot::test::ShoeLineWriter writer_;
 };
 
 QString makeStudy(const QTemporaryDir& dir) {

@@ -4,7 +4,7 @@
 // reports and stamps them.
 #include "engine/io/sensors/OscGyroReceiver.h"
 #include "engine/io/sensors/SensorClock.h"
-#include "tests/live/sensors/SocatHelpers.h"
+#include "tests/common/SocatHelpers.h"
 
 #include <gtest/gtest.h>
 #include <lo/lo.h>

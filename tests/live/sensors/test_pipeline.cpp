@@ -8,7 +8,7 @@
 #include "engine/io/sensors/SerialSource.h"
 #include "engine/io/sensors/ShoeProtocol.h"
 #include "engine/io/sensors/ShoeSimulator.h"
-#include "tests/live/sensors/SocatHelpers.h"
+#include "tests/common/SocatHelpers.h"
 
 #include <gtest/gtest.h>
 

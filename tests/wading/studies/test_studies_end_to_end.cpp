@@ -75,13 +75,14 @@ TEST(WadingStudiesEndToEnd, ListeningTestOfSixteenParticipantsInThePapersForm) {
     // Spearman correlations between the four scales: 6 pairs over 16 x 6 cells each.
     ASSERT_EQ(a.correlations.size(), 6u);
     for (const auto& c : a.correlations) EXPECT_EQ(c.n, 96u);
-    // The report: a box plot per scale (six boxes each) in HTML and Markdown.
+    // The report: per scale a figure of means with 95 % CIs and a box plot (six boxes each) in
+    // HTML and Markdown.
     const std::string html = analysis::renderRatingReport(a, analysis::ReportFormat::Html);
     EXPECT_EQ(std::count(html.begin(), html.end(), '\n') > 0, true);
     std::size_t svgs = 0, boxes = 0;
     for (std::size_t at = 0; (at = html.find("<svg", at)) != std::string::npos; ++at) ++svgs;
     for (std::size_t at = 0; (at = html.find("<rect", at)) != std::string::npos; ++at) ++boxes;
-    EXPECT_EQ(svgs, 4u);
+    EXPECT_EQ(svgs, 8u);
     EXPECT_EQ(boxes, 24u);
     const std::string md = analysis::renderRatingReport(a, analysis::ReportFormat::Markdown);
     EXPECT_NE(md.find("## Scale naturalness (0 to 10)"), std::string::npos);

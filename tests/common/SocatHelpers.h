@@ -1,9 +1,13 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // Test helpers: a socat pseudo-terminal pair as a child process, a raw writer emulating the
-// shoes at 1 kHz, and a recorder of a source's state transitions.
+// shoes at 1 kHz (ShoeLineWriter: a ShoeScript's lines from a thread of its own), and a recorder
+// of a source's state transitions.
+#include "engine/dsp/Random.h"
 #include "engine/io/sensors/SensorClock.h"
 #include "engine/io/sensors/SensorStatus.h"
+#include "engine/io/sensors/ShoeProtocol.h"
+#include "engine/io/sensors/ShoeSimulator.h"
 #include "tests/common/ScratchDir.h"
 
 #include <algorithm>
@@ -127,6 +131,35 @@ inline void paced(int fd, std::size_t ticks,
         if (times) (*times)[i] = sensorClockSeconds();
     }
 }
+
+/// Writes a ShoeScript's header and lines at 1 kHz (line i at start + i ms, its sensor noise
+/// seeded with 3) into `fd` from a thread of its own, until destroyed or a write fails. The
+/// script must outlive the writer.
+class ShoeLineWriter {
+  public:
+    ShoeLineWriter(int fd, const ShoeScript& script)
+        : thread_([this, fd, &script] {
+              writeAll(fd, shoeHeaderLine());
+              Random noise(3);
+              const auto start = std::chrono::steady_clock::now();
+              for (std::size_t i = 0; !stop_.load(); ++i) {
+                  std::this_thread::sleep_until(start + std::chrono::milliseconds(i));
+                  if (!writeAll(fd, formatShoeLine(static_cast<std::uint32_t>(i),
+                                                   script.sample(i, noise))))
+                      break;
+              }
+          }) {}
+    ~ShoeLineWriter() {
+        stop_ = true;
+        thread_.join();
+    }
+    ShoeLineWriter(const ShoeLineWriter&) = delete;
+    ShoeLineWriter& operator=(const ShoeLineWriter&) = delete;
+
+  private:
+    std::atomic<bool> stop_{false};
+    std::thread thread_;
+};
 
 /// State transitions seen by the status callback, with their times.
 struct Transitions {
