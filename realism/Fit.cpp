@@ -250,6 +250,7 @@ void seedImpactModes(toml::table& root, const std::vector<RecordedMode>& recorde
             mt.insert("gain", g);
             mt.insert("mass_kg", m);
             mt.insert("t60_s", t60);
+            mt.is_inline(true); // one line per mode, as hand-written presets have them
             return mt;
         };
         for (const auto& r : rec) {
