@@ -87,7 +87,7 @@ std::vector<Knob> knobsFor(const toml::table& root) {
     std::vector<Knob> k;
     auto mul2 = [](double k2) { return [k2](double v, int) { return v * std::exp2(k2); }; };
     if (hasLayer(root, "impact")) {
-        k.push_back({{"decay", "every mode's t60_s x 2^k", -4.5, 1, 0, 0},
+        k.push_back({{"decay", "every mode's t60_s x 2^k", -4.5, 2, 0, 0},
                      [](toml::table& r, double x, const Ranges& rg) {
                          eachMode(r, rg, [&](toml::table& m, const std::string& p) {
                              if (auto v = m["t60_s"].value<double>())
@@ -187,18 +187,116 @@ double peakOf(const engine::AudioBuffer& a) {
     return p;
 }
 
-} // namespace
+struct ModeRow {
+    double f = 0, t60 = 0, mass = 1, gain = 1;
+};
 
-FitResult fitSurface(const std::string& presetFile, const std::vector<Recording>& real,
-                     const FitOptions& options) {
-    const auto t0 = std::chrono::steady_clock::now();
-    toml::table root;
+int impactModeCount(const toml::table& root) {
+    int n = 0;
+    if (const auto* layers = root["layer"].as_array())
+        for (const auto& node : *layers)
+            if (const auto* t = node.as_table())
+                if (t->get("type") && t->get("type")->value<std::string>() == "impact")
+                    if (const auto* modes = (*t)["modes"].as_array())
+                        n = std::max(n, int(modes->size()));
+    return n;
+}
+
+// Replaces every impact layer's modes by the recorded ones (Fit.h, "Modal seed").
+void seedImpactModes(toml::table& root, const std::vector<RecordedMode>& recorded,
+                     double clusterOctaves) {
+    auto* layers = root["layer"].as_array();
+    if (!layers) return;
+    for (auto& node : *layers) {
+        auto* t = node.as_table();
+        if (!t || !t->get("type") || t->get("type")->value<std::string>() != "impact") continue;
+        auto* modes = (*t)["modes"].as_array();
+        if (!modes || modes->empty()) continue;
+        std::vector<ModeRow> orig;
+        for (auto& m : *modes)
+            if (auto* mt = m.as_table())
+                orig.push_back({(*mt)["freq_hz"].value<double>().value_or(0),
+                                (*mt)["t60_s"].value<double>().value_or(0),
+                                (*mt)["mass_kg"].value<double>().value_or(1.0),
+                                (*mt)["gain"].value<double>().value_or(1.0)});
+        if (orig.empty()) continue;
+        const std::size_t n = orig.size();
+        // The strongest recorded modes, at most as many as the layer had, by frequency.
+        std::vector<RecordedMode> rec = recorded;
+        std::stable_sort(rec.begin(), rec.end(), [](const RecordedMode& a, const RecordedMode& b) {
+            return a.gain > b.gain;
+        });
+        if (rec.size() > n) rec.resize(n);
+        std::sort(rec.begin(), rec.end(), [](const RecordedMode& a, const RecordedMode& b) {
+            return a.frequencyHz < b.frequencyHz;
+        });
+        double mobility = 0; // sum of g^2 / m of the original modes
+        for (const auto& o : orig) mobility += o.gain * o.gain / o.mass;
+        double recSum = 0;
+        for (const auto& r : rec) recSum += r.gain;
+        const double topHz = rec.empty() ? 0 : rec.back().frequencyHz;
+        std::vector<ModeRow> fill;
+        for (const auto& o : orig)
+            if (rec.size() + fill.size() < n && o.f > topHz * std::exp2(clusterOctaves))
+                fill.push_back(o);
+        double fillMobility = 0;
+        for (const auto& o : fill) fillMobility += o.gain * o.gain / o.mass;
+        const double scale =
+            recSum > 0 ? std::max(mobility - fillMobility, 0.5 * mobility) / recSum : 0;
+        toml::array out;
+        auto row = [](double f, double g, double m, double t60) {
+            toml::table mt;
+            mt.insert("freq_hz", std::round(f * 10) / 10);
+            mt.insert("gain", g);
+            mt.insert("mass_kg", m);
+            mt.insert("t60_s", t60);
+            mt.is_inline(true); // one line per mode, as hand-written presets have them
+            return mt;
+        };
+        for (const auto& r : rec) {
+            const ModeRow* near = &orig.front();
+            for (const auto& o : orig)
+                if (std::fabs(std::log2(o.f / r.frequencyHz)) <
+                    std::fabs(std::log2(near->f / r.frequencyHz)))
+                    near = &o;
+            const double mob = r.gain * scale; // g^2 / m of this mode
+            double mass = near->mass, g = std::sqrt(mob * mass);
+            if (g > 10.0) {
+                g = 10.0;
+                mass = 100.0 / mob;
+            }
+            out.push_back(row(r.frequencyHz, g, mass, std::clamp(r.t60S, 0.001, 30.0)));
+        }
+        for (const auto& o : fill) out.push_back(row(o.f, o.gain, o.mass, o.t60));
+        t->insert_or_assign("modes", out);
+    }
+}
+
+toml::table parsePreset(const std::string& presetFile) {
     try {
-        root = toml::parse_file(presetFile);
+        return toml::parse_file(presetFile);
     } catch (const toml::parse_error& e) {
         throw std::invalid_argument(
             fmt::format("{}: not a TOML preset: {}", presetFile, e.description()));
     }
+}
+
+} // namespace
+
+std::string modalSeededPreset(const std::string& presetFile,
+                              const std::vector<RecordedMode>& modes) {
+    toml::table root = parsePreset(presetFile);
+    if (!hasLayer(root, "impact"))
+        throw std::invalid_argument(fmt::format("{}: no impact layer to seed", presetFile));
+    if (modes.empty()) throw std::invalid_argument("modal seed: no recorded mode");
+    seedImpactModes(root, modes, ModalSeedOptions{}.clusterOctaves);
+    return toText(root);
+}
+
+FitResult fitSurface(const std::string& presetFile, const std::vector<Recording>& real,
+                     const FitOptions& options) {
+    const auto t0 = std::chrono::steady_clock::now();
+    toml::table root = parsePreset(presetFile);
     if (root.get("base"))
         throw std::invalid_argument(fmt::format(
             "{}: a `base` preset; fit its base preset instead (it inherits the fit)", presetFile));
@@ -252,9 +350,34 @@ FitResult fitSurface(const std::string& presetFile, const std::vector<Recording>
         hi.push_back(k.info.hi);
     }
     result.distanceBefore = distanceOf(root);
+    const toml::table originalTable = root; // loudness reference
+    // Starting points: the preset itself, or (modal seed) the recordings' modes estimated on
+    // the signal and on its first difference; each is refined, the better result is kept.
+    struct Start {
+        toml::table table;
+        std::string name;
+        std::vector<RecordedMode> modes;
+        std::vector<std::string> skipped;
+    };
+    std::vector<Start> starts;
+    if (options.modalSeed && hasLayer(root, "impact")) {
+        for (bool emphasis : {false, true}) {
+            auto so = options.seed;
+            so.maxModes = impactModeCount(root);
+            so.preEmphasis = emphasis;
+            Start s{
+                root, emphasis ? "recorded modes (first difference)" : "recorded modes", {}, {}};
+            s.modes = recordedModes(real, so, &s.skipped);
+            seedImpactModes(s.table, s.modes, so.clusterOctaves);
+            starts.push_back(std::move(s));
+        }
+    } else {
+        starts.push_back({root, "the preset's own parameters", {}, {}});
+    }
     int evals = 0;
-    double best = result.distanceBefore;
-    std::vector<double> bestX = x;
+    double best = 0, overall = 1e300;
+    std::vector<double> bestX = x, overallX = x;
+    std::size_t overallStart = 0;
     struct Ctx {
         std::function<double(const std::vector<double>&)> f;
     } ctx{[&](const std::vector<double>& xv) {
@@ -264,32 +387,56 @@ FitResult fitSurface(const std::string& presetFile, const std::vector<Recording>
             best = d;
             bestX = xv;
         }
-        if (options.progress && !options.progress(evals, d, best)) throw nlopt::forced_stop();
+        if (options.progress && !options.progress(evals, d, std::min(best, overall)))
+            throw nlopt::forced_stop();
         return d;
     }};
-    nlopt::opt opt(nlopt::LN_BOBYQA, static_cast<unsigned>(knobs.size()));
-    opt.set_lower_bounds(lo);
-    opt.set_upper_bounds(hi);
-    std::vector<double> step;
-    for (std::size_t i = 0; i < knobs.size(); ++i) step.push_back(0.25 * (hi[i] - lo[i]));
-    opt.set_initial_step(step);
-    opt.set_maxeval(options.maxEvaluations);
-    opt.set_xtol_abs(1e-3);
-    opt.set_min_objective([](const std::vector<double>& xv, std::vector<double>&,
-                             void* data) { return static_cast<Ctx*>(data)->f(xv); },
-                          &ctx);
-    double fmin = 0;
-    try {
-        opt.optimize(x, fmin);
-    } catch (const nlopt::forced_stop&) {
-    } catch (const nlopt::roundoff_limited&) {
+    bool stopped = false;
+    for (std::size_t si = 0; si < starts.size() && !stopped; ++si) {
+        root = starts[si].table; // `build` applies the knobs to `root`
+        const double d0 = starts[si].modes.empty() ? result.distanceBefore : distanceOf(root);
+        best = d0;
+        x.assign(knobs.size(), 0.0);
+        bestX = x;
+        nlopt::opt opt(nlopt::LN_BOBYQA, static_cast<unsigned>(knobs.size()));
+        opt.set_lower_bounds(lo);
+        opt.set_upper_bounds(hi);
+        std::vector<double> step;
+        for (std::size_t i = 0; i < knobs.size(); ++i) step.push_back(0.25 * (hi[i] - lo[i]));
+        opt.set_initial_step(step);
+        opt.set_maxeval(options.maxEvaluations);
+        opt.set_xtol_abs(1e-3);
+        opt.set_min_objective([](const std::vector<double>& xv, std::vector<double>&,
+                                 void* data) { return static_cast<Ctx*>(data)->f(xv); },
+                              &ctx);
+        double fmin = 0;
+        try {
+            opt.optimize(x, fmin);
+        } catch (const nlopt::forced_stop&) {
+            stopped = true;
+        } catch (const nlopt::roundoff_limited&) {
+        }
+        if (best < overall) {
+            overall = best;
+            overallX = bestX;
+            overallStart = si;
+            result.distanceSeeded = d0;
+        }
+    }
+    root = starts[overallStart].table;
+    bestX = overallX;
+    if (options.modalSeed && hasLayer(originalTable, "impact")) {
+        result.modalSeeded = true;
+        result.seededModes = starts[overallStart].modes;
+        result.seedSkipped = starts[overallStart].skipped;
+        result.seedStart = starts[overallStart].name;
     }
     // Keep the original's loudness: the render's peak equals the original's.
     toml::table fitted = build(bestX);
-    const double peakBefore = peakOf(render(root));
+    const double peakBefore = peakOf(render(originalTable));
     const double peakAfter = peakOf(render(fitted));
     if (peakBefore > 0 && peakAfter > 0) {
-        const double g = root["gain_db"].value<double>().value_or(0.0) +
+        const double g = originalTable["gain_db"].value<double>().value_or(0.0) +
                          20.0 * std::log10(peakBefore / peakAfter);
         fitted.insert_or_assign("gain_db", std::round(g * 10.0) / 10.0);
     }
@@ -328,6 +475,18 @@ FitResult fitSurface(const std::string& presetFile, const std::vector<Recording>
     toml::table kt;
     for (const auto& k : result.knobs) kt.insert(k.name, std::round(k.value * 1000) / 1000);
     prov.insert("knobs", kt);
+    if (result.modalSeeded) {
+        toml::table seed;
+        seed.insert("method", "matrix pencil on the strongest steps, clustered across files "
+                              "and sources (realism/ModalSeed.h)");
+        seed.insert("start", result.seedStart);
+        seed.insert("modes", static_cast<std::int64_t>(result.seededModes.size()));
+        seed.insert("modes_per_step", options.seed.modesPerStep);
+        seed.insert("steps_per_file", options.seed.stepsPerFile);
+        seed.insert("starts_tried", static_cast<std::int64_t>(starts.size()));
+        seed.insert("distance", std::round(result.distanceSeeded * 1000) / 1000);
+        prov.insert("modal_seed", seed);
+    }
     fitted.insert_or_assign("provenance", prov);
     result.presetText = toText(fitted);
     result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -16,7 +16,22 @@
 ///    level (splash_noise_db + k), slosh level (slosh_db + k).
 /// The fitted preset keeps the original's loudness: its top-level gain_db is re-calibrated so
 /// that the render's peak equals the original's.
+///
+/// Modal seed (solids, FitOptions::modalSeed, on by default): before the optimiser starts, the
+/// impact layers' modes are replaced by the material's recorded modes (ModalSeed.h: matrix
+/// pencil on the recordings' strongest steps, clustered across files and sources), as many as
+/// the preset had (so the cost stays that of the original). Each seeded mode keeps the modal
+/// mass of the original mode nearest in frequency and gets the contact-point gain g with
+/// g^2 / m proportional to its recorded amplitude (a struck mode's velocity at the contact
+/// point is g^2 J / m for an impulse J), scaled so that the sum of g^2 / m, the floor's
+/// mobility at the contact, is the original's; where g would exceed the parameter's range
+/// (10) the mass is lowered instead (same g^2 / m). With fewer recorded modes than the preset
+/// has, the original modes above the highest recorded one fill the rest. Two seeds are made,
+/// from the pencil on the signal and on its first difference (ModalSeedOptions::preEmphasis;
+/// the first finds the strong low modes, the second the modes of the upper octaves); each is
+/// refined by the knobs with up to maxEvaluations renders, and the better result is kept.
 #include "realism/Compare.h"
+#include "realism/ModalSeed.h"
 
 #include <functional>
 #include <string>
@@ -30,6 +45,10 @@ struct FitOptions {
     /// Called after every evaluation (evaluation number, its distance, best so far); return
     /// false to stop the fit early (cancellation).
     std::function<bool(int, double, double)> progress;
+    /// Seed the impact layers' modes from the recordings (see above); false = refine the
+    /// preset's own modes (`underfoot fit --no-modal-seed`).
+    bool modalSeed = true;
+    ModalSeedOptions seed; ///< maxModes is set to each impact layer's mode count
 };
 
 struct FitKnob {
@@ -44,6 +63,11 @@ struct FitResult {
     double seconds = 0; ///< wall-clock time of the fit
     std::vector<FitKnob> knobs;
     std::string optimiser;
+    bool modalSeeded = false;              ///< the modes were seeded from the recordings
+    double distanceSeeded = 0;             ///< distance of the seeded preset, before refining
+    std::vector<RecordedMode> seededModes; ///< the recorded modes written into the preset
+    std::vector<std::string> seedSkipped;  ///< recordings that yielded no mode
+    std::string seedStart;                 ///< the starting point the result was refined from
 };
 
 /// Fits a preset file (a surface with its own layers; a `base` preset is fitted through its
@@ -51,5 +75,11 @@ struct FitResult {
 /// a broken preset, std::runtime_error when the recordings hold no step.
 FitResult fitSurface(const std::string& presetFile, const std::vector<Recording>& real,
                      const FitOptions& options);
+
+/// The preset's text with its impact layers' modes replaced by `modes` as the modal seed does
+/// (see above). Throws std::invalid_argument when the preset has no impact layer or `modes`
+/// is empty, engine::PresetError for a broken preset.
+std::string modalSeededPreset(const std::string& presetFile,
+                              const std::vector<RecordedMode>& modes);
 
 } // namespace underfoot::realism

@@ -2,6 +2,8 @@
 // `underfoot fit`: fit a surface preset to recorded footsteps (analysis by synthesis, NLopt).
 //   fit --surface gravel [--real FILES_OR_DIRS...] -o gravel_fitted.toml [--evaluations 80]
 //   fit --surface wood --modes 8     modal estimate (matrix pencil) of every recorded strike
+//   fit --surface wood -o wood.toml --no-modal-seed   refine the preset's own modes only
+// Solids (impact layers) are first seeded with the recordings' modes (realism/ModalSeed.h).
 // Without --real the recordings of the surface's material come from the cache of
 // scripts/fetch-recordings.sh. The output is a normal preset with a [provenance] table.
 #include "app/cli/CommandRegistry.h"
@@ -29,6 +31,7 @@ struct FitArgs {
     rl::FitOptions options;
     bool quiet = false;
     int modes = 0; ///< --modes K: print K modes of every recording and stop
+    bool noModalSeed = false;
 };
 
 // The matrix pencil modes of every recording (strongest step, from its peak): the starting
@@ -91,6 +94,7 @@ int runFit(FitArgs& a) {
         }
     }
     a.options.maxEvaluations = a.evaluations;
+    a.options.modalSeed = !a.noModalSeed;
     if (!a.quiet)
         a.options.progress = [](int n, double d, double best) {
             if (n % 10 == 0)
@@ -119,6 +123,16 @@ int runFit(FitArgs& a) {
     } catch (const eng::PresetError& e) {
         throw UserError(
             fmt::format("fit: the fitted preset does not load (engine bug): {}", e.what()));
+    }
+    if (r.modalSeeded) {
+        fmt::print("modal seed from {} ({} modes; distance {:.3f} -> {:.3f} seeded):\n",
+                   r.seedStart, r.seededModes.size(), r.distanceBefore, r.distanceSeeded);
+        for (const auto& m : r.seededModes)
+            fmt::print("  {:8.1f} Hz  T60 {:6.3f} s  gain {:6.1f} dB  support {:4.0f} %  ({} "
+                       "estimates)\n",
+                       m.frequencyHz, m.t60S, 20 * std::log10(m.gain), 100 * m.support,
+                       m.observations);
+        for (const auto& f : r.seedSkipped) fmt::print("  (no mode from {})\n", f);
     }
     fmt::print("{}: distance {:.3f} -> {:.3f} after {} evaluations ({}) in {:.1f} s -> {}\n",
                a.surface, r.distanceBefore, r.distanceAfter, r.evaluations, r.optimiser, r.seconds,
@@ -155,6 +169,9 @@ CommandRegistrar reg("fit", [](CLI::App& app, int& exitCode) {
                     "print the K strongest modes (matrix pencil: Hz, T60, gain) of every "
                     "recording's strongest step instead of fitting")
         ->check(CLI::Range(1, 64));
+    cmd->add_flag("--no-modal-seed", args->noModalSeed,
+                  "solids: start from the preset's own modes instead of the recordings' modes "
+                  "(matrix pencil, clustered across files and sources)");
     cmd->callback([args, &exitCode] { exitCode = runFit(*args); });
 });
 
