@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "realism/Descriptors.h"
 
-#include <fftw3.h>
+#include "engine/dsp/RealFft.h"
+
 #include <fmt/core.h>
 
 #include <algorithm>
@@ -24,9 +25,9 @@ double db(double p) {
 // within 40 dB of the loudest frame; a step shorter than one frame is zero-padded.
 std::vector<double> stepSpectrum(const std::vector<float>& x, std::size_t b, std::size_t e) {
     const auto n = static_cast<std::size_t>(kFft);
-    double* in = fftw_alloc_real(n);
-    fftw_complex* out = fftw_alloc_complex(n / 2 + 1);
-    fftw_plan plan = fftw_plan_dft_r2c_1d(kFft, in, out, FFTW_ESTIMATE);
+    engine::RealFft fft(kFft); // plans under FFTW's planner lock: callers run on worker threads
+    double* in = fft.time();
+    const fftw_complex* out = fft.spectrum();
     std::vector<double> window(n);
     for (std::size_t i = 0; i < n; ++i)
         window[i] = 0.5 - 0.5 * std::cos(2.0 * std::numbers::pi * double(i) / double(n));
@@ -35,7 +36,7 @@ std::vector<double> stepSpectrum(const std::vector<float>& x, std::size_t b, std
     for (std::size_t s = b; s < e; s += static_cast<std::size_t>(kHop)) {
         for (std::size_t i = 0; i < n; ++i)
             in[i] = (s + i < e ? double(x[s + i]) : 0.0) * window[i];
-        fftw_execute(plan);
+        fft.forward();
         std::vector<double> p(n / 2 + 1);
         double sum = 0;
         for (std::size_t k = 0; k <= n / 2; ++k) {
@@ -46,9 +47,6 @@ std::vector<double> stepSpectrum(const std::vector<float>& x, std::size_t b, std
         energy.push_back(sum);
         if (s + n >= e) break;
     }
-    fftw_destroy_plan(plan);
-    fftw_free(in);
-    fftw_free(out);
     std::vector<double> mean(n / 2 + 1, 0.0);
     if (frames.empty()) return mean;
     const double maxE = *std::max_element(energy.begin(), energy.end());

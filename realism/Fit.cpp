@@ -387,7 +387,9 @@ FitResult fitSurface(const std::string& presetFile, const std::vector<Recording>
             best = d;
             bestX = xv;
         }
-        if (options.progress && !options.progress(evals, d, std::min(best, overall)))
+        if (options.progress &&
+            !options.progress(evals, options.maxEvaluations * static_cast<int>(starts.size()), d,
+                              std::min(best, overall)))
             throw nlopt::forced_stop();
         return d;
     }};

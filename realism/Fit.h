@@ -42,9 +42,10 @@ namespace underfoot::realism {
 struct FitOptions {
     RenderSpec spec{"cadence=100", 6.0, 11, 48000};
     int maxEvaluations = 80;
-    /// Called after every evaluation (evaluation number, its distance, best so far); return
-    /// false to stop the fit early (cancellation).
-    std::function<bool(int, double, double)> progress;
+    /// Called after every evaluation (evaluation number, the fit's whole budget of evaluations:
+    /// maxEvaluations per starting point, its distance, best so far); return false to stop the
+    /// fit early (cancellation).
+    std::function<bool(int, int, double, double)> progress;
     /// Seed the impact layers' modes from the recordings (see above); false = refine the
     /// preset's own modes (`underfoot fit --no-modal-seed`).
     bool modalSeed = true;

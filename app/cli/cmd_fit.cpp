@@ -96,9 +96,10 @@ int runFit(FitArgs& a) {
     a.options.maxEvaluations = a.evaluations;
     a.options.modalSeed = !a.noModalSeed;
     if (!a.quiet)
-        a.options.progress = [](int n, double d, double best) {
+        a.options.progress = [](int n, int budget, double d, double best) {
             if (n % 10 == 0)
-                fmt::print("  evaluation {}: distance {:.3f} (best {:.3f})\n", n, d, best);
+                fmt::print("  evaluation {} of at most {}: distance {:.3f} (best {:.3f})\n", n,
+                           budget, d, best);
             return true;
         };
     rl::FitResult r;

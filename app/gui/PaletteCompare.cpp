@@ -20,14 +20,11 @@
 #include <QVBoxLayout>
 #include <QtConcurrent/QtConcurrent>
 
-#include <fftw3.h>
-
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <limits>
-#include <mutex>
 #include <numeric>
 
 namespace underfoot::gui {
@@ -74,11 +71,9 @@ QString valueText(double v, const char* unit) {
 PaletteCompare::PaletteCompare(PaletteHooks hooks, QWidget* parent)
     : QWidget(parent), hooks_(std::move(hooks)),
       cacheDir_(QString::fromStdString(realism::defaultRecordingsDir())) {
-    // Renders, descriptors and spectrograms plan FFTs (double precision) on worker threads while
-    // the other views may do the same: make FFTW's planner thread-safe once for the process.
-    static std::once_flag fftwOnce;
-    std::call_once(fftwOnce, [] { fftw_make_planner_thread_safe(); });
-
+    // Renders, descriptors and spectrograms plan FFTs on worker threads while the other views
+    // may do the same: every plan in Underfoot is made under engine::fftwPlannerMutex()
+    // (engine/dsp/RealFft.h), so no FFTW thread support is needed.
     auto* useMaterial = new QPushButton(tr("Recordings of this &material:"), this);
     useMaterial->setAccessibleName(tr("Compare with the cached recordings of the chosen material"));
     material_ = new QComboBox(this);
@@ -535,9 +530,10 @@ bool PaletteCompare::startFit(int maxEvaluations) {
         tr("evaluation 0 of %1 · rendering the current settings").arg(maxEvaluations));
     fitLabel_->setText(tr("Fitting %1 to %2…").arg(stemOf(file), reference_->label));
     setMessage(QString(), false);
-    options.progress = [this, cancel = cancel_](int k, double d, double best) {
+    options.progress = [this, cancel = cancel_](int k, int budget, double d, double best) {
         QMetaObject::invokeMethod(
-            this, [this, k, d, best] { fitEvaluated(k, d, best); }, Qt::QueuedConnection);
+            this, [this, k, budget, d, best] { fitEvaluated(k, budget, d, best); },
+            Qt::QueuedConnection);
         return !cancel->load();
     };
     fitJob_ = QtConcurrent::run(
@@ -565,8 +561,12 @@ void PaletteCompare::cancelFit() {
     progress_->setFormat(progress_->format() + tr(" · cancelling after this evaluation"));
 }
 
-void PaletteCompare::fitEvaluated(int evaluation, double distance, double best) {
+void PaletteCompare::fitEvaluated(int evaluation, int budget, double distance, double best) {
     if (!fitRunning_) return;
+    if (budget != fitBudget_) { // a solid is refined from two starting points (Fit.h)
+        fitBudget_ = budget;
+        progress_->setRange(0, budget);
+    }
     progress_->setValue(std::min(evaluation, fitBudget_));
     progress_->setFormat(tr("evaluation %1 of %2 · this one %3 · best distance so far %4")
                              .arg(evaluation)

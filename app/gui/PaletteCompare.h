@@ -135,7 +135,7 @@ class PaletteCompare : public QWidget {
     void referenceDone(quint64 generation, std::shared_ptr<PaletteReference> ref,
                        const QString& error);
     void comparisonDone(const PaletteComparison& c);
-    void fitEvaluated(int evaluation, double distance, double best);
+    void fitEvaluated(int evaluation, int budget, double distance, double best);
     void fitDone(const PaletteFitOutcome& outcome);
     void showComparison(const PaletteComparison& c);
     void chooseFiles();

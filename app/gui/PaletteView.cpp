@@ -373,20 +373,14 @@ QString PaletteView::applyPresetText(const QString& text) {
     // The fit is of the palette's own (self-contained) preset: the same parameters in the same
     // order; a base preset's prefix ("wood:.") and layer numbering may differ, the key may not.
     const auto& ps = surface->parameters();
-    if (static_cast<int>(ps.size()) != params_->rowCount())
-        return tr("the preset has %1 parameters, the palette %2: not the same surface layout")
-            .arg(ps.size())
-            .arg(params_->rowCount());
+    if (static_cast<int>(ps.size()) != params_->rowCount()) return showFittedPreset(text);
     const auto key = [](const std::string& path) { return path.substr(path.rfind('.') + 1); };
     for (int r = 0; r < params_->rowCount(); ++r) {
         const std::string path =
             params_->item(r, PathCol)->data(Qt::UserRole).toString().toStdString();
         const auto& p = ps[static_cast<std::size_t>(r)];
         auto* spin = static_cast<QDoubleSpinBox*>(params_->cellWidget(r, ValueCol));
-        if (key(path) != key(p.path))
-            return tr("parameter %1 of the preset is %2 in the palette: not the same layout")
-                .arg(r + 1)
-                .arg(q(path));
+        if (key(path) != key(p.path)) return showFittedPreset(text);
         if (p.value < spin->minimum() || p.value > spin->maximum())
             return tr("%1 = %2 is outside its range %3 … %4")
                 .arg(q(path))
@@ -401,6 +395,36 @@ QString PaletteView::applyPresetText(const QString& text) {
         spin->setValue(p.value); // each change restarts the comparison's debounce: one compare
     }
     return {};
+}
+
+QString PaletteView::showFittedPreset(const QString& text) {
+    if (currentFile_.isEmpty()) return tr("no surface is selected");
+    if (!fittedDir_) fittedDir_ = std::make_unique<QTemporaryDir>();
+    if (!fittedDir_->isValid()) return tr("no temporary folder for the fitted preset");
+    QString base = QFileInfo(currentFile_).completeBaseName();
+    if (base.endsWith("_fitted")) base.chop(7);
+    const QString path = fittedDir_->filePath(base + "_fitted.toml");
+    {
+        QFile f(path);
+        if (!f.open(QIODevice::WriteOnly | QIODevice::Truncate) ||
+            f.write(text.toUtf8()) != text.toUtf8().size())
+            return tr("cannot write %1").arg(path);
+    }
+    QListWidgetItem* item = nullptr;
+    for (int i = 0; i < list_->count(); ++i)
+        if (list_->item(i)->data(Qt::UserRole).toString() == path) item = list_->item(i);
+    if (!item) {
+        item = new QListWidgetItem(tr("%1 (fitted, not saved)").arg(base), list_);
+        item->setData(Qt::UserRole, path);
+        item->setToolTip(tr("The fitted preset has another layout than %1 (e.g. fewer modes); "
+                            "save it to keep it.")
+                             .arg(base));
+    }
+    if (list_->currentItem() == item)
+        showSurface(); // same entry, new text
+    else
+        list_->setCurrentItem(item);
+    return currentFile_ == path ? QString() : tr("the fitted preset could not be shown");
 }
 
 bool PaletteView::setParameter(const QString& path, double value) {

@@ -8,9 +8,11 @@
 #include "engine/control/VirtualWalker.h"
 
 #include <QFutureWatcher>
+#include <QTemporaryDir>
 #include <QWidget>
 
 #include <map>
+#include <memory>
 #include <string>
 
 class QListWidget;
@@ -56,7 +58,9 @@ class PaletteView : public QWidget {
     /// The "compare with a recording / fit" panel (PaletteCompare.h).
     PaletteCompare* compareView() const { return compare_; }
     /// Puts the parameter values of a preset of the same layout (e.g. the fit of the current
-    /// settings) into the table; returns "" or the problem (nothing is changed then).
+    /// settings) into the table. A preset of another layout (a fit seeded from recorded modes
+    /// may have fewer modes) becomes a new, unsaved entry "<surface> (fitted)" of the list,
+    /// selected. Returns "" or the problem (nothing is changed then).
     QString applyPresetText(const QString& text);
     /// The virtual walker set in the view.
     engine::WalkerParameters walkerParameters() const;
@@ -71,6 +75,7 @@ class PaletteView : public QWidget {
     void audition();
     void renderToWav();
     void setMessage(const QString& text, bool error);
+    QString showFittedPreset(const QString& text);
 
     QString dataDir_;
     QString currentFile_;
@@ -88,6 +93,7 @@ class PaletteView : public QWidget {
     QFutureWatcher<CostMeasurement>* costWatcher_;
     AudioOutput* audio_ = nullptr;
     PaletteCompare* compare_ = nullptr;
+    std::unique_ptr<QTemporaryDir> fittedDir_; ///< unsaved fitted presets of another layout
 };
 
 } // namespace underfoot::gui

@@ -173,15 +173,19 @@ class PaletteCompareTest : public QObject {
         QVERIFY2(finished.front().front().toBool(), qPrintable(c->message()));
         QVERIFY(!progress.isEmpty());
         int last = 0;
+        // A solid is refined from two starting points (its recorded modes from the signal and
+        // from its first difference, realism/Fit.h): the budget is 8 per start.
+        const int budget = progress.front().at(1).toInt();
+        QVERIFY(budget == 8 || budget == 16);
         for (const auto& args : progress) {
-            QCOMPARE(args.at(1).toInt(), 8);
+            QCOMPARE(args.at(1).toInt(), budget);
             QVERIFY(args.at(0).toInt() > last); // evaluation k of N, increasing
             last = args.at(0).toInt();
         }
         const auto& fit = *c->lastFit();
         QVERIFY(!fit.cancelled);
         QCOMPARE(fit.result.evaluations, last);
-        QVERIFY(last <= 8);
+        QVERIFY(last <= budget);
         qInfo("fit wood to a metal render: %d evaluations, %.3f -> %.3f in %.1f s",
               fit.result.evaluations, fit.result.distanceBefore, fit.result.distanceAfter,
               fit.result.seconds);
