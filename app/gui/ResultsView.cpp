@@ -89,7 +89,7 @@ QString exportStudy(const QString& studyPath, const QString& folder,
     try {
         if (!QDir().mkpath(folder))
             return QObject::tr("%1: cannot create the folder; choose a writable one.").arg(folder);
-        const auto store = exp::StudyStore::open(studyPath.toStdString());
+        const auto store = exp::StudyStore::openForReading(studyPath.toStdString());
         const QDir dir(folder);
         const int total = 7;
         int done = 0;

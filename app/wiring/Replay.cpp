@@ -50,7 +50,7 @@ LiveRun readMetersFile(const fs::path& recording) {
 ReplayRender renderTrialReplay(const ReplayRequest& q) {
     exp::ReplayInfo info;
     try {
-        const auto store = exp::StudyStore::open(q.study);
+        const auto store = exp::StudyStore::openForReading(q.study);
         info = store.trialForReplay(q.participant, q.trial);
     } catch (const std::exception& e) {
         throw ReplayError(e.what());
@@ -155,10 +155,16 @@ ReplayRender renderTrialReplay(const ReplayRequest& q) {
         }
         out.audio = renderStimulusFromGrf(stimulus, grf, info.renderSeed, rate, out.blockSize);
         out.description =
-            fmt::format("{} trial {} ({}{}{}): {:.1f} s from {}, render seed {}, block {}",
+            fmt::format("{} trial {} ({}{}{}): {:.1f} s from {}, render seed {}, block {}{}",
                         info.participant, info.trialIndex + 1, stimulus.surface,
                         stimulus.soundscape ? " + " : "", stimulus.soundscape.value_or(""),
-                        double(out.audio.frames()) / rate, source, out.seed, out.blockSize);
+                        double(out.audio.frames()) / rate, source, out.seed, out.blockSize,
+                        recording && !q.blockSize && !live.blockSize
+                            ? fmt::format(" (assumed: {}.meters.toml, which holds the live block "
+                                          "size, is missing; if the live block differed, pass "
+                                          "--block)",
+                                          recording->string())
+                            : std::string());
         return out;
     } catch (const ReplayError&) {
         throw;
