@@ -67,7 +67,7 @@ class ConsolePlayer final : public exp::StimulusPlayer {
             wiring::LivePlayerOptions o;
             const QDir dir = QFileInfo(studyPath).dir();
             o.studyFolder = dir.path().toStdString();
-            o.recordingFolder = dir.filePath("grf_recordings").toStdString();
+            o.recordingFolder = dir.filePath("recordings").toStdString();
             QDir().mkpath(QString::fromStdString(o.recordingFolder));
             if (sensors.shoes) attachShoes(*engine, sensors, participant, o);
             o.scene.gyroReceiver = sensors.gyros;
