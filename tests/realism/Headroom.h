@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <map>
 #include <string>
 #include <vector>
@@ -35,9 +36,15 @@ struct WorstPeak {
 inline std::map<std::string, WorstPeak> worstPeaks(const std::vector<std::string>& walkers,
                                                    int seeds, double seconds) {
     std::map<std::string, WorstPeak> worst;
+    // UNDERFOOT_HEADROOM_SURFACES=deep_snow,gravel limits a run to those surfaces (re-checking
+    // one preset without the whole soak).
+    const char* only = std::getenv("UNDERFOOT_HEADROOM_SURFACES");
+    const std::string onlyList = only ? "," + std::string(only) + "," : "";
     for (const auto& info : listSurfaces())
         for (const auto& walker : walkers)
             for (int seed = 1; seed <= seeds; ++seed) {
+                if (!onlyList.empty() && onlyList.find("," + info.id + ",") == std::string::npos)
+                    break;
                 const auto grf =
                     walkerGrf(WalkerParameters::parse(walker), seconds, 48000, std::uint64_t(seed));
                 RenderOptions o;
