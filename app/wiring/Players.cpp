@@ -6,6 +6,7 @@
 #include "engine/io/sensors/SensorClock.h"
 #include "engine/io/sensors/SensorLog.h"
 #include "engine/render/Renderer.h"
+#include "engine/render/SafetyLimiter.h"
 #include "soundscapes/Library.h"
 #include "soundscapes/Renderer.h"
 
@@ -390,6 +391,8 @@ eng::AudioBuffer renderStimulusFromGrf(const exp::Stimulus& stimulus, const eng:
     options.seed = seed;
     options.tailSeconds = 1.0;
     if (stimulus.reverb) options.scene.impulseResponse = *stimulus.reverb;
+    // The live engine limits each output after the soundscape is mixed in: so does the replay.
+    options.limit = false;
     auto r = eng::renderSurface(stimulus.surface, grf, options);
     if (stimulus.soundscape && stimulus.modalities != exp::Modalities::Haptic) {
         // As the live scene mixes it: same seed, unity gain.
@@ -403,6 +406,19 @@ eng::AudioBuffer renderStimulusFromGrf(const exp::Stimulus& stimulus, const eng:
             r.audio.samples[2 * i] += l[i];
             r.audio.samples[2 * i + 1] += rr[i];
         }
+    }
+    const std::size_t n = r.audio.frames();
+    std::vector<float> l(n), rr(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        l[i] = r.audio.samples[2 * i];
+        rr[i] = r.audio.samples[2 * i + 1];
+    }
+    eng::StereoSafetyLimiter limiter;
+    limiter.prepare(rate);
+    limiter.process(l.data(), rr.data(), static_cast<int>(n));
+    for (std::size_t i = 0; i < n; ++i) {
+        r.audio.samples[2 * i] = l[i];
+        r.audio.samples[2 * i + 1] = rr[i];
     }
     return std::move(r.audio);
 }

@@ -87,7 +87,7 @@ RenderResult renderSurface(const std::string& surface, const GrfSignal& grf,
             inPtr[c] = in[c].data();
         }
         scene.process(inPtr.data(), l.data(), r.data(), static_cast<int>(n));
-        limiter.process(l.data(), r.data(), static_cast<int>(n));
+        if (options.limit) limiter.process(l.data(), r.data(), static_cast<int>(n));
         for (std::size_t i = 0; i < n; ++i) {
             result.audio.samples[2 * (start + i)] = l[i];
             result.audio.samples[2 * (start + i) + 1] = r[i];

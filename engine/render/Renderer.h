@@ -19,6 +19,10 @@ struct RenderOptions {
     std::uint64_t seed = 1;
     SceneOptions scene;
     double tailSeconds = 0.0; ///< silence of the GRF appended so that rings and reverb decay
+    /// Pass the output through the safety limiter. A caller that mixes more into the render
+    /// (replay adds the soundscape, as the live engine does before its limiter) turns it off
+    /// and limits the mix itself.
+    bool limit = true;
 };
 
 struct RenderResult {
