@@ -10,12 +10,12 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <map>
-#include <regex>
 #include <sstream>
 #include <stdexcept>
 
@@ -162,21 +162,44 @@ std::vector<Knob> knobsFor(const toml::table& root) {
     return k;
 }
 
-// TOML text with every long decimal written with 6 significant digits (readable presets).
+// TOML text with every long decimal (7 or more digits after the point, as toml++ writes a
+// computed double) written with 6 significant digits (readable presets).
 std::string toText(const toml::table& t) {
     std::ostringstream s;
     s << t << "\n";
     const std::string text = s.str();
-    static const std::regex longNumber(R"(-?\d+\.\d{7,}(e[-+]?\d+)?)");
+    const std::size_t n = text.size();
+    const auto digit = [&](std::size_t i) {
+        return i < n && std::isdigit(static_cast<unsigned char>(text[i])) != 0;
+    };
     std::string out;
-    auto it = std::sregex_iterator(text.begin(), text.end(), longNumber);
-    std::size_t last = 0;
-    for (; it != std::sregex_iterator(); ++it) {
-        out += text.substr(last, static_cast<std::size_t>(it->position()) - last);
-        std::string v = fmt::format("{:.6g}", std::stod(it->str()));
-        if (v.find_first_of(".e") == std::string::npos) v += ".0";
-        out += v;
-        last = static_cast<std::size_t>(it->position() + it->length());
+    std::size_t last = 0, i = 0;
+    while (i < n) {
+        std::size_t j = i + (text[i] == '-' ? 1 : 0);
+        const std::size_t intStart = j;
+        while (digit(j)) ++j;
+        if (j == intStart) { // not a number here
+            ++i;
+            continue;
+        }
+        if (j < n && text[j] == '.') {
+            const std::size_t fracStart = ++j;
+            while (digit(j)) ++j;
+            if (j - fracStart >= 7) {
+                if (j < n && text[j] == 'e') { // exponent, when it has digits
+                    std::size_t e = j + 1;
+                    if (e < n && (text[e] == '-' || text[e] == '+')) ++e;
+                    const std::size_t expStart = e;
+                    while (digit(e)) ++e;
+                    if (e > expStart) j = e;
+                }
+                std::string v = fmt::format("{:.6g}", std::stod(text.substr(i, j - i)));
+                if (v.find_first_of(".e") == std::string::npos) v += ".0";
+                out += text.substr(last, i - last) + v;
+                last = j;
+            }
+        }
+        i = j;
     }
     return out + text.substr(last);
 }
