@@ -456,6 +456,95 @@ std::string comparisonSentence(const ComparisonRow& c) {
     return out + ".";
 }
 
+/// Ratings per stimulus of one group: each answer as a dot, the mean as a bar with its 95 %
+/// confidence interval (t), stimuli by their protocol labels.
+std::string ratingMeansSvg(const AnalysisReport& r, const std::string& group, bool realism) {
+    const AnswerList* answers = nullptr;
+    for (const auto& m : r.confusions)
+        if (m.group == group) answers = &m.columns;
+    std::vector<const SummaryRow*> rows;
+    double lo = HUGE_VAL, hi = -HUGE_VAL;
+    std::size_t longest = 0;
+    for (const auto& s : r.summary) {
+        if (s.group != group) continue;
+        const MeanSummary& m = realism ? s.realism : s.quality;
+        if (m.values.empty()) continue;
+        rows.push_back(&s);
+        for (double v : m.values) {
+            lo = std::min(lo, v);
+            hi = std::max(hi, v);
+        }
+        if (!std::isnan(m.ci.lower)) {
+            lo = std::min(lo, m.ci.lower);
+            hi = std::max(hi, m.ci.upper);
+        }
+        longest = std::max(longest, stimulusLabel(s.stimulus, answers).size());
+    }
+    if (rows.empty()) return {};
+    lo = std::floor(lo);
+    hi = std::ceil(hi);
+    if (hi <= lo) hi = lo + 1;
+    constexpr int rowH = 28, plotW = 420, top = 34, bottom = 46;
+    const int left = std::max(110, static_cast<int>(longest) * 7 + 16);
+    const int width = left + plotW + 30,
+              height = top + rowH * static_cast<int>(rows.size()) + bottom;
+    const auto sx = [&](double v) { return left + plotW * (v - lo) / (hi - lo); };
+    const char* measure = realism ? "realism" : "quality";
+    std::string out = fmt::format("<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{}\" "
+                                  "height=\"{}\" viewBox=\"0 0 {} {}\" role=\"img\" "
+                                  "font-family=\"sans-serif\" font-size=\"12\">\n",
+                                  width, height, width, height);
+    out += "<title>" + xmlEscape(fmt::format("Mean {} per stimulus, {}", measure, group)) +
+           "</title>\n";
+    const int axisY = top + rowH * static_cast<int>(rows.size());
+    const double span = hi - lo;
+    const double step = span <= 10 ? 1 : std::ceil(span / 10);
+    for (double v = lo; v <= hi + 1e-9; v += step) {
+        out += fmt::format("<line x1=\"{0:.1f}\" y1=\"{1}\" x2=\"{0:.1f}\" y2=\"{2}\" "
+                           "stroke=\"#e3e3e3\"/>\n<text x=\"{0:.1f}\" y=\"{3}\" "
+                           "text-anchor=\"middle\">{4}</text>\n",
+                           sx(v), top - 6, axisY, axisY + 16, fixed(v, 0));
+    }
+    out += fmt::format("<line x1=\"{}\" y1=\"{}\" x2=\"{}\" y2=\"{}\" stroke=\"#444\"/>\n", left,
+                       axisY, left + plotW, axisY);
+    out += fmt::format("<text class=\"axis-title\" x=\"{}\" y=\"{}\" text-anchor=\"middle\" "
+                       "font-weight=\"bold\">{} rating: mean with 95 % CI (bar), each answer "
+                       "(dot)</text>\n",
+                       left + plotW / 2, axisY + 36, realism ? "Realism" : "Quality");
+    out += fmt::format("<text class=\"axis-title\" x=\"{}\" y=\"16\" text-anchor=\"middle\" "
+                       "font-weight=\"bold\">Stimulus</text>\n",
+                       left / 2);
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+        const SummaryRow& s = *rows[i];
+        const MeanSummary& m = realism ? s.realism : s.quality;
+        const std::string label = stimulusLabel(s.stimulus, answers);
+        const int y = top + rowH * static_cast<int>(i) + rowH / 2;
+        out += fmt::format("<text class=\"row-label\" x=\"{}\" y=\"{}\" text-anchor=\"end\">{}"
+                           "</text>\n",
+                           left - 8, y + 4, xmlEscape(label));
+        // Answers as dots, spread over the row by a fixed pattern (no randomness in a report).
+        for (std::size_t k = 0; k < m.values.size(); ++k) {
+            const double dy = (static_cast<double>(k % 7) - 3.0) * 2.2;
+            out += fmt::format("<circle class=\"point\" cx=\"{:.1f}\" cy=\"{:.1f}\" r=\"2.5\" "
+                               "fill=\"#1f77b4\" fill-opacity=\"0.35\"/>\n",
+                               sx(m.values[k]), y + dy);
+        }
+        if (!std::isnan(m.ci.lower))
+            out += fmt::format("<line class=\"ci\" x1=\"{:.1f}\" y1=\"{}\" x2=\"{:.1f}\" "
+                               "y2=\"{}\" stroke=\"#111\" stroke-width=\"2\"/>\n",
+                               sx(m.ci.lower), y, sx(m.ci.upper), y);
+        out += fmt::format(
+            "<rect class=\"mean\" x=\"{:.1f}\" y=\"{}\" width=\"3\" height=\"16\" "
+            "fill=\"#d62728\"><title>{}: mean {} {}{}, n {}</title></rect>\n",
+            sx(m.mean) - 1.5, y - 8, xmlEscape(label), measure, fixed(m.mean, 2),
+            std::isnan(m.ci.lower)
+                ? std::string()
+                : fmt::format(", 95 % CI {} to {}", fixed(m.ci.lower, 2), fixed(m.ci.upper, 2)),
+            count(m.n));
+    }
+    return out + "</svg>\n";
+}
+
 std::string renderHtml(const AnalysisReport& r) {
     const std::string title = r.title.empty() ? std::string("Underfoot analysis") : r.title;
     std::string out =
@@ -490,6 +579,28 @@ std::string renderHtml(const AnalysisReport& r) {
     out += "<h2>Categories</h2>\n";
     for (const auto& m : r.categories) out += htmlTable(categoryTable(m));
     out += "<h2>Summary</h2>\n" + htmlTable(summaryTable(r));
+    if (r.hasRatings) {
+        out += "<h2>Ratings</h2>\n";
+        std::vector<std::string> groups;
+        for (const auto& s : r.summary)
+            if (std::find(groups.begin(), groups.end(), s.group) == groups.end())
+                groups.push_back(s.group);
+        for (const bool realism : {true, false})
+            for (const auto& g : groups) {
+                const std::string svg = ratingMeansSvg(r, g, realism);
+                if (svg.empty()) continue;
+                out += "<figure class=\"ratings\" id=\"" +
+                       xmlEscape(std::string(realism ? "realism-" : "quality-") + g) +
+                       "\">\n<figcaption>" +
+                       xmlEscape(fmt::format(
+                           "{}, {}: mean per stimulus with its 95 % confidence interval (t) and "
+                           "every answer{}",
+                           realism ? "Realism" : "Quality", g,
+                           realism ? " (correct answers only)"
+                                   : " (all answers except \"I don't know\")")) +
+                       "</figcaption>\n" + svg + "</figure>\n";
+            }
+    }
     if (!r.comparisons.empty()) {
         out += "<h2>Tests</h2>\n<ul class=\"tests\">\n";
         for (const auto& c : r.comparisons)

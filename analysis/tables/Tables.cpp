@@ -179,6 +179,7 @@ MeanSummary meanSummary(const std::vector<double>& values, double confLevel) {
     MeanSummary m;
     m.n = dbl(values.size());
     m.ci.level = confLevel;
+    m.values = values;
     if (values.empty()) return m;
     m.mean = numerics::mean(values);
     if (values.size() < 2) return m;

@@ -64,6 +64,7 @@ struct MeanSummary {
     double sd = std::numeric_limits<double>::quiet_NaN();
     double se = std::numeric_limits<double>::quiet_NaN();
     Interval ci;
+    std::vector<double> values; ///< the individual ratings, in trial order (for the figures)
 };
 
 /// One row of the studies' per-stimulus summary.

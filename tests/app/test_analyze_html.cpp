@@ -225,4 +225,35 @@ TEST(AnalyzeHtml, IdentificationStudyShowsHeatMapsWithCountsAndRowPercentsAndTes
     }
     EXPECT_GT(sentences, 0u);
     EXPECT_EQ(occurrences(page, "<ul class=\"tests\">"), 1u);
+    // Ratings of an identification study: per group and scale, each stimulus's mean with its
+    // 95 % t interval (computed here) and one dot per answer.
+    ASSERT_TRUE(r.hasRatings);
+    std::size_t means = 0, points = 0;
+    for (const auto& s : r.summary)
+        for (const bool realism : {true, false}) {
+            const auto& m = realism ? s.realism : s.quality;
+            if (m.values.empty()) continue;
+            ++means;
+            points += m.values.size();
+            double sum = 0;
+            for (double v : m.values) sum += v;
+            const double n = static_cast<double>(m.values.size()), mean = sum / n;
+            EXPECT_NEAR(m.mean, mean, 1e-12);
+            std::string interval;
+            if (m.values.size() >= 2) {
+                double ss = 0;
+                for (double v : m.values) ss += (v - mean) * (v - mean);
+                const double half = boost::math::quantile(boost::math::students_t(n - 1), 0.975) *
+                                    std::sqrt(ss / (n - 1) / n);
+                interval = fmt::format(", 95 % CI {:.2f} to {:.2f}", mean - half, mean + half);
+            }
+            EXPECT_NE(page.find(fmt::format("mean {} {:.2f}{}, n {:.0f}</title>",
+                                            realism ? "realism" : "quality", mean, interval, n)),
+                      std::string::npos)
+                << s.group << " " << s.stimulus.surfaceId << (realism ? " realism" : " quality");
+        }
+    EXPECT_GT(means, 0u);
+    EXPECT_EQ(occurrences(page, "<rect class=\"mean\""), means);
+    EXPECT_EQ(occurrences(page, "<circle class=\"point\""), points);
+    EXPECT_GT(occurrences(page, "Realism rating: mean with 95 % CI (bar), each answer (dot)"), 0u);
 }
