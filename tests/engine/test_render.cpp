@@ -8,6 +8,8 @@
 
 #include "tests/common/ScratchDir.h"
 
+#include "tests/common/CliRun.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -20,19 +22,9 @@ using namespace underfoot::engine;
 namespace fs = std::filesystem;
 
 namespace {
-struct CommandResult {
-    int exitCode;
-    std::string output;
-};
+using underfoot::test::CommandResult;
 CommandResult run(const std::string& args) {
-    const std::string cmd =
-        std::string(UNDERFOOT_BINARY_DIR) + "/app/cli/underfoot " + args + " 2>&1";
-    FILE* pipe = popen(cmd.c_str(), "r");
-    std::string out;
-    char buf[512];
-    while (pipe && fgets(buf, sizeof buf, pipe)) out += buf;
-    const int status = pipe ? pclose(pipe) : -1;
-    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+    return underfoot::test::runUnderfootCli(args);
 }
 fs::path tempDir() {
     return underfoot::test::scratchDir("test_render");

@@ -3,6 +3,8 @@
 #include "engine/render/Renderer.h"
 #include "engine/render/SceneBench.h"
 
+#include "tests/common/CliRun.h"
+
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -14,19 +16,9 @@
 using namespace underfoot::engine;
 
 namespace {
-struct CommandResult {
-    int exitCode;
-    std::string output;
-};
+using underfoot::test::CommandResult;
 CommandResult runUnderfoot(const std::string& args) {
-    const std::string cmd =
-        std::string(UNDERFOOT_BINARY_DIR) + "/app/cli/underfoot " + args + " 2>&1";
-    FILE* pipe = popen(cmd.c_str(), "r");
-    std::string out;
-    char buf[512];
-    while (pipe && fgets(buf, sizeof buf, pipe)) out += buf;
-    const int status = pipe ? pclose(pipe) : -1;
-    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+    return underfoot::test::runUnderfootCli(args);
 }
 
 std::vector<float> renderBlocks(FootstepScene& scene, const GrfSignal& grf, int block) {
