@@ -285,29 +285,21 @@ void HuntCrossleyImpactT<Real>::process(const float* fext, float* out, int n) no
     for (int i = 0; i < n; ++i) {
         const double fNext = fext ? double(fext[i]) : 0.0;
         double y = 0.0;
-        if (os == 1) {
-            // (the same force values as the general interpolation below gives for os = 1)
-            const double f0 = lastExternal_, f1 = lastExternal_ + (fNext - lastExternal_);
-            if (!step(f0, f1, sub > 1, y)) {
-                // The bodies touch in this sample: resolve it in `sub` exact sub-steps.
-                setFineRate(true);
-                for (int j = 0; j < sub; ++j)
-                    step(f0 + (f1 - f0) * double(j) / sub, f0 + (f1 - f0) * double(j + 1) / sub,
-                         false, y);
-                setFineRate(false);
-            }
-        }
+        // One step from force f0 to f1; when the bodies touch in it, `sub` exact sub-steps.
+        const auto advance = [&](double f0, double f1) {
+            if (step(f0, f1, sub > 1, y)) return;
+            setFineRate(true);
+            for (int j = 0; j < sub; ++j)
+                step(f0 + (f1 - f0) * double(j) / sub, f0 + (f1 - f0) * double(j + 1) / sub, false,
+                     y);
+            setFineRate(false);
+        };
+        if (os == 1) // (the same force values as the general interpolation below gives)
+            advance(lastExternal_, lastExternal_ + (fNext - lastExternal_));
         for (int k = 0; k < os && os > 1; ++k) {
             // Linear interpolation of the external force inside the sample.
-            const double f1 = lastExternal_ + (fNext - lastExternal_) * double(k + 1) / os;
-            const double f0 = lastExternal_ + (fNext - lastExternal_) * double(k) / os;
-            if (!step(f0, f1, sub > 1, y)) {
-                setFineRate(true);
-                for (int j = 0; j < sub; ++j)
-                    step(f0 + (f1 - f0) * double(j) / sub, f0 + (f1 - f0) * double(j + 1) / sub,
-                         false, y);
-                setFineRate(false);
-            }
+            advance(lastExternal_ + (fNext - lastExternal_) * double(k) / os,
+                    lastExternal_ + (fNext - lastExternal_) * double(k + 1) / os);
             y = decimator_.processSample(y);
         }
         lastExternal_ = fNext;
