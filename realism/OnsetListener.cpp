@@ -116,10 +116,6 @@ std::vector<ListenerConfig> listenerGrid() {
     return g;
 }
 
-ListenerConfig defaultListenerConfig() {
-    return {FeatureSet::Onset, false, Decision::Centroid};
-}
-
 void normaliseBySource(std::vector<ListenerFile>& files, bool standardise) {
     std::set<std::string> sources;
     for (const auto& f : files) sources.insert(f.source);

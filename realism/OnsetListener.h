@@ -60,17 +60,13 @@ struct ListenerConfig {
 /// decisions). Includes the previous default listener: scalars, centred, centroid.
 std::vector<ListenerConfig> listenerGrid();
 
-/// The configuration leave-one-source-out chose on all four sources of the recordings cache
-/// (docs/realism.md); the default of `underfoot compare --listener`.
-ListenerConfig defaultListenerConfig();
-
 /// Centres (and with `standardise` scales) every file's steps by its source's per-feature
 /// median (and robust spread, with the features' floors) of the files' medians.
 void normaliseBySource(std::vector<ListenerFile>& files, bool standardise);
 
 class OnsetListener {
   public:
-    explicit OnsetListener(ListenerConfig c = defaultListenerConfig()) : cfg_(c) {}
+    explicit OnsetListener(ListenerConfig c) : cfg_(c) {}
     /// Trains on labelled, source-normalised files. Throws std::invalid_argument when there
     /// are none or one has no label or steps of another length.
     void train(const std::vector<ListenerFile>& files);

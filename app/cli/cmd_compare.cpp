@@ -35,7 +35,7 @@ struct CompareArgs {
     std::string output;
     std::string features;         ///< --features: CSV of every file's listener features
     bool classicListener = false; ///< --classic-listener: no centring, bands, one centroid
-    bool centredListener = false; ///< --centred-listener: the previous default (14 scalars)
+    bool onsetListener = false;   ///< --onset-listener: onset features, configuration grid
     bool listenerGrid = false;    ///< --listener-grid: every configuration's figures
     rl::RenderSpec spec;
 };
@@ -286,8 +286,9 @@ void printVerdicts(const std::vector<eng::SurfaceInfo>& infos,
                         n, matOk, matN);
 }
 
-// The default listener (realism/OnsetListener.h): onset features, its configuration chosen by
-// leave-one-source-out; prints its figures, the nested estimate and the renders' verdict.
+// The onset listener (realism/OnsetListener.h): its configuration chosen from a fixed grid by
+// leave-one-source-out on the recordings; prints its figures, the nested estimate and the
+// renders' verdict.
 int runOnsetListener(const CompareArgs& a) {
     const auto recs = manifest(a);
     rl::AnalysisOptions o;
@@ -315,12 +316,12 @@ int runOnsetListener(const CompareArgs& a) {
                 csv << "\n";
             }
     }
-    const auto cfg = rl::defaultListenerConfig();
-    std::string body = fmt::format(
-        "<p>Listener on onset features (realism/OnsetListener.h), configuration {} (band "
-        "{:.0f}-{:.0f} Hz), trained on recordings only.</p>",
-        cfg.name(), o.minHz, o.maxHz);
     const auto grid = rl::listenerGrid();
+    const auto cfg = rl::chooseConfig(files, grid);
+    std::string body = fmt::format(
+        "<p>Onset listener (realism/OnsetListener.h), configuration {} chosen among {} by "
+        "leave-one-source-out (band {:.0f}-{:.0f} Hz), trained on recordings only.</p>",
+        cfg.name(), grid.size(), o.minHz, o.maxHz);
     if (a.listenerGrid) {
         fmt::print("every configuration, leave-one-source-out over {} recordings (material, "
                    "category):\n",
@@ -330,9 +331,10 @@ int runOnsetListener(const CompareArgs& a) {
             fmt::print("  {:<36} {:>2}/{}  {:>2}/{}\n", c.name(), r.materialCorrect, r.files,
                        r.categoryCorrect, r.files);
         }
-        fmt::print("chosen on all sources: {}\n", rl::chooseConfig(files, grid).name());
+        fmt::print("chosen on all sources: {}\n", cfg.name());
     }
-    printLoso(rl::leaveOneSourceOut(files, cfg), files.size(), "listener " + cfg.name(), body);
+    printLoso(rl::leaveOneSourceOut(files, cfg), files.size(), "onset listener " + cfg.name(),
+              body);
     const auto nested = rl::nestedLeaveOneSourceOut(files, grid);
     for (const auto& [src, c] : nested.chosen)
         fmt::print("nested: held out {}: chose {} on the other sources\n", src, c.name());
@@ -364,9 +366,9 @@ int runOnsetListener(const CompareArgs& a) {
     return 0;
 }
 
-// The previous listeners (realism/Listener.h): --centred-listener, --classic-listener.
+// The default listener and the first one (realism/Listener.h, --classic-listener).
 int runListener(const CompareArgs& a) {
-    if (!a.classicListener && !a.centredListener) return runOnsetListener(a);
+    if (a.onsetListener) return runOnsetListener(a);
     const auto recs = manifest(a);
     rl::AnalysisOptions o;
     o.maxHz = rl::sharedMaxHz(recs, a.spec.rateHz);
@@ -403,7 +405,7 @@ int runListener(const CompareArgs& a) {
                              "and material"
                            : "one centroid per material");
     printLoso(rl::leaveOneSourceOut(ex, lo), ex.size(),
-              a.classicListener ? "first listener" : "centred listener", body);
+              a.classicListener ? "first listener" : "listener", body);
     rl::Listener l(lo);
     auto trainSet = ex;
     if (lo.centrePerSource) rl::centreBySource(trainSet);
@@ -432,10 +434,10 @@ int runCompare(const CompareArgs& a) {
     const int modes = int(!a.surface.empty()) + int(a.all) + int(a.listener);
     if (modes != 1)
         throw UserError("compare: give exactly one of --surface S, --all or --listener");
-    if (a.classicListener && a.centredListener)
-        throw UserError("compare: give at most one of --classic-listener and --centred-listener");
-    if (a.listenerGrid && (a.classicListener || a.centredListener))
-        throw UserError("compare: --listener-grid goes with the default listener only");
+    if (a.classicListener && a.onsetListener)
+        throw UserError("compare: give at most one of --classic-listener and --onset-listener");
+    if (a.listenerGrid && !a.onsetListener)
+        throw UserError("compare: --listener-grid goes with --onset-listener");
     if (!a.real.empty() && a.surface.empty())
         throw UserError("compare: --real goes with --surface");
     try {
@@ -477,15 +479,17 @@ CommandRegistrar reg("compare", [](CLI::App& app, int& exitCode) {
     cmd->add_flag("--classic-listener", args->classicListener,
                   "with --listener: the first listener (one centroid per material on all "
                   "features, no centring by source), for comparison");
-    cmd->add_flag("--centred-listener", args->centredListener,
-                  "with --listener: the previous default (14 whole-step descriptors, each source "
-                  "centred, one centroid per source and material), for comparison");
+    cmd->add_flag("--onset-listener", args->onsetListener,
+                  "with --listener: the onset listener (features of the first 30/80/150 ms after "
+                  "the contact and the whole-step descriptors, configuration chosen from a fixed "
+                  "grid by leave-one-source-out) with its nested estimate");
     cmd->add_flag("--listener-grid", args->listenerGrid,
-                  "with --listener: print every configuration's leave-one-source-out figures");
+                  "with --onset-listener: print every configuration's leave-one-source-out "
+                  "figures");
     cmd->add_option("--features", args->features,
                     "with --listener: write the listener's features (CSV: name, source, material, "
-                    "then one column per feature; the default listener writes every step of "
-                    "every recording, the previous ones every file and render)");
+                    "then one column per feature; with --onset-listener every step of every "
+                    "recording, otherwise every file and render)");
     cmd->callback([args, &exitCode] { exitCode = runCompare(*args); });
 });
 

@@ -70,16 +70,18 @@ TEST(RealismOnsetFeatures, LevelInvariantAndMeasureWhatTheySay) {
     const auto quiet = strike(300, 0.3, 0.025, 1);
     const auto fq = onsetFeatures(quiet, kFs, whole(quiet), o);
     for (std::size_t k = 0; k < fl.size(); ++k)
-        EXPECT_NEAR(fl[k], fq[k], 1e-6) << onsetFeatureInfo()[k].key;
+        EXPECT_NEAR(fl[k], fq[k], 1e-4) << onsetFeatureInfo()[k].key; // float samples
     // centroid of the first 80 ms near the tone's frequency (octaves re 1 Hz)
     EXPECT_NEAR(fl[featureIndex("centroid_80ms")], std::log2(300.0), 0.3);
     EXPECT_NEAR(fh[featureIndex("centroid_80ms")], std::log2(3000.0), 0.3);
     EXPECT_GT(fh[featureIndex("hilo_30ms")], fl[featureIndex("hilo_30ms")] + 20);
     EXPECT_GT(fh[featureIndex("slope_80ms")], fl[featureIndex("slope_80ms")]);
-    // a fast decay puts more of the first 150 ms into the first 30 ms and falls further
+    // T60 0.3 s falls 6 dB in 30 ms: the first 30 ms hold 1 - 10^-0.6 = 75 % (-1.25 dB) of the
+    // first 150 ms; a fast decay (T60 30 ms) holds nearly all of it and falls further
+    EXPECT_NEAR(fl[featureIndex("early_30_150")], -1.25, 0.3);
     const auto fast = strike(300, 0.03, 0.5, 1);
     const auto ff = onsetFeatures(fast, kFs, whole(fast), o);
-    EXPECT_GT(ff[featureIndex("early_30_150")], fl[featureIndex("early_30_150")] + 3);
+    EXPECT_NEAR(ff[featureIndex("early_30_150")], 0.0, 0.05);
     EXPECT_GT(ff[featureIndex("fall_20_40ms")], fl[featureIndex("fall_20_40ms")] + 10);
     // a fall of a decaying tone: T60 0.3 s -> 60 dB / 0.3 s * ~30 ms = about 6 dB
     EXPECT_NEAR(fl[featureIndex("fall_20_40ms")], 6.0, 2.0);
@@ -158,11 +160,12 @@ TEST(RealismOnsetListener, EveryDecisionHearsSeparableMaterialsAcrossShiftedSour
     l.train(train);
     EXPECT_EQ(l.classify(files[6]), "gravel") << files[6].name;
     EXPECT_THROW(l.classify(ListenerFile{"x", "s", "", {{1.0, 2.0}}}), std::invalid_argument);
-    EXPECT_THROW(OnsetListener().classify(files[0]), std::logic_error);
+    EXPECT_THROW(OnsetListener({}).classify(files[0]), std::logic_error);
     std::vector<ListenerFile> twoSources(files.begin(), files.begin() + 12);
     EXPECT_THROW(nestedLeaveOneSourceOut(twoSources, listenerGrid()), std::invalid_argument);
     EXPECT_EQ(listenerGrid().size(), 24u);
-    EXPECT_NE(std::find(listenerGrid().begin(), listenerGrid().end(), defaultListenerConfig()),
+    const ListenerConfig previousDefault{FeatureSet::Scalars, false, Decision::Centroid};
+    EXPECT_NE(std::find(listenerGrid().begin(), listenerGrid().end(), previousDefault),
               listenerGrid().end());
 }
 
@@ -197,7 +200,7 @@ TEST(RealismOnsetListener, HierarchicalDecidesTheCategoryFirstAndStepsVote) {
 }
 
 // The real recordings (scripts/fetch-recordings.sh). Skipped, saying so, without the cache.
-TEST(RealRecordings, OnsetListenerNestedEstimateHoldsItsFloorAndIsDeterministic) {
+TEST(RealRecordingsOnset, ListenerNestedEstimateHoldsItsFloorAndIsDeterministic) {
     const auto dir = defaultRecordingsDir();
     if (!fs::exists(fs::path(dir) / "manifest.csv"))
         GTEST_SKIP() << "no recordings cache at " << dir
@@ -219,15 +222,18 @@ TEST(RealRecordings, OnsetListenerNestedEstimateHoldsItsFloorAndIsDeterministic)
     const auto grid = listenerGrid();
     const auto nested = nestedLeaveOneSourceOut(files, grid);
     ASSERT_EQ(nested.heldOut.files, 83);
-    // Measured (docs/realism.md, "The listener"): see kNestedMaterial, kNestedCategory.
-    constexpr int kNestedMaterial = 0, kNestedCategory = 0; // set from the measurement
-    constexpr int kMargin = 3;                              // files
+    // Measured on 25 Nov 2026 (docs/realism.md, "The listener"): material 22/83, category
+    // 53/83. A change that makes the listener worse on unseen sources by more than 3 files
+    // fails here.
+    constexpr int kNestedMaterial = 22, kNestedCategory = 53, kMargin = 3;
     EXPECT_GE(nested.heldOut.materialCorrect, kNestedMaterial - kMargin);
     EXPECT_GE(nested.heldOut.categoryCorrect, kNestedCategory - kMargin);
     const auto again = nestedLeaveOneSourceOut(files, grid);
     EXPECT_EQ(again.heldOut.confusion, nested.heldOut.confusion);
     EXPECT_EQ(again.chosen, nested.chosen);
-    // The default listener is what the grid chooses on all four sources.
-    EXPECT_EQ(chooseConfig(files, grid), defaultListenerConfig())
-        << chooseConfig(files, grid).name();
+    // What `compare --listener --onset-listener` uses: the grid's choice on all four sources.
+    const ListenerConfig chosen = chooseConfig(files, grid);
+    EXPECT_EQ(chosen.name(), "scalars/centred/step-vote");
+    const auto loso = leaveOneSourceOut(files, chosen);
+    EXPECT_GE(loso.categoryCorrect, kNestedCategory - kMargin);
 }
