@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <numbers>
 #include <stdexcept>
 
@@ -153,11 +154,11 @@ std::vector<double> onsetFeatures(const std::vector<float>& x, double fs, StepSp
     std::vector<double> f;
     const int n = 1 << static_cast<int>(std::ceil(std::log2(0.150 * fs + 1)));
     engine::RealFft fft(n); // plans under FFTW's planner lock
-    SpectralShape s80;
-    for (double w : kWindowsS) {
-        const auto s = shape(windowSpectrum(fft, x, t0, at(w), fs), fs, n, o);
+    SpectralShape s80;      // the 80 ms window's band balance follows the window features
+    for (std::size_t w = 0; w < std::size(kWindowsS); ++w) {
+        const auto s = shape(windowSpectrum(fft, x, t0, at(kWindowsS[w]), fs), fs, n, o);
         f.insert(f.end(), {s.centroidOct, s.slopeDbPerOct, s.hiLoDb, s.flatnessDb});
-        if (w == 0.080) s80 = s;
+        if (w == 1) s80 = s;
     }
     f.insert(f.end(), {s80.band[0], s80.band[1], s80.band[2], s80.band[3]});
 

@@ -3,6 +3,7 @@
 //   compare --surface gravel [--real FILES_OR_DIRS...] [-o report.html]
 //   compare --all [-o report.html]          every surface with recordings of its material
 //   compare --listener [-o report.html]     the listener's real baseline and its verdicts
+//           [--classic-listener | --onset-listener [--listener-grid]]   other listeners
 // Without --real, recordings come from the cache of scripts/fetch-recordings.sh
 // (--recordings DIR, default $UNDERFOOT_RECORDINGS or build/recordings).
 #include "app/cli/CommandRegistry.h"
