@@ -152,7 +152,10 @@ LosoResult leaveOneSourceOut(const std::vector<Example>& input, ListenerOptions 
                 ++r.materialCorrect;
                 ++ps.first;
             }
-            if (categoryOfMaterial(p) == categoryOfMaterial(e.material)) ++r.categoryCorrect;
+            if (categoryOfMaterial(p) == categoryOfMaterial(e.material)) {
+                ++r.categoryCorrect;
+                ++r.perSourceCategory[held];
+            }
         }
     }
     return r;

@@ -73,6 +73,7 @@ struct LosoResult {
     int categoryCorrect = 0;     ///< of those, put in their category
     int unseenMaterialFiles = 0; ///< held-out files of a material no other source recorded
     std::map<std::string, std::pair<int, int>> perSource; ///< source -> (material ok, files)
+    std::map<std::string, int> perSourceCategory;         ///< source -> category ok
 };
 
 /// Leave-one-source-out evaluation over labelled examples of two or more sources (centred by

@@ -3,7 +3,7 @@
 """How the listener's configuration was chosen (docs/realism.md, "The listener").
 
     underfoot compare --listener --features features.csv
-    python3 realism/listener_grid.py features.csv
+    python3 realism/listener_grid.py features.csv [--by-category]
 
 Reads the per-file listener features written by `compare --features` and evaluates, leave-one-
 source-out on the recordings only, a small fixed grid: feature set (all, scalar descriptors
@@ -15,6 +15,11 @@ Listener.cpp (training set median and IQR / 1.349 with the descriptors' floors).
 Choosing the best cell of that grid on the same held-out sources flatters it, so the script
 also prints a nested estimate: for each held-out source the configuration is chosen by a
 leave-one-source-out run on the other sources only, then scored on the held-out one.
+The inner choice takes the configuration with the most materials right (with --by-category:
+the most categories right, then materials, as the onset listener's grid does, so the two
+nested estimates can be compared like for like). The onset listener's grid (onset features,
+realism/OnsetListener.h) is evaluated in C++: `underfoot compare --listener --onset-listener
+--listener-grid`.
 Pure Python (no numpy), a few seconds.
 """
 import csv
@@ -105,6 +110,7 @@ def loso(examples, feats, mode, method, only=None):
 
 
 def main():
+    by_category = "--by-category" in sys.argv[2:]
     rows = list(csv.reader(open(sys.argv[1])))
     header, data = rows[0], rows[1:]
     rec = [(r[0], r[1], r[2], [float(v) for v in r[3:]]) for r in data if r[1] != "synthetic"]
@@ -124,7 +130,10 @@ def main():
     tot = [0, 0, 0]
     for held in sorted({e[1] for e in rec}):
         inner = [e for e in rec if e[1] != held]
-        f, c, m = max(grid, key=lambda g: loso(inner, sets[g[0]], mode[g[1]], method[g[2]])[0])
+        def score(g):
+            mc, cc, _ = loso(inner, sets[g[0]], mode[g[1]], method[g[2]])
+            return (cc, mc) if by_category else mc
+        f, c, m = max(grid, key=score)
         mc, cc, n = loso(rec, sets[f], mode[c], method[m], only=held)
         print(f"nested: held out {held}: chose {f}/{c}/{m} on the others -> "
               f"material {mc}/{n}, category {cc}/{n}")

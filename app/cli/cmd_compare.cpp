@@ -3,6 +3,7 @@
 //   compare --surface gravel [--real FILES_OR_DIRS...] [-o report.html]
 //   compare --all [-o report.html]          every surface with recordings of its material
 //   compare --listener [-o report.html]     the listener's real baseline and its verdicts
+//           [--classic-listener | --onset-listener [--listener-grid]]   other listeners
 // Without --real, recordings come from the cache of scripts/fetch-recordings.sh
 // (--recordings DIR, default $UNDERFOOT_RECORDINGS or build/recordings).
 #include "app/cli/CommandRegistry.h"
@@ -10,6 +11,7 @@
 #include "engine/surfaces/Surface.h"
 #include "realism/Compare.h"
 #include "realism/Listener.h"
+#include "realism/OnsetListener.h"
 
 #include <fmt/core.h>
 
@@ -34,6 +36,8 @@ struct CompareArgs {
     std::string output;
     std::string features;         ///< --features: CSV of every file's listener features
     bool classicListener = false; ///< --classic-listener: no centring, bands, one centroid
+    bool onsetListener = false;   ///< --onset-listener: onset features, configuration grid
+    bool listenerGrid = false;    ///< --listener-grid: every configuration's figures
     rl::RenderSpec spec;
 };
 
@@ -203,7 +207,169 @@ int runAll(const CompareArgs& a) {
     return 0;
 }
 
+// Prints (and appends to the HTML body) a leave-one-source-out result: totals, per held-out
+// source, confusion table.
+void printLoso(const rl::LosoResult& loso, std::size_t recordings, const std::string& what,
+               std::string& body) {
+    fmt::print("{}, leave-one-source-out over {} recordings: material {}/{} ({:.0f} %), "
+               "category {}/{} ({:.0f} %); {} held-out files of a material no other source has "
+               "were not scored\n",
+               what, recordings, loso.materialCorrect, loso.files,
+               100.0 * loso.materialCorrect / std::max(loso.files, 1), loso.categoryCorrect,
+               loso.files, 100.0 * loso.categoryCorrect / std::max(loso.files, 1),
+               loso.unseenMaterialFiles);
+    body += fmt::format("<p>{}, leave-one-source-out: material {}/{}, category {}/{}.</p><ul>",
+                        what, loso.materialCorrect, loso.files, loso.categoryCorrect, loso.files);
+    for (const auto& [src, mf] : loso.perSource) {
+        const auto it = loso.perSourceCategory.find(src);
+        const int cat = it == loso.perSourceCategory.end() ? 0 : it->second;
+        fmt::print("  held out {:<10} material {:>2}/{:<2}  category {:>2}/{}\n", src, mf.first,
+                   mf.second, cat, mf.second);
+        body += fmt::format("<li>held out {}: material {}/{}, category {}/{}</li>", src, mf.first,
+                            mf.second, cat, mf.second);
+    }
+    body += "</ul><table><tr><th>true \\ heard</th>";
+    std::set<std::string> cols;
+    for (const auto& [t, row] : loso.confusion)
+        for (const auto& [p, n] : row) cols.insert(p), cols.insert(t);
+    for (const auto& c : cols) body += "<th>" + c + "</th>";
+    body += "</tr>";
+    fmt::print("confusion (rows: true material, columns: heard):\n{:<8}", "");
+    for (const auto& c : cols) fmt::print(" {:>6}", c);
+    fmt::print("\n");
+    for (const auto& t : cols) {
+        if (!loso.confusion.count(t)) continue;
+        fmt::print("{:<8}", t);
+        body += "<tr><th>" + t + "</th>";
+        for (const auto& c : cols) {
+            const auto& row = loso.confusion.at(t);
+            const int n = row.count(c) ? row.at(c) : 0;
+            fmt::print(" {:>6}", n);
+            body += fmt::format("<td>{}</td>", n);
+        }
+        fmt::print("\n");
+        body += "</tr>";
+    }
+    body += "</table>";
+}
+
+// The verdict on every surface's render (heard[i] is the material heard in infos[i]'s render).
+void printVerdicts(const std::vector<eng::SurfaceInfo>& infos,
+                   const std::vector<std::string>& heard, std::string& body) {
+    fmt::print("\n{:<22} {:<9} {:<9} {:<9} {:<9} {}\n", "surface", "category", "heard cat",
+               "material", "heard", "verdict");
+    body += "<h2>Verdict on every surface (listener trained on all recordings)</h2><table><tr><th>"
+            "surface</th><th>category</th><th>heard category</th><th>material</th><th>heard as</th>"
+            "</tr>\n";
+    int catOk = 0, matOk = 0, matN = 0, n = 0;
+    for (std::size_t i = 0; i < infos.size(); ++i) {
+        const auto& info = infos[i];
+        const auto cat = std::string(eng::toString(info.category));
+        const auto heardCat = rl::categoryOfMaterial(heard[i]);
+        const auto mat = rl::materialOfSurface(info.id);
+        ++n;
+        catOk += heardCat == cat;
+        if (!mat.empty()) {
+            ++matN;
+            matOk += heard[i] == mat;
+        }
+        fmt::print("{:<22} {:<9} {:<9} {:<9} {:<9} {}{}\n", info.id, cat, heardCat,
+                   mat.empty() ? "-" : mat, heard[i],
+                   heardCat == cat ? "category ok" : "WRONG category",
+                   mat.empty() ? "" : (heard[i] == mat ? ", material ok" : ", wrong material"));
+        body += fmt::format("<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>\n",
+                            info.id, cat, heardCat, mat.empty() ? "-" : mat, heard[i]);
+    }
+    fmt::print("synthetic: category right for {}/{}, material right for {}/{} surfaces with a "
+               "recorded material\n",
+               catOk, n, matOk, matN);
+    body += fmt::format("</table><p>Category right for {}/{}; material right for {}/{}.</p>", catOk,
+                        n, matOk, matN);
+}
+
+// The onset listener (realism/OnsetListener.h): its configuration chosen from a fixed grid by
+// leave-one-source-out on the recordings; prints its figures, the nested estimate and the
+// renders' verdict.
+int runOnsetListener(const CompareArgs& a) {
+    const auto recs = manifest(a);
+    rl::AnalysisOptions o;
+    o.maxHz = rl::sharedMaxHz(recs, a.spec.rateHz);
+    std::vector<rl::ListenerFile> files;
+    for (const auto& r : recs) {
+        try {
+            files.push_back(rl::describeListenerFile(r.file, r.source, r.material,
+                                                     eng::readAudioFile(r.path), o));
+        } catch (const std::invalid_argument&) {
+            fmt::print("warning: {}: no step found, left out\n", r.file);
+        }
+    }
+    if (!a.features.empty()) { // every step's features, before normalisation by source
+        std::ofstream csv(a.features);
+        if (!csv) throw UserError(fmt::format("--features {}: cannot write this file", a.features));
+        csv << "name,source,material,step";
+        for (std::size_t k = 0; k < rl::listenerFeatureCount(); ++k)
+            csv << "," << rl::listenerFeatureKey(k);
+        csv << "\n";
+        for (const auto& f : files)
+            for (std::size_t s = 0; s < f.steps.size(); ++s) {
+                csv << fmt::format("{},{},{},{}", f.name, f.source, f.material, s);
+                for (double v : f.steps[s]) csv << fmt::format(",{:.6g}", v);
+                csv << "\n";
+            }
+    }
+    const auto grid = rl::listenerGrid();
+    const auto cfg = rl::chooseConfig(files, grid);
+    std::string body = fmt::format(
+        "<p>Onset listener (realism/OnsetListener.h), configuration {} chosen among {} by "
+        "leave-one-source-out (band {:.0f}-{:.0f} Hz), trained on recordings only.</p>",
+        cfg.name(), grid.size(), o.minHz, o.maxHz);
+    if (a.listenerGrid) {
+        fmt::print("every configuration, leave-one-source-out over {} recordings (material, "
+                   "category):\n",
+                   files.size());
+        for (const auto& c : grid) {
+            const auto r = rl::leaveOneSourceOut(files, c);
+            fmt::print("  {:<36} {:>2}/{}  {:>2}/{}\n", c.name(), r.materialCorrect, r.files,
+                       r.categoryCorrect, r.files);
+        }
+        fmt::print("chosen on all sources: {}\n", cfg.name());
+    }
+    printLoso(rl::leaveOneSourceOut(files, cfg), files.size(), "onset listener " + cfg.name(),
+              body);
+    const auto nested = rl::nestedLeaveOneSourceOut(files, grid);
+    for (const auto& [src, c] : nested.chosen)
+        fmt::print("nested: held out {}: chose {} on the other sources\n", src, c.name());
+    printLoso(nested.heldOut, files.size(),
+              fmt::format("nested estimate (configuration chosen among {} without the held-out "
+                          "source)",
+                          grid.size()),
+              body);
+    auto trainSet = files;
+    rl::normaliseBySource(trainSet, cfg.standardisePerSource);
+    rl::OnsetListener l(cfg);
+    l.train(trainSet);
+    std::vector<rl::ListenerFile> synth;
+    std::vector<eng::SurfaceInfo> infos;
+    for (const auto& info : eng::listSurfaces()) {
+        try {
+            synth.push_back(rl::describeListenerFile(info.id, "synthetic", "",
+                                                     rl::renderForComparison(info.id, a.spec), o));
+        } catch (const std::invalid_argument&) {
+            continue; // no step in the render
+        }
+        infos.push_back(info);
+    }
+    rl::normaliseBySource(synth, cfg.standardisePerSource); // the renders are one more source
+    std::vector<std::string> heard;
+    for (const auto& f : synth) heard.push_back(l.classify(f));
+    printVerdicts(infos, heard, body);
+    if (!a.output.empty()) writeHtml(a.output, "Underfoot listener", body);
+    return 0;
+}
+
+// The default listener and the first one (realism/Listener.h, --classic-listener).
 int runListener(const CompareArgs& a) {
+    if (a.onsetListener) return runOnsetListener(a);
     const auto recs = manifest(a);
     rl::AnalysisOptions o;
     o.maxHz = rl::sharedMaxHz(recs, a.spec.rateHz);
@@ -228,7 +394,6 @@ int runListener(const CompareArgs& a) {
     }
     rl::ListenerOptions lo;
     if (a.classicListener) lo = {false, false, false};
-    const auto loso = rl::leaveOneSourceOut(ex, lo);
     std::string body = fmt::format(
         "<p>Nearest-centroid listener on {} descriptors{} (band {:.0f}-{:.0f} Hz), {}, trained on "
         "recordings only.</p>",
@@ -240,48 +405,12 @@ int runListener(const CompareArgs& a) {
         lo.centrePerSource ? "every source centred on its own median, one centroid per source "
                              "and material"
                            : "one centroid per material");
-    fmt::print("listener, leave-one-source-out over {} recordings: material {}/{} ({:.0f} %), "
-               "category {}/{} ({:.0f} %); {} held-out files of a material no other source has "
-               "were not scored\n",
-               ex.size(), loso.materialCorrect, loso.files,
-               100.0 * loso.materialCorrect / std::max(loso.files, 1), loso.categoryCorrect,
-               loso.files, 100.0 * loso.categoryCorrect / std::max(loso.files, 1),
-               loso.unseenMaterialFiles);
-    body += fmt::format("<p>Leave-one-source-out: material {}/{}, category {}/{}.</p><table><tr>"
-                        "<th>true \\ heard</th>",
-                        loso.materialCorrect, loso.files, loso.categoryCorrect, loso.files);
-    std::set<std::string> cols;
-    for (const auto& [t, row] : loso.confusion)
-        for (const auto& [p, n] : row) cols.insert(p), cols.insert(t);
-    for (const auto& c : cols) body += "<th>" + c + "</th>";
-    body += "</tr>";
-    fmt::print("confusion (rows: true material, columns: heard):\n{:<8}", "");
-    for (const auto& c : cols) fmt::print(" {:>6}", c);
-    fmt::print("\n");
-    for (const auto& t : cols) {
-        if (!loso.confusion.count(t)) continue;
-        fmt::print("{:<8}", t);
-        body += "<tr><th>" + t + "</th>";
-        for (const auto& c : cols) {
-            const auto& row = loso.confusion.at(t);
-            const int n = row.count(c) ? row.at(c) : 0;
-            fmt::print(" {:>6}", n);
-            body += fmt::format("<td>{}</td>", n);
-        }
-        fmt::print("\n");
-        body += "</tr>";
-    }
-    body += "</table>";
+    printLoso(rl::leaveOneSourceOut(ex, lo), ex.size(),
+              a.classicListener ? "first listener" : "listener", body);
     rl::Listener l(lo);
     auto trainSet = ex;
     if (lo.centrePerSource) rl::centreBySource(trainSet);
     l.train(trainSet);
-    fmt::print("\n{:<22} {:<9} {:<9} {:<9} {:<9} {}\n", "surface", "category", "heard cat",
-               "material", "heard", "verdict");
-    body += "<h2>Verdict on every surface (listener trained on all recordings)</h2><table><tr><th>"
-            "surface</th><th>category</th><th>heard category</th><th>material</th><th>heard as</th>"
-            "</tr>\n";
-    int catOk = 0, matOk = 0, matN = 0, n = 0;
     // The renders are one more source: described first, centred on their own median.
     std::vector<rl::Example> synth;
     std::vector<eng::SurfaceInfo> infos;
@@ -295,30 +424,9 @@ int runListener(const CompareArgs& a) {
         if (csv.is_open()) csv << featureLine(synth.back());
     }
     if (lo.centrePerSource) rl::centreBySource(synth);
-    for (std::size_t i = 0; i < infos.size(); ++i) {
-        const auto& info = infos[i];
-        const auto heard = l.classify(synth[i].features);
-        const auto cat = std::string(eng::toString(info.category));
-        const auto heardCat = rl::categoryOfMaterial(heard);
-        const auto mat = rl::materialOfSurface(info.id);
-        ++n;
-        catOk += heardCat == cat;
-        if (!mat.empty()) {
-            ++matN;
-            matOk += heard == mat;
-        }
-        fmt::print("{:<22} {:<9} {:<9} {:<9} {:<9} {}{}\n", info.id, cat, heardCat,
-                   mat.empty() ? "-" : mat, heard,
-                   heardCat == cat ? "category ok" : "WRONG category",
-                   mat.empty() ? "" : (heard == mat ? ", material ok" : ", wrong material"));
-        body += fmt::format("<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>\n",
-                            info.id, cat, heardCat, mat.empty() ? "-" : mat, heard);
-    }
-    fmt::print("synthetic: category right for {}/{}, material right for {}/{} surfaces with a "
-               "recorded material\n",
-               catOk, n, matOk, matN);
-    body += fmt::format("</table><p>Category right for {}/{}; material right for {}/{}.</p>", catOk,
-                        n, matOk, matN);
+    std::vector<std::string> heard;
+    for (const auto& e : synth) heard.push_back(l.classify(e.features));
+    printVerdicts(infos, heard, body);
     if (!a.output.empty()) writeHtml(a.output, "Underfoot listener", body);
     return 0;
 }
@@ -327,6 +435,10 @@ int runCompare(const CompareArgs& a) {
     const int modes = int(!a.surface.empty()) + int(a.all) + int(a.listener);
     if (modes != 1)
         throw UserError("compare: give exactly one of --surface S, --all or --listener");
+    if (a.classicListener && a.onsetListener)
+        throw UserError("compare: give at most one of --classic-listener and --onset-listener");
+    if (a.listenerGrid && !a.onsetListener)
+        throw UserError("compare: --listener-grid goes with --onset-listener");
     if (!a.real.empty() && a.surface.empty())
         throw UserError("compare: --real goes with --surface");
     try {
@@ -368,9 +480,17 @@ CommandRegistrar reg("compare", [](CLI::App& app, int& exitCode) {
     cmd->add_flag("--classic-listener", args->classicListener,
                   "with --listener: the first listener (one centroid per material on all "
                   "features, no centring by source), for comparison");
+    cmd->add_flag("--onset-listener", args->onsetListener,
+                  "with --listener: the onset listener (features of the first 30/80/150 ms after "
+                  "the contact and the whole-step descriptors, configuration chosen from a fixed "
+                  "grid by leave-one-source-out) with its nested estimate");
+    cmd->add_flag("--listener-grid", args->listenerGrid,
+                  "with --onset-listener: print every configuration's leave-one-source-out "
+                  "figures");
     cmd->add_option("--features", args->features,
-                    "with --listener: write every recording's and render's listener features "
-                    "(CSV: name, source, material, then one column per feature)");
+                    "with --listener: write the listener's features (CSV: name, source, material, "
+                    "then one column per feature; with --onset-listener every step of every "
+                    "recording, otherwise every file and render)");
     cmd->callback([args, &exitCode] { exitCode = runCompare(*args); });
 });
 
