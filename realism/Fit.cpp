@@ -409,9 +409,22 @@ FitResult fitSurface(const std::string& presetFile, const std::vector<Recording>
     const auto original = engine::Surface::load(presetFile); // keeps parameters() alive
     for (const auto& p : original->parameters()) ranges[p.path] = {p.minValue, p.maxValue};
     auto knobs = knobsFor(root);
+    for (const auto& name : options.keep) {
+        const auto it = std::find_if(knobs.begin(), knobs.end(),
+                                     [&](const Knob& k) { return k.info.name == name; });
+        if (it == knobs.end()) {
+            std::string names;
+            for (const auto& k : knobs) names += (names.empty() ? "" : ", ") + k.info.name;
+            throw std::invalid_argument(fmt::format(
+                "{}: no knob \"{}\" to keep (this preset's knobs: {})", presetFile, name, names));
+        }
+        knobs.erase(it);
+    }
     if (knobs.empty())
         throw std::invalid_argument(
-            fmt::format("{}: no impact, grains or bubbles layer to fit", presetFile));
+            options.keep.empty()
+                ? fmt::format("{}: no impact, grains or bubbles layer to fit", presetFile)
+                : fmt::format("{}: every knob is kept: nothing to fit", presetFile));
 
     AnalysisOptions ao;
     ao.maxHz = sharedMaxHz(real, options.spec.rateHz);
@@ -637,6 +650,11 @@ FitResult fitSurface(const std::string& presetFile, const std::vector<Recording>
     toml::table kt;
     for (const auto& k : result.knobs) kt.insert(k.name, std::round(k.value * 1000) / 1000);
     prov.insert("knobs", kt);
+    if (!options.keep.empty()) {
+        toml::array kept;
+        for (const auto& k : options.keep) kept.push_back(k);
+        prov.insert("knobs_kept", kept);
+    }
     if (result.contrastive) {
         toml::table ct;
         ct.insert("objective", "d_own + contrast x max(0, d_own - nearest other + margin)");

@@ -71,6 +71,9 @@ struct FitOptions {
     std::string ownMaterial;
     double contrast = 0.0; ///< LAMBDA of the hinge penalty (see above); 0 = plain fit
     double margin = 0.1;   ///< M: how much closer to the own material than to any other
+    /// Knobs held at their start (by name, e.g. "grain_band": a designed property the fit must
+    /// keep); an unknown name throws std::invalid_argument naming the knobs there are.
+    std::vector<std::string> keep;
 };
 
 /// Distance of a render to its own recordings and to the nearest other material.

@@ -215,6 +215,9 @@ CommandRegistrar reg("fit", [](CLI::App& app, int& exitCode) {
                     "how much closer (in distance units) the render must be to its own "
                     "recordings than to any other material's before the penalty stops")
         ->capture_default_str();
+    cmd->add_option("--keep", args->options.keep,
+                    "knobs to hold at the preset's values (e.g. grain_band: a designed property "
+                    "the fit must not move)");
     cmd->add_option("-o,--output", args->output, "fitted preset (.toml)");
     cmd->add_flag("-q,--quiet", args->quiet, "no progress lines");
     cmd->add_option("--modes", args->modes,

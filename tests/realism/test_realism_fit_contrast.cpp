@@ -172,3 +172,23 @@ TEST_F(FitContrast, PlainFitLandsNearerTheOtherMaterialTheContrastiveOneDoesNot)
     const auto again = fitSurface(preset_, own_, options(2.0));
     EXPECT_EQ(again.presetText, contrast.presetText);
 }
+
+TEST_F(FitContrast, KeptKnobsStayAndUnknownOnesAreNamed) {
+    auto o = options(2.0);
+    o.maxEvaluations = 8;
+    o.keep = {"grain_band"};
+    const auto r = fitSurface(preset_, own_, o);
+    for (const auto& k : r.knobs) EXPECT_NE(k.name, "grain_band");
+    const auto root = toml::parse(r.presetText);
+    EXPECT_DOUBLE_EQ(root["layer"][0]["freq_min_hz"].value<double>().value_or(0), 600.0);
+    EXPECT_DOUBLE_EQ(root["layer"][0]["freq_max_hz"].value<double>().value_or(0), 2400.0);
+    EXPECT_EQ(root["provenance"]["knobs_kept"][0].value<std::string>().value_or(""), "grain_band");
+    o.keep = {"grain_bandwidth"};
+    try {
+        fitSurface(preset_, own_, o);
+        ADD_FAILURE() << "an unknown knob was accepted";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("grain_bandwidth"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("grain_q"), std::string::npos) << e.what();
+    }
+}
