@@ -96,8 +96,9 @@ struct FitResult {
     double seconds = 0; ///< wall-clock time of the fit
     std::vector<FitKnob> knobs;
     std::string optimiser;
-    bool modalSeeded = false;              ///< the modes were seeded from the recordings
-    double distanceSeeded = 0;             ///< distance of the seeded preset, before refining
+    bool modalSeeded = false; ///< the modes were seeded from the recordings
+    double distanceSeeded =
+        0; ///< objective J of the seeded preset before refining (its distance without contrast)
     std::vector<RecordedMode> seededModes; ///< the recorded modes written into the preset
     std::vector<std::string> seedSkipped;  ///< recordings that yielded no mode
     std::string seedStart;                 ///< the starting point the result was refined from
