@@ -55,6 +55,34 @@ void eachLayerKey(toml::table& root, const std::string& type, const std::string&
     }
 }
 
+// Calls f(layer, index) for every grains layer with ongoing events (not onset-only: some
+// events_per_* > 0).
+void eachGrainEventLayer(toml::table& root, const std::function<void(toml::table&, int)>& f) {
+    auto* layers = root["layer"].as_array();
+    if (!layers) return;
+    int i = 0;
+    for (auto& node : *layers) {
+        auto* t = node.as_table();
+        if (t && t->get("type") && t->get("type")->value<std::string>() == "grains") {
+            double rate = 0;
+            for (const char* key :
+                 {"events_per_kn_rise", "events_per_kn_fall", "events_per_s_per_kn"})
+                rate += (*t)[key].value<double>().value_or(0.0);
+            if (rate > 0) f(*t, i);
+        }
+        ++i;
+    }
+}
+
+// A grains layer that only makes the heel's onset event (onset_energy > 0, no event rates).
+bool isThudLayer(const toml::table& t) {
+    if (!t.get("type") || t.get("type")->value<std::string>() != "grains") return false;
+    double rate = 0;
+    for (const char* key : {"events_per_kn_rise", "events_per_kn_fall", "events_per_s_per_kn"})
+        rate += t[key].value<double>().value_or(0.0);
+    return rate <= 0 && t["onset_energy"].value<double>().value_or(0.0) > 0;
+}
+
 void eachMode(toml::table& root, const Ranges& ranges,
               const std::function<void(toml::table& mode, const std::string& path)>& f) {
     auto* layers = root["layer"].as_array();
@@ -130,6 +158,49 @@ std::vector<Knob> knobsFor(const toml::table& root) {
                               {"events_per_kn_rise", "events_per_kn_fall", "events_per_s_per_kn"})
                              eachLayerKey(r, "grains", key, rg, mul2(x));
                      }});
+        // The heel's thud: the level of the onset-only layers (one event when the heel loads).
+        bool thud = false;
+        if (const auto* layers = root["layer"].as_array())
+            for (const auto& node : *layers)
+                if (const auto* t = node.as_table()) thud = thud || isThudLayer(*t);
+        if (thud)
+            k.push_back(
+                {{"thud", "heel thud: gain_db of the onset-only layers + k", -18, 18, 0, 0},
+                 [](toml::table& r, double x, const Ranges& rg) {
+                     auto* layers = r["layer"].as_array();
+                     int i = 0;
+                     for (auto& node : *layers) {
+                         auto* t = node.as_table();
+                         if (t && isThudLayer(*t))
+                             if (auto v = (*t)["gain_db"].value<double>())
+                                 t->insert_or_assign(
+                                     "gain_db",
+                                     clampTo(rg, fmt::format("layer[{}].gain_db", i), *v + x));
+                         ++i;
+                     }
+                 }});
+        // Crunch cascades: burst_events (default 0) + k on every layer of ongoing events (not
+        // the onset-only ones), then their delays burst_ms (default 2 ms) x 2^k.
+        k.push_back({{"burst", "crunch cascades: burst_events + k (at least 0)", -2, 4, 0, 0},
+                     [](toml::table& r, double x, const Ranges& rg) {
+                         eachGrainEventLayer(r, [&](toml::table& t, int i) {
+                             const double v = t["burst_events"].value<double>().value_or(0.0);
+                             const double nv = clampTo(rg, fmt::format("layer[{}].burst_events", i),
+                                                       std::max(0.0, v + x));
+                             if (nv != v) t.insert_or_assign("burst_events", nv);
+                         });
+                     }});
+        k.push_back({{"burst_length", "length of the cascades: burst_ms x 2^k", -2, 3, 0, 0},
+                     [](toml::table& r, double x, const Ranges& rg) {
+                         eachGrainEventLayer(r, [&](toml::table& t, int i) {
+                             if (t["burst_events"].value<double>().value_or(0.0) <= 0 || x == 0)
+                                 return;
+                             const double v = t["burst_ms"].value<double>().value_or(2.0);
+                             t.insert_or_assign("burst_ms",
+                                                clampTo(rg, fmt::format("layer[{}].burst_ms", i),
+                                                        v * std::exp2(x)));
+                         });
+                     }});
         if (grainLayers > 1)
             k.push_back(
                 {{"layer_balance", "first grain layer +k dB, the others -k dB", -12, 12, 0, 0},
@@ -153,6 +224,12 @@ std::vector<Knob> knobsFor(const toml::table& root) {
                          eachLayerKey(r, "bubbles", "splash_noise_db", rg,
                                       [x](double v, int) { return v + x; });
                      }});
+        k.push_back(
+            {{"splash_length", "splash length (splash_ms, splash_decay_ms) x 2^k", -2, 2, 0, 0},
+             [mul2](toml::table& r, double x, const Ranges& rg) {
+                 eachLayerKey(r, "bubbles", "splash_ms", rg, mul2(x));
+                 eachLayerKey(r, "bubbles", "splash_decay_ms", rg, mul2(x));
+             }});
         k.push_back({{"slosh_level", "slosh_db + k", -20, 6, 0, 0},
                      [](toml::table& r, double x, const Ranges& rg) {
                          eachLayerKey(r, "bubbles", "slosh_db", rg,
@@ -306,6 +383,11 @@ toml::table parsePreset(const std::string& presetFile) {
 
 } // namespace
 
+double contrastiveObjective(double own, double nearest, double contrast, double margin) {
+    if (contrast <= 0 || nearest < 0) return own;
+    return own + contrast * std::max(0.0, own - nearest + margin);
+}
+
 std::string modalSeededPreset(const std::string& presetFile,
                               const std::vector<RecordedMode>& modes) {
     toml::table root = parsePreset(presetFile);
@@ -327,9 +409,22 @@ FitResult fitSurface(const std::string& presetFile, const std::vector<Recording>
     const auto original = engine::Surface::load(presetFile); // keeps parameters() alive
     for (const auto& p : original->parameters()) ranges[p.path] = {p.minValue, p.maxValue};
     auto knobs = knobsFor(root);
+    for (const auto& name : options.keep) {
+        const auto it = std::find_if(knobs.begin(), knobs.end(),
+                                     [&](const Knob& k) { return k.info.name == name; });
+        if (it == knobs.end()) {
+            std::string names;
+            for (const auto& k : knobs) names += (names.empty() ? "" : ", ") + k.info.name;
+            throw std::invalid_argument(fmt::format(
+                "{}: no knob \"{}\" to keep (this preset's knobs: {})", presetFile, name, names));
+        }
+        knobs.erase(it);
+    }
     if (knobs.empty())
         throw std::invalid_argument(
-            fmt::format("{}: no impact, grains or bubbles layer to fit", presetFile));
+            options.keep.empty()
+                ? fmt::format("{}: no impact, grains or bubbles layer to fit", presetFile)
+                : fmt::format("{}: every knob is kept: nothing to fit", presetFile));
 
     AnalysisOptions ao;
     ao.maxHz = sharedMaxHz(real, options.spec.rateHz);
@@ -355,15 +450,67 @@ FitResult fitSurface(const std::string& presetFile, const std::vector<Recording>
         std::ofstream(tmpFile) << toText(t);
         return renderForComparison(tmpFile, options.spec);
     };
-    auto distanceOf = [&](const toml::table& t) {
-        try {
-            const auto steps = describeSteps(render(t), ao);
-            if (steps.empty()) return 100.0;
-            return compareSteps(steps, realSteps).distance;
-        } catch (const engine::PresetError&) {
-            return 100.0; // a knob combination the preset's ranges refuse
-        }
+    // Other materials (contrast): each compared on the band its recordings share with the
+    // render, as `underfoot compare --all` does.
+    struct Target {
+        std::string material;
+        AnalysisOptions ao;
+        std::vector<StepDescriptors> steps;
     };
+    std::vector<Target> others;
+    if (options.contrast > 0) {
+        std::map<std::string, std::vector<Recording>> byMaterial;
+        for (const auto& r : options.others)
+            if (!r.material.empty() && r.material != options.ownMaterial)
+                byMaterial[r.material].push_back(r);
+        for (const auto& [material, recs] : byMaterial) {
+            Target t{material, {}, {}};
+            t.ao.maxHz = sharedMaxHz(recs, options.spec.rateHz);
+            for (const auto& r : recs) {
+                auto s = describeFile(r.path, t.ao);
+                t.steps.insert(t.steps.end(), s.begin(), s.end());
+            }
+            if (!t.steps.empty()) others.push_back(std::move(t));
+        }
+    }
+    auto evaluate = [&](const toml::table& t) {
+        FitDistances d;
+        bool failed = false;
+        try {
+            const auto audio = render(t);
+            std::map<double, std::vector<StepDescriptors>> described; // by band limit
+            auto stepsAt = [&](const AnalysisOptions& o) -> const std::vector<StepDescriptors>& {
+                auto it = described.find(o.maxHz);
+                if (it == described.end())
+                    it = described.emplace(o.maxHz, describeSteps(audio, o)).first;
+                return it->second;
+            };
+            const auto& own = stepsAt(ao);
+            if (own.empty()) throw std::invalid_argument("the render holds no footstep");
+            d.own = compareSteps(own, realSteps).distance;
+            d.nearest = -1;
+            for (const auto& o : others) {
+                const double x = compareSteps(stepsAt(o.ao), o.steps).distance;
+                if (d.nearest < 0 || x < d.nearest) {
+                    d.nearest = x;
+                    d.nearestMaterial = o.material;
+                }
+            }
+        } catch (const engine::PresetError&) { // a knob combination the preset's ranges refuse
+            failed = true;
+        } catch (const std::invalid_argument&) { // a render without a footstep
+            failed = true;
+        }
+        if (failed) {
+            d.own = 100.0;
+            d.nearest = others.empty() ? -1 : 0.0;
+            d.nearestMaterial = others.empty() ? "" : "(none)";
+        }
+        d.objective = contrastiveObjective(d.own, d.nearest, options.contrast, options.margin);
+        if (d.nearest < 0) d.nearest = 0;
+        return d;
+    };
+    auto distanceOf = [&](const toml::table& t) { return evaluate(t).objective; };
 
     FitResult result;
     result.optimiser = "NLopt LN_BOBYQA";
@@ -372,7 +519,9 @@ FitResult fitSurface(const std::string& presetFile, const std::vector<Recording>
         lo.push_back(k.info.lo);
         hi.push_back(k.info.hi);
     }
-    result.distanceBefore = distanceOf(root);
+    result.before = evaluate(root);
+    result.distanceBefore = result.before.own;
+    result.contrastive = !others.empty();
     const toml::table originalTable = root; // loudness reference
     // Starting points: the preset itself, or (modal seed) the recordings' modes estimated on
     // the signal and on its first difference; each is refined, the better result is kept.
@@ -419,7 +568,7 @@ FitResult fitSurface(const std::string& presetFile, const std::vector<Recording>
     bool stopped = false;
     for (std::size_t si = 0; si < starts.size() && !stopped; ++si) {
         root = starts[si].table; // `build` applies the knobs to `root`
-        const double d0 = starts[si].modes.empty() ? result.distanceBefore : distanceOf(root);
+        const double d0 = starts[si].modes.empty() ? result.before.objective : distanceOf(root);
         best = d0;
         x.assign(knobs.size(), 0.0);
         bestX = x;
@@ -465,7 +614,8 @@ FitResult fitSurface(const std::string& presetFile, const std::vector<Recording>
                          20.0 * std::log10(peakBefore / peakAfter);
         fitted.insert_or_assign("gain_db", std::round(g * 10.0) / 10.0);
     }
-    result.distanceAfter = distanceOf(fitted);
+    result.after = evaluate(fitted);
+    result.distanceAfter = result.after.own;
     fs::remove_all(tmp);
     result.evaluations = evals;
     for (std::size_t i = 0; i < knobs.size(); ++i) {
@@ -500,6 +650,25 @@ FitResult fitSurface(const std::string& presetFile, const std::vector<Recording>
     toml::table kt;
     for (const auto& k : result.knobs) kt.insert(k.name, std::round(k.value * 1000) / 1000);
     prov.insert("knobs", kt);
+    if (!options.keep.empty()) {
+        toml::array kept;
+        for (const auto& k : options.keep) kept.push_back(k);
+        prov.insert("knobs_kept", kept);
+    }
+    if (result.contrastive) {
+        toml::table ct;
+        ct.insert("objective", "d_own + contrast x max(0, d_own - nearest other + margin)");
+        ct.insert("contrast", options.contrast);
+        ct.insert("margin", options.margin);
+        toml::array materials;
+        for (const auto& o : others) materials.push_back(o.material);
+        ct.insert("other_materials", materials);
+        ct.insert("nearest_other_before", result.before.nearestMaterial);
+        ct.insert("nearest_other_distance_before", std::round(result.before.nearest * 1000) / 1000);
+        ct.insert("nearest_other_after", result.after.nearestMaterial);
+        ct.insert("nearest_other_distance_after", std::round(result.after.nearest * 1000) / 1000);
+        prov.insert("contrast", ct);
+    }
     if (result.modalSeeded) {
         toml::table seed;
         seed.insert("method", "matrix pencil on the strongest steps, clustered across files "

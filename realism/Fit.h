@@ -10,10 +10,13 @@
 ///  - impact: mode decay (every t60_s x 2^k), contact stiffness (x 10^k), spectral tilt of
 ///    the mode gains (gain x (f / 1 kHz)^k);
 ///  - grains: resonance band (freq_min/max_hz x 2^k), resonance Q (q_min/max x 2^k), event
-///    rates (events_per_* x 2^k, at most x 2 so that the cost stays bounded), balance of the first
-///    layer against the others (+-k dB);
-///  - bubbles: bubble size (radius_min/max_mm x 2^k), splash noise band (splash_hz x 2^k) and
-///    level (splash_noise_db + k), slosh level (slosh_db + k).
+///    rates (events_per_* x 2^k, at most x 2 so that the cost stays bounded), the heel's thud
+///    (gain_db + k of the onset-only layers, when there is one), crunch cascades (burst_events + k,
+///    at least 0, on the layers of ongoing events) and their length (burst_ms x 2^k), balance of
+///    the first layer against the others (+-k dB);
+///  - bubbles: bubble size (radius_min/max_mm x 2^k), splash noise band (splash_hz x 2^k),
+///    level (splash_noise_db + k) and length (splash_ms, splash_decay_ms x 2^k), slosh level
+///    (slosh_db + k).
 /// The fitted preset keeps the original's loudness: its top-level gain_db is re-calibrated so
 /// that the render's peak equals the original's.
 ///
@@ -30,6 +33,17 @@
 /// from the pencil on the signal and on its first difference (ModalSeedOptions::preEmphasis;
 /// the first finds the strong low modes, the second the modes of the upper octaves); each is
 /// refined by the knobs with up to maxEvaluations renders, and the better result is kept.
+///
+/// Contrastive objective (FitOptions::others, contrast, margin; `underfoot fit --contrast
+/// LAMBDA --margin M`): minimising the distance to the own recordings alone can land a render
+/// that is even closer to another material's recordings (sand fitted towards a hiss that the
+/// water recordings have too). With recordings of other materials given, the fit minimises
+///     J = d_own + LAMBDA x max(0, d_own - min over other materials d_other + M)
+/// i.e. the plain distance while the render is at least M closer to its own material than to
+/// the nearest other one, plus a hinge penalty otherwise. Each other material is compared on
+/// the band its own recordings share with the render (as `underfoot compare --all` does), so
+/// the nearest other material of the fit is the one `compare --all` reports for the same
+/// render. LAMBDA = 0 (or no other recordings) is the plain fit, bit for bit.
 #include "realism/Compare.h"
 #include "realism/ModalSeed.h"
 
@@ -50,6 +64,24 @@ struct FitOptions {
     /// preset's own modes (`underfoot fit --no-modal-seed`).
     bool modalSeed = true;
     ModalSeedOptions seed; ///< maxModes is set to each impact layer's mode count
+    /// Recordings of other materials (Recording::material set; those of the own material, if
+    /// any, are ignored by name of `ownMaterial`). Empty: no contrast.
+    std::vector<Recording> others;
+    /// The own material's name, to skip it in `others` ("" = keep every other recording).
+    std::string ownMaterial;
+    double contrast = 0.0; ///< LAMBDA of the hinge penalty (see above); 0 = plain fit
+    double margin = 0.1;   ///< M: how much closer to the own material than to any other
+    /// Knobs held at their start (by name, e.g. "grain_band": a designed property the fit must
+    /// keep); an unknown name throws std::invalid_argument naming the knobs there are.
+    std::vector<std::string> keep;
+};
+
+/// Distance of a render to its own recordings and to the nearest other material.
+struct FitDistances {
+    double own = 0;
+    std::string nearestMaterial; ///< "" when no other material was given
+    double nearest = 0;          ///< distance to it
+    double objective = 0;        ///< J (see above)
 };
 
 struct FitKnob {
@@ -64,12 +96,21 @@ struct FitResult {
     double seconds = 0; ///< wall-clock time of the fit
     std::vector<FitKnob> knobs;
     std::string optimiser;
-    bool modalSeeded = false;              ///< the modes were seeded from the recordings
-    double distanceSeeded = 0;             ///< distance of the seeded preset, before refining
+    bool modalSeeded = false; ///< the modes were seeded from the recordings
+    double distanceSeeded =
+        0; ///< objective J of the seeded preset before refining (its distance without contrast)
     std::vector<RecordedMode> seededModes; ///< the recorded modes written into the preset
     std::vector<std::string> seedSkipped;  ///< recordings that yielded no mode
     std::string seedStart;                 ///< the starting point the result was refined from
+    /// Contrast (FitOptions::contrast > 0 and other materials given): own distance, nearest
+    /// other material and objective of the original preset and of the fitted one.
+    bool contrastive = false;
+    FitDistances before, after;
 };
+
+/// The contrastive objective J = own + contrast x max(0, own - nearest + margin); `own` alone
+/// when there is no other material (nearest < 0) or contrast is 0.
+double contrastiveObjective(double own, double nearest, double contrast, double margin);
 
 /// Fits a preset file (a surface with its own layers; a `base` preset is fitted through its
 /// base). Throws std::invalid_argument when it has no fittable layer, engine::PresetError for

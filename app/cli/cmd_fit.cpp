@@ -3,6 +3,8 @@
 //   fit --surface gravel [--real FILES_OR_DIRS...] -o gravel_fitted.toml [--evaluations 80]
 //   fit --surface wood --modes 8     modal estimate (matrix pencil) of every recorded strike
 //   fit --surface wood -o wood.toml --no-modal-seed   refine the preset's own modes only
+//   fit --surface beach_sand -o s.toml --contrast 2 --margin 0.1   (the defaults) also push the
+//       render away from the nearest other material of the recordings cache (realism/Fit.h)
 // Solids (impact layers) are first seeded with the recordings' modes (realism/ModalSeed.h).
 // Without --real the recordings of the surface's material come from the cache of
 // scripts/fetch-recordings.sh. The output is a normal preset with a [provenance] table.
@@ -33,6 +35,24 @@ struct FitArgs {
     int modes = 0; ///< --modes K: print K modes of every recording and stop
     bool noModalSeed = false;
 };
+
+// Recordings of every other material in the cache, for the contrastive objective; empty (with
+// a note) when there is no cache or it holds no other material.
+std::vector<rl::Recording> otherMaterials(const FitArgs& a, const std::string& own) {
+    const auto dir = a.recordings.empty() ? rl::defaultRecordingsDir() : a.recordings;
+    std::vector<rl::Recording> out;
+    try {
+        for (auto& r : rl::loadManifest(dir))
+            if (!r.material.empty() && r.material != own) out.push_back(r);
+    } catch (const std::runtime_error& e) {
+        if (!a.recordings.empty()) throw UserError(e.what()); // named explicitly: must load
+        fmt::print("note: no recordings cache ({}): fitting without contrast\n", e.what());
+        return {};
+    }
+    if (out.empty())
+        fmt::print("note: {} holds no other material: fitting without contrast\n", dir);
+    return out;
+}
 
 // The matrix pencil modes of every recording (strongest step, from its peak): the starting
 // point for a solid's modal parameters (frequencies, T60s, relative gains).
@@ -93,6 +113,20 @@ int runFit(FitArgs& a) {
             throw UserError(e.what());
         }
     }
+    if (!(std::isfinite(a.options.contrast) && a.options.contrast >= 0))
+        throw UserError(fmt::format("fit: --contrast {}: expected a number >= 0 (0 = plain fit)",
+                                    a.options.contrast));
+    if (!(std::isfinite(a.options.margin) && a.options.margin >= 0 && a.options.margin <= 5))
+        throw UserError(
+            fmt::format("fit: --margin {}: expected a distance from 0 to 5", a.options.margin));
+    if (a.options.contrast > 0) {
+        a.options.ownMaterial = rl::materialOfSurface(a.surface);
+        try {
+            a.options.others = otherMaterials(a, a.options.ownMaterial);
+        } catch (const std::runtime_error& e) {
+            throw UserError(e.what());
+        }
+    }
     a.options.maxEvaluations = a.evaluations;
     a.options.modalSeed = !a.noModalSeed;
     if (!a.quiet)
@@ -138,6 +172,12 @@ int runFit(FitArgs& a) {
     fmt::print("{}: distance {:.3f} -> {:.3f} after {} evaluations ({}) in {:.1f} s -> {}\n",
                a.surface, r.distanceBefore, r.distanceAfter, r.evaluations, r.optimiser, r.seconds,
                a.output);
+    if (r.contrastive)
+        fmt::print("nearest other material: {} {:.3f} -> {} {:.3f} (contrast {}, margin {}: {})\n",
+                   r.before.nearestMaterial, r.before.nearest, r.after.nearestMaterial,
+                   r.after.nearest, a.options.contrast, a.options.margin,
+                   r.after.own < r.after.nearest ? "closer to its own recordings"
+                                                 : "NOT closer to its own recordings");
     for (const auto& k : r.knobs)
         fmt::print("  {:<14} {:>7.3f}   ({})\n", k.name, k.value, k.meaning);
     return 0;
@@ -164,6 +204,20 @@ CommandRegistrar reg("fit", [](CLI::App& app, int& exitCode) {
         ->check(CLI::Range(2.0, 60.0));
     cmd->add_option("--seed", args->options.spec.seed, "seed of the renders")
         ->capture_default_str();
+    args->options.contrast = 2.0; // the CLI's defaults (the library's are 0: plain fit)
+    args->options.margin = 0.1;
+    cmd->add_option("--contrast", args->options.contrast,
+                    "weight LAMBDA of the penalty max(0, d_own - d_nearest_other + margin) "
+                    "against the other materials of the recordings cache; 0 = minimise the "
+                    "distance to the own recordings only")
+        ->capture_default_str();
+    cmd->add_option("--margin", args->options.margin,
+                    "how much closer (in distance units) the render must be to its own "
+                    "recordings than to any other material's before the penalty stops")
+        ->capture_default_str();
+    cmd->add_option("--keep", args->options.keep,
+                    "knobs to hold at the preset's values (e.g. grain_band: a designed property "
+                    "the fit must not move)");
     cmd->add_option("-o,--output", args->output, "fitted preset (.toml)");
     cmd->add_flag("-q,--quiet", args->quiet, "no progress lines");
     cmd->add_option("--modes", args->modes,
