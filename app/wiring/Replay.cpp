@@ -42,8 +42,10 @@ LiveMeters parseLiveMeters(const std::string& text, const std::string& file) {
     try {
         const toml::table t = toml::parse(text, file);
         if (auto r = t["sample_rate"].value<double>(); r && *r > 0) run.sampleRateHz = *r;
-        if (auto b = t["block_size"].value<std::int64_t>(); b && *b > 0 && *b <= 65536)
-            run.blockSize = static_cast<int>(*b);
+        // as_integer, not value<int64_t>: toml++ casts a float such as 1.8e91 to int64_t
+        // unchecked (undefined behaviour; found by fuzz_live_meters).
+        if (const auto* b = t["block_size"].as_integer(); b && b->get() > 0 && b->get() <= 65536)
+            run.blockSize = static_cast<int>(b->get());
     } catch (const toml::parse_error& e) {
         throw ReplayError(fmt::format("{}:{}:{}: {}", file, e.source().begin.line,
                                       e.source().begin.column, e.description()));

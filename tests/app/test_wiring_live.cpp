@@ -278,6 +278,10 @@ TEST(Wiring, MetersFileGivesTheLiveRateAndBlockSize) {
     const auto unset = wir::parseLiveMeters("sample_rate = -1\nblock_size = 70000\n", "x");
     EXPECT_FALSE(unset.sampleRateHz);
     EXPECT_FALSE(unset.blockSize);
+    // A float block size is not a block size; 1.8e91 was cast to an integer unchecked by toml++
+    // (undefined behaviour; found by fuzz_live_meters, regressions/live_meters/).
+    for (const char* text : {"block_size = 1.8e91\n", "block_size = 64.0\n"})
+        EXPECT_FALSE(wir::parseLiveMeters(text, "x").blockSize) << text;
     try {
         (void)wir::parseLiveMeters("sample_rate = 48000\nblock_size = [\n", "grf.wav.meters.toml");
         FAIL() << "bad TOML was accepted";

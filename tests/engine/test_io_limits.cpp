@@ -166,4 +166,19 @@ TEST(IoLimits, EmptyOrTruncatedSettingsAndCalibrationFilesAreRefused) {
     const auto emptyCal = (dir / "P07_empty.toml").string();
     std::ofstream(emptyCal) << "";
     EXPECT_THROW((void)loadStepThresholds(emptyCal), std::runtime_error);
+    // A float version too large for an integer was cast unchecked by toml++ (undefined
+    // behaviour, regressions/calibration/ of task fuzz4): now refused as any other version.
+    for (const char* version : {"1.8e91", "1.0", "\"1\""}) {
+        const auto odd = (dir / "P07_version.toml").string();
+        std::string changed = text;
+        changed.replace(changed.find("version = 1"), 11, std::string("version = ") + version);
+        std::ofstream(odd) << changed;
+        try {
+            (void)loadStepThresholds(odd);
+            FAIL() << "version = " << version << " was accepted";
+        } catch (const std::runtime_error& e) {
+            EXPECT_NE(std::string(e.what()).find("version: expected 1"), std::string::npos)
+                << e.what();
+        }
+    }
 }
