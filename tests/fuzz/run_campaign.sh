@@ -52,8 +52,9 @@ failed=0
 printf '%-22s %8s %12s %7s %7s %8s  %s\n' target seconds executions cov ft rss_mb findings
 for t in "${targets[@]}"; do
   log="$work/$t/fuzz.log"
-  execs=$(grep -oE 'stat::number_of_executed_units: [0-9]+' "$log" 2>/dev/null | awk '{print $2}')
-  rss=$(grep -oE 'stat::peak_rss_mb: [0-9]+' "$log" 2>/dev/null | awk '{print $2}')
+  # libFuzzer prints its final stats once, or twice after a finding: the last ones count.
+  execs=$(grep -E '^stat::number_of_executed_units:' "$log" 2>/dev/null | tail -1 | awk '{print $2}')
+  rss=$(grep -E '^stat::peak_rss_mb:' "$log" 2>/dev/null | tail -1 | awk '{print $2}')
   last=$(grep -E '^#[0-9]+' "$log" 2>/dev/null | tail -1)
   cov=$(echo "$last" | grep -oE 'cov: [0-9]+' | awk '{print $2}')
   ft=$(echo "$last" | grep -oE 'ft: [0-9]+' | awk '{print $2}')
