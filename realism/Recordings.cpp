@@ -47,6 +47,7 @@ std::vector<Recording> loadManifest(const std::string& dir) {
         std::stringstream ss(line);
         std::string cell;
         while (std::getline(ss, cell, ',')) f.push_back(cell);
+        if (line.back() == ',') f.emplace_back(); // an empty last column (recordist) is a column
         if (f.size() != 7)
             throw std::runtime_error(
                 fmt::format("{}:{}: expected 7 comma-separated columns ({}), got {}", path, lineNo,

@@ -15,6 +15,8 @@
 #include <toml++/toml.h>
 
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 
 namespace underfoot::wiring {
 namespace {
@@ -23,29 +25,33 @@ namespace eng = underfoot::engine;
 namespace exp = underfoot::experiment;
 namespace fs = std::filesystem;
 
-/// What the live engine wrote next to a trial's recording (LivePlayer).
-struct LiveRun {
-    std::optional<double> rate;
-    std::optional<int> blockSize;
-};
-
-LiveRun readMetersFile(const fs::path& recording) {
-    LiveRun run;
+LiveMeters readMetersFile(const fs::path& recording) {
     const fs::path meters = recording.string() + ".meters.toml";
-    if (!fs::exists(meters)) return run;
+    if (!fs::exists(meters)) return {};
+    std::ifstream in(meters, std::ios::binary);
+    if (!in) throw ReplayError(fmt::format("{}: cannot read the meters file", meters.string()));
+    std::ostringstream text;
+    text << in.rdbuf();
+    return parseLiveMeters(text.str(), meters.string());
+}
+
+} // namespace
+
+LiveMeters parseLiveMeters(const std::string& text, const std::string& file) {
+    LiveMeters run;
     try {
-        const toml::table t = toml::parse_file(meters.string());
-        if (auto r = t["sample_rate"].value<double>(); r && *r > 0) run.rate = *r;
-        if (auto b = t["block_size"].value<std::int64_t>(); b && *b > 0 && *b <= 65536)
-            run.blockSize = static_cast<int>(*b);
+        const toml::table t = toml::parse(text, file);
+        if (auto r = t["sample_rate"].value<double>(); r && *r > 0) run.sampleRateHz = *r;
+        // as_integer, not value<int64_t>: toml++ casts a float such as 1.8e91 to int64_t
+        // unchecked (undefined behaviour; found by fuzz_live_meters).
+        if (const auto* b = t["block_size"].as_integer(); b && b->get() > 0 && b->get() <= 65536)
+            run.blockSize = static_cast<int>(b->get());
     } catch (const toml::parse_error& e) {
-        throw ReplayError(fmt::format("{}:{}:{}: {}", meters.string(), e.source().begin.line,
+        throw ReplayError(fmt::format("{}:{}:{}: {}", file, e.source().begin.line,
                                       e.source().begin.column, e.description()));
     }
     return run;
 }
-
-} // namespace
 
 ReplayRender renderTrialReplay(const ReplayRequest& q) {
     exp::ReplayInfo info;
@@ -62,7 +68,7 @@ ReplayRender renderTrialReplay(const ReplayRequest& q) {
             "file is what was heard, nothing is rendered for it",
             q.trial + 1, q.participant, *stimulus.clip));
     std::optional<fs::path> recording;
-    LiveRun live;
+    LiveMeters live;
     // A simulated participant's sensor trial: its feet were a virtual walker whose parameters
     // the trial stores as text (issue #17).
     std::optional<exp::SimulatedWalker> simulatedWalker;
@@ -82,7 +88,7 @@ ReplayRender renderTrialReplay(const ReplayRequest& q) {
     }
     ReplayRender out;
     out.seed = info.renderSeed;
-    out.sampleRateHz = q.sampleRateHz.value_or(live.rate.value_or(48000.0));
+    out.sampleRateHz = q.sampleRateHz.value_or(live.sampleRateHz.value_or(48000.0));
     out.blockSize = q.blockSize.value_or(live.blockSize.value_or(256));
     const double rate = out.sampleRateHz;
     if (!(rate >= 8000 && rate <= 384000))

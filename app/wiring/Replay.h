@@ -39,6 +39,15 @@ struct ReplayRender {
     int blockSize = 0;
 };
 
+/// What the live engine wrote next to a trial's recording, `<recording>.meters.toml`
+/// (LivePlayer): the rate and block size the replay reproduces (absent or out of range: unset).
+struct LiveMeters {
+    std::optional<double> sampleRateHz;
+    std::optional<int> blockSize;
+};
+/// Parses the text of a `.meters.toml` file; throws ReplayError naming `file`:line:column.
+LiveMeters parseLiveMeters(const std::string& text, const std::string& file);
+
 /// Renders one stored trial. Throws ReplayError with a message naming the study, the trial and
 /// what is missing (a live sensor trial without recording, a lab-supplied clip, a bad file).
 ReplayRender renderTrialReplay(const ReplayRequest& request);

@@ -194,8 +194,10 @@ StepThresholds loadStepThresholds(const std::string& path) {
     if (format != "underfoot-step-thresholds")
         throw std::runtime_error(fmt::format("{}: format: expected \"underfoot-step-thresholds\"",
                                              where(root.get("format"))));
-    const auto version = root["version"].value<std::int64_t>();
-    if (version != 1)
+    // as_integer, not value<int64_t>: toml++ casts a float such as 1e300 to int64_t unchecked
+    // (undefined behaviour; the pattern fuzz_live_meters found).
+    const auto* version = root["version"].as_integer();
+    if (!version || version->get() != 1)
         throw std::runtime_error(
             fmt::format("{}: version: expected 1", where(root.get("version"))));
     StepThresholds t;

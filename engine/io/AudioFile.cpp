@@ -109,6 +109,22 @@ AudioBuffer readAudioFile(const std::string& path) {
 AudioBuffer readAudioFile(const std::string& path, double targetRateHz) {
     AudioBuffer in = readAudioFile(path);
     if (in.sampleRateHz == targetRateHz) return in;
+    // The header's rate is outside input: libsamplerate converts at most 256 x up or down, and
+    // the resampled length (memory and work) is frames x target / source, so it stays within
+    // the same limit of samples as a file read at its own rate (found by fuzz_audio_file).
+    const double ratio = targetRateHz / in.sampleRateHz;
+    if (std::isfinite(ratio) && ratio > 0 && !src_is_valid_ratio(ratio))
+        throw FileError(
+            fmt::format("{}: sample rate {} Hz cannot be resampled to {} Hz (at most "
+                        "256 times up or down); expected {:.0f} to {:.0f} Hz",
+                        path, in.sampleRateHz, targetRateHz, targetRateHz / 256.0,
+                        std::min(256.0 * targetRateHz, static_cast<double>(kMaxAudioFileRateHz))));
+    const double resampled = static_cast<double>(in.frames()) * ratio * in.channels;
+    if (resampled > static_cast<double>(kMaxAudioFileSamples))
+        throw FileError(fmt::format("{}: {} frames of {} channels at {} Hz resampled to {} Hz "
+                                    "would be {:.0f} samples; expected at most {}",
+                                    path, in.frames(), in.channels, in.sampleRateHz, targetRateHz,
+                                    resampled, kMaxAudioFileSamples));
     return resample(in, targetRateHz);
 }
 

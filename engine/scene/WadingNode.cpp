@@ -281,6 +281,12 @@ GaitArrivals parseGaitArrivals(const std::string& text, const std::string& file)
         if (line.front() == '#') {
             constexpr std::string_view key = "# samples = ";
             if (line.substr(0, key.size()) == key) {
+                // One run length, before the frames it bounds (a later one would leave frames
+                // already read outside the run; found by fuzz_gait_arrivals).
+                if (haveSamples)
+                    throw fail(fmt::format("`{}`: a second `# samples = ` line; expected one, "
+                                           "before the header",
+                                           line));
                 const auto v = line.substr(key.size());
                 const auto r = std::from_chars(v.data(), v.data() + v.size(), a.samples);
                 if (r.ec != std::errc{} || r.ptr != v.data() + v.size() || a.samples <= 0)

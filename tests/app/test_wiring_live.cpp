@@ -4,6 +4,7 @@
 // live trial with a soundscape replays (renderer + soundscape as `underfoot replay` mixes it)
 // to the samples that were played.
 #include "app/wiring/Players.h"
+#include "app/wiring/Replay.h"
 #include "engine/control/GrfFile.h"
 #include "engine/render/Renderer.h"
 #include "engine/scene/WadingNode.h"
@@ -262,4 +263,30 @@ TEST(Wiring, WaterStimulusPlaysTheWadingNodeAndRecordsItsGait) {
                     1e-6)
             << k;
     EXPECT_TRUE(fs::exists(recording + ".meters.toml"));
+}
+
+// The `.meters.toml` side file the replay reads (parseLiveMeters, fuzzed by fuzz_live_meters):
+// what LivePlayer writes gives the live rate and block size; a value out of range is left unset
+// (the replay's defaults); bad syntax is a ReplayError naming the file, line and column.
+TEST(Wiring, MetersFileGivesTheLiveRateAndBlockSize) {
+    const auto m = wir::parseLiveMeters("# Measured by the live engine\nscene = \"gravel\"\n"
+                                        "sample_rate = 44100\nblock_size = 64\nframes = 11200\n",
+                                        "grf.wav.meters.toml");
+    ASSERT_TRUE(m.sampleRateHz && m.blockSize);
+    EXPECT_EQ(*m.sampleRateHz, 44100.0);
+    EXPECT_EQ(*m.blockSize, 64);
+    const auto unset = wir::parseLiveMeters("sample_rate = -1\nblock_size = 70000\n", "x");
+    EXPECT_FALSE(unset.sampleRateHz);
+    EXPECT_FALSE(unset.blockSize);
+    // A float block size is not a block size; 1.8e91 was cast to an integer unchecked by toml++
+    // (undefined behaviour; found by fuzz_live_meters, regressions/live_meters/).
+    for (const char* text : {"block_size = 1.8e91\n", "block_size = 64.0\n"})
+        EXPECT_FALSE(wir::parseLiveMeters(text, "x").blockSize) << text;
+    try {
+        (void)wir::parseLiveMeters("sample_rate = 48000\nblock_size = [\n", "grf.wav.meters.toml");
+        FAIL() << "bad TOML was accepted";
+    } catch (const wir::ReplayError& e) {
+        EXPECT_NE(std::string(e.what()).find("grf.wav.meters.toml:"), std::string::npos)
+            << e.what();
+    }
 }

@@ -93,6 +93,28 @@ TEST(IoLimits, AudioRateOutsideTheDocumentedRangeIsRefused) {
     }
 }
 
+// Found by fuzz_audio_file (task fuzz4; regressions/audio_file/): a 100 Hz file read at the
+// engine rate (lab clips, wading recordings) escaped as a bare std::invalid_argument from the
+// resampler ("ratio 480 ... outside libsamplerate's range"), without the file's name.
+TEST(IoLimits, AudioFileTooSlowToResampleIsRefusedNamingTheFile) {
+    const auto slow = writeWav("resample_100hz.wav", 100, 1, 64, 128);
+    try {
+        (void)readAudioFile(slow, 48000.0);
+        FAIL() << "a 100 Hz file was resampled x480";
+    } catch (const FileError& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find(slow), std::string::npos) << what;
+        EXPECT_NE(what.find("sample rate 100 Hz cannot be resampled to 48000 Hz"),
+                  std::string::npos)
+            << what;
+    }
+    // Within libsamplerate's range the file is resampled: 64 frames at 1 kHz -> 3072 at 48 kHz.
+    const auto ok = writeWav("resample_1khz.wav", 1000, 1, 64, 128);
+    const AudioBuffer a = readAudioFile(ok, 48000.0);
+    EXPECT_EQ(a.sampleRateHz, 48000.0);
+    EXPECT_EQ(a.frames(), 3072u);
+}
+
 TEST(IoLimits, GrfCsvWithHugeTimeStepIsRefusedBeforeResampling) {
     const auto path = (underfoot::test::scratchDir("io_limits") / "slow.csv").string();
     std::ofstream(path) << "time_s,left\n0,100\n1000000,200\n2000000,300\n";
@@ -144,4 +166,19 @@ TEST(IoLimits, EmptyOrTruncatedSettingsAndCalibrationFilesAreRefused) {
     const auto emptyCal = (dir / "P07_empty.toml").string();
     std::ofstream(emptyCal) << "";
     EXPECT_THROW((void)loadStepThresholds(emptyCal), std::runtime_error);
+    // A float version too large for an integer was cast unchecked by toml++ (undefined
+    // behaviour, regressions/calibration/ of task fuzz4): now refused as any other version.
+    for (const char* version : {"1.8e91", "1.0", "\"1\""}) {
+        const auto odd = (dir / "P07_version.toml").string();
+        std::string changed = text;
+        changed.replace(changed.find("version = 1"), 11, std::string("version = ") + version);
+        std::ofstream(odd) << changed;
+        try {
+            (void)loadStepThresholds(odd);
+            FAIL() << "version = " << version << " was accepted";
+        } catch (const std::runtime_error& e) {
+            EXPECT_NE(std::string(e.what()).find("version: expected 1"), std::string::npos)
+                << e.what();
+        }
+    }
 }

@@ -128,6 +128,40 @@ TEST(RealismRecordings, ManifestErrorsNameTheFileAndLine) {
     fs::remove_all(dir);
 }
 
+// Found while seeding fuzz_recordings_manifest (task fuzz4): a row whose last column (recordist,
+// the one column that may be empty) was empty counted 6 columns and the whole manifest was
+// refused.
+TEST(RealismRecordings, ManifestAcceptsAnEmptyRecordist) {
+    const auto dir = scratch("manifest_recordist");
+    {
+        std::ofstream(dir / "manifest.csv")
+            << "file,source,package,version,licence,material,recordist\r\n"
+            << "lab/snow/take 1.wav,lab,lab,2026-11,CC-BY-4.0,snow,\r\n"
+            << "a/b.wav,src,pkg,1,CC0-1.0,metal,someone\n";
+    }
+    const auto rows = loadManifest(dir.string());
+    ASSERT_EQ(rows.size(), 2u);
+    EXPECT_EQ(rows[0].file, "lab/snow/take 1.wav");
+    EXPECT_EQ(rows[0].material, "snow");
+    EXPECT_EQ(rows[0].recordist, "");
+    EXPECT_EQ(rows[1].recordist, "someone");
+    // An empty required column is still refused with the file and line.
+    {
+        std::ofstream(dir / "manifest.csv")
+            << "file,source,package,version,licence,material,recordist\n"
+            << "a/b.wav,src,pkg,1,CC0-1.0,,\n";
+    }
+    try {
+        loadManifest(dir.string());
+        FAIL() << "an empty material was accepted";
+    } catch (const std::runtime_error& e) {
+        EXPECT_NE(std::string(e.what()).find("manifest.csv:2: column 6 is empty"),
+                  std::string::npos)
+            << e.what();
+    }
+    fs::remove_all(dir);
+}
+
 // The real recordings (scripts/fetch-recordings.sh). Skipped, saying so, without the cache.
 class RealRecordings : public ::testing::Test {
   protected:

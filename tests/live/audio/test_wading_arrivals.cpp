@@ -177,5 +177,11 @@ TEST(WadingArrivals, BadFilesAreRefusedNamingFileLineAndWhatWasExpected) {
     EXPECT_NE(message("# samples = 100\n" + header + "x,0,1,2,3,4\n")
                   .find("a.csv:3: sample `x`: expected a whole number"),
               std::string::npos);
+    // Found by fuzz_gait_arrivals (regressions/gait_arrivals/): a second `# samples` line after
+    // the frames shortened the run and left frames already read outside it.
+    EXPECT_NE(message("# samples = 9600\n" + header + "480,0.01,1,2,3,4\n# samples = 96\n")
+                  .find("a.csv:4: `# samples = 96`: a second `# samples = ` line"),
+              std::string::npos)
+        << message("# samples = 9600\n" + header + "480,0.01,1,2,3,4\n# samples = 96\n");
     EXPECT_THROW(eng::readGaitArrivals("/nonexistent/a.csv"), eng::GaitFileError);
 }
