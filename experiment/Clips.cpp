@@ -3,12 +3,15 @@
 
 #include <fmt/format.h>
 
+#include <charconv>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <set>
 #include <sstream>
 #include <stdexcept>
+#include <type_traits>
 
 namespace underfoot::experiment {
 
@@ -112,21 +115,37 @@ std::vector<ClipRecord> readClipManifest(const std::string& clipDir) {
         ClipRecord r;
         r.stimulusId = cells[0];
         r.file = cells[1];
-        r.source = cells[2] == "wading"      ? ClipSource::Wading
-                   : cells[2] == "footsteps" ? ClipSource::Footsteps
-                                             : ClipSource::Lab;
-        try {
-            r.seed = std::stoull(cells[3]);
-            r.seconds = std::stod(cells[4]);
-            r.sampleRateHz = std::stod(cells[5]);
-            r.frames = static_cast<std::size_t>(std::stoull(cells[6]));
-        } catch (const std::exception&) {
-            throw std::runtime_error(fmt::format("{}:{}: seed, seconds, sample_rate_hz and "
-                                                 "frames must be numbers",
-                                                 path, lineNo));
-        }
-        if (!std::isfinite(r.seconds) || !std::isfinite(r.sampleRateHz))
-            throw std::runtime_error(fmt::format("{}:{}: non-finite number", path, lineNo));
+        if (cells[2] == "wading")
+            r.source = ClipSource::Wading;
+        else if (cells[2] == "footsteps")
+            r.source = ClipSource::Footsteps;
+        else if (cells[2] == "lab")
+            r.source = ClipSource::Lab;
+        else
+            throw std::runtime_error(fmt::format("{}:{}: source '{}': expected wading, footsteps "
+                                                 "or lab",
+                                                 path, lineNo, cells[2]));
+        // Whole cells only: "7abc" is not 7 and "-1" is not 2^64 - 1 (std::stoull accepted
+        // both; found reviewing fuzz_clip_manifest).
+        const auto whole = [&](const std::string& cell, const char* name, auto& v) {
+            const auto parsed = std::from_chars(cell.data(), cell.data() + cell.size(), v);
+            if (parsed.ec != std::errc{} || parsed.ptr != cell.data() + cell.size())
+                throw std::runtime_error(fmt::format(
+                    "{}:{}: {} '{}': expected a whole number 0 to {}", path, lineNo, name, cell,
+                    std::numeric_limits<std::remove_reference_t<decltype(v)>>::max()));
+        };
+        const auto real = [&](const std::string& cell, const char* name, double& v) {
+            const auto parsed = std::from_chars(cell.data(), cell.data() + cell.size(), v);
+            if (parsed.ec != std::errc{} || parsed.ptr != cell.data() + cell.size() ||
+                !std::isfinite(v) || v < 0)
+                throw std::runtime_error(fmt::format("{}:{}: {} '{}': expected a finite number "
+                                                     ">= 0",
+                                                     path, lineNo, name, cell));
+        };
+        whole(cells[3], "seed", r.seed);
+        real(cells[4], "seconds", r.seconds);
+        real(cells[5], "sample_rate_hz", r.sampleRateHz);
+        whole(cells[6], "frames", r.frames);
         r.sha256 = cells[7];
         out.push_back(std::move(r));
     }

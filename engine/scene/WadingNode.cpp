@@ -228,6 +228,7 @@ namespace {
 constexpr const char* kArrivalsHeader =
     "sample,time_s,left_thigh_dps,right_thigh_dps,left_shank_dps,right_shank_dps";
 constexpr std::size_t kMaxArrivals = 100'000'000;
+constexpr double kMaxArrivalGapS = 30.0; ///< longest stretch of a replayed run without a frame
 
 } // namespace
 
@@ -379,6 +380,26 @@ AudioBuffer renderWadingArrivals(const WadingOptions& options, const GaitArrival
         arrivals.samples > static_cast<std::int64_t>(24 * 3600 * options.sampleRateHz))
         throw WadingOptionError(
             fmt::format("a run of {} samples: expected 1 sample to 24 hours", arrivals.samples));
+    // The run's length is a number read from the file: it may only extend kMaxGapS past the
+    // frames around it, so the memory it asks for is bounded by what the file holds (a live
+    // node receives gyroscope frames every ~10 ms; a gap of half a minute is a lost sensor).
+    const auto maxGap = static_cast<std::int64_t>(kMaxArrivalGapS * options.sampleRateHz);
+    std::int64_t previous = 0;
+    for (const auto& f : arrivals.frames) {
+        if (f.sample - previous > maxGap)
+            throw WadingOptionError(fmt::format(
+                "gait arrivals: {:.1f} s without a frame (sample {} to {}): expected at most "
+                "{:.0f} s between frames; such a gap is a lost gyroscope, whose trial cannot be "
+                "replayed from its arrivals",
+                double(f.sample - previous) / options.sampleRateHz, previous, f.sample,
+                kMaxArrivalGapS));
+        previous = f.sample;
+    }
+    if (arrivals.samples - previous > maxGap)
+        throw WadingOptionError(fmt::format(
+            "gait arrivals: a run of {} samples whose last frame is at sample {}: expected the "
+            "run to end at most {:.0f} s after its last frame",
+            arrivals.samples, previous, kMaxArrivalGapS));
     WadingNode node(options, std::make_unique<RecordedGaitSource>(arrivals.frames), 0);
     node.prepare({options.sampleRateHz, blockSize});
     node.reset(options.seed);

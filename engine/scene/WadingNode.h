@@ -140,7 +140,9 @@ class RecordedGaitSource final : public GaitSource {
 /// Re-renders a live wading node's run: the same node (options, seed) fed the recorded frames at
 /// their samples, in blocks of `blockSize` (the live block size) for `arrivals.samples` samples,
 /// then the offline output stage (StereoSafetyLimiter, as renderWading). Identical to what the
-/// live node rendered when blockSize is the live one. Throws WadingOptionError / PresetError.
+/// live node rendered when blockSize is the live one. A run with more than 30 s without a
+/// frame (from its start, between frames, or after the last) is refused, so the memory asked
+/// for is bounded by the frames the file holds. Throws WadingOptionError / PresetError.
 AudioBuffer renderWadingArrivals(const WadingOptions& options, const GaitArrivals& arrivals,
                                  int blockSize, LimiterReport* limiter = nullptr);
 

@@ -185,3 +185,36 @@ TEST(WadingArrivals, BadFilesAreRefusedNamingFileLineAndWhatWasExpected) {
         << message("# samples = 9600\n" + header + "480,0.01,1,2,3,4\n# samples = 96\n");
     EXPECT_THROW(eng::readGaitArrivals("/nonexistent/a.csv"), eng::GaitFileError);
 }
+
+// The run length is a number read from the file: a tiny file must not make the replay allocate
+// hours of audio (found reviewing fuzz_gait_arrivals: `# samples` up to 24 h asked ~33 GB).
+TEST(WadingArrivals, ARunFarLongerThanItsFramesIsRefusedBeforeAllocating) {
+    eng::WadingOptions options;
+    options.sampleRateHz = 48000;
+    const auto refused = [&](const eng::GaitArrivals& a) {
+        try {
+            eng::renderWadingArrivals(options, a, 64);
+        } catch (const eng::WadingOptionError& e) {
+            return std::string(e.what());
+        }
+        return std::string("(accepted)");
+    };
+    eng::GaitArrivals a;
+    a.samples = 24LL * 3600 * 48000 - 1; // under the 24 h cap: the gaps must refuse it
+    a.frames.push_back({480, {}});
+    EXPECT_NE(refused(a).find("expected the run to end at most 30 s after its last frame"),
+              std::string::npos)
+        << refused(a);
+    a.frames.push_back({480 + 31 * 48000, {}});
+    EXPECT_NE(refused(a).find("31.0 s without a frame (sample 480 to 1488480)"), std::string::npos)
+        << refused(a);
+    eng::GaitArrivals late;
+    late.samples = 40 * 48000;
+    late.frames.push_back({31 * 48000, {}});
+    EXPECT_NE(refused(late).find("31.0 s without a frame (sample 0 to"), std::string::npos)
+        << refused(late);
+    eng::GaitArrivals fine; // 2 s with a frame every 10 ms is replayed
+    fine.samples = 2 * 48000;
+    for (std::int64_t s = 0; s < fine.samples; s += 480) fine.frames.push_back({s, {}});
+    EXPECT_EQ(eng::renderWadingArrivals(options, fine, 64).frames(), 96000u);
+}

@@ -11,6 +11,8 @@
 #include <SQLiteCpp/SQLiteCpp.h>
 #include <gtest/gtest.h>
 
+#include <fmt/format.h>
+
 #include <fstream>
 
 using namespace underfoot;
@@ -65,6 +67,37 @@ void renderClips(const Protocol& p, const std::string& dir, double seconds) {
 }
 
 } // namespace
+
+// A manifest's numbers are whole cells: "7abc" and "-1" were read as 7 and 2^64 - 1, and an
+// unknown source as "lab" (found reviewing fuzz_clip_manifest).
+TEST(WadingListeningMode, ClipManifestRefusesPartNumbersNegativeSeedsAndUnknownSources) {
+    const std::string dir = scratchFile("manifest_numbers");
+    std::filesystem::create_directories(dir);
+    const auto read = [&](const std::string& row) {
+        std::ofstream(dir + "/" + kClipManifest)
+            << "stimulus_id,file,source,seed,seconds,sample_rate_hz,frames,sha256\n"
+            << row << "\n";
+        try {
+            const auto m = readClipManifest(dir);
+            return fmt::format("(accepted seed {})", m.at(0).seed);
+        } catch (const std::runtime_error& e) {
+            return std::string(e.what());
+        }
+    };
+    EXPECT_EQ(read("a,a.wav,lab,18446744073709551615,2.5,48000,120000,00"),
+              "(accepted seed 18446744073709551615)");
+    const auto has = [](const std::string& message, const std::string& part) {
+        return message.find(part) != std::string::npos;
+    };
+    EXPECT_TRUE(has(read("a,a.wav,lab,7abc,2.5,48000,120000,00"),
+                    "clips.csv:2: seed '7abc': expected a whole number"))
+        << read("a,a.wav,lab,7abc,2.5,48000,120000,00");
+    EXPECT_TRUE(has(read("a,a.wav,lab,-1,2.5,48000,120000,00"), "seed '-1'"));
+    EXPECT_TRUE(has(read("a,a.wav,lab,1,2.5s,48000,120000,00"), "seconds '2.5s'"));
+    EXPECT_TRUE(has(read("a,a.wav,lab,1,2.5,48000,-5,00"), "frames '-5'"));
+    EXPECT_TRUE(has(read("a,a.wav,studio,1,2.5,48000,5,00"),
+                    "source 'studio': expected wading, footsteps or lab"));
+}
 
 TEST(WadingListeningMode, ClipsRenderThroughTheWadingEngineWithStoredSeeds) {
     const Protocol p = loadProtocol(shippedProtocol("wading_listening.toml"));
