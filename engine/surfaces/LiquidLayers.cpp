@@ -39,6 +39,9 @@ void BubblesLayer::prepare(const ProcessSpec& spec) {
     stream_.prepare(sampleRateHz_, maxEventsPerSecond_);
     derivativeG_ = onePoleCoefficientTau(control_.derivativeMs * 1e-3, sampleRateHz_);
     splashDecayG_ = onePoleCoefficientTau(control_.splashDecayMs * 1e-3, sampleRateHz_);
+    splashRiseG_ = control_.splashRiseMs > 0
+                       ? onePoleCoefficientTau(control_.splashRiseMs * 1e-3, sampleRateHz_)
+                       : 0.0;
     wakeG_ = onePoleCoefficientTau(control_.wakeMs * 1e-3, sampleRateHz_);
     motionG_ = onePoleCoefficientTau(0.03, sampleRateHz_); // 30 ms: the water follows the foot
     const double guard = 0.45 * sampleRateHz_;
@@ -128,7 +131,12 @@ void BubblesLayer::processChunk(const float* grf, float* out, int n) noexcept {
         rate_[static_cast<std::size_t>(i)] = static_cast<float>(rate);
         wakeEnv_ *= wakeG_;
         if (wakeEnv_ < kWakeEnd) wakeEnv_ = 0.0; // 60 dB down: the wake is over
-        splashEnv_ = splashDrive > splashEnv_ ? splashDrive : splashEnv_ * splashDecayG_;
+        if (splashDrive <= splashEnv_)
+            splashEnv_ *= splashDecayG_;
+        else if (splashRiseG_ > 0) // the splash develops: rise towards the drive
+            splashEnv_ = splashDrive + splashRiseG_ * (splashEnv_ - splashDrive);
+        else
+            splashEnv_ = splashDrive;
         motionEnv_ = motionDrive + motionG_ * (motionEnv_ - motionDrive);
         const double splashAmp = splashGain_ * splashEnv_;
         const double sloshAmp = sloshGain_ * (motionEnv_ + wakeEnv_);
@@ -192,6 +200,10 @@ std::unique_ptr<SurfaceLayer> makeBubblesLayer(PresetReader& r, const AccuracyOp
                           "centre of the splash noise band", true);
     c.splashDecayMs = r.number("splash_decay_ms", 40.0, 2.0, 1000.0, "ms",
                                "decay time constant of the splash noise", true);
+    c.splashRiseMs =
+        r.number("splash_rise_ms", 0.0, 0.0, 500.0, "ms",
+                 "rise time constant of the splash noise towards the landing's drive: the splash "
+                 "develops after the foot lands (0: at once)");
     c.wakeMs = r.number("wake_ms", 0.0, 0.0, 2000.0, "ms",
                         "decay time constant of the motion after the foot leaves (0: none)");
     c.wakeBubblesHz = r.number("wake_bubbles_hz", 0.0, 0.0, 5000.0, "bubbles/s",

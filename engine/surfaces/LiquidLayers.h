@@ -7,7 +7,9 @@
 ///  - splash: during the first splash_ms of each contact, bubbles start at
 ///    splash_bubbles_per_kn x max(dF/dt, 0) per second (i.e. so many bubbles per kN of load taken
 ///    on while the foot lands) and a splash noise (band-pass at splash_hz) follows the same drive
-///    with a decay of splash_decay_ms;
+///    with a decay of splash_decay_ms (with splash_rise_ms > 0 the noise envelope rises towards
+///    the drive with that time constant instead of at once: a splash develops, the sheet of water
+///    thrown up and its drops falling back peak some tens of ms after the foot lands);
 ///  - stirring: while in contact, bubbles_per_kn x |dF/dt| bubbles per second (the foot moves and
 ///    pushes water around);
 ///  - wake: when the foot leaves (the load falls below contact_threshold_n) a motion envelope
@@ -33,6 +35,7 @@ struct BubblesControl {
     double splashNoiseDb = -120.0; ///< <= -120: off
     double splashHz = 3000.0;
     double splashDecayMs = 40.0;
+    double splashRiseMs = 0.0; ///< 0: the splash noise follows the landing at once
     double wakeMs = 0.0;
     double wakeBubblesHz = 0.0;
     double sloshDb = -120.0; ///< <= -120: off
@@ -60,7 +63,7 @@ class BubblesLayer final : public SurfaceLayer {
     BubblesControl control_;
     int maxEventsPerSecond_;
     double sampleRateHz_ = 48000.0;
-    double derivativeG_ = 0, splashDecayG_ = 0, wakeG_ = 0, motionG_ = 0;
+    double derivativeG_ = 0, splashDecayG_ = 0, splashRiseG_ = 0, wakeG_ = 0, motionG_ = 0;
     double gain_ = 1.0, splashGain_ = 0.0, sloshGain_ = 0.0;
     Biquad splashFilter_, sloshFilter_;
     Random noise_;

@@ -1,0 +1,100 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Water, deep snow, dry leaves and forest underbrush stay where their re-voicing put them
+// (docs/realism.md, "Heard in their category: liquids, snows, leaves and underbrush"): the
+// descriptors that made the listener hear them as solids lie within about one recorded spread
+// of their material's recordings (leaves and underbrush, which have none, of all recorded
+// aggregates). Each check is a robust z of realism/Distance.h against the recordings of
+// scripts/fetch-recordings.sh, not a listener verdict (which moves with every other preset,
+// the renders being centred as one source). The presets of main before the re-voicing fail
+// every bound below (their figures are in the comments); skipped without the cache.
+#include "realism/Compare.h"
+#include "realism/Recordings.h"
+
+#include <fmt/core.h>
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <set>
+#include <string>
+#include <vector>
+
+using namespace underfoot::realism;
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Bound {
+    Descriptor d;
+    double maxZ; ///< largest robust z allowed
+};
+
+class HeardInTheirCategory : public ::testing::Test {
+  protected:
+    void SetUp() override {
+        dir_ = defaultRecordingsDir();
+        if (!fs::exists(fs::path(dir_) / "manifest.csv"))
+            GTEST_SKIP()
+                << "no recordings cache at " << dir_
+                << ": run `bash scripts/fetch-recordings.sh` (or set UNDERFOOT_RECORDINGS)";
+        recs_ = loadManifest(dir_);
+    }
+
+    std::vector<Recording> of(const std::set<std::string>& materials) const {
+        std::vector<Recording> out;
+        for (const auto& r : recs_)
+            if (materials.count(r.material)) out.push_back(r);
+        return out;
+    }
+
+    // Renders the surface as `underfoot compare` does (walker cadence=100, 10 s, seed 7),
+    // prints its z on every descriptor and checks the bounds and the distance.
+    SurfaceComparison check(const std::string& surface, const std::set<std::string>& materials,
+                            const std::vector<Bound>& bounds, double maxDistance) const {
+        const auto real = of(materials);
+        EXPECT_GE(real.size(), 5u) << surface;
+        auto c = compareSurface(surface, real, RenderSpec{});
+        std::string line = fmt::format("{:<18} distance {:.2f}:", surface, c.comparison.distance);
+        for (int d = 0; d < kDescriptorCount; ++d)
+            line += fmt::format(" {} {:.2f}", descriptorInfo(d).key,
+                                c.comparison.d[static_cast<std::size_t>(d)].z);
+        std::printf("%s\n", line.c_str());
+        for (const auto& b : bounds)
+            EXPECT_LE(c.comparison.d[static_cast<std::size_t>(b.d)].z, b.maxZ)
+                << surface << ": " << descriptorInfo(b.d).key;
+        EXPECT_LE(c.comparison.distance, maxDistance) << surface;
+        EXPECT_GE(c.comparison.syntheticSteps, 8) << surface;
+        return c;
+    }
+
+    std::string dir_;
+    std::vector<Recording> recs_;
+};
+
+} // namespace
+
+// Water (wading): the fitted preset was a short tonal ping of landing bubbles at 1.4-3 kHz;
+// recorded water steps are long splash noise spread over the band. main before: 250 Hz-1 kHz
+// z 1.51 (-14 dB of the whole band vs a recorded median of -5), flatness z 0.80, decay to
+// -20 dB 31 ms (recorded median 63 ms), distance 0.60.
+TEST_F(HeardInTheirCategory, WaterIsASplashSpreadOverTheBandAndLong) {
+    const auto c =
+        check("water", {"water"}, {{kBandLowMid, 0.75}, {kFlatness, 0.75}, {kBandLow, 0.75}}, 0.58);
+    const auto& decay = c.comparison.d[kDecay20];
+    EXPECT_GE(decay.synthetic, decay.realMedian) << "a water step decays at least as slowly as "
+                                                    "the median recorded one";
+}
+
+// Deep snow: main's was muffled and narrow (flatness z 4.27, 4-16 kHz z 4.28: -41 dB) with too
+// little low energy (20-250 Hz z 2.51), distance 1.40 to the snow recordings.
+TEST_F(HeardInTheirCategory, DeepSnowIsBroadAndLowLikeRecordedSnow) {
+    check("deep_snow", {"snow"}, {{kFlatness, 1.5}, {kBandHigh, 2.0}, {kBandLow, 1.0}}, 0.8);
+}
+
+// Dry leaves and underbrush (no recordings of their own) against every recorded aggregate:
+// main's were brighter and flatter than any (leaves: centroid z 1.39, flatness 1.40, 4-16 kHz
+// 1.36, distance 1.11; underbrush: 1.47, 1.17, 1.26, 1.11).
+TEST_F(HeardInTheirCategory, LeavesAndUnderbrushLieAmongTheRecordedAggregates) {
+    const std::set<std::string> aggregates = {"gravel", "sand", "snow", "dirt", "grass"};
+    for (const char* s : {"dry_leaves", "forest_underbrush"})
+        check(s, aggregates, {{kCentroid, 1.0}, {kFlatness, 1.0}, {kBandHigh, 1.0}}, 0.85);
+}
