@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <stdexcept>
 
 namespace underfoot::engine {
@@ -43,6 +45,9 @@ void ElastoPlasticFrictionT<Real>::prepare(double fs) {
     px_ = (m22_ * s1 - m12_ * s2) / det_;
     pv_ = (m11_ * s2 - m21_ * s1) / det_;
     kd_ = pv_ + resonator_.mobility(0);
+    stiffPlusDamp_ = params_.sigma0 + params_.sigma1 / T;
+    dampOverT_ = params_.sigma1 / T;
+    stiffTPlusDamp_ = params_.sigma0 * T + params_.sigma1;
     reset(0);
 }
 
@@ -54,13 +59,15 @@ void ElastoPlasticFrictionT<Real>::reset(std::uint64_t seed) noexcept {
 }
 
 template <typename Real>
-double ElastoPlasticFrictionT<Real>::alphaOf(double z, double v, double zss,
-                                             double zba) const noexcept {
+inline double ElastoPlasticFrictionT<Real>::alphaOf(double z, double v, double zss,
+                                                    double zba) const noexcept {
     if (v == 0.0 || (z > 0) != (v > 0)) return 0.0; // opposite signs: elastic only
     const double az = std::fabs(z), ass = std::fabs(zss);
     if (az <= zba) return 0.0;
     if (az >= ass) return 1.0;
-    return 0.5 * std::sin(kPi * (az - 0.5 * (ass + zba)) / (ass - zba)) + 0.5;
+    const double t = 2.0 * (az - 0.5 * (ass + zba)) / (ass - zba); // in (-1, 1)
+    if (params_.libmFunctions) return 0.5 * std::sin(0.5 * kPi * t) + 0.5;
+    return 0.5 * frictionSinHalfPi(t) + 0.5;
 }
 
 template <typename Real>
@@ -116,17 +123,22 @@ double ElastoPlasticFrictionT<Real>::processSample(double normal, double drive, 
         if ((ok0 || okp) && std::fabs(zc) > zba) {
             const double sgn = vp >= 0.0 ? 1.0 : -1.0;
             const double vs = vp / params_.stribeckVelocity;
-            zss = sgn * (fc + (fs - fc) * std::exp(-vs * vs)) / params_.sigma0;
+            const double stribeck =
+                params_.libmFunctions ? std::exp(-vs * vs) : frictionExpNeg(-vs * vs);
+            zss = sgn * (fc + (fs - fc) * stribeck) / params_.sigma0;
             if (zss != 0.0) a = alphaOf(zc, vp, zss, zba);
         }
-        const double d = 1.0 + (a > 0.0 ? T * vp * a / zss : 0.0);
-        const double constant =
-            params_.sigma0 * z0 / d + params_.sigma1 * (z0 / d - z0) / T + noise;
-        const double slope = params_.sigma0 * T / d + params_.sigma1 / d + params_.sigma2;
+        // (1/d computed once; sigma0 + sigma1 / T and sigma0 T + sigma1 precomputed: the same
+        // quantities as sigma0 z0 / d + sigma1 (z0 / d - z0) / T and sigma0 T / d + sigma1 / d,
+        // rounded differently)
+        const double invD = a > 0.0 ? 1.0 / (1.0 + T * vp * a / zss) : 1.0;
+        const double zd = z0 * invD;
+        const double constant = stiffPlusDamp_ * zd - dampOverT_ * z0 + noise;
+        const double slope = stiffTPlusDamp_ * invD + params_.sigma2;
         const double next = (vRelPred - kd_ * constant) / (1.0 + kd_ * slope);
         const bool converged = std::fabs(next - v1) < 1e-9;
         v1 = next;
-        z1 = (z0 + T * v1) / d;
+        z1 = (z0 + T * v1) * invD;
         force = constant + slope * v1;
         zp = z1;
         if (converged && pass > 0) break;

@@ -1,10 +1,13 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Elasto-plastic friction: stick, slip, Coulomb level, stability for very stiff bristles.
 #include "engine/models/Friction.h"
+#include "engine/render/AccuracyCost.h"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 using namespace underfoot::engine;
 
@@ -91,4 +94,84 @@ TEST(ElastoPlasticFriction, StickSlipUnderASteadyDragMakesAPeriodicCreak) {
     // Period ~ (f_s - f_c) / (k v) = 15 N / (5e5 N/m * 0.02 m/s) = 1.5 ms -> hundreds per second.
     EXPECT_GT(slips, 100);
     EXPECT_LT(slips, 2000);
+}
+
+// issue #18: the fixed point's Stribeck exp and raised sine are polynomials with stated error
+// bounds instead of libm calls.
+TEST(FrictionFunctions, ErrorsStayWithinTheirStatedBounds) {
+    double worstExp = 0.0, worstSin = 0.0;
+    for (int i = 0; i <= 2000000; ++i) {
+        const double y = -60.0 * i / 2000000.0; // the Stribeck argument -(v / v_s)^2
+        const double ref = std::exp(y);
+        worstExp = std::max(worstExp, std::fabs(frictionExpNeg(y) - ref) / ref);
+        const double t = -1.0 + 2.0 * i / 2000000.0;
+        worstSin = std::max(worstSin, std::fabs(frictionSinHalfPi(t) - std::sin(0.5 * kPi * t)));
+    }
+    EXPECT_LT(worstExp, 1e-15);
+    EXPECT_LT(worstSin, 1e-15);
+    EXPECT_EQ(frictionExpNeg(0.0), 1.0);
+    EXPECT_EQ(frictionExpNeg(-800.0), 0.0);
+    EXPECT_EQ(frictionSinHalfPi(0.0), 0.0);
+    EXPECT_NEAR(frictionSinHalfPi(1.0), 1.0, 1e-15);
+}
+
+namespace {
+struct CreakRender {
+    std::vector<float> out;
+    int slips = 0;
+    double rmsDb = 0.0;
+};
+// The bench's creaking-wood scenario (engine/render/AccuracyCost.cpp, friction-creak).
+CreakRender renderCreak(bool libm, double seconds) {
+    FrictionParams p;
+    p.sigma0 = 2e5;
+    p.sigma1 = 150.0;
+    p.sigma2 = 0.2;
+    p.sigma3 = 0.05;
+    p.staticCoefficient = 0.55;
+    p.dynamicCoefficient = 0.25;
+    p.stribeckVelocity = 0.02;
+    p.breakAway = 0.6;
+    p.exciterMassKg = 0.02;
+    p.driveStiffness = 5e5;
+    p.driveDamping = 2.0;
+    p.libmFunctions = libm;
+    ElastoPlasticFriction f;
+    f.configure(p,
+                {{310, 0.06, 0.05},
+                 {690, 0.05, 0.04},
+                 {1130, 0.04, 0.04},
+                 {1870, 0.03, 0.05},
+                 {2650, 0.02, 0.06}},
+                {{1.0, 0.8, 0.7, 0.5, 0.3}});
+    const double fs = 48000.0;
+    f.prepare(fs);
+    f.reset(7);
+    CreakRender r;
+    r.out.resize(static_cast<std::size_t>(seconds * fs));
+    double anchor = 0.0, energy = 0.0;
+    bool sliding = false;
+    for (std::size_t i = 0; i < r.out.size(); ++i) {
+        anchor += 0.05 / fs;
+        r.out[i] = static_cast<float>(f.processSample(105.0, 0.0, anchor, 0.05));
+        energy += double(r.out[i]) * double(r.out[i]);
+        const bool now = std::fabs(f.relativeVelocity()) > 0.01;
+        if (now && !sliding) ++r.slips;
+        sliding = now;
+        if (i % 64 == 63) f.resonator().flushTinyState();
+    }
+    r.rmsDb = 10.0 * std::log10(energy / double(r.out.size()));
+    return r;
+}
+} // namespace
+
+// Stick-slip is chaotic: after a few thousand samples two solvers that differ in the last bits
+// no longer agree sample by sample, so the polynomial functions are judged on 5 s renders by
+// the third-octave spectrum, the level and the rate of slip onsets (creak events).
+TEST(ElastoPlasticFriction, PolynomialFunctionsKeepTheCreakSpectrumLevelAndEventRate) {
+    const CreakRender ref = renderCreak(true, 5.0), fast = renderCreak(false, 5.0);
+    ASSERT_GT(ref.slips, 1000); // ~770 creak events per second
+    EXPECT_LE(spectralDistanceDb(fast.out, ref.out, 48000.0), 0.5);
+    EXPECT_LE(std::fabs(fast.rmsDb - ref.rmsDb), 0.5);
+    EXPECT_LE(std::fabs(fast.slips - ref.slips), 0.05 * ref.slips);
 }
