@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <stdexcept>
 
 namespace underfoot::engine {
@@ -21,6 +23,10 @@ void ElastoPlasticFrictionT<Real>::configure(const FrictionParams& p, std::vecto
         throw std::invalid_argument("friction: Stribeck velocity and mass must be > 0");
     if (!(p.breakAway > 0.0 && p.breakAway < 1.0))
         throw std::invalid_argument("friction: break-away fraction must lie in (0, 1)");
+    if (p.maxIterations < 1 || p.maxIterations > 1000)
+        throw std::invalid_argument("friction: maxIterations must lie in [1, 1000]");
+    if (!nonNegative(p.tolerance))
+        throw std::invalid_argument("friction: tolerance must be finite and >= 0");
     params_ = p;
     resonator_.configure(std::move(modes), std::move(gains));
 }
@@ -43,6 +49,9 @@ void ElastoPlasticFrictionT<Real>::prepare(double fs) {
     px_ = (m22_ * s1 - m12_ * s2) / det_;
     pv_ = (m11_ * s2 - m21_ * s1) / det_;
     kd_ = pv_ + resonator_.mobility(0);
+    stiffPlusDamp_ = params_.sigma0 + params_.sigma1 / T;
+    dampOverT_ = params_.sigma1 / T;
+    stiffTPlusDamp_ = params_.sigma0 * T + params_.sigma1;
     reset(0);
 }
 
@@ -51,16 +60,19 @@ void ElastoPlasticFrictionT<Real>::reset(std::uint64_t seed) noexcept {
     resonator_.reset();
     rng_.setSeed(seed);
     z_ = v_ = force_ = exciterX_ = exciterV_ = lastExternal_ = 0;
+    stats_ = FrictionSolveStats{};
 }
 
 template <typename Real>
-double ElastoPlasticFrictionT<Real>::alphaOf(double z, double v, double zss,
-                                             double zba) const noexcept {
+inline double ElastoPlasticFrictionT<Real>::alphaOf(double z, double v, double zss,
+                                                    double zba) const noexcept {
     if (v == 0.0 || (z > 0) != (v > 0)) return 0.0; // opposite signs: elastic only
     const double az = std::fabs(z), ass = std::fabs(zss);
     if (az <= zba) return 0.0;
     if (az >= ass) return 1.0;
-    return 0.5 * std::sin(kPi * (az - 0.5 * (ass + zba)) / (ass - zba)) + 0.5;
+    const double t = 2.0 * (az - 0.5 * (ass + zba)) / (ass - zba); // in (-1, 1)
+    if (params_.libmFunctions) return 0.5 * std::sin(0.5 * kPi * t) + 0.5;
+    return 0.5 * frictionSinHalfPi(t) + 0.5;
 }
 
 template <typename Real>
@@ -90,14 +102,21 @@ double ElastoPlasticFrictionT<Real>::processSample(double normal, double drive, 
     // integrated by backward Euler, z1 = z0 + T v1 (1 - alpha z1 / z_ss). With the plastic factor
     // alpha / z_ss taken at a trial state (vp, zp), z1 = (z0 + T v1) / d with
     // d = 1 + T vp alpha / z_ss >= 1 (vp / z_ss >= 0): F is linear in v1 and h has a closed-form
-    // root. Fixed-point passes refine the trial; alpha is taken at the larger of its values at z0
-    // and at the trial z1, so a stiff bristle cannot overshoot z_ss within a sample (with
-    // alpha = 1, z1 is a weighted mean of z0 and z_ss). The force applied is exactly the one the
-    // root was solved with (consistency keeps the coupling stable). Each pass costs one exp and
-    // at most two sines: bounded work per sample. Sticking (alpha = 0) is exact in one pass.
+    // root. Fixed-point passes refine the trial, starting from the previous sample's relative
+    // velocity (warm start), until a pass moves v1 and z1 by at most `tolerance` relative to
+    // max(|v1|, v_s) and max(|z1|, T v_s), at most maxIterations passes. alpha is taken at the
+    // larger of its values at z0 and at the trial z1, so a stiff bristle cannot overshoot z_ss
+    // within a sample (with alpha = 1, z1 is a weighted mean of z0 and z_ss). The force applied
+    // is exactly the one the root was solved with (consistency keeps the coupling stable). Each
+    // pass costs at most one exp and one sine: bounded work per sample.
     const double zba = params_.breakAway * fc / params_.sigma0;
-    double v1 = vRelPred, z1 = 0.0, force = 0.0, zp = z0;
-    for (int pass = 0; pass < params_.maxIterations && inContact > 0.0; ++pass) {
+    const double vScale = params_.stribeckVelocity, zScale = T * params_.stribeckVelocity;
+    const double tol = params_.tolerance;
+    double v1 = params_.warmStart ? v_ : vRelPred, z1 = 0.0, force = 0.0, zp = z0;
+    int passes = 0, plain = 0; // plain: passes since the last extrapolation
+    bool converged = false;
+    double vBefore = 0.0, zBefore = 0.0; // the trial of the previous pass
+    while (inContact > 0.0 && passes < params_.maxIterations) {
         const double vp = v1;
         // alpha is the larger of its values at z0 and at the trial zp. alphaOf is 0 for a z of
         // the other sign than vp or with |z| <= z_ba, and non-decreasing in |z| otherwise (a
@@ -116,20 +135,51 @@ double ElastoPlasticFrictionT<Real>::processSample(double normal, double drive, 
         if ((ok0 || okp) && std::fabs(zc) > zba) {
             const double sgn = vp >= 0.0 ? 1.0 : -1.0;
             const double vs = vp / params_.stribeckVelocity;
-            zss = sgn * (fc + (fs - fc) * std::exp(-vs * vs)) / params_.sigma0;
+            const double stribeck =
+                params_.libmFunctions ? std::exp(-vs * vs) : frictionExpNeg(-vs * vs);
+            zss = sgn * (fc + (fs - fc) * stribeck) / params_.sigma0;
             if (zss != 0.0) a = alphaOf(zc, vp, zss, zba);
         }
-        const double d = 1.0 + (a > 0.0 ? T * vp * a / zss : 0.0);
-        const double constant =
-            params_.sigma0 * z0 / d + params_.sigma1 * (z0 / d - z0) / T + noise;
-        const double slope = params_.sigma0 * T / d + params_.sigma1 / d + params_.sigma2;
-        const double next = (vRelPred - kd_ * constant) / (1.0 + kd_ * slope);
-        const bool converged = std::fabs(next - v1) < 1e-9;
-        v1 = next;
-        z1 = (z0 + T * v1) / d;
+        // (1/d computed once; sigma0 + sigma1 / T and sigma0 T + sigma1 precomputed: the same
+        // quantities as sigma0 z0 / d + sigma1 (z0 / d - z0) / T and sigma0 T / d + sigma1 / d,
+        // rounded differently)
+        const double invD = a > 0.0 ? 1.0 / (1.0 + T * vp * a / zss) : 1.0;
+        const double zd = z0 * invD;
+        const double constant = stiffPlusDamp_ * zd - dampOverT_ * z0 + noise;
+        const double slope = stiffTPlusDamp_ * invD + params_.sigma2;
+        v1 = (vRelPred - kd_ * constant) / (1.0 + kd_ * slope);
+        z1 = (z0 + T * v1) * invD;
         force = constant + slope * v1;
-        zp = z1;
-        if (converged && pass > 0) break;
+        ++passes;
+        if (std::fabs(v1 - vp) <= tol * std::max(std::fabs(v1), vScale) &&
+            std::fabs(z1 - zp) <= tol * std::max(std::fabs(z1), zScale)) {
+            converged = true;
+            break;
+        }
+        // Aitken's delta-squared on each of v and z after two plain passes: the passes converge
+        // linearly (ratios ~0.1 to 0.5 while slipping), the extrapolation skips most of them.
+        // Only the trial changes: convergence is still judged on a plain pass (its result equals
+        // its trial), so the solution is the same fixed point.
+        double vNext = v1, zNext = z1;
+        if (params_.extrapolate && ++plain >= 2) {
+            const double dv0 = vp - vBefore, dv1 = v1 - vp, dz0 = zp - zBefore, dz1 = z1 - zp;
+            const double denV = dv1 - dv0, denZ = dz1 - dz0;
+            if (denV != 0.0 && denZ != 0.0) {
+                vNext = v1 - dv1 * dv1 / denV;
+                zNext = z1 - dz1 * dz1 / denZ;
+                plain = 0;
+            }
+        }
+        vBefore = vp;
+        zBefore = zp;
+        v1 = vNext;
+        zp = zNext;
+    }
+    if (inContact > 0.0) {
+        ++stats_.samples;
+        stats_.passes += static_cast<std::uint64_t>(passes);
+        if (!converged) ++stats_.capHits;
+        stats_.maxPassesInOneSample = std::max(stats_.maxPassesInOneSample, passes);
     }
     // Commit: friction acts against the exciter's relative motion, with it on the resonator.
     exciterX_ = xePred - px_ * force;

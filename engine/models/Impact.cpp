@@ -4,6 +4,9 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace underfoot::engine {
 
@@ -45,6 +48,12 @@ void HuntCrossleyImpactT<Real>::prepare(const ProcessSpec& spec) {
     resonator_.setOutputPickup(listen_);
     resonator_.setEnergyTracking(true); // the passivity guard's energies in O(1) per trial
     const double M = params_.exciterMassKg;
+    stiffness_ = params_.stiffness;
+    dissipation_ = params_.dissipation;
+    shape_ = params_.alpha == 1.0   ? Shape::Linear
+             : params_.alpha == 1.5 ? Shape::Hertz
+             : params_.alpha == 2.0 ? Shape::Square
+                                    : Shape::General;
     coarseT_ = T_;
     coarseKc_ = T_ * T_ / (6.0 * M) + resonator_.compliance(0); // exact for a linear force ramp
     coarseKd_ = T_ / (2.0 * M) + resonator_.mobility(0);
@@ -52,6 +61,11 @@ void HuntCrossleyImpactT<Real>::prepare(const ProcessSpec& spec) {
     resonator_.setFineRate(true);
     fineKc_ = fineT_ * fineT_ / (6.0 * M) + resonator_.compliance(0);
     fineKd_ = fineT_ / (2.0 * M) + resonator_.mobility(0);
+    for (auto* sc : {&coarseConstants_, &fineConstants_}) {
+        const double t = sc == &fineConstants_ ? fineT_ : coarseT_;
+        // (the values the step used to compute inline, in the same order)
+        *sc = {t * t, t * t / (6.0 * M), 0.5 * t / M, 0.5 * t};
+    }
     setFineRate(false);
     if (params_.oversampling > 1)
         decimator_.design(FilterType::Lowpass, 8, internalFs_, 0.45 * fs_);
@@ -64,6 +78,7 @@ void HuntCrossleyImpactT<Real>::setFineRate(bool fine) noexcept {
     T_ = fine ? fineT_ : coarseT_;
     kc_ = fine ? fineKc_ : coarseKc_;
     kd_ = fine ? fineKd_ : coarseKd_;
+    stepConstants_ = fine ? fineConstants_ : coarseConstants_;
 }
 
 template <typename Real>
@@ -92,15 +107,37 @@ void HuntCrossleyImpactT<Real>::strike(double velocity) noexcept {
     quietSamples_ = 0;
 }
 
+namespace {
+// IEEE square root without the errno branch std::sqrt keeps for negative arguments (the
+// contact only takes roots of positive compressions): the same correctly rounded value.
+inline double rootOf(double x) noexcept {
+#if defined(__SSE2__)
+    return _mm_cvtsd_f64(_mm_sqrt_sd(_mm_setzero_pd(), _mm_set_sd(x)));
+#else
+    return std::sqrt(x);
+#endif
+}
+} // namespace
+
 template <typename Real>
 inline double HuntCrossleyImpactT<Real>::contactForce(double c, double cdot) const noexcept {
     if (c <= 0.0) return 0.0;
-    const double a = params_.alpha;
-    const double ca = (a == 1.0)   ? c
-                      : (a == 1.5) ? c * std::sqrt(c)
-                      : (a == 2.0) ? c * c
-                                   : std::pow(c, a);
-    return std::max(0.0, params_.stiffness * ca * (1.0 + params_.dissipation * cdot));
+    double ca; // c^alpha: the shapes in use without pow (chosen once in prepare())
+    switch (shape_) {
+    case Shape::Linear:
+        ca = c;
+        break;
+    case Shape::Hertz:
+        ca = c * rootOf(c);
+        break;
+    case Shape::Square:
+        ca = c * c;
+        break;
+    default:
+        ca = std::pow(c, params_.alpha);
+        break;
+    }
+    return std::max(0.0, stiffness_ * ca * (1.0 + dissipation_ * cdot));
 }
 
 template <typename Real>
@@ -114,7 +151,8 @@ double HuntCrossleyImpactT<Real>::solveForce(double ch, double dh) noexcept {
     double lo = 0.0, hi = fMax;
     double f = std::clamp(lastForce_, lo, hi);
     int it = 0;
-    for (; it < params_.newtonIterations; ++it) {
+    const int iterations = params_.newtonIterations;
+    for (; it < iterations; ++it) {
         const double c = ch - kc_ * f, cd = dh - kd_ * f;
         const double hc = contactForce(c, cd);
         const double g = f - hc;
@@ -126,7 +164,7 @@ double HuntCrossleyImpactT<Real>::solveForce(double ch, double dh) noexcept {
         double dg = 1.0;
         if (hc > 0.0) {
             // dHC/dF = -(k a c^(a-1) (1 + mu cd) kc + k c^a mu kd)
-            const double a = params_.alpha, k = params_.stiffness, mu = params_.dissipation;
+            const double a = params_.alpha, k = stiffness_, mu = dissipation_;
             const double ca = hc / (k * (1.0 + mu * cd)); // c^a, reused
             dg += k * (a * ca / c * (1.0 + mu * cd) * kc_ + ca * mu * kd_);
         }
@@ -154,15 +192,16 @@ bool HuntCrossleyImpactT<Real>::step(double fextNow, double fextNext, bool abort
     };
     auto trial = [&](double held, double scale) {
         const double aNow = (fextNow - held * lastForce_) / M;
-        const double xPred = exciterX_ + T * exciterV_ + T * T * (aNow / 3.0 + aNextExt / 6.0);
-        const double vPred = exciterV_ + 0.5 * T * (aNow + aNextExt);
+        const double xPred =
+            exciterX_ + T * exciterV_ + stepConstants_.tt * (aNow / 3.0 + aNextExt / 6.0);
+        const double vPred = exciterV_ + stepConstants_.halfT * (aNow + aNextExt);
         resonator_.predict(held);
         const double ch = xPred - resonator_.predictedPosition(0);
         const double dh = vPred - resonator_.predictedVelocity(0);
         Trial t{};
         t.force = scale * solveForce(ch, dh);
-        t.x = xPred - T * T / (6.0 * M) * t.force;
-        t.v = vPred - 0.5 * T / M * t.force;
+        t.x = xPred - stepConstants_.xPerForce * t.force;
+        t.v = vPred - stepConstants_.vPerForce * t.force;
         return t;
     };
     // Energy of the bodies after a trial (the resonator's prediction must be the trial's).

@@ -118,6 +118,14 @@ class HuntCrossleyImpactT {
     int quietSamples_ = 0;
     double sleepVelocity_ = 1e-10;
     double kc_ = 0, kd_ = 0; // instantaneous compliance and mobility of the compression
+    // Per-step constants of the current rate (setFineRate) and the contact law's (prepare).
+    struct StepConstants {
+        double tt, xPerForce, vPerForce, halfT; // T^2, T^2 / 6M, T / 2M, T / 2
+    };
+    StepConstants stepConstants_{}, coarseConstants_{}, fineConstants_{};
+    double stiffness_ = 0, dissipation_ = 0;
+    enum class Shape { Linear, Hertz, Square, General };
+    Shape shape_ = Shape::Hertz;
     double coarseT_ = 0, coarseKc_ = 0, coarseKd_ = 0, fineT_ = 0, fineKc_ = 0, fineKd_ = 0;
     Butterworth decimator_;
     ContactStats stats_;

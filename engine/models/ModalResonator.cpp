@@ -177,6 +177,7 @@ void ModalResonatorT<Real>::fillBank(Bank& b, const std::vector<ModeCoefficients
 
 template <typename Real>
 void ModalResonatorT<Real>::prepare(double sampleRateHz, int fineSubsteps) {
+    pending_ = false; // the state is reset below
     sampleRateHz_ = sampleRateHz;
     fine_ = false;
     const std::size_t n = modes_.size(), np = gains_.size(), n2 = padded(n);
@@ -227,6 +228,7 @@ void ModalResonatorT<Real>::prepare(double sampleRateHz, int fineSubsteps) {
     vh_.assign(n2, Real(0));
     u_.assign(n2, Real(0));
     heldZero_ = true;
+    pending_ = false;
     predictedEnergyValid_ = false;
     energyValid_ = true;
     committedEnergy_ = 0.0;
@@ -241,6 +243,7 @@ void ModalResonatorT<Real>::reset() noexcept {
     std::fill(u_.begin(), u_.end(), Real(0));
     x0_ = v0_ = outputVelocity_ = predictedX0_ = predictedV0_ = predictedVo_ = 0.0;
     heldZero_ = true;
+    pending_ = false;
     predictedEnergyValid_ = false;
     energyValid_ = true;
     committedEnergy_ = 0.0;
@@ -252,13 +255,14 @@ void ModalResonatorT<Real>::predict(double heldScale) noexcept {
     const std::size_t pairs = q_.size() / 2;
     const PairCoefficients* c = bank().pairs.data();
     const PairGains* gg = pairGains_.data();
-    const Real *q = q_.data(), *v = v_.data();
-    Real *qh = qh_.data(), *vh = vh_.data();
     D2 x0 = {0.0, 0.0}, v0 = {0.0, 0.0}, vo = {0.0, 0.0};
     predictedEnergyValid_ = false;
+    if (pending_ && heldScale == 0.0) settle(); // (the passivity guard's trials; rare)
     if (heldZero_ || heldScale == 0.0) {
         // Free ringing (no force held from the last sample): the same values without the
         // force terms (they would add exactly zero).
+        const Real *q = q_.data(), *v = v_.data();
+        Real *qh = qh_.data(), *vh = vh_.data();
         for (std::size_t k = 0; k < pairs; ++k) {
             const std::size_t i = 2 * k;
             const V qi = load2<Real, V>(q + i), vi = load2<Real, V>(v + i);
@@ -274,13 +278,33 @@ void ModalResonatorT<Real>::predict(double heldScale) noexcept {
         }
     } else {
         const Real h = static_cast<Real>(heldScale);
-        const Real* u = u_.data();
         D2 e = {0.0, 0.0}, slope = {0.0, 0.0};
-        auto run = [&](auto withEnergy) {
+        // One pass over the modes: with a commit pending (the last sample's force, see commit())
+        // the state is first completed from the last prediction, as a separate commit pass
+        // would (the same operations: the same values), then predicted. `held` is false when
+        // heldScale is 1 (1 x u is u: the multiplication is skipped, same values).
+        auto run = [&](auto withEnergy, auto fused, auto held) {
+            Real *q = q_.data(), *v = v_.data(), *u = u_.data();
+            Real *qh = qh_.data(), *vh = vh_.data();
+            const Real* gm = gainOverMass_.data() + pendingPickup_ * q_.size();
+            const Real f = pendingForce_;
             for (std::size_t k = 0; k < pairs; ++k) {
                 const std::size_t i = 2 * k;
-                const V qi = load2<Real, V>(q + i), vi = load2<Real, V>(v + i);
-                const V ui = h * load2<Real, V>(u + i);
+                V qi, vi, uc;
+                if constexpr (decltype(fused)::value) {
+                    uc = load2<Real, V>(gm + i) * f;
+                    qi = load2<Real, V>(qh + i) + load2<Real, V>(c[k].b1x) * uc;
+                    vi = load2<Real, V>(vh + i) + load2<Real, V>(c[k].b1v) * uc;
+                    store2(q + i, qi);
+                    store2(v + i, vi);
+                    store2(u + i, uc);
+                } else {
+                    qi = load2<Real, V>(q + i);
+                    vi = load2<Real, V>(v + i);
+                    uc = load2<Real, V>(u + i);
+                }
+                V ui = uc;
+                if constexpr (decltype(held)::value) ui = h * uc;
                 const V x = load2<Real, V>(c[k].a00) * qi + load2<Real, V>(c[k].a01) * vi +
                             load2<Real, V>(c[k].b0x) * ui;
                 const V y = load2<Real, V>(c[k].a10) * qi + load2<Real, V>(c[k].a11) * vi +
@@ -300,13 +324,23 @@ void ModalResonatorT<Real>::predict(double heldScale) noexcept {
                 }
             }
         };
+        using T = std::true_type;
+        using F = std::false_type;
+        const bool fused = pending_, held = heldScale != 1.0;
+        pending_ = false;
         if (trackEnergy_) {
-            run(std::true_type{});
+            if (fused)
+                held ? run(T{}, T{}, T{}) : run(T{}, T{}, F{});
+            else
+                held ? run(T{}, F{}, T{}) : run(T{}, F{}, F{});
             predictedEnergy_ = e[0] + e[1];
             predictedEnergySlope_ = slope[0] + slope[1];
             predictedEnergyValid_ = true;
         } else {
-            run(std::false_type{});
+            if (fused)
+                held ? run(F{}, T{}, T{}) : run(F{}, T{}, F{});
+            else
+                held ? run(F{}, F{}, T{}) : run(F{}, F{}, F{});
         }
     }
     predictedX0_ = x0[0] + x0[1];
@@ -315,7 +349,27 @@ void ModalResonatorT<Real>::predict(double heldScale) noexcept {
 }
 
 template <typename Real>
+void ModalResonatorT<Real>::applyPending() const noexcept {
+    using V = V2<Real>;
+    pending_ = false;
+    const std::size_t n2 = q_.size();
+    const Real f = pendingForce_;
+    const Real* gm = gainOverMass_.data() + pendingPickup_ * n2;
+    const PairCoefficients* c = bank().pairs.data();
+    const Real *qh = qh_.data(), *vh = vh_.data();
+    Real *q = q_.data(), *v = v_.data(), *u = u_.data();
+    for (std::size_t i = 0; i < n2; i += 2) {
+        const PairCoefficients& ci = c[i / 2];
+        const V ui = load2<Real, V>(gm + i) * f;
+        store2(q + i, load2<Real, V>(qh + i) + load2<Real, V>(ci.b1x) * ui);
+        store2(v + i, load2<Real, V>(vh + i) + load2<Real, V>(ci.b1v) * ui);
+        store2(u + i, ui);
+    }
+}
+
+template <typename Real>
 void ModalResonatorT<Real>::commit(int p, double forceN) noexcept {
+    settle();
     if (forceN == 0.0) {
         // No new force: the state is the prediction (swapping the buffers does not allocate),
         // and so are the pickup sums predict() computed.
@@ -331,24 +385,16 @@ void ModalResonatorT<Real>::commit(int p, double forceN) noexcept {
         predictedEnergyValid_ = false;
         return;
     }
-    using V = V2<Real>;
     heldZero_ = false;
-    const std::size_t n2 = q_.size(), pp = static_cast<std::size_t>(p);
-    const Real f = static_cast<Real>(forceN);
+    const std::size_t pp = static_cast<std::size_t>(p);
     const Bank& b = bank();
-    const Real* gm = gainOverMass_.data() + pp * n2;
-    const PairCoefficients* c = b.pairs.data();
-    const Real *qh = qh_.data(), *vh = vh_.data();
-    Real *q = q_.data(), *v = v_.data(), *u = u_.data();
-    for (std::size_t i = 0; i < n2; i += 2) {
-        const PairCoefficients& ci = c[i / 2];
-        const V ui = load2<Real, V>(gm + i) * f;
-        store2(q + i, load2<Real, V>(qh + i) + load2<Real, V>(ci.b1x) * ui);
-        store2(v + i, load2<Real, V>(vh + i) + load2<Real, V>(ci.b1v) * ui);
-        store2(u + i, ui);
-    }
+    // The per-mode update q = qh + b1x u, v = vh + b1v u, u = F g / m is deferred into the next
+    // predict() (or settle()).
+    pending_ = true;
+    pendingForce_ = static_cast<Real>(forceN);
+    pendingPickup_ = pp;
     // The pickup sums are linear in the force: the prediction's plus the force times the sums
-    // of the instantaneous responses (no second pass over the modes).
+    // of the instantaneous responses (no pass over the modes).
     x0_ = predictedX0_ + forceN * b.dx0[pp];
     v0_ = predictedV0_ + forceN * b.dv0[pp];
     outputVelocity_ = predictedVo_ + forceN * b.dvo[pp];
@@ -392,6 +438,7 @@ double ModalResonatorT<Real>::energyIfCommittedSlow(int p, double forceN) const 
 
 template <typename Real>
 void ModalResonatorT<Real>::setOutputPickup(int p) {
+    settle();
     outputPickup_ = p;
     outGain_.assign(padded(modes_.size()), 0.0);
     for (std::size_t i = 0; i < modes_.size(); ++i)
@@ -416,6 +463,7 @@ double ModalResonatorT<Real>::pickupSum(const std::vector<Real>& x, int p,
 
 template <typename Real>
 double ModalResonatorT<Real>::energyLoop() const noexcept {
+    settle();
     double e = 0;
     for (std::size_t i = 0; i < modes_.size(); ++i) {
         const double q = q_[i], v = coefficients_[i].quasiStatic ? 0.0 : double(v_[i]);
@@ -426,6 +474,7 @@ double ModalResonatorT<Real>::energyLoop() const noexcept {
 
 template <typename Real>
 void ModalResonatorT<Real>::flushTinyState() noexcept {
+    settle();
     for (std::size_t i = 0; i < q_.size(); ++i) {
         q_[i] = static_cast<Real>(snapToZero(q_[i]));
         v_[i] = static_cast<Real>(snapToZero(v_[i]));
@@ -437,6 +486,7 @@ void ModalResonatorT<Real>::flushTinyState() noexcept {
 
 template <typename Real>
 double ModalResonatorT<Real>::peakModalVelocity() const noexcept {
+    settle();
     double m = 0;
     for (std::size_t i = 0; i < modes_.size(); ++i) {
         const double wd = kTwoPi * modes_[i].frequencyHz;

@@ -64,7 +64,10 @@ class ModalResonatorT {
     /// Selects the fine (true) or coarse (false) coefficient set for the following steps.
     void setFineRate(bool fine) noexcept {
         const bool f = fine && !fineCoefficients_.empty();
-        if (f != fine_) predictedEnergyValid_ = false;
+        if (f != fine_) {
+            settle(); // a deferred commit uses the coefficients of the rate it was made at
+            predictedEnergyValid_ = false;
+        }
         fine_ = f;
     }
     /// With tracking on, predict() also computes the prediction's energy terms while a force is
@@ -106,19 +109,29 @@ class ModalResonatorT {
             return predictedEnergy_ + forceN * predictedEnergySlope_ + forceN * forceN * bank().c2;
         return energyIfCommittedSlow(p, forceN);
     }
-    /// Completes the sample with force `forceN` acting at pickup p (at n+1).
+    /// Completes the sample with force `forceN` acting at pickup p (at n+1). The pickup sums
+    /// (position(0), contactVelocity(), the output pickup's velocity) and the tracked energy are
+    /// known at once; the per-mode update is deferred into the next predict(), which then makes
+    /// one pass over the modes per sample (the same operations in the same order as a separate
+    /// pass: the same values). Anything else that reads the modes completes it first.
     void commit(int p, double forceN) noexcept;
 
     /// The pickup whose velocity velocity(p) returns fastest (computed during commit()).
     void setOutputPickup(int p);
 
     // ---- after commit ----
-    double position(int p) const noexcept { return p == 0 ? x0_ : pickupSum(q_, p, false); }
+    double position(int p) const noexcept {
+        if (p == 0) return x0_;
+        settle();
+        return pickupSum(q_, p, false);
+    }
     /// Velocity of the contact point (pickup 0), all modes included (computed by commit()).
     double contactVelocity() const noexcept { return v0_; }
     double velocity(int p) const noexcept {
         // Quasi-static modes do not radiate (their "velocity" is a finite difference).
-        return p == outputPickup_ ? outputVelocity_ : pickupSum(v_, p, true);
+        if (p == outputPickup_) return outputVelocity_;
+        settle();
+        return pickupSum(v_, p, true);
     }
     /// Mechanical energy stored in the modes (kinetic + potential), joules.
     double energy() const noexcept {
@@ -166,6 +179,11 @@ class ModalResonatorT {
     void fillBank(Bank& bank, const std::vector<ModeCoefficients>& c);
     const Bank& bank() const noexcept { return fine_ ? fineBank_ : coarseBank_; }
     double energyLoop() const noexcept;
+    /// Applies a commit() deferred into the next predict() (see commit()).
+    void settle() const noexcept {
+        if (pending_) applyPending();
+    }
+    void applyPending() const noexcept;
     double energyIfCommittedSlow(int p, double forceN) const noexcept;
     double predictedSum(const std::vector<Real>& x, int p) const noexcept {
         return pickupSum(x, p, false);
@@ -181,8 +199,14 @@ class ModalResonatorT {
     bool fine_ = false;
     // Per-mode arrays are padded to an even length (two modes per SIMD step, see the .cpp) with
     // modes whose coefficients and gains are zero.
-    std::vector<Real> gainOverMass_;          // [pickup * padded modes + mode] = g[p][i] / m_i
-    std::vector<Real> q_, v_, qh_, vh_, u_;   // state, prediction, last generalized force
+    std::vector<Real> gainOverMass_; // [pickup * padded modes + mode] = g[p][i] / m_i
+    // State, prediction, last generalized force. q_, v_, u_ may lag a commit() by one deferred
+    // update (pending_): settle() completes it, also from const readers, hence mutable.
+    mutable std::vector<Real> q_, v_, u_;
+    std::vector<Real> qh_, vh_;
+    mutable bool pending_ = false;
+    Real pendingForce_ = Real(0);
+    std::size_t pendingPickup_ = 0;
     std::vector<double> kx_, kv_;             // per pickup
     std::vector<double> kxFine_, kvFine_;     // per pickup, fine rate
     std::vector<double> w0sq_;                // undamped angular frequency squared, per mode
