@@ -98,14 +98,42 @@ UNDERFOOT_MAC_KERNEL(macSse, , __m128, 4, _mm_loadu_ps, _mm_storeu_ps, _mm_add_p
                      _mm_mul_ps)
 UNDERFOOT_MAC_KERNEL(macAvx, __attribute__((target("avx"))), __m256, 8, _mm256_loadu_ps,
                      _mm256_storeu_ps, _mm256_add_ps, _mm256_sub_ps, _mm256_mul_ps)
+// AVX-512F has fused multiply-adds, into which GCC would contract the intrinsics' products and
+// sums (-ffp-contract=fast is its default): not in these kernels, whose results must be those of
+// the SSE and AVX ones (tested).
+#define UNDERFOOT_AVX512 __attribute__((target("avx512f"), optimize("fp-contract=off")))
+UNDERFOOT_MAC_KERNEL(macAvx512Body, UNDERFOOT_AVX512, __m512, 16, _mm512_loadu_ps, _mm512_storeu_ps,
+                     _mm512_add_ps, _mm512_sub_ps, _mm512_mul_ps)
 #undef UNDERFOOT_MAC_KERNEL
 
+/// AVX-512 over the multiples of 16 bins, AVX over the last 8 (stride is a multiple of 8).
 template <int C, bool Two>
-void mac(bool avx, const MacPtrs& p, int stride) noexcept {
-    if (avx)
+void macAvx512(const MacPtrs& p, int stride) noexcept {
+    const int body = stride / 16 * 16;
+    if (body > 0) macAvx512Body<C, Two>(p, body);
+    if (body == stride) return;
+    MacPtrs rest = p;
+    for (auto& x : rest.x) x += body;
+    for (auto& hc : rest.h)
+        for (auto& h : hc) h += body;
+    for (auto& ac : rest.acc)
+        for (auto& a : ac) a += body;
+    macAvx<C, Two>(rest, stride - body);
+}
+
+template <int C, bool Two>
+void mac(Convolver::Simd simd, const MacPtrs& p, int stride) noexcept {
+    switch (simd) {
+    case Convolver::Simd::Avx512:
+        macAvx512<C, Two>(p, stride);
+        break;
+    case Convolver::Simd::Avx:
         macAvx<C, Two>(p, stride);
-    else
+        break;
+    default:
         macSse<C, Two>(p, stride);
+        break;
+    }
 }
 
 /// The direct-form head over a run of m <= kTick outputs: y[t] = sum over k of h[k] x[t - k],
@@ -177,8 +205,44 @@ __attribute__((target("avx"))) void headAvx(const float* hl, const float* hr, co
     headScalar(hl, hr, line, t, m, yl, yr);
 }
 
-bool cpuHasAvx() noexcept {
-    return __builtin_cpu_supports("avx") != 0;
+UNDERFOOT_AVX512 void headAvx512(const float* hl, const float* hr, const float* line, int m,
+                                 float* yl, float* yr) noexcept {
+    constexpr int q = Convolver::kHeadLength;
+    int t = 0;
+    for (; t + 32 <= m; t += 32) { // two vectors of outputs share the tap broadcasts
+        __m512 l0 = _mm512_setzero_ps(), l1 = l0, r0 = l0, r1 = l0;
+        for (int k = 0; k < q; ++k) {
+            const __m512 x0 = _mm512_loadu_ps(line + q - 1 + t - k);
+            const __m512 x1 = _mm512_loadu_ps(line + q - 1 + t + 16 - k);
+            const __m512 a = _mm512_set1_ps(hl[k]), b = _mm512_set1_ps(hr[k]);
+            l0 = _mm512_add_ps(l0, _mm512_mul_ps(a, x0));
+            l1 = _mm512_add_ps(l1, _mm512_mul_ps(a, x1));
+            r0 = _mm512_add_ps(r0, _mm512_mul_ps(b, x0));
+            r1 = _mm512_add_ps(r1, _mm512_mul_ps(b, x1));
+        }
+        _mm512_storeu_ps(yl + t, l0);
+        _mm512_storeu_ps(yl + t + 16, l1);
+        _mm512_storeu_ps(yr + t, r0);
+        _mm512_storeu_ps(yr + t + 16, r1);
+    }
+    for (; t + 16 <= m; t += 16) {
+        __m512 l = _mm512_setzero_ps(), r = l;
+        for (int k = 0; k < q; ++k) {
+            const __m512 x = _mm512_loadu_ps(line + q - 1 + t - k);
+            l = _mm512_add_ps(l, _mm512_mul_ps(_mm512_set1_ps(hl[k]), x));
+            r = _mm512_add_ps(r, _mm512_mul_ps(_mm512_set1_ps(hr[k]), x));
+        }
+        _mm512_storeu_ps(yl + t, l);
+        _mm512_storeu_ps(yr + t, r);
+    }
+    if (t < m) headAvx(hl, hr, line + t, m - t, yl + t, yr + t); // the last < 16 outputs
+}
+#undef UNDERFOOT_AVX512
+
+Convolver::Simd cpuSimd() noexcept {
+    if (__builtin_cpu_supports("avx512f") != 0) return Convolver::Simd::Avx512;
+    if (__builtin_cpu_supports("avx") != 0) return Convolver::Simd::Avx;
+    return Convolver::Simd::Sse;
 }
 
 // SSE2 passes of the split transforms. Each does per element exactly the IEEE operations of the
@@ -256,12 +320,12 @@ struct Convolver::Stage {
     FftwFloats spectrum; // 2 (P + 1): interleaved complex, FFT output / inverse input
     FftwFloats time;     // 2P: inverse FFT output
     Plan forward, inverse;
-    std::vector<float> cur;          // P: the input block being filled
-    std::vector<float> hRe, hIm;     // [channel][partition][stride], scaled by 1 / 2P
-    std::vector<float> xRe, xIm;     // [slot][stride], ring of the last N input spectra
-    std::vector<float> accRe, accIm; // [channel][stride]
-    std::vector<float> out;          // [channel][2][P]: playing and being computed
-    bool avx = false;                // run the AVX kernels (same results as SSE)
+    std::vector<float> cur;                      // P: the input block being filled
+    std::vector<float> hRe, hIm;                 // [channel][partition][stride], scaled by 1 / 2P
+    std::vector<float> xRe, xIm;                 // [slot][stride], ring of the last N input spectra
+    std::vector<float> accRe, accIm;             // [channel][stride]
+    std::vector<float> out;                      // [channel][2][P]: playing and being computed
+    Convolver::Simd simd = Convolver::Simd::Sse; // kernels (all give the same results)
     // Split transforms: a complex FFT of n = 2P = n1 x n2 points as n1 DFTs of n2 points over
     // the strided input (index i1 + n1 i2), a twiddle W_n^(i1 k2), and n2 DFTs of n1 points
     // (the "four-step" FFT; Bailey 1990; output in natural order). Every piece is a few DFTs,
@@ -348,9 +412,9 @@ struct Convolver::Stage {
                 }
             }
             if (channels == 2)
-                two ? mac<2, true>(avx, p, count) : mac<2, false>(avx, p, count);
+                two ? mac<2, true>(simd, p, count) : mac<2, false>(simd, p, count);
             else
-                two ? mac<1, true>(avx, p, count) : mac<1, false>(avx, p, count);
+                two ? mac<1, true>(simd, p, count) : mac<1, false>(simd, p, count);
         }
     }
 
@@ -637,7 +701,7 @@ void Convolver::prepare(const AudioBuffer& impulseResponse, double sampleRateHz,
         if (!std::isfinite(v))
             throw std::invalid_argument("Convolver: impulse response holds non-finite samples");
     release();
-    avx_ = cpuHasAvx();
+    simd_ = std::min(cpuSimd(), simdLimit_);
 
     // Resample; keep the frequency response: taps scale with 1/rate.
     AudioBuffer ir = impulseResponse;
@@ -752,7 +816,7 @@ void Convolver::prepare(const AudioBuffer& impulseResponse, double sampleRateHz,
         s->accRe.assign(ch * stride, 0.0f);
         s->accIm.assign(ch * stride, 0.0f);
         s->out.assign(ch * 2 * static_cast<std::size_t>(P), 0.0f);
-        s->avx = avx_;
+        s->simd = simd_;
         // Partition spectra: taps [begin + jP, begin + (j+1)P) zero-padded to 2P, scaled by
         // 1 / 2P (FFTW's inverse is unnormalised).
         const float scale = 1.0f / static_cast<float>(P2);
@@ -804,7 +868,9 @@ void Convolver::process(const float* in, float* outL, float* outR, int n) noexce
         const auto bytes = sizeof(float) * static_cast<std::size_t>(m);
         float yl[kTick], yr[kTick];
         std::memcpy(line + q - 1, in + i, bytes); // before any output: in may alias out
-        if (avx_)
+        if (simd_ == Simd::Avx512)
+            headAvx512(headL_.data(), headR_.data(), line, m, yl, yr);
+        else if (simd_ == Simd::Avx)
             headAvx(headL_.data(), headR_.data(), line, m, yl, yr);
         else
             headSse(headL_.data(), headR_.data(), line, m, yl, yr);

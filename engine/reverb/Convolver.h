@@ -59,6 +59,16 @@ class Convolver {
     void prepare(const AudioBuffer& impulseResponse, double sampleRateHz, int blockSize);
     /// Clears the signal history (no allocation: usable wherever process() is).
     void reset() noexcept;
+    /// Instruction sets of the products and of the direct head. Every level does per bin and
+    /// per output the same IEEE operations in the same order (no FMA): the output is
+    /// bit-identical whichever level the CPU runs (tested).
+    enum class Simd { Sse = 0, Avx = 1, Avx512 = 2 };
+    /// The widest level the next prepare() may use (default: the widest the CPU has). For tests
+    /// and benchmarks.
+    void limitSimd(Simd limit) noexcept { simdLimit_ = limit; }
+    /// The level prepare() chose.
+    Simd simd() const noexcept { return simd_; }
+
     /// Mono in, stereo out; in may alias outL or outR. No allocation, no locks, no waiting.
     void process(const float* in, float* outL, float* outR, int n) noexcept;
 
@@ -77,7 +87,8 @@ class Convolver {
     AudioBuffer ir_;
     std::size_t irLength_ = 0;
     bool stereoIr_ = false;
-    bool avx_ = false;                 ///< AVX kernels (bit-identical to the SSE ones)
+    Simd simd_ = Simd::Sse;            ///< kernels in use (all bit-identical)
+    Simd simdLimit_ = Simd::Avx512;    ///< the widest level prepare() may choose
     std::vector<float> headL_, headR_; ///< the first kHeadLength taps
     std::vector<float> line_;          ///< the 63 previous inputs, then the current run
     int phase_ = 0;                    ///< input samples since the last tick, 0 .. kTick - 1
