@@ -298,29 +298,8 @@ Scenario makeScenario(const std::string& id) {
                 }};
     }
     if (id == "friction-creak") {
-        // Creaking-wood friction layer (engine/data/surfaces/creaking_wood.toml).
-        FrictionParams p;
-        p.sigma0 = 2e5;
-        p.sigma1 = 150.0;
-        p.sigma2 = 0.2;
-        p.sigma3 = 0.05;
-        p.staticCoefficient = 0.55;
-        p.dynamicCoefficient = 0.25;
-        p.stribeckVelocity = 0.02;
-        p.breakAway = 0.6;
-        p.exciterMassKg = 0.02;
-        p.driveStiffness = 5e5;
-        p.driveDamping = 2.0;
         auto f = std::make_shared<ElastoPlasticFriction>();
-        f->configure(p,
-                     {{310, 0.06, 0.05},
-                      {690, 0.05, 0.04},
-                      {1130, 0.04, 0.04},
-                      {1870, 0.03, 0.05},
-                      {2650, 0.02, 0.06}},
-                     {{1.0, 0.8, 0.7, 0.5, 0.3}});
-        f->prepare(kRate);
-        f->reset(7);
+        configureCreakScenario(*f);
         auto anchor = std::make_shared<double>(0.0);
         return {f, [f, anchor](int, float* out) {
                     for (int i = 0; i < kBlock; ++i) {
@@ -380,6 +359,30 @@ const std::vector<std::string>& scenarioIds() {
         "impact-strikes",   "impact-pressed", "impact-metal",           "friction-creak",
         "aggregate-gravel", "bubbles",        "aggregate-gravel-1voice"};
     return ids;
+}
+
+void configureCreakScenario(ElastoPlasticFriction& f, FrictionParams p) {
+    // Creaking-wood friction layer (engine/data/surfaces/creaking_wood.toml).
+    p.sigma0 = 2e5;
+    p.sigma1 = 150.0;
+    p.sigma2 = 0.2;
+    p.sigma3 = 0.05;
+    p.staticCoefficient = 0.55;
+    p.dynamicCoefficient = 0.25;
+    p.stribeckVelocity = 0.02;
+    p.breakAway = 0.6;
+    p.exciterMassKg = 0.02;
+    p.driveStiffness = 5e5;
+    p.driveDamping = 2.0;
+    f.configure(p,
+                {{310, 0.06, 0.05},
+                 {690, 0.05, 0.04},
+                 {1130, 0.04, 0.04},
+                 {1870, 0.03, 0.05},
+                 {2650, 0.02, 0.06}},
+                {{1.0, 0.8, 0.7, 0.5, 0.3}});
+    f.prepare(kRate);
+    f.reset(7);
 }
 
 ScenarioMeasurement measureScenario(const std::string& id, double seconds, int repeats) {

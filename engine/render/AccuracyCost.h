@@ -11,6 +11,7 @@
 ///  - particle event cap: a granular surface's events per second capped, against a high cap;
 ///  - surfaces: real-time factor of one voice of every bundled surface.
 /// Timings are wall-clock on this machine and noisy: read them as ratios within one run.
+#include "engine/models/Friction.h"
 #include "engine/models/Impact.h"
 
 #include <string>
@@ -73,6 +74,12 @@ std::vector<KnobMeasurement> measureKnobs(double seconds = 4.0);
 ///   aggregate-gravel-1voice the same grains with one voice and no bursts: like for like with
 ///                   SDT's crumpling patch (one resonator retriggered by every event).
 const std::vector<std::string>& scenarioIds();
+
+/// The friction-creak scenario's model, configured (creaking_wood.toml's friction layer:
+/// bristle and Stribeck parameters, 5 modes) and prepared at 48 kHz, reset with seed 7; `p`
+/// may override the solver's options (its physical parameters are replaced). Drive it with
+/// processSample(105.0, 0.0, anchor, 0.05), the anchor advancing 0.05 m/s.
+void configureCreakScenario(ElastoPlasticFriction& f, FrictionParams p = {});
 
 struct ScenarioMeasurement {
     std::string id;

@@ -133,33 +133,14 @@ struct SolveOptions {
 // The bench's creaking-wood scenario (engine/render/AccuracyCost.cpp, friction-creak).
 CreakRender renderCreak(const SolveOptions& o, double seconds) {
     FrictionParams p;
-    p.sigma0 = 2e5;
-    p.sigma1 = 150.0;
-    p.sigma2 = 0.2;
-    p.sigma3 = 0.05;
-    p.staticCoefficient = 0.55;
-    p.dynamicCoefficient = 0.25;
-    p.stribeckVelocity = 0.02;
-    p.breakAway = 0.6;
-    p.exciterMassKg = 0.02;
-    p.driveStiffness = 5e5;
-    p.driveDamping = 2.0;
     p.libmFunctions = o.libm;
     p.warmStart = o.warmStart;
     p.extrapolate = o.extrapolate;
     p.maxIterations = o.maxIterations;
     p.tolerance = o.tolerance;
     ElastoPlasticFriction f;
-    f.configure(p,
-                {{310, 0.06, 0.05},
-                 {690, 0.05, 0.04},
-                 {1130, 0.04, 0.04},
-                 {1870, 0.03, 0.05},
-                 {2650, 0.02, 0.06}},
-                {{1.0, 0.8, 0.7, 0.5, 0.3}});
+    configureCreakScenario(f, p); // the bench's friction-creak scenario, 48 kHz, seed 7
     const double fs = 48000.0;
-    f.prepare(fs);
-    f.reset(7);
     CreakRender r;
     r.out.resize(static_cast<std::size_t>(seconds * fs));
     double anchor = 0.0, energy = 0.0;
