@@ -196,16 +196,23 @@ void OnsetListener::train(const std::vector<ListenerFile>& files) {
         return c;
     };
     centroids_.clear();
-    for (const auto& [m, src] : groups)
+    // (the group's fields as plain references: clang 14 cannot capture structured bindings)
+    for (const auto& group : groups) {
+        const auto& m = group.first;
+        const auto& src = group.second;
         centroids_.push_back({m, categoryOfMaterial(m), centroid([&](const ListenerFile& f) {
                                   return f.material == m && f.source == src;
                               })});
+    }
     categoryCentroids_.clear();
-    for (const auto& [c, src] : catGroups)
+    for (const auto& group : catGroups) {
+        const auto& c = group.first;
+        const auto& src = group.second;
         categoryCentroids_.push_back({"", c, centroid([&](const ListenerFile& f) {
                                           return categoryOfMaterial(f.material) == c &&
                                                  f.source == src;
                                       })});
+    }
     train_.clear();
     for (std::size_t i = 0; i < files.size(); ++i) train_.push_back({files[i].material, z[i]});
 }
