@@ -4,6 +4,8 @@
 /// -P 6`) under a server name of its own, standing in for the sound card in the live tests.
 /// RtAudio's JACK API then sees the device "system" with 4 inputs and 6 outputs. The server is a
 /// child that dies with the test program (PR_SET_PDEATHSIG), even when a test crashes.
+#include "engine/io/AudioDevice.h"
+
 #include <chrono>
 #include <csignal>
 #include <cstdio>
@@ -97,6 +99,21 @@ class JackDummyServer {
                 ready_ = true;
                 break;
             }
+            std::this_thread::sleep_for(std::chrono::milliseconds(100));
+        }
+        // The ports exist, but on a loaded machine RtAudio's probe of the new server can still
+        // fail for a moment (a client that cannot open leaves the device out of the list: the
+        // live engine then says `audio device "system" not found`). Ready means the engine's
+        // own device list shows it, within the same 10 s.
+        for (int i = 0; i < 100 && ready_; ++i) {
+            bool seen = false;
+            try {
+                for (const auto& d : engine::listAudioDevices("jack"))
+                    seen = seen || d.name == "system";
+            } catch (const std::exception&) {
+            }
+            if (seen) break;
+            if (i == 99) ready_ = false;
             std::this_thread::sleep_for(std::chrono::milliseconds(100));
         }
     }
