@@ -27,24 +27,10 @@ import csv
 import math
 import sys
 
-NS = 14  # scalar descriptors (realism/Descriptors.h)
-KEYS = ["centroid", "rolloff85", "flatness", "band_20_250", "band_250_1k", "band_1k_4k",
-        "band_4k_16k", "peakiness", "grain_rate", "crest", "decay20", "attack", "active",
-        "temporal_centroid"]
-FLOORS = [0.5, 0.5, 3, 3, 3, 3, 3, 3, 0.5, 3, 0.5, 0.5, 0.5, 0.5]
-CATEGORY = {"wood": "solid", "metal": "solid", "hard": "solid", "ice": "solid",
-            "carpet": "solid", "gravel": "aggregate", "sand": "aggregate",
-            "snow": "aggregate", "dirt": "aggregate", "grass": "aggregate", "water": "liquid"}
+from listener_common import CATEGORY, FLOORS, KEYS, NS, quantile
+
 # Bundled surfaces without a recorded material (engine/data/surfaces/*.toml `category`).
 SURFACE_CATEGORY = {"dry_leaves": "aggregate", "forest_underbrush": "aggregate"}
-
-
-def quantile(v, p):
-    v = sorted(v)
-    h = (len(v) - 1) * p
-    lo = math.floor(h)
-    hi = min(lo + 1, len(v) - 1)
-    return v[lo] + (h - lo) * (v[hi] - v[lo])
 
 
 def read(path):

@@ -26,19 +26,7 @@ import csv
 import math
 import sys
 
-NS = 14  # scalar descriptors (realism/Descriptors.h), then third-octave bands
-FLOORS = [0.5, 0.5, 3, 3, 3, 3, 3, 3, 0.5, 3, 0.5, 0.5, 0.5, 0.5]
-CATEGORY = {"wood": "solid", "metal": "solid", "hard": "solid", "ice": "solid",
-            "carpet": "solid", "gravel": "aggregate", "sand": "aggregate",
-            "snow": "aggregate", "dirt": "aggregate", "grass": "aggregate", "water": "liquid"}
-
-
-def quantile(v, p):
-    v = sorted(v)
-    h = (len(v) - 1) * p
-    lo = math.floor(h)
-    hi = min(lo + 1, len(v) - 1)
-    return v[lo] + (h - lo) * (v[hi] - v[lo])
+from listener_common import CATEGORY, FLOORS, NS, quantile
 
 
 def spread(v, k):
