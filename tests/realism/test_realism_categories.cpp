@@ -9,6 +9,7 @@
 // every bound below (their figures are in the comments); skipped without the cache.
 #include "realism/Compare.h"
 #include "realism/Recordings.h"
+#include "tests/realism/RecordingsCache.h"
 
 #include <fmt/core.h>
 #include <gtest/gtest.h>
@@ -28,17 +29,8 @@ struct Bound {
     double maxZ; ///< largest robust z allowed
 };
 
-class HeardInTheirCategory : public ::testing::Test {
+class HeardInTheirCategory : public underfoot::realism::test::RecordingsCacheTest {
   protected:
-    void SetUp() override {
-        dir_ = defaultRecordingsDir();
-        if (!fs::exists(fs::path(dir_) / "manifest.csv"))
-            GTEST_SKIP()
-                << "no recordings cache at " << dir_
-                << ": run `bash scripts/fetch-recordings.sh` (or set UNDERFOOT_RECORDINGS)";
-        recs_ = loadManifest(dir_);
-    }
-
     std::vector<Recording> of(const std::set<std::string>& materials) const {
         std::vector<Recording> out;
         for (const auto& r : recs_)
@@ -65,9 +57,6 @@ class HeardInTheirCategory : public ::testing::Test {
         EXPECT_GE(c.comparison.syntheticSteps, 8) << surface;
         return c;
     }
-
-    std::string dir_;
-    std::vector<Recording> recs_;
 };
 
 } // namespace

@@ -3,6 +3,7 @@
 #include "realism/Compare.h"
 #include "realism/Listener.h"
 #include "realism/Recordings.h"
+#include "tests/realism/RecordingsCache.h"
 
 #include <gtest/gtest.h>
 
@@ -163,19 +164,7 @@ TEST(RealismRecordings, ManifestAcceptsAnEmptyRecordist) {
 }
 
 // The real recordings (scripts/fetch-recordings.sh). Skipped, saying so, without the cache.
-class RealRecordings : public ::testing::Test {
-  protected:
-    void SetUp() override {
-        dir_ = defaultRecordingsDir();
-        if (!fs::exists(fs::path(dir_) / "manifest.csv"))
-            GTEST_SKIP()
-                << "no recordings cache at " << dir_
-                << ": run `bash scripts/fetch-recordings.sh` (or set UNDERFOOT_RECORDINGS)";
-        recs_ = loadManifest(dir_);
-    }
-    std::string dir_;
-    std::vector<Recording> recs_;
-};
+class RealRecordings : public underfoot::realism::test::RecordingsCacheTest {};
 
 TEST_F(RealRecordings, EveryRecordingHasStepsAndTheListenerBeatsChance) {
     ASSERT_GE(recs_.size(), 20u);

@@ -5,6 +5,8 @@
 #include "realism/OnsetListener.h"
 #include "realism/Recordings.h"
 
+#include "tests/realism/RecordingsCache.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -200,12 +202,11 @@ TEST(RealismOnsetListener, HierarchicalDecidesTheCategoryFirstAndStepsVote) {
 }
 
 // The real recordings (scripts/fetch-recordings.sh). Skipped, saying so, without the cache.
-TEST(RealRecordingsOnset, ListenerNestedEstimateHoldsItsFloorAndIsDeterministic) {
-    const auto dir = defaultRecordingsDir();
-    if (!fs::exists(fs::path(dir) / "manifest.csv"))
-        GTEST_SKIP() << "no recordings cache at " << dir
-                     << ": run `bash scripts/fetch-recordings.sh` (or set UNDERFOOT_RECORDINGS)";
-    const auto recs = loadManifest(dir);
+class RealRecordingsOnset : public underfoot::realism::test::RecordingsCacheTest {};
+
+TEST_F(RealRecordingsOnset, ListenerNestedEstimateHoldsItsFloorAndIsDeterministic) {
+    const auto& dir = dir_;
+    const auto& recs = recs_;
     std::set<std::string> sources;
     for (const auto& r : recs) sources.insert(r.source);
     if (recs.size() != 90 || sources.size() != 4)

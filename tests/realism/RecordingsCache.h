@@ -1,0 +1,29 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+/// Tests on the real recordings (scripts/fetch-recordings.sh): a fixture that loads the cache's
+/// manifest, and skips the test, saying so, when there is no cache.
+#include "realism/Recordings.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace underfoot::realism::test {
+
+class RecordingsCacheTest : public ::testing::Test {
+  protected:
+    void SetUp() override {
+        dir_ = defaultRecordingsDir();
+        if (!std::filesystem::exists(std::filesystem::path(dir_) / "manifest.csv"))
+            GTEST_SKIP()
+                << "no recordings cache at " << dir_
+                << ": run `bash scripts/fetch-recordings.sh` (or set UNDERFOOT_RECORDINGS)";
+        recs_ = loadManifest(dir_);
+    }
+    std::string dir_;
+    std::vector<Recording> recs_;
+};
+
+} // namespace underfoot::realism::test
