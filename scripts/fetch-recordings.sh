@@ -20,9 +20,9 @@
 #   ufoai-sound    base/0snd.pk3 sound/footsteps/ (CC-BY-SA-3.0; sand.ogg, sand2.ogg GPL-2;
 #                  per file in its copyright file): carpet, dirt, grass, gravel, sand, snow,
 #                  splash (water), stone and tile (hard floor), wood. Its metal1 and metal3
-#                  (GPL-2+, "Nexuiz GPL data" in its copyright file) are Nexuiz's
-#                  metalfootstep01 and 05 re-encoded (their descriptors differ by 0.16-0.20 rms,
-#                  any other two files by >= 1.5): they are taken once, from nexuiz-data.
+#                  (GPL-2+, Nexuiz among their copyright holders in its copyright file) are
+#                  Nexuiz's metalfootstep01 and 05 re-encoded (their descriptors differ by
+#                  0.16-0.20 rms, any other two files by >= 1.5): taken once, from nexuiz-data.
 #   lugaru-data    Sounds/FootStep{Grass,Snow,Stone}[12].ogg (CC-BY-SA-3.0, Wolfire Games)
 #   nexuiz-data    data/data.pk3 sound/misc/footstep0[1-6].wav (the default step: hard floor)
 #                  and metalfootstep0[1-6].wav (metal) (GPL-2+, Alientrap)
