@@ -71,10 +71,11 @@ for p in ${UNDERFOOT_RECORDINGS_SKIP:-}; do
         ;;
     esac
 done
-# A source's folder from an earlier run would keep files the new manifest does not list.
-rm -rf "${cache:?}"/{minetest,openarena,ufoai,lugaru,nexuiz,openclonk,redeclipse}
-
 manifest="$cache/manifest.csv"
+# A source's folder from an earlier run would keep files the new manifest does not list; the
+# old manifest goes too, so that a run that fails leaves no cache (the tests then skip, naming
+# this script) rather than a manifest of deleted files.
+rm -rf "${cache:?}"/{minetest,openarena,ufoai,lugaru,nexuiz,openclonk,redeclipse} "$manifest"
 echo "file,source,package,version,licence,material,recordist" >"$manifest.tmp"
 
 # ---- minetest-data -------------------------------------------------------------------------
