@@ -11,16 +11,37 @@
 # The audio is not shipped in the repository: it stays under its own licence (named per file in
 # the manifest, from each package's copyright file) and is fetched on demand.
 #
-# Sources (four independent packages, different microphones, rooms and processing; about
-# 110 MB downloaded in all):
+# Sources (seven independent packages, different microphones, rooms and processing; about
+# 1.35 GB downloaded in all, of which redeclipse-data is 862 MB):
 #   minetest-data  minetest_game's default_*_footstep*.ogg (CC0-1.0 / CC-BY-3.0 / CC-BY-SA-3.0,
 #                  per file in mods/default/README.txt; freesound.org recordists)
 #   openarena-data baseoa/pak0.pk3 sound/player/footsteps/ (GPL-2+): boot (hard floor),
 #                  clank (metal), splash (water)
 #   ufoai-sound    base/0snd.pk3 sound/footsteps/ (CC-BY-SA-3.0; sand.ogg, sand2.ogg GPL-2;
-#                  metal1, metal3 GPL-2+; per file in its copyright file): carpet, dirt, grass,
-#                  gravel, sand, snow, splash (water), stone and tile (hard floor), wood, metal
+#                  per file in its copyright file): carpet, dirt, grass, gravel, sand, snow,
+#                  splash (water), stone and tile (hard floor), wood. Its metal1 and metal3
+#                  (GPL-2+, Nexuiz among their copyright holders in its copyright file) are
+#                  Nexuiz's metalfootstep01 and 05 re-encoded (their descriptors differ by
+#                  0.16-0.20 rms, any other two files by >= 1.5): taken once, from nexuiz-data.
 #   lugaru-data    Sounds/FootStep{Grass,Snow,Stone}[12].ogg (CC-BY-SA-3.0, Wolfire Games)
+#   nexuiz-data    data/data.pk3 sound/misc/footstep0[1-6].wav (the default step: hard floor)
+#                  and metalfootstep0[1-6].wav (metal) (GPL-2+, Alientrap)
+#   openclonk-data Sound.ocg (a c4group archive, unpacked with c4group from the openclonk
+#                  package): Clonk/Movement/StepHard[1-5].ogg, played on the materials a
+#                  clonk cannot dig (rock, granite, brick...: hard floor) (CC-BY-3.0,
+#                  HerbertBoland, freesound.org sound 31962, per Sound.ocg/authors.txt).
+#                  StepSoft is left out: it plays on every diggable material (earth, sand...).
+#   redeclipse-data data/sounds/player/concstep*.ogg (concrete: hard floor) and swimstep*.ogg
+#                  ("liquid footsteps" in redeclipse's config/sounds/player.cfg: water)
+#                  (CC-BY-SA-3.0, Red Eclipse Team). footstep*.ogg, the default step, names
+#                  no material and is left out.
+#
+# The first four are required: a failed download stops the script, naming the package. The
+# last three can be left out on purpose (each is then named on the output), e.g. where 1.35 GB
+# is too much to download:
+#   UNDERFOOT_RECORDINGS_SKIP="redeclipse-data nexuiz-data openclonk-data" bash scripts/fetch-recordings.sh
+# With nexuiz-data left out UFO:AI's metal1 and metal3 are kept (the four-source cache of
+# before, 90 files). The tests and `underfoot compare` read whatever the manifest lists.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 cache="${1:-${UNDERFOOT_RECORDINGS:-$root/build/recordings}}"
@@ -37,7 +58,24 @@ download() { # package -> path of the .deb in $work
     ls "$work"/"$1"_*.deb
 }
 
+skipped() { # package -> true when UNDERFOOT_RECORDINGS_SKIP names it
+    case " ${UNDERFOOT_RECORDINGS_SKIP:-} " in *" $1 "*) return 0 ;; esac
+    return 1
+}
+for p in ${UNDERFOOT_RECORDINGS_SKIP:-}; do
+    case "$p" in
+    nexuiz-data | openclonk-data | redeclipse-data) echo "fetch-recordings: leaving out $p (UNDERFOOT_RECORDINGS_SKIP)" ;;
+    *)
+        echo "fetch-recordings: UNDERFOOT_RECORDINGS_SKIP: '$p' is not an optional source (nexuiz-data openclonk-data redeclipse-data)" >&2
+        exit 2
+        ;;
+    esac
+done
 manifest="$cache/manifest.csv"
+# A source's folder from an earlier run would keep files the new manifest does not list; the
+# old manifest goes too, so that a run that fails leaves no cache (the tests then skip, naming
+# this script) rather than a manifest of deleted files.
+rm -rf "${cache:?}"/{minetest,openarena,ufoai,lugaru,nexuiz,openclonk,redeclipse} "$manifest"
 echo "file,source,package,version,licence,material,recordist" >"$manifest.tmp"
 
 # ---- minetest-data -------------------------------------------------------------------------
@@ -127,8 +165,14 @@ snow snow1,snow2,snow3,snow4 CC-BY-SA-3.0 UFO:AI_team
 water splash1,splash2,splash3,splash4 CC-BY-SA-3.0 UFO:AI_team
 hard stone1,stone2,stone3,stone4,tile1,tile2,tile3,tile4 CC-BY-SA-3.0 UFO:AI_team
 wood wood1,wood2,wood3,wood4 CC-BY-SA-3.0 UFO:AI_team
-metal metal1,metal3 GPL-2+ UFO:AI_team_(Nexuiz_GPL_data)
 LIST
+if skipped nexuiz-data; then # otherwise they come from nexuiz-data (metalfootstep01 and 05)
+    mkdir -p "$cache/ufoai/metal"
+    for name in metal1 metal3; do
+        cp "$work/ufo/sound/footsteps/$name.ogg" "$cache/ufoai/metal/"
+        echo "ufoai/metal/$name.ogg,ufoai,ufoai-sound,$ver,GPL-2+,metal,UFO:AI team (Nexuiz GPL data)" >>"$manifest.tmp"
+    done
+fi
 cp "$work/ufoai/usr/share/doc/ufoai-sound/copyright" "$cache/licences/ufoai-sound.copyright"
 
 # ---- lugaru-data ---------------------------------------------------------------------------
@@ -149,6 +193,95 @@ hard Stone
 LIST
 cp "$work/lugaru/usr/share/doc/lugaru-data/copyright" "$cache/licences/lugaru-data.copyright"
 
+# The later sources: one .deb at a time, removed after use (redeclipse-data is 862 MB); only the
+# files used are extracted.
+extract() { # deb dest paths... : only those paths (tar wildcards) of the package
+    local deb="$1" dest="$2"
+    shift 2
+    mkdir -p "$dest"
+    dpkg-deb --fsys-tarfile "$deb" | tar -x -C "$dest" --wildcards "$@"
+}
+
+# ---- nexuiz-data ---------------------------------------------------------------------------
+if ! skipped nexuiz-data; then
+    deb="$(download nexuiz-data)"
+    ver="$(dpkg-deb -f "$deb" Version)"
+    extract "$deb" "$work/nexuiz" ./usr/share/games/nexuiz/data/data.pk3 ./usr/share/doc/nexuiz-data/copyright
+    rm -f "$deb"
+    pk3="$work/nexuiz/usr/share/games/nexuiz/data/data.pk3"
+    python3 - "$pk3" "$work/nx" <<'PY' 2>/dev/null || unzip -q -o "$pk3" 'sound/misc/*footstep0*.wav' -d "$work/nx"
+import re, sys, zipfile
+z = zipfile.ZipFile(sys.argv[1])
+for n in z.namelist():
+    if re.fullmatch(r"sound/misc/(metal)?footstep0[0-9]\.wav", n):
+        z.extract(n, sys.argv[2])
+PY
+    rm -f "$pk3"
+    while read -r material prefix; do
+        mkdir -p "$cache/nexuiz/$material"
+        for f in "$work"/nx/sound/misc/"$prefix"0[1-6].wav; do
+            [ -f "$f" ] || continue
+            cp "$f" "$cache/nexuiz/$material/"
+            echo "nexuiz/$material/$(basename "$f"),nexuiz,nexuiz-data,$ver,GPL-2+,$material,Alientrap (Nexuiz)" >>"$manifest.tmp"
+        done
+    done <<'LIST'
+hard footstep
+metal metalfootstep
+LIST
+    cp "$work/nexuiz/usr/share/doc/nexuiz-data/copyright" "$cache/licences/nexuiz-data.copyright"
+fi
+
+# ---- openclonk-data ------------------------------------------------------------------------
+if ! skipped openclonk-data; then
+    # c4group (openclonk's archive tool, in the openclonk package: needs only libz and
+    # libstdc++) unpacks Sound.ocg; the package is extracted, not installed.
+    deb="$(download openclonk)"
+    extract "$deb" "$work/openclonk-bin" ./usr/bin/c4group
+    rm -f "$deb"
+    deb="$(download openclonk-data)"
+    ver="$(dpkg-deb -f "$deb" Version)"
+    extract "$deb" "$work/openclonk" ./usr/share/games/openclonk/Sound.ocg ./usr/share/doc/openclonk-data/copyright
+    rm -f "$deb"
+    (cd "$work/openclonk/usr/share/games/openclonk" && "$work/openclonk-bin/usr/bin/c4group" Sound.ocg -x >/dev/null) || {
+        echo "fetch-recordings: openclonk's c4group could not unpack Sound.ocg of openclonk-data" >&2
+        exit 1
+    }
+    snd="$work/openclonk/usr/share/games/openclonk/Sound.ocg"
+    mkdir -p "$cache/openclonk/hard"
+    for f in "$snd"/Clonk.ocg/Movement.ocg/StepHard[1-5].ogg; do
+        [ -f "$f" ] || continue
+        cp "$f" "$cache/openclonk/hard/"
+        echo "openclonk/hard/$(basename "$f"),openclonk,openclonk-data,$ver,CC-BY-3.0,hard,HerbertBoland (freesound.org)" >>"$manifest.tmp"
+    done
+    cp "$work/openclonk/usr/share/doc/openclonk-data/copyright" "$cache/licences/openclonk-data.copyright"
+    cp "$snd/authors.txt" "$cache/licences/openclonk-data-Sound-authors.txt"
+    rm -rf "$work/openclonk" "$work/openclonk-bin"
+fi
+
+# ---- redeclipse-data -----------------------------------------------------------------------
+if ! skipped redeclipse-data; then
+    deb="$(download redeclipse-data)"
+    ver="$(dpkg-deb -f "$deb" Version)"
+    rd=./usr/share/games/redeclipse/data/sounds
+    extract "$deb" "$work/redeclipse" "$rd/player/concstep*.ogg" "$rd/player/swimstep*.ogg" \
+        "$rd/readme.txt" ./usr/share/doc/redeclipse-data/copyright
+    rm -f "$deb"
+    while read -r material prefix; do
+        mkdir -p "$cache/redeclipse/$material"
+        for f in "$work/redeclipse/$rd/player/$prefix"*.ogg; do
+            [ -f "$f" ] || continue
+            cp "$f" "$cache/redeclipse/$material/"
+            echo "redeclipse/$material/$(basename "$f"),redeclipse,redeclipse-data,$ver,CC-BY-SA-3.0,$material,Red Eclipse Team" >>"$manifest.tmp"
+        done
+    done <<'LIST'
+hard concstep
+water swimstep
+LIST
+    cp "$work/redeclipse/usr/share/doc/redeclipse-data/copyright" "$cache/licences/redeclipse-data.copyright"
+    cp "$work/redeclipse/$rd/readme.txt" "$cache/licences/redeclipse-data-sounds-readme.txt"
+fi
+
 mv "$manifest.tmp" "$manifest"
 n=$(($(wc -l <"$manifest") - 1))
-echo "fetch-recordings: $n recorded footstep files in $cache (manifest: $manifest)"
+nsrc=$(tail -n +2 "$manifest" | cut -d, -f2 | sort -u | wc -l)
+echo "fetch-recordings: $n recorded footstep files from $nsrc sources in $cache (manifest: $manifest)"
