@@ -54,6 +54,9 @@ void ElastoPlasticFrictionT<Real>::prepare(double fs) {
     stiffTPlusDamp_ = params_.sigma0 * T + params_.sigma1;
     invSigma0_ = 1.0 / params_.sigma0;
     invStribeck_ = 1.0 / params_.stribeckVelocity;
+    minusTwoOverVs_ = -2.0 * invStribeck_;
+    d0_ = 1.0 + kd_ * params_.sigma2 + kd_ * stiffTPlusDamp_;
+    d1_ = (1.0 + kd_ * params_.sigma2) * T;
     reset(0);
 }
 
@@ -81,14 +84,16 @@ template <typename Real>
 [[gnu::always_inline]] inline typename ElastoPlasticFrictionT<Real>::Pass
 ElastoPlasticFrictionT<Real>::passAt(const SolveInput& in, double p) const noexcept {
     // The plain pass with the plastic factor fixed at p: d = 1 + T p (>= 1), the bristle
-    // z1 = (z0 + T v1) / d and the force constant + slope v1 linear in v1, whose coupling
-    // v1 = vRelPred - kd F has the closed-form root below.
+    // z1 = (z0 + T v1) / d and the force F = sC / d + dC + (ST / d + sigma2) v1 (sC = (sigma0 +
+    // sigma1 / T) z0, dC = noise - sigma1 z0 / T, ST = sigma0 T + sigma1), whose coupling
+    // v1 = vRelPred - kd F has the closed-form root v1 = (n0 + n1 p) / (d0 + d1 p) (numerator and
+    // denominator multiplied by d: n0 = A - kd sC, n1 = A T, d0 = B + kd ST, d1 = B T with
+    // A = vRelPred - kd dC, B = 1 + kd sigma2).
     Pass x;
-    x.w = 1.0 / (1.0 + T_ * p);
-    const double constant = in.sC * x.w + in.dC;
-    x.den = 1.0 + kd_ * (stiffTPlusDamp_ * x.w + params_.sigma2);
-    x.v = (in.vRelPred - kd_ * constant) / x.den;
-    x.z = (in.z0 + T_ * x.v) * x.w;
+    x.invD = 1.0 / (1.0 + T_ * p);
+    x.invDen = 1.0 / (d0_ + d1_ * p);
+    x.v = (in.n0 + in.n1 * p) * x.invDen;
+    x.z = (in.z0 + T_ * x.v) * x.invD;
     return x;
 }
 
@@ -110,9 +115,9 @@ ElastoPlasticFrictionT<Real>::plasticRate(const SolveInput& in, double v, double
     // |z_ss(v)| = (f_c + (f_s - f_c) e) / sigma0, e = exp(-(v / v_s)^2) (Stribeck).
     const double u = v * invStribeck_;
     const double e = Libm ? std::exp(-u * u) : frictionExpNeg(-u * u);
-    const double ass = (in.fc + (in.fs - in.fc) * e) * invSigma0_;
+    const double ass = in.zssC + in.zssD * e;
     if (!(ass > 0.0)) return {0.0, 0.0, 0.0}; // z_ss = 0: alpha is taken as 0 (as alphaOf)
-    const double dAss = -2.0 * u * invStribeck_ * (in.fs - in.fc) * e * invSigma0_; // d|z_ss|/dv
+    const double dAss = minusTwoOverVs_ * u * (in.zssD * e); // d|z_ss| / dv
     const double invAss = 1.0 / ass;
     double a = 1.0, daDz = 0.0, daDass = 0.0;
     if (az < ass) {
@@ -137,7 +142,7 @@ ElastoPlasticFrictionT<Real>::plasticRate(const SolveInput& in, double v, double
 template <typename Real>
 double ElastoPlasticFrictionT<Real>::lastSolveResidual() const noexcept {
     const SolveInput& in = in_;
-    if (!(in.fc > 0.0 || in.fs > 0.0)) return 0.0;
+    if (!(in.zssC > 0.0 || in.zssD > 0.0)) return 0.0;
     const Plastic P = params_.libmFunctions ? plasticRate<true>(in, in.vOut, in.zOut)
                                             : plasticRate<false>(in, in.vOut, in.zOut);
     const Pass x = passAt(in, P.p);
@@ -149,7 +154,7 @@ double ElastoPlasticFrictionT<Real>::lastSolveResidual() const noexcept {
 template <typename Real>
 template <bool Libm>
 [[gnu::always_inline]] inline typename ElastoPlasticFrictionT<Real>::Pass
-ElastoPlasticFrictionT<Real>::solveNewton(const SolveInput& in, int& passes,
+ElastoPlasticFrictionT<Real>::solveNewton(const SolveInput& in, double vRelPred, int& passes,
                                           bool& converged) noexcept {
     // Newton on the plastic rate p. A plain pass with the plastic factor fixed at p is
     // psi(p) = (v1, z1) (passAt, with d = 1 + T p); the solution is the fixed point
@@ -162,7 +167,7 @@ ElastoPlasticFrictionT<Real>::solveNewton(const SolveInput& in, int& passes,
     // Warm start: the last two samples' p extrapolated linearly (p varies smoothly while
     // slipping; 0 while sticking).
     double pk = params_.warmStart ? std::max(0.0, 2.0 * p_ - pPrev_)
-                                  : plasticRate<Libm>(in, in.vRelPred, in.z0).p;
+                                  : plasticRate<Libm>(in, vRelPred, in.z0).p;
     // lo: the largest trial with g > 0 (-1 before one: g(0) >= 0 anyway); hi: the smallest
     // with g < 0. The root lies in [max(lo, 0), hi].
     double lo = -1.0, hi = HUGE_VAL;
@@ -180,11 +185,10 @@ ElastoPlasticFrictionT<Real>::solveNewton(const SolveInput& in, int& passes,
             lo = pk;
         else
             hi = pk;
-        // psi'(p): dw/dp = -T w^2, dv/dw = -kd (sigma0 z0 + sigma1 z0 / T + (sigma0 T +
-        // sigma1) v) / den, dz/dw = (z0 + T v) + T w dv/dw.
-        const double dvdw = -kd_ * (in.sC + stiffTPlusDamp_ * x.v) / x.den;
-        const double dzdw = (in.z0 + T * x.v) + T * x.w * dvdw;
-        const double gp = (P.dv * dvdw + P.dz * dzdw) * (-T * x.w * x.w) - 1.0;
+        // psi'(p): dv/dp = (n1 - d1 v) / (d0 + d1 p), dz/dp = T (dv/dp - z) / d.
+        const double dvdp = (in.n1 - d1_ * x.v) * x.invDen;
+        const double dzdp = T * (dvdp - x.z) * x.invD;
+        const double gp = P.dv * dvdp + P.dz * dzdp - 1.0;
         double next = pk - g / gp;
         if (next < 0.0) next = 0.0; // (p >= 0; a NaN step fails the bracket test below)
         if (!(next > lo && next < hi)) next = hi < HUGE_VAL ? 0.5 * (std::max(lo, 0.0) + hi) : P.p;
@@ -259,17 +263,28 @@ double ElastoPlasticFrictionT<Real>::processSample(double normal, double drive, 
     if (inContact > 0.0 && params_.newton) {
         // Shipped: Newton on the plastic rate (solveNewton); the output is the plain pass at
         // the final p, whose force is the one its v1 was solved with.
-        SolveInput in{vRelPred, z0, stiffPlusDamp_ * z0, -dampOverT_ * z0 + noise, fc, fs, zba};
-        const Pass x = params_.libmFunctions ? solveNewton<true>(in, passes, converged)
-                                             : solveNewton<false>(in, passes, converged);
+        SolveInput in;
+        in.z0 = z0;
+        in.sC = stiffPlusDamp_ * z0;
+        in.dC = -dampOverT_ * z0 + noise;
+        const double A = vRelPred - kd_ * in.dC;
+        in.n0 = A - kd_ * in.sC;
+        in.n1 = A * T;
+        in.zssC = fc * invSigma0_;
+        in.zssD = (fs - fc) * invSigma0_;
+        in.zba = zba;
+        const Pass x = params_.libmFunctions ? solveNewton<true>(in, vRelPred, passes, converged)
+                                             : solveNewton<false>(in, vRelPred, passes, converged);
         v1 = x.v;
         z1 = x.z;
-        force = in.sC * x.w + in.dC + (stiffTPlusDamp_ * x.w + params_.sigma2) * x.v;
-        in.vOut = v1;
-        in.zOut = z1;
-        in_ = in;
+        force = in.sC * x.invD + in.dC + (stiffTPlusDamp_ * x.invD + params_.sigma2) * x.v;
+        if (trackResidual_) {
+            in.vOut = v1;
+            in.zOut = z1;
+            in_ = in;
+        }
     }
-    if (!(inContact > 0.0 && params_.newton)) in_.fc = in_.fs = 0.0; // (no Newton residual)
+    if (trackResidual_ && !(inContact > 0.0 && params_.newton)) in_.zssC = in_.zssD = 0.0;
     while (inContact > 0.0 && !params_.newton && passes < params_.maxIterations) {
         const double vp = v1;
         // alpha is the larger of its values at z0 and at the trial zp. alphaOf is 0 for a z of

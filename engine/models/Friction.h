@@ -160,10 +160,15 @@ class ElastoPlasticFrictionT {
     double exciterVelocity() const noexcept { return exciterV_; }
     double exciterPosition() const noexcept { return exciterX_; }
     const FrictionSolveStats& solveStats() const noexcept { return stats_; }
-    /// How far the last sample's Newton solution is from the fixed point: the move of one plain
-    /// pass from it, max(|dv| / max(|v|, v_s), |dz| / max(|z|, T v_s)) (the convergence
-    /// criterion's measure, to compare with `tolerance`). 0 without contact; for tests (it
-    /// recomputes a pass; the fixed-point solver (newton = false) leaves it at 0).
+    /// With tracking on (off by default: it costs a few stores a sample), lastSolveResidual()
+    /// tells how far the last sample's Newton solution is from the fixed point: the move of one
+    /// plain pass from it, max(|dv| / max(|v|, v_s), |dz| / max(|z|, T v_s)) (the convergence
+    /// criterion's measure, to compare with `tolerance`). 0 without contact, without tracking
+    /// or with the fixed-point solver (newton = false). For tests.
+    void setResidualTracking(bool on) noexcept {
+        trackResidual_ = on;
+        in_ = SolveInput{};
+    }
     double lastSolveResidual() const noexcept;
     const ModalResonatorT<Real>& resonator() const noexcept { return resonator_; }
     ModalResonatorT<Real>& resonator() noexcept { return resonator_; }
@@ -177,19 +182,22 @@ class ElastoPlasticFrictionT {
     };
     /// One sample's data for the Newton solve (kept for lastSolveResidual()).
     struct SolveInput {
-        double vRelPred = 0, z0 = 0, sC = 0, dC = 0, fc = 0, fs = 0, zba = 0;
+        double z0 = 0, sC = 0, dC = 0, n0 = 0, n1 = 0; // (see passAt)
+        double zssC = 0, zssD = 0; // |z_ss| = zssC + zssD e: f_c / sigma0, (f_s - f_c) / sigma0
+        double zba = 0;
         double vOut = 0, zOut = 0; // the solution returned
     };
     struct Pass {
-        double v, z, w, den; // v1, z1, 1 / d, 1 + kd slope
+        double v, z, invD, invDen; // v1, z1, 1 / d, 1 / (d0 + d1 p)
     };
     Pass passAt(const SolveInput& in, double p) const noexcept;
     template <bool Libm>
     Plastic plasticRate(const SolveInput& in, double v, double z) const noexcept;
     template <bool Libm>
-    Pass solveNewton(const SolveInput& in, int& passes, bool& converged) noexcept;
+    Pass solveNewton(const SolveInput& in, double vRelPred, int& passes, bool& converged) noexcept;
     SolveInput in_;
-    double invSigma0_ = 1.0, invStribeck_ = 1.0;
+    bool trackResidual_ = false;
+    double invSigma0_ = 1.0, invStribeck_ = 1.0, minusTwoOverVs_ = -2.0, d0_ = 1.0, d1_ = 0.0;
 
     FrictionParams params_;
     ModalResonatorT<Real> resonator_;

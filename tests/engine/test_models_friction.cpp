@@ -143,6 +143,7 @@ CreakRender renderCreak(const SolveOptions& o, double seconds) {
     p.tolerance = o.tolerance;
     ElastoPlasticFriction f;
     configureCreakScenario(f, p); // the bench's friction-creak scenario, 48 kHz, seed 7
+    f.setResidualTracking(true);
     const double fs = 48000.0;
     CreakRender r;
     r.out.resize(static_cast<std::size_t>(seconds * fs));
