@@ -55,6 +55,7 @@ void ElastoPlasticFrictionT<Real>::prepare(double fs) {
     invSigma0_ = 1.0 / params_.sigma0;
     invStribeck_ = 1.0 / params_.stribeckVelocity;
     minusTwoOverVs_ = -2.0 * invStribeck_;
+    pMax_ = 1e18 / T;
     d0_ = 1.0 + kd_ * params_.sigma2 + kd_ * stiffTPlusDamp_;
     d1_ = (1.0 + kd_ * params_.sigma2) * T;
     reset(0);
@@ -134,6 +135,9 @@ ElastoPlasticFrictionT<Real>::plasticRate(const SolveInput& in, double v, double
     }
     const double r = std::fabs(v) * invAss; // |v| / |z_ss|
     const double p = a * r;
+    // (capped at pMax_, where T p ~ 1e18 leaves z1 = (z0 + T v1) / (1 + T p) at 0 to double
+    // precision: |z_ss| can underflow towards 0 with mu_d = 0 at high speed, and p with it to inf)
+    if (!(p < pMax_)) return {pMax_, 0.0, 0.0};
     const double dv = sgn * a * invAss + (r * daDass - p * invAss) * dAss;
     const double dz = trial ? r * daDz * sgn : 0.0;
     return {p, dv, dz};

@@ -198,6 +198,7 @@ class ElastoPlasticFrictionT {
     SolveInput in_;
     bool trackResidual_ = false;
     double invSigma0_ = 1.0, invStribeck_ = 1.0, minusTwoOverVs_ = -2.0, d0_ = 1.0, d1_ = 0.0;
+    double pMax_ = 1e18 * 48000.0; // cap of the plastic rate (T pMax = 1e18)
 
     FrictionParams params_;
     ModalResonatorT<Real> resonator_;
