@@ -134,10 +134,10 @@ ElastoPlasticFrictionT<Real>::plasticRate(const SolveInput& in, double v, double
         daDass = -dadt * (1.0 + t) * invW; // d a / d|z_ss|
     }
     const double r = std::fabs(v) * invAss; // |v| / |z_ss|
-    const double p = a * r;
     // (capped at pMax_, where T p ~ 1e18 leaves z1 = (z0 + T v1) / (1 + T p) at 0 to double
-    // precision: |z_ss| can underflow towards 0 with mu_d = 0 at high speed, and p with it to inf)
-    if (!(p < pMax_)) return {pMax_, 0.0, 0.0};
+    // precision: |z_ss| can underflow towards 0 with mu_d = 0 at high speed, and p with it to inf;
+    // the derivatives are then not finite, and the step falls back to the bracket)
+    const double p = a * r < pMax_ ? a * r : pMax_;
     const double dv = sgn * a * invAss + (r * daDass - p * invAss) * dAss;
     const double dz = trial ? r * daDz * sgn : 0.0;
     return {p, dv, dz};
