@@ -52,6 +52,12 @@ void ElastoPlasticFrictionT<Real>::prepare(double fs) {
     stiffPlusDamp_ = params_.sigma0 + params_.sigma1 / T;
     dampOverT_ = params_.sigma1 / T;
     stiffTPlusDamp_ = params_.sigma0 * T + params_.sigma1;
+    invSigma0_ = 1.0 / params_.sigma0;
+    invStribeck_ = 1.0 / params_.stribeckVelocity;
+    minusTwoOverVs_ = -2.0 * invStribeck_;
+    pMax_ = 1e18 / T;
+    d0_ = 1.0 + kd_ * params_.sigma2 + kd_ * stiffTPlusDamp_;
+    d1_ = (1.0 + kd_ * params_.sigma2) * T;
     reset(0);
 }
 
@@ -59,7 +65,7 @@ template <typename Real>
 void ElastoPlasticFrictionT<Real>::reset(std::uint64_t seed) noexcept {
     resonator_.reset();
     rng_.setSeed(seed);
-    z_ = v_ = force_ = exciterX_ = exciterV_ = lastExternal_ = 0;
+    z_ = v_ = force_ = exciterX_ = exciterV_ = lastExternal_ = p_ = pPrev_ = 0;
     stats_ = FrictionSolveStats{};
 }
 
@@ -73,6 +79,148 @@ inline double ElastoPlasticFrictionT<Real>::alphaOf(double z, double v, double z
     const double t = 2.0 * (az - 0.5 * (ass + zba)) / (ass - zba); // in (-1, 1)
     if (params_.libmFunctions) return 0.5 * std::sin(0.5 * kPi * t) + 0.5;
     return 0.5 * frictionSinHalfPi(t) + 0.5;
+}
+
+template <typename Real>
+[[gnu::always_inline]] inline typename ElastoPlasticFrictionT<Real>::Pass
+ElastoPlasticFrictionT<Real>::passAt(const SolveInput& in, double p) const noexcept {
+    // The plain pass with the plastic factor fixed at p: d = 1 + T p (>= 1), the bristle
+    // z1 = (z0 + T v1) / d and the force F = sC / d + dC + (ST / d + sigma2) v1 (sC = (sigma0 +
+    // sigma1 / T) z0, dC = noise - sigma1 z0 / T, ST = sigma0 T + sigma1), whose coupling
+    // v1 = vRelPred - kd F has the closed-form root v1 = (n0 + n1 p) / (d0 + d1 p) (numerator and
+    // denominator multiplied by d: n0 = A - kd sC, n1 = A T, d0 = B + kd ST, d1 = B T with
+    // A = vRelPred - kd dC, B = 1 + kd sigma2).
+    Pass x;
+    x.invD = 1.0 / (1.0 + T_ * p);
+    x.invDen = 1.0 / (d0_ + d1_ * p);
+    x.v = (in.n0 + in.n1 * p) * x.invDen;
+    x.z = (in.z0 + T_ * x.v) * x.invD;
+    return x;
+}
+
+template <typename Real>
+template <bool Libm>
+[[gnu::always_inline]] inline typename ElastoPlasticFrictionT<Real>::Plastic
+ElastoPlasticFrictionT<Real>::plasticRate(const SolveInput& in, double v, double z) const noexcept {
+    // The same alpha as the fixed-point pass: the larger of alpha(z0, v) and alpha(z, v), i.e.
+    // alpha at the candidate of v's sign with the larger |z| (0 when neither has v's sign or
+    // the candidate is within the break-away). With s = sgn(v), a candidate of v's sign has
+    // s z > 0 and the other sign s z <= 0 <= z_ba, so the candidate is the larger of s z0 and
+    // s z, and it counts when it exceeds z_ba (z0 on a tie, as alphaOf's max).
+    if (v == 0.0) return {0.0, 0.0, 0.0};
+    const double sgn = v > 0.0 ? 1.0 : -1.0;
+    const double s0 = sgn * in.z0, s1 = sgn * z;
+    const bool trial = s1 > s0; // z_c is the trial's z
+    const double az = trial ? s1 : s0;
+    if (!(az > in.zba)) return {0.0, 0.0, 0.0};
+    // |z_ss(v)| = (f_c + (f_s - f_c) e) / sigma0, e = exp(-(v / v_s)^2) (Stribeck).
+    const double u = v * invStribeck_;
+    const double e = Libm ? std::exp(-u * u) : frictionExpNeg(-u * u);
+    const double ass = in.zssC + in.zssD * e;
+    if (!(ass > 0.0)) return {0.0, 0.0, 0.0}; // z_ss = 0: alpha is taken as 0 (as alphaOf)
+    const double dAss = minusTwoOverVs_ * u * (in.zssD * e); // d|z_ss| / dv
+    const double invAss = 1.0 / ass;
+    double a = 1.0, daDz = 0.0, daDass = 0.0;
+    if (az < ass) {
+        // raised sine in t = 2 (|z| - (|z_ss| + z_ba) / 2) / (|z_ss| - z_ba) in (-1, 1)
+        const double invW = 1.0 / (ass - in.zba);
+        const double t = 2.0 * (az - 0.5 * (ass + in.zba)) * invW;
+        const double sn = Libm ? std::sin(0.5 * kPi * t) : frictionSinHalfPi(t);
+        a = 0.5 * sn + 0.5;
+        // da/dt = (pi / 4) cos(pi t / 2), cos = sqrt(1 - sin^2) >= 0 on [-1, 1] (only the
+        // Newton step uses derivatives: their rounding does not change the converged solution)
+        const double dadt = 0.25 * kPi * std::sqrt(std::max(0.0, 1.0 - sn * sn));
+        daDz = dadt * 2.0 * invW;          // d a / d|z|
+        daDass = -dadt * (1.0 + t) * invW; // d a / d|z_ss|
+    }
+    const double r = std::fabs(v) * invAss; // |v| / |z_ss|
+    // (capped at pMax_, where T p ~ 1e18 leaves z1 = (z0 + T v1) / (1 + T p) at 0 to double
+    // precision: |z_ss| can underflow towards 0 with mu_d = 0 at high speed, and p with it to inf;
+    // the derivatives are then not finite, and the step falls back to the bracket)
+    const double p = a * r < pMax_ ? a * r : pMax_;
+    const double dv = sgn * a * invAss + (r * daDass - p * invAss) * dAss;
+    const double dz = trial ? r * daDz * sgn : 0.0;
+    return {p, dv, dz};
+}
+
+template <typename Real>
+double ElastoPlasticFrictionT<Real>::lastSolveResidual() const noexcept {
+    const SolveInput& in = in_;
+    if (!(in.zssC > 0.0 || in.zssD > 0.0)) return 0.0;
+    const Plastic P = params_.libmFunctions ? plasticRate<true>(in, in.vOut, in.zOut)
+                                            : plasticRate<false>(in, in.vOut, in.zOut);
+    const Pass x = passAt(in, P.p);
+    const double vs = params_.stribeckVelocity;
+    return std::max(std::fabs(x.v - in.vOut) / std::max(std::fabs(x.v), vs),
+                    std::fabs(x.z - in.zOut) / std::max(std::fabs(x.z), T_ * vs));
+}
+
+template <typename Real>
+template <bool Libm>
+[[gnu::always_inline]] inline typename ElastoPlasticFrictionT<Real>::Pass
+ElastoPlasticFrictionT<Real>::solveNewton(const SolveInput& in, double vRelPred, int& passes,
+                                          bool& converged) noexcept {
+    // Newton on the plastic rate p. A plain pass with the plastic factor fixed at p is
+    // psi(p) = (v1, z1) (passAt, with d = 1 + T p); the solution is the fixed point
+    // p = P(psi(p)), P = plasticRate. g(p) = P(psi(p)) - p is continuous, g(0) >= 0 and g < 0
+    // for large p (P(psi(p)) stays bounded as psi(p) tends to z1 = 0), so a root lies in
+    // [lo, hi]; Newton steps with g' = grad P . psi'(p) - 1 stay inside the bracket or are
+    // replaced by a bisection (or, before an upper end is known, by the plain pass p <- P).
+    const double T = T_, tol = params_.tolerance;
+    const double vScale = params_.stribeckVelocity, zScale = T * params_.stribeckVelocity;
+    // Warm start: the last two samples' p extrapolated linearly (p varies smoothly while
+    // slipping; 0 while sticking).
+    double pk = params_.warmStart ? std::max(0.0, 2.0 * p_ - pPrev_)
+                                  : plasticRate<Libm>(in, vRelPred, in.z0).p;
+    // lo: the largest trial with g > 0 (-1 before one: g(0) >= 0 anyway); hi: the smallest
+    // with g < 0. The root lies in [max(lo, 0), hi].
+    double lo = -1.0, hi = HUGE_VAL;
+    double lastStep = 0.0;
+    Pass x = passAt(in, pk);
+    while (true) {
+        const Plastic P = plasticRate<Libm>(in, x.v, x.z);
+        ++passes;
+        const double g = P.p - pk;
+        if (g == 0.0) { // pk is a fixed point (a sticking sample: p = 0 = P)
+            converged = true;
+            break;
+        }
+        if (g > 0.0)
+            lo = pk;
+        else
+            hi = pk;
+        // psi'(p): dv/dp = (n1 - d1 v) / (d0 + d1 p), dz/dp = T (dv/dp - z) / d.
+        const double dvdp = (in.n1 - d1_ * x.v) * x.invDen;
+        const double dzdp = T * (dvdp - x.z) * x.invD;
+        const double gp = P.dv * dvdp + P.dz * dzdp - 1.0;
+        double next = pk - g / gp;
+        if (next < 0.0) next = 0.0; // (p >= 0; a NaN step fails the bracket test below)
+        if (!(next > lo && next < hi)) next = hi < HUGE_VAL ? 0.5 * (std::max(lo, 0.0) + hi) : P.p;
+        const double step = std::fabs(next - pk);
+        // Contraction of this step against the last one: the error left after a step of a
+        // sequence contracting by theta < 1 is at most theta / (1 - theta) times the step
+        // (for Newton far less: about theta^2 times it). With no earlier step, factor 1: the
+        // fixed-point criterion itself (a pass that moves by at most tol).
+        const double theta = lastStep > 0.0 ? step / lastStep : 1.0;
+        const double factor = theta < 0.5 ? theta / (1.0 - theta) : 1.0;
+        lastStep = step;
+        pk = next;
+        const double vb = x.v, zb = x.z;
+        x = passAt(in, pk);
+        // Converged when the error left in v and z (estimated from the step as above) is at
+        // most tol relative to max(|v|, v_s) and max(|z|, T v_s): the plain passes' criterion
+        // (a pass that moves by at most tol leaves an error of about theta / (1 - theta) tol,
+        // theta up to ~0.5 there).
+        if (factor * std::fabs(x.v - vb) <= tol * std::max(std::fabs(x.v), vScale) &&
+            factor * std::fabs(x.z - zb) <= tol * std::max(std::fabs(x.z), zScale)) {
+            converged = true;
+            break;
+        }
+        if (passes >= params_.maxIterations) break;
+    }
+    pPrev_ = p_;
+    p_ = pk;
+    return x;
 }
 
 template <typename Real>
@@ -116,7 +264,32 @@ double ElastoPlasticFrictionT<Real>::processSample(double normal, double drive, 
     int passes = 0, plain = 0; // plain: passes since the last extrapolation
     bool converged = false;
     double vBefore = 0.0, zBefore = 0.0; // the trial of the previous pass
-    while (inContact > 0.0 && passes < params_.maxIterations) {
+    if (inContact > 0.0 && params_.newton) {
+        // Shipped: Newton on the plastic rate (solveNewton); the output is the plain pass at
+        // the final p, whose force is the one its v1 was solved with.
+        SolveInput in;
+        in.z0 = z0;
+        in.sC = stiffPlusDamp_ * z0;
+        in.dC = -dampOverT_ * z0 + noise;
+        const double A = vRelPred - kd_ * in.dC;
+        in.n0 = A - kd_ * in.sC;
+        in.n1 = A * T;
+        in.zssC = fc * invSigma0_;
+        in.zssD = (fs - fc) * invSigma0_;
+        in.zba = zba;
+        const Pass x = params_.libmFunctions ? solveNewton<true>(in, vRelPred, passes, converged)
+                                             : solveNewton<false>(in, vRelPred, passes, converged);
+        v1 = x.v;
+        z1 = x.z;
+        force = in.sC * x.invD + in.dC + (stiffTPlusDamp_ * x.invD + params_.sigma2) * x.v;
+        if (trackResidual_) {
+            in.vOut = v1;
+            in.zOut = z1;
+            in_ = in;
+        }
+    }
+    if (trackResidual_ && !(inContact > 0.0 && params_.newton)) in_.zssC = in_.zssD = 0.0;
+    while (inContact > 0.0 && !params_.newton && passes < params_.maxIterations) {
         const double vp = v1;
         // alpha is the larger of its values at z0 and at the trial zp. alphaOf is 0 for a z of
         // the other sign than vp or with |z| <= z_ba, and non-decreasing in |z| otherwise (a
