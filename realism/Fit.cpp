@@ -217,6 +217,10 @@ std::vector<Knob> knobsFor(const toml::table& root) {
                          [mul2](toml::table& r, double x, const Ranges& rg) {
                              eachLayerKey(r, "grains", "heel_ms", rg, mul2(x));
                          }});
+            k.push_back({{"heel_decay", "heel burst's decay (heel_decay_ms) x 2^k", -2, 2, 0, 0},
+                         [mul2](toml::table& r, double x, const Ranges& rg) {
+                             eachLayerKey(r, "grains", "heel_decay_ms", rg, mul2(x));
+                         }});
             k.push_back(
                 {{"heel_energy", "heel burst's energy scale (heel_energy) x 2^k", -3, 3, 0, 0},
                  [mul2](toml::table& r, double x, const Ranges& rg) {

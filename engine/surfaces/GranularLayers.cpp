@@ -48,7 +48,8 @@ void GrainsLayer::prepare(const ProcessSpec& spec) {
     scale_.assign(block, 0.0f);
     buffer_.assign(block, 0.0f);
     tailLength_ = static_cast<int>(kTailSeconds * sampleRateHz_);
-    heelEnd_ = static_cast<std::int64_t>(std::ceil(10.0 * control_.heelMs * 1e-3 * sampleRateHz_));
+    heelEnd_ = static_cast<std::int64_t>(
+        std::ceil((control_.heelMs + 10.0 * control_.heelDecayMs) * 1e-3 * sampleRateHz_));
     reset(0);
 }
 
@@ -70,9 +71,10 @@ double GrainsLayer::heelEnvelope() noexcept {
         heelAge_ = -1;
         return 0.0;
     }
-    const double x =
-        static_cast<double>(heelAge_++) / (control_.heelMs * 1e-3 * sampleRateHz_); // t / T
-    return x * std::exp(1.0 - x);
+    const double t = static_cast<double>(heelAge_++) / sampleRateHz_;
+    const double peak = control_.heelMs * 1e-3;
+    if (t < peak) return t / peak * std::exp(1.0 - t / peak);     // rise: (t / T) exp(1 - t / T)
+    return std::exp(-(t - peak) / (control_.heelDecayMs * 1e-3)); // then the settling decay
 }
 
 void GrainsLayer::process(const float* grf, float* out, int n) noexcept {
@@ -232,10 +234,14 @@ std::unique_ptr<SurfaceLayer> makeGrainsLayer(PresetReader& r, const AccuracyOpt
     c.heelRateHz = r.number(
         "heel_rate_hz", 0.0, 0.0, 20000.0, "events/s",
         "heel burst: extra events at the heel's impact, at most this rate at heel_ms after the "
-        "contact, following (t / heel_ms) exp(1 - t / heel_ms): the sole's first impact crushes "
-        "the most grains (0: none)");
+        "contact, rising as (t / heel_ms) exp(1 - t / heel_ms), then decaying with "
+        "heel_decay_ms: the sole's first impact crushes the most grains (0: none)");
     c.heelMs = r.number("heel_ms", 15.0, 1.0, 200.0, "ms",
                         "heel burst: time from the heel's contact to the burst's peak", true);
+    c.heelDecayMs = r.number("heel_decay_ms", 30.0, 1.0, 1000.0, "ms",
+                             "heel burst: decay time constant after its peak, exp(-(t - "
+                             "heel_ms) / heel_decay_ms) (the crushed bed settling)",
+                             true);
     c.heelEnergy =
         r.number("heel_energy", 1.0, 0.0, 100.0, "x energy scale at 1 kN",
                  "heel burst: energy scale of its events at the peak (follows the same envelope)");

@@ -28,8 +28,9 @@
 /// within tens of ms, before the load has built up, so a bed of sand or dirt crushes and
 /// shifts most in the first 20-30 ms of the contact (recorded sand and dirt steps peak there)
 /// whatever the slower load curve does later. When the load first exceeds the contact
-/// threshold in a step, an envelope e(t) = (t / T) exp(1 - t / T) starts (T = heel_ms: peak 1
-/// at T, then a decay; it ends at 10 T). It adds heel_rate_hz x e(t) events/s whose energy
+/// threshold in a step, an envelope starts: e(t) = (t / T) exp(1 - t / T) up to its peak 1 at
+/// T = heel_ms, then exp(-(t - T) / D), D = heel_decay_ms (the crushed bed settling; it ends at
+/// T + 10 D). It adds heel_rate_hz x e(t) events/s whose energy
 /// scale is heel_energy x e(t) (saturated like the others by energy_saturation); the two
 /// streams are one Poisson process (rates add) whose energy scale is their rate-weighted mean.
 /// No random draw of its own, computed per sample: deterministic and block-size independent;
@@ -58,9 +59,10 @@ struct GrainsControl {
     double lowpassHz = 0.0;  ///< 0: off
     double highpassHz = 0.0; ///< 0: off
     double gainDb = 0.0;
-    double heelRateHz = 0.0; ///< heel burst: peak extra event rate (0: no burst)
-    double heelMs = 15.0;    ///< heel burst: time from contact to its peak
-    double heelEnergy = 1.0; ///< heel burst: energy scale of its events at the peak
+    double heelRateHz = 0.0;   ///< heel burst: peak extra event rate (0: no burst)
+    double heelMs = 15.0;      ///< heel burst: time from contact to its peak
+    double heelDecayMs = 30.0; ///< heel burst: decay time constant after the peak
+    double heelEnergy = 1.0;   ///< heel burst: energy scale of its events at the peak
 };
 
 class GrainsLayer final : public SurfaceLayer {
@@ -95,7 +97,7 @@ class GrainsLayer final : public SurfaceLayer {
     bool sleeping_ = true;
     int tailSamples_ = 0, tailLength_ = 0;
     std::int64_t heelAge_ = -1; ///< samples since the heel burst started; -1: none running
-    std::int64_t heelEnd_ = 0;  ///< its length (10 heel_ms) in samples
+    std::int64_t heelEnd_ = 0;  ///< its length (heel_ms + 10 heel_decay_ms) in samples
 };
 
 /// Factory for the layer table: reads every parameter of a grains layer (with unit and range).
