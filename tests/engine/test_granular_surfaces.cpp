@@ -263,7 +263,7 @@ TEST(GranularSurfaces, CalibratedToAboutMinus12DbfsPeak) {
 TEST(GranularSurfaces, SurfacesAreDistinctByTheNumbers) {
     const auto& f = allFigures();
     auto at = [&](const char* id) { return f.at(id); };
-    // Gravel: hard small stones, bright; sand: a dull, low crunch (measured 3040 vs 297 Hz).
+    // Gravel: hard small stones, bright; sand: a dull, low crunch (measured 3040 vs 371 Hz).
     EXPECT_GT(at("gravel").centroidHz, 2.0 * at("beach_sand").centroidHz);
     // Deep snow: muffled, far lower than gravel (measured 440 Hz).
     EXPECT_LT(at("deep_snow").centroidHz, 0.4 * at("gravel").centroidHz);
@@ -273,7 +273,7 @@ TEST(GranularSurfaces, SurfacesAreDistinctByTheNumbers) {
     // Recorded sand steps are lower, sparser and shorter than recorded snow steps (`underfoot
     // compare` medians: centroid 329 vs 558 Hz, 38 vs 61 grains/s; issue #13, docs/realism.md
     // "Heel-driven grains and several starts"): sand's grains now come from the heel's impact
-    // alone, below deep snow (measured 297 vs 440 Hz, 47 vs 589 events per step, 0.00 vs 0.72
+    // alone, below deep snow (measured 371 vs 440 Hz, 59 vs 589 events per step, 0.00 vs 0.72
     // of the step's energy after 0.2 s). Before, sand was the brighter, denser one (1073 vs
     // 694 Hz, 964 vs 589 events), which the recordings contradict.
     EXPECT_LT(at("beach_sand").centroidHz, at("deep_snow").centroidHz);
