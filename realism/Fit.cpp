@@ -4,6 +4,7 @@
 #include "engine/render/Renderer.h"
 #include "engine/surfaces/Surface.h"
 
+#include <boost/random/sobol.hpp>
 #include <fmt/core.h>
 #include <nlopt.hpp>
 #include <toml++/toml.h>
@@ -201,6 +202,31 @@ std::vector<Knob> knobsFor(const toml::table& root) {
                                                         v * std::exp2(x)));
                          });
                      }});
+        // Heel burst (GranularLayers.h): only where a layer has one (heel_rate_hz > 0).
+        bool heel = false;
+        if (const auto* layers = root["layer"].as_array())
+            for (const auto& node : *layers)
+                if (const auto* t = node.as_table())
+                    heel = heel || (*t)["heel_rate_hz"].value<double>().value_or(0.0) > 0;
+        if (heel) {
+            k.push_back({{"heel_rate", "heel burst's peak rate (heel_rate_hz) x 2^k", -3, 2, 0, 0},
+                         [mul2](toml::table& r, double x, const Ranges& rg) {
+                             eachLayerKey(r, "grains", "heel_rate_hz", rg, mul2(x));
+                         }});
+            k.push_back({{"heel_time", "heel burst's time to peak (heel_ms) x 2^k", -2, 2, 0, 0},
+                         [mul2](toml::table& r, double x, const Ranges& rg) {
+                             eachLayerKey(r, "grains", "heel_ms", rg, mul2(x));
+                         }});
+            k.push_back({{"heel_decay", "heel burst's decay (heel_decay_ms) x 2^k", -2, 2, 0, 0},
+                         [mul2](toml::table& r, double x, const Ranges& rg) {
+                             eachLayerKey(r, "grains", "heel_decay_ms", rg, mul2(x));
+                         }});
+            k.push_back(
+                {{"heel_energy", "heel burst's energy scale (heel_energy) x 2^k", -3, 3, 0, 0},
+                 [mul2](toml::table& r, double x, const Ranges& rg) {
+                     eachLayerKey(r, "grains", "heel_energy", rg, mul2(x));
+                 }});
+        }
         if (grainLayers > 1)
             k.push_back(
                 {{"layer_balance", "first grain layer +k dB, the others -k dB", -12, 12, 0, 0},
@@ -383,6 +409,28 @@ toml::table parsePreset(const std::string& presetFile) {
 
 } // namespace
 
+std::vector<std::vector<double>> fitStartPoints(int count, const std::vector<double>& lo,
+                                                const std::vector<double>& hi) {
+    if (count < 1) throw std::invalid_argument(fmt::format("fit: {} starts: expected >= 1", count));
+    if (lo.size() != hi.size() || lo.empty())
+        throw std::invalid_argument("fit: starting points need one [lo, hi] per knob");
+    for (std::size_t i = 0; i < lo.size(); ++i)
+        if (!(lo[i] <= 0 && 0 <= hi[i]))
+            throw std::invalid_argument(
+                fmt::format("fit: knob {}'s box [{}, {}] does not hold 0", i, lo[i], hi[i]));
+    std::vector<std::vector<double>> points{std::vector<double>(lo.size(), 0.0)};
+    if (count == 1) return points;
+    boost::random::sobol sobol(lo.size()); // the first point is the box's centre
+    const double range = static_cast<double>(sobol.max()) - static_cast<double>(sobol.min()) + 1;
+    for (int p = 1; p < count; ++p) {
+        std::vector<double> x(lo.size());
+        for (std::size_t i = 0; i < lo.size(); ++i)
+            x[i] = lo[i] + (hi[i] - lo[i]) * (static_cast<double>(sobol() - sobol.min()) / range);
+        points.push_back(std::move(x));
+    }
+    return points;
+}
+
 double contrastiveObjective(double own, double nearest, double contrast, double margin) {
     if (contrast <= 0 || nearest < 0) return own;
     return own + contrast * std::max(0.0, own - nearest + margin);
@@ -546,10 +594,14 @@ FitResult fitSurface(const std::string& presetFile, const std::vector<Recording>
     } else {
         starts.push_back({root, "the preset's own parameters", {}, {}});
     }
+    const auto points = fitStartPoints(options.starts, lo, hi);
+    result.startPoints = static_cast<int>(points.size());
+    const int runs = static_cast<int>(starts.size() * points.size());
     int evals = 0;
     double best = 0, overall = 1e300;
     std::vector<double> bestX = x, overallX = x;
-    std::size_t overallStart = 0;
+    std::size_t overallStart = 0, overallPoint = 0;
+    std::vector<double> tableD0(starts.size(), 0.0); // objective of each starting preset
     struct Ctx {
         std::function<double(const std::vector<double>&)> f;
     } ctx{[&](const std::vector<double>& xv) {
@@ -560,17 +612,23 @@ FitResult fitSurface(const std::string& presetFile, const std::vector<Recording>
             bestX = xv;
         }
         if (options.progress &&
-            !options.progress(evals, options.maxEvaluations * static_cast<int>(starts.size()), d,
-                              std::min(best, overall)))
+            !options.progress(evals, options.maxEvaluations * runs, d, std::min(best, overall)))
             throw nlopt::forced_stop();
         return d;
     }};
     bool stopped = false;
-    for (std::size_t si = 0; si < starts.size() && !stopped; ++si) {
+    for (std::size_t run = 0; run < starts.size() * points.size() && !stopped; ++run) {
+        const std::size_t si = run / points.size(), pi = run % points.size();
         root = starts[si].table; // `build` applies the knobs to `root`
-        const double d0 = starts[si].modes.empty() ? result.before.objective : distanceOf(root);
-        best = d0;
-        x.assign(knobs.size(), 0.0);
+        double d0 = 1e300;
+        if (pi == 0) { // the starting preset itself
+            d0 = starts[si].modes.empty() ? result.before.objective : distanceOf(root);
+            best = d0;
+            tableD0[si] = d0;
+        } else {
+            best = 1e300; // BOBYQA evaluates its starting point first
+        }
+        x = points[pi];
         bestX = x;
         nlopt::opt opt(nlopt::LN_BOBYQA, static_cast<unsigned>(knobs.size()));
         opt.set_lower_bounds(lo);
@@ -590,13 +648,16 @@ FitResult fitSurface(const std::string& presetFile, const std::vector<Recording>
             stopped = true;
         } catch (const nlopt::roundoff_limited&) {
         }
+        result.startObjectives.push_back(best);
         if (best < overall) {
             overall = best;
             overallX = bestX;
             overallStart = si;
-            result.distanceSeeded = d0;
+            overallPoint = pi;
+            result.distanceSeeded = tableD0[si];
         }
     }
+    result.bestStartPoint = static_cast<int>(overallPoint);
     root = starts[overallStart].table;
     bestX = overallX;
     if (options.modalSeed && hasLayer(originalTable, "impact")) {
@@ -650,6 +711,19 @@ FitResult fitSurface(const std::string& presetFile, const std::vector<Recording>
     toml::table kt;
     for (const auto& k : result.knobs) kt.insert(k.name, std::round(k.value * 1000) / 1000);
     prov.insert("knobs", kt);
+    if (options.starts > 1) {
+        toml::table st;
+        st.insert("points", static_cast<std::int64_t>(points.size()));
+        st.insert("method", "the preset's own knobs and the first points - 1 points of the Sobol "
+                            "sequence (Boost.Random sobol) scaled into the knobs' box, each "
+                            "refined by BOBYQA");
+        st.insert("evaluations_per_start", options.maxEvaluations);
+        st.insert("best", static_cast<std::int64_t>(overallPoint));
+        toml::array reached;
+        for (double o : result.startObjectives) reached.push_back(std::round(o * 1000) / 1000);
+        st.insert("objectives", reached);
+        prov.insert("starts", st);
+    }
     if (!options.keep.empty()) {
         toml::array kept;
         for (const auto& k : options.keep) kept.push_back(k);

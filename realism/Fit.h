@@ -74,6 +74,12 @@ struct FitOptions {
     /// Knobs held at their start (by name, e.g. "grain_band": a designed property the fit must
     /// keep); an unknown name throws std::invalid_argument naming the knobs there are.
     std::vector<std::string> keep;
+    /// Starting points of the optimiser per starting preset (`underfoot fit --starts N`): the
+    /// preset's own knobs (all 0) and the first N - 1 points of the Sobol sequence (Boost.Random
+    /// `sobol`, Joe-Kuo direction numbers; a fixed, stated set: no seed to store) scaled into
+    /// the knobs' box; each is refined by BOBYQA with up to maxEvaluations renders and the best
+    /// result is kept. 1 (the default) is the local fit from the preset, bit for bit.
+    int starts = 1;
 };
 
 /// Distance of a render to its own recordings and to the nearest other material.
@@ -102,11 +108,20 @@ struct FitResult {
     std::vector<RecordedMode> seededModes; ///< the recorded modes written into the preset
     std::vector<std::string> seedSkipped;  ///< recordings that yielded no mode
     std::string seedStart;                 ///< the starting point the result was refined from
+    int startPoints = 1;    ///< knob starting points per starting preset (FitOptions::starts)
+    int bestStartPoint = 0; ///< the one the result was refined from (0: the preset's own knobs)
+    std::vector<double> startObjectives; ///< best objective reached from each starting point
     /// Contrast (FitOptions::contrast > 0 and other materials given): own distance, nearest
     /// other material and objective of the original preset and of the fitted one.
     bool contrastive = false;
     FitDistances before, after;
 };
+
+/// The knob vectors the fit starts from (FitOptions::starts): all zeros, then the first
+/// `count - 1` Sobol points scaled into [lo, hi]. Throws std::invalid_argument when count < 1
+/// or the bounds differ in size or are not ordered.
+std::vector<std::vector<double>> fitStartPoints(int count, const std::vector<double>& lo,
+                                                const std::vector<double>& hi);
 
 /// The contrastive objective J = own + contrast x max(0, own - nearest + margin); `own` alone
 /// when there is no other material (nearest < 0) or contrast is 0.

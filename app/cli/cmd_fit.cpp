@@ -5,6 +5,8 @@
 //   fit --surface wood -o wood.toml --no-modal-seed   refine the preset's own modes only
 //   fit --surface beach_sand -o s.toml --contrast 2 --margin 0.1   (the defaults) also push the
 //       render away from the nearest other material of the recordings cache (realism/Fit.h)
+//   fit --surface beach_sand -o s.toml --starts 8   global search: BOBYQA from the preset and
+//       from 7 Sobol points of the knobs' box, the best kept (realism/Fit.h)
 // Solids (impact layers) are first seeded with the recordings' modes (realism/ModalSeed.h).
 // Without --real the recordings of the surface's material come from the cache of
 // scripts/fetch-recordings.sh. The output is a normal preset with a [provenance] table.
@@ -172,6 +174,13 @@ int runFit(FitArgs& a) {
     fmt::print("{}: distance {:.3f} -> {:.3f} after {} evaluations ({}) in {:.1f} s -> {}\n",
                a.surface, r.distanceBefore, r.distanceAfter, r.evaluations, r.optimiser, r.seconds,
                a.output);
+    if (r.startPoints > 1) {
+        fmt::print("starts: {} (best from {}):", r.startPoints,
+                   r.bestStartPoint == 0 ? std::string("the preset")
+                                         : fmt::format("Sobol point {}", r.bestStartPoint));
+        for (double o : r.startObjectives) fmt::print(" {:.3f}", o);
+        fmt::print("\n");
+    }
     if (r.contrastive)
         fmt::print("nearest other material: {} {:.3f} -> {} {:.3f} (contrast {}, margin {}: {})\n",
                    r.before.nearestMaterial, r.before.nearest, r.after.nearestMaterial,
@@ -218,6 +227,11 @@ CommandRegistrar reg("fit", [](CLI::App& app, int& exitCode) {
     cmd->add_option("--keep", args->options.keep,
                     "knobs to hold at the preset's values (e.g. grain_band: a designed property "
                     "the fit must not move)");
+    cmd->add_option("--starts", args->options.starts,
+                    "starting points of the optimiser: the preset and N - 1 Sobol points of the "
+                    "knobs' box, each refined with up to --evaluations renders; the best is kept")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 64));
     cmd->add_option("-o,--output", args->output, "fitted preset (.toml)");
     cmd->add_flag("-q,--quiet", args->quiet, "no progress lines");
     cmd->add_option("--modes", args->modes,

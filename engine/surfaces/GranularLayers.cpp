@@ -48,6 +48,8 @@ void GrainsLayer::prepare(const ProcessSpec& spec) {
     scale_.assign(block, 0.0f);
     buffer_.assign(block, 0.0f);
     tailLength_ = static_cast<int>(kTailSeconds * sampleRateHz_);
+    heelEnd_ = static_cast<std::int64_t>(
+        std::ceil((control_.heelMs + 10.0 * control_.heelDecayMs) * 1e-3 * sampleRateHz_));
     reset(0);
 }
 
@@ -60,6 +62,19 @@ void GrainsLayer::reset(std::uint64_t seed) noexcept {
     onsetArmed_ = true;
     sleeping_ = true;
     tailSamples_ = 0;
+    heelAge_ = -1;
+}
+
+double GrainsLayer::heelEnvelope() noexcept {
+    if (heelAge_ < 0) return 0.0;
+    if (heelAge_ >= heelEnd_) {
+        heelAge_ = -1;
+        return 0.0;
+    }
+    const double t = static_cast<double>(heelAge_++) / sampleRateHz_;
+    const double peak = control_.heelMs * 1e-3;
+    if (t < peak) return t / peak * std::exp(1.0 - t / peak);     // rise: (t / T) exp(1 - t / T)
+    return std::exp(-(t - peak) / (control_.heelDecayMs * 1e-3)); // then the settling decay
 }
 
 void GrainsLayer::process(const float* grf, float* out, int n) noexcept {
@@ -86,6 +101,9 @@ void GrainsLayer::processChunk(const float* grf, float* out, int n) noexcept {
     bool contactSeen = false;
     for (int i = 0; i < n; ++i) {
         const double f = sanitizeForce(grf[i]);
+        if (control_.heelRateHz > 0) // heel burst: starts at a landing, not at a cut (below)
+            heelAge_ = previousF_ <= threshold && f > threshold ? (f - previousF_ > kJumpN ? -1 : 0)
+                                                                : (f > threshold ? heelAge_ : -1);
         if (previousF_ <= threshold && f - previousF_ > kJumpN) {
             // No foot lands this fast: the GRF starts mid-stance (a file or walker starting in
             // the middle of a step). Take the load as already there: no landing, no rise.
@@ -111,6 +129,18 @@ void GrainsLayer::processChunk(const float* grf, float* out, int n) noexcept {
             double scale = load * (1.0 + control_.riseEnergy * rise / kDerivativeRefKnPerS);
             if (control_.energySaturation > 0) // soft saturation: linear below, bounded above
                 scale = control_.energySaturation * std::tanh(scale / control_.energySaturation);
+            if (heelAge_ >= 0) { // heel burst: one Poisson stream, rate-weighted energy scale
+                const double e = heelEnvelope();
+                const double heelRate = control_.heelRateHz * e;
+                double heelScale = control_.heelEnergy * e;
+                if (control_.energySaturation > 0)
+                    heelScale = control_.energySaturation *
+                                std::tanh(heelScale / control_.energySaturation);
+                const double base = static_cast<double>(rate_[u]);
+                if (base + heelRate > 0)
+                    scale = (base * scale + heelRate * heelScale) / (base + heelRate);
+                rate_[u] = static_cast<float>(base + heelRate);
+            }
             scale_[u] = static_cast<float>(scale);
             if (onsetArmed_ && f >= control_.onsetForceN) {
                 onsetArmed_ = false;
@@ -201,6 +231,20 @@ std::unique_ptr<SurfaceLayer> makeGrainsLayer(PresetReader& r, const AccuracyOpt
         r.number("lowpass_hz", 0.0, 0.0, 20000.0, "Hz", "tone: 2nd-order low-pass cutoff (0: off)");
     c.highpassHz =
         r.number("highpass_hz", 20.0, 0.0, 5000.0, "Hz", "2nd-order high-pass cutoff (0: off)");
+    c.heelRateHz = r.number(
+        "heel_rate_hz", 0.0, 0.0, 20000.0, "events/s",
+        "heel burst: extra events at the heel's impact, at most this rate at heel_ms after the "
+        "contact, rising as (t / heel_ms) exp(1 - t / heel_ms), then decaying with "
+        "heel_decay_ms: the sole's first impact crushes the most grains (0: none)");
+    c.heelMs = r.number("heel_ms", 15.0, 1.0, 200.0, "ms",
+                        "heel burst: time from the heel's contact to the burst's peak", true);
+    c.heelDecayMs = r.number("heel_decay_ms", 30.0, 1.0, 1000.0, "ms",
+                             "heel burst: decay time constant after its peak, exp(-(t - "
+                             "heel_ms) / heel_decay_ms) (the crushed bed settling)",
+                             true);
+    c.heelEnergy =
+        r.number("heel_energy", 1.0, 0.0, 100.0, "x energy scale at 1 kN",
+                 "heel burst: energy scale of its events at the peak (follows the same envelope)");
     if (c.lowpassHz > 0 && c.lowpassHz < 20) c.lowpassHz = 20; // a 0+ cutoff would mute everything
     return std::make_unique<GrainsLayer>(m, c, options);
 }

@@ -23,6 +23,19 @@
 /// walker makes more and stronger breaks, but the bed under the sole releases only so much
 /// energy at a time, so the layer's output stays below sqrt(resonances) x cap x gain for any
 /// load. 0 (the default): no bound.
+/// Heel burst (heel_rate_hz > 0; docs/realism.md "Heel-driven grains and several starts"): the
+/// heel's first impact crushes the most grains. The sole lands at its highest speed and stops
+/// within tens of ms, before the load has built up, so a bed of sand or dirt crushes and
+/// shifts most in the first 20-30 ms of the contact (recorded sand and dirt steps peak there)
+/// whatever the slower load curve does later. When the load first exceeds the contact
+/// threshold in a step, an envelope starts: e(t) = (t / T) exp(1 - t / T) up to its peak 1 at
+/// T = heel_ms, then exp(-(t - T) / D), D = heel_decay_ms (the crushed bed settling; it ends at
+/// T + 10 D). It adds heel_rate_hz x e(t) events/s whose energy
+/// scale is heel_energy x e(t) (saturated like the others by energy_saturation); the two
+/// streams are one Poisson process (rates add) whose energy scale is their rate-weighted mean.
+/// No random draw of its own, computed per sample: deterministic and block-size independent;
+/// bounded by amplitude_cap like every event. A load that appears mid-stance (a cut, above)
+/// starts no burst. heel_rate_hz = 0 (the default): exactly the process above.
 /// The sum of the voices goes through an optional 2nd-order Butterworth high-pass and low-pass
 /// (tone) and the layer gain.
 #include "engine/dsp/Biquad.h"
@@ -46,6 +59,10 @@ struct GrainsControl {
     double lowpassHz = 0.0;  ///< 0: off
     double highpassHz = 0.0; ///< 0: off
     double gainDb = 0.0;
+    double heelRateHz = 0.0;   ///< heel burst: peak extra event rate (0: no burst)
+    double heelMs = 15.0;      ///< heel burst: time from contact to its peak
+    double heelDecayMs = 30.0; ///< heel burst: decay time constant after the peak
+    double heelEnergy = 1.0;   ///< heel burst: energy scale of its events at the peak
 };
 
 class GrainsLayer final : public SurfaceLayer {
@@ -64,6 +81,8 @@ class GrainsLayer final : public SurfaceLayer {
 
   private:
     void processChunk(const float* grf, float* out, int n) noexcept;
+    /// Heel burst: the envelope at this sample (advances it); 0 when no burst runs.
+    double heelEnvelope() noexcept;
     AggregateModel model_;
     GrainsControl control_;
     int maxEventsPerSecond_;
@@ -77,6 +96,8 @@ class GrainsLayer final : public SurfaceLayer {
     bool onsetArmed_ = true;
     bool sleeping_ = true;
     int tailSamples_ = 0, tailLength_ = 0;
+    std::int64_t heelAge_ = -1; ///< samples since the heel burst started; -1: none running
+    std::int64_t heelEnd_ = 0;  ///< its length (heel_ms + 10 heel_decay_ms) in samples
 };
 
 /// Factory for the layer table: reads every parameter of a grains layer (with unit and range).

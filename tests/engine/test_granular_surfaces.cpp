@@ -263,15 +263,22 @@ TEST(GranularSurfaces, CalibratedToAboutMinus12DbfsPeak) {
 TEST(GranularSurfaces, SurfacesAreDistinctByTheNumbers) {
     const auto& f = allFigures();
     auto at = [&](const char* id) { return f.at(id); };
-    // Gravel: hard small stones, bright; sand: dull hiss (measured 3431 vs 1073 Hz).
+    // Gravel: hard small stones, bright; sand: a dull, low crunch (measured 3040 vs 371 Hz).
     EXPECT_GT(at("gravel").centroidHz, 2.0 * at("beach_sand").centroidHz);
-    // Deep snow: muffled and lower than both (measured 694 Hz).
+    // Deep snow: muffled, far lower than gravel (measured 440 Hz).
     EXPECT_LT(at("deep_snow").centroidHz, 0.4 * at("gravel").centroidHz);
-    EXPECT_LT(at("deep_snow").centroidHz, 0.8 * at("beach_sand").centroidHz);
-    // Snow crunches are cascades of fewer, larger breaks; gravel and sand are dense streams of
-    // small impacts (measured 589 vs 1277 and 964 events per step).
+    // Snow crunches are cascades of fewer, larger breaks; gravel is a dense stream of small
+    // impacts (measured 589 vs 1177 events per step).
     EXPECT_LT(at("deep_snow").eventsPerStep, 0.6 * at("gravel").eventsPerStep);
-    EXPECT_LT(at("deep_snow").eventsPerStep, 0.8 * at("beach_sand").eventsPerStep);
+    // Recorded sand steps are lower, sparser and shorter than recorded snow steps (`underfoot
+    // compare` medians: centroid 329 vs 558 Hz, 38 vs 61 grains/s; issue #13, docs/realism.md
+    // "Heel-driven grains and several starts"): sand's grains now come from the heel's impact
+    // alone, below deep snow (measured 371 vs 440 Hz, 59 vs 589 events per step, 0.00 vs 0.72
+    // of the step's energy after 0.2 s). Before, sand was the brighter, denser one (1073 vs
+    // 694 Hz, 964 vs 589 events), which the recordings contradict.
+    EXPECT_LT(at("beach_sand").centroidHz, at("deep_snow").centroidHz);
+    EXPECT_LT(at("beach_sand").eventsPerStep, 0.5 * at("deep_snow").eventsPerStep);
+    EXPECT_LT(at("beach_sand").lateShare + 0.3, at("deep_snow").lateShare);
     // Snow keeps compacting through the stance: more of its energy comes after the heel peak
     // (measured 0.71 vs 0.44 of the step's energy after 0.2 s; 0.87 vs 0.77 of the
     // walk within 20 dB of its loudest 10 ms).

@@ -11,6 +11,7 @@
 #include <toml++/toml.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -191,4 +192,60 @@ TEST_F(FitContrast, KeptKnobsStayAndUnknownOnesAreNamed) {
         EXPECT_NE(std::string(e.what()).find("grain_bandwidth"), std::string::npos) << e.what();
         EXPECT_NE(std::string(e.what()).find("grain_q"), std::string::npos) << e.what();
     }
+}
+
+// Several starts (FitOptions::starts, `underfoot fit --starts N`): the preset's own knobs and
+// N - 1 Sobol points of the knob box, each refined by BOBYQA; the best result is kept.
+TEST(FitStarts, ThePresetThenSobolPointsInsideTheBox) {
+    const std::vector<double> lo{-1.5, -2, -2, -12}, hi{1.5, 2, 1, 12};
+    const auto one = fitStartPoints(1, lo, hi);
+    ASSERT_EQ(one.size(), 1u);
+    EXPECT_EQ(one[0], std::vector<double>(4, 0.0));
+    const auto p = fitStartPoints(9, lo, hi);
+    ASSERT_EQ(p.size(), 9u);
+    EXPECT_EQ(p[0], std::vector<double>(4, 0.0));
+    EXPECT_EQ(p[1], (std::vector<double>{0.0, 0.0, -0.5, 0.0})); // Sobol's first: the centre
+    for (std::size_t i = 1; i < p.size(); ++i)
+        for (std::size_t k = 0; k < lo.size(); ++k) {
+            EXPECT_GE(p[i][k], lo[k]);
+            EXPECT_LT(p[i][k], hi[k]);
+            for (std::size_t j = 1; j < i; ++j) EXPECT_NE(p[i], p[j]);
+        }
+    // Each coordinate of the first 7 Sobol points (with the sequence's origin, a (0, 3, s)-net)
+    // falls in a different eighth of its range: the points spread over the whole box.
+    for (std::size_t k = 0; k < lo.size(); ++k) {
+        std::vector<int> cells(8, 0);
+        for (std::size_t i = 1; i < 8; ++i)
+            ++cells[static_cast<std::size_t>((p[i][k] - lo[k]) / (hi[k] - lo[k]) * 8)];
+        EXPECT_EQ(cells, (std::vector<int>{0, 1, 1, 1, 1, 1, 1, 1})) << "knob " << k;
+    }
+    EXPECT_EQ(fitStartPoints(9, lo, hi), p); // a fixed set
+    EXPECT_THROW(fitStartPoints(0, lo, hi), std::invalid_argument);
+    EXPECT_THROW(fitStartPoints(3, {0.5}, {1.0}), std::invalid_argument); // 0 outside the box
+}
+
+TEST_F(FitContrast, SeveralStartsAreDeterministicAndNoWorseThanOne) {
+    auto o = options(2.0);
+    o.maxEvaluations = 10;
+    const auto single = fitSurface(preset_, own_, o);
+    EXPECT_EQ(single.startPoints, 1);
+    EXPECT_EQ(single.presetText.find("[provenance.starts]"), std::string::npos);
+    o.starts = 3;
+    const auto multi = fitSurface(preset_, own_, o);
+    ASSERT_EQ(multi.startObjectives.size(), 3u);
+    ASSERT_EQ(single.startObjectives.size(), 1u);
+    EXPECT_LE(multi.evaluations, 30);
+    EXPECT_GT(multi.evaluations, single.evaluations);
+    // The first start is the single fit: the best of three is no worse.
+    EXPECT_EQ(multi.startObjectives[0], single.startObjectives[0]);
+    const auto bestIt =
+        std::min_element(multi.startObjectives.begin(), multi.startObjectives.end());
+    EXPECT_LE(*bestIt, single.startObjectives[0]);
+    EXPECT_EQ(bestIt - multi.startObjectives.begin(), multi.bestStartPoint);
+    const auto root = toml::parse(multi.presetText);
+    EXPECT_EQ(root["provenance"]["starts"]["points"].value<std::int64_t>().value_or(0), 3);
+    EXPECT_EQ(root["provenance"]["starts"]["best"].value<std::int64_t>().value_or(-1),
+              multi.bestStartPoint);
+    // Same preset text twice: the same fitted preset.
+    EXPECT_EQ(fitSurface(preset_, own_, o).presetText, multi.presetText);
 }
