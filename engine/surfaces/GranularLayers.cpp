@@ -59,6 +59,7 @@ void GrainsLayer::reset(std::uint64_t seed) noexcept {
     highpass_.reset();
     previousF_ = 0.0;
     derivative_ = 0.0;
+    contactPeakN_ = 0.0;
     onsetArmed_ = true;
     sleeping_ = true;
     tailSamples_ = 0;
@@ -117,7 +118,10 @@ void GrainsLayer::processChunk(const float* grf, float* out, int n) noexcept {
         if (f > threshold) {
             contactSeen = true;
             const double kn = f * 1e-3;
-            const double rise = std::max(derivative_, 0.0);
+            const double loadRise = std::max(derivative_, 0.0);
+            // Load memory: a load the layer has carried in this contact breaks nothing new.
+            const double rise = f >= control_.felicityRatio * contactPeakN_ ? loadRise : 0.0;
+            contactPeakN_ = std::max(contactPeakN_, f);
             const double fall = std::max(-derivative_, 0.0);
             rate_[u] = static_cast<float>(control_.eventsPerSecondPerKn * kn +
                                           control_.eventsPerKnRise * rise +
@@ -146,12 +150,13 @@ void GrainsLayer::processChunk(const float* grf, float* out, int n) noexcept {
                 onsetArmed_ = false;
                 if (control_.onsetEnergy > 0)
                     model_.trigger(control_.onsetEnergy *
-                                   std::clamp(rise / kDerivativeRefKnPerS, 0.1, 3.0));
+                                   std::clamp(loadRise / kDerivativeRefKnPerS, 0.1, 3.0));
             }
         } else {
             rate_[u] = 0.0f;
             scale_[u] = 0.0f;
             onsetArmed_ = true;
+            contactPeakN_ = 0.0;
         }
     }
     float* buffer = buffer_.data();
@@ -227,6 +232,12 @@ std::unique_ptr<SurfaceLayer> makeGrainsLayer(PresetReader& r, const AccuracyOpt
         r.number("derivative_ms", 5.0, 0.5, 50.0, "ms", "smoothing time constant of dF/dt", true);
     c.contactThresholdN = r.number("contact_threshold_n", 5.0, 0.5, 100.0, "N",
                                    "load below which the foot is off the ground (silence)", true);
+    c.felicityRatio = r.number(
+        "felicity_ratio", 0.0, 0.0, 1.0, "x contact's peak load",
+        "load memory: the rise terms (events_per_kn_rise, rise_energy) count only while the load "
+        "is at least this fraction of the highest load of the contact so far (a brittle crust "
+        "breaks only under a load it has not carried yet: the Kaiser effect; 0: every rise "
+        "counts)");
     c.lowpassHz =
         r.number("lowpass_hz", 0.0, 0.0, 20000.0, "Hz", "tone: 2nd-order low-pass cutoff (0: off)");
     c.highpassHz =

@@ -36,6 +36,12 @@
 /// No random draw of its own, computed per sample: deterministic and block-size independent;
 /// bounded by amplitude_cap like every event. A load that appears mid-stance (a cut, above)
 /// starts no burst. heel_rate_hz = 0 (the default): exactly the process above.
+/// Load memory (felicity_ratio R > 0): the two rise terms (events_per_kn_rise, rise_energy) count
+/// only while F >= R x the highest load of this contact so far. A brittle crust or bond breaks
+/// under a load it has not carried yet and is silent when reloaded below it (the Kaiser effect of
+/// acoustic emission; R is its Felicity ratio: 1 = strict, < 1 = it re-breaks a little before the
+/// old maximum). The memory is cleared when the foot leaves (F <= contact_threshold_n). 0 (the
+/// default): every load rise counts.
 /// The sum of the voices goes through an optional 2nd-order Butterworth high-pass and low-pass
 /// (tone) and the layer gain.
 #include "engine/dsp/Biquad.h"
@@ -63,6 +69,7 @@ struct GrainsControl {
     double heelMs = 15.0;      ///< heel burst: time from contact to its peak
     double heelDecayMs = 30.0; ///< heel burst: decay time constant after the peak
     double heelEnergy = 1.0;   ///< heel burst: energy scale of its events at the peak
+    double felicityRatio = 0.0; ///< rise terms only while F >= ratio x the contact's peak; 0: off
 };
 
 class GrainsLayer final : public SurfaceLayer {
@@ -93,6 +100,7 @@ class GrainsLayer final : public SurfaceLayer {
     bool useLowpass_ = false, useHighpass_ = false;
     std::vector<float> rate_, scale_, buffer_;
     double previousF_ = 0.0, derivative_ = 0.0;
+    double contactPeakN_ = 0.0; ///< highest load of this contact so far (felicity_ratio)
     bool onsetArmed_ = true;
     bool sleeping_ = true;
     int tailSamples_ = 0, tailLength_ = 0;

@@ -284,8 +284,9 @@ TEST(GranularSurfaces, SurfacesAreDistinctByTheNumbers) {
     // walk within 20 dB of its loudest 10 ms).
     EXPECT_GT(at("deep_snow").lateShare, at("gravel").lateShare + 0.15);
     EXPECT_GT(at("deep_snow").activeFraction, at("gravel").activeFraction + 0.05);
-    // Frozen snow is brighter and spikier than deep snow (measured 2069 vs 694 Hz, crest 22.5
-    // vs 19.2 dB).
+    // Frozen snow is brighter and spikier than deep snow: the heel's cracks of its crust
+    // (measured 947 vs 440 Hz, crest 24.7 vs 20.0 dB; 2069 Hz before its re-voicing against the
+    // snow recordings, docs/realism.md "Frozen snow: a crust that breaks").
     EXPECT_GT(at("frozen_snow").centroidHz, 2.0 * at("deep_snow").centroidHz);
     EXPECT_GT(at("frozen_snow").crestDb, at("deep_snow").crestDb + 1.0);
     // Dirt plus pebbles: mostly low earth (more power below 500 Hz than gravel and sparser).
