@@ -137,12 +137,14 @@ class WadingScene {
         Biquad splashHp, splashLp;
         double splashEnv = 0;
         double splashWait = 0;
-        Random random;
+        Random random;       // flow noise (per sample) and gurgle (per chunk)
+        Random splashRandom; // splash (its own stream: the draws do not interleave per block)
         Loop recording[kWadingLayerCount];
         Biquad eqLow, eqHigh;
         ControlRamp gain[kWadingLayerCount];
     };
     void applyFrame(const GaitFrame& frame) noexcept;
+    void chunkControls() noexcept; // at a chunk grid point: EQ coefficients, gurgle
     void renderChunk(float* left, float* right, int n) noexcept;
     void loadRecording(int layer, const std::string& path);
 
