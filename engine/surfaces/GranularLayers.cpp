@@ -95,9 +95,17 @@ void GrainsLayer::process(const float* grf, float* out, int n) noexcept {
 void GrainsLayer::processChunk(const float* grf, float* out, int n) noexcept {
     const double threshold = control_.contactThresholdN;
     if (sleeping_) {
-        int first = 0; // the layer wakes at the first sample in contact
-        while (first < n && !(sanitizeForce(grf[first]) > threshold)) ++first;
-        if (first > 0) previousF_ = sanitizeForce(grf[first - 1]);
+        // The layer wakes at the first sample in contact. Until then only the load's smoothed
+        // derivative is tracked (as awake), so a landing's rise is the same whenever it wakes.
+        const double toKnPerS = sampleRateHz_ * 1e-3;
+        int first = 0;
+        for (; first < n; ++first) {
+            const double f = sanitizeForce(grf[first]);
+            if (f > threshold) break;
+            const double raw = (f - previousF_) * toKnPerS;
+            previousF_ = f;
+            derivative_ = raw + derivativeG_ * (derivative_ - raw);
+        }
         if (first == n) return;
         sleeping_ = false;
         tailSamples_ = 0;
@@ -192,8 +200,8 @@ void GrainsLayer::processChunk(const float* grf, float* out, int n) noexcept {
 void GrainsLayer::sleepDecision() noexcept {
     const bool contactSeen = contactSinceGridPoint_;
     contactSinceGridPoint_ = false;
-    if (sleeping_) return;
     derivative_ = snapToZero(derivative_);
+    if (sleeping_) return;
     highpass_.snapTinyState();
     lowpass_.snapTinyState();
     if (!contactSeen && model_.idle()) {
@@ -201,8 +209,7 @@ void GrainsLayer::sleepDecision() noexcept {
         if (tailSamples_ >= tailLength_) { // rung out: sleep with clean state
             lowpass_.reset();
             highpass_.reset();
-            derivative_ = 0.0;
-            sleeping_ = true;
+            sleeping_ = true; // (the load's derivative is still tracked while asleep)
         }
     } else {
         tailSamples_ = 0;

@@ -89,9 +89,17 @@ void BubblesLayer::process(const float* grf, float* out, int n) noexcept {
 void BubblesLayer::processChunk(const float* grf, float* out, int n) noexcept {
     const double threshold = control_.contactThresholdN;
     if (sleeping_) {
-        int first = 0; // the layer wakes at the first sample in contact
-        while (first < n && !(sanitizeForce(grf[first]) > threshold)) ++first;
-        if (first > 0) previousF_ = sanitizeForce(grf[first - 1]);
+        // The layer wakes at the first sample in contact. Until then only the load's smoothed
+        // derivative is tracked (as awake), so a landing's rise is the same whenever it wakes.
+        const double toKnPerS = sampleRateHz_ * 1e-3;
+        int first = 0;
+        for (; first < n; ++first) {
+            const double f = sanitizeForce(grf[first]);
+            if (f > threshold) break;
+            const double raw = (f - previousF_) * toKnPerS;
+            previousF_ = f;
+            derivative_ = raw + derivativeG_ * (derivative_ - raw);
+        }
         if (first == n) return;
         sleeping_ = false;
         tailSamples_ = 0;
@@ -165,8 +173,8 @@ void BubblesLayer::processChunk(const float* grf, float* out, int n) noexcept {
 void BubblesLayer::sleepDecision() noexcept {
     const bool contactSeen = contactSinceGridPoint_;
     contactSinceGridPoint_ = false;
-    if (sleeping_) return;
     derivative_ = snapToZero(derivative_);
+    if (sleeping_) return;
     wakeEnv_ = snapToZero(wakeEnv_);
     splashEnv_ = snapToZero(splashEnv_);
     motionEnv_ = snapToZero(motionEnv_);
@@ -176,8 +184,8 @@ void BubblesLayer::sleepDecision() noexcept {
         if (tailSamples_ >= tailLength_) {
             splashFilter_.reset();
             sloshFilter_.reset();
-            wakeEnv_ = splashEnv_ = motionEnv_ = derivative_ = 0.0;
-            sleeping_ = true;
+            wakeEnv_ = splashEnv_ = motionEnv_ = 0.0;
+            sleeping_ = true; // (the load's derivative is still tracked while asleep)
         }
     } else {
         tailSamples_ = 0;
