@@ -19,7 +19,7 @@ namespace underfoot::engine {
 namespace fs = std::filesystem;
 
 namespace {
-constexpr int kChunk = 32; // control/EQ update granularity, samples
+constexpr int kChunk = WadingScene::kChunkSamples; // control/EQ update granularity, samples
 double dbToGain(double db) noexcept {
     return std::pow(10.0, db / 20.0);
 }
@@ -314,11 +314,10 @@ void WadingScene::reset(std::uint64_t seed) noexcept {
         v.bubbles.reset(Random::deriveSeed(seed, 20 + s));
         v.splashBubbles.reset(Random::deriveSeed(seed, 30 + s));
         v.random.setSeed(Random::deriveSeed(seed, 40 + s));
-        v.splashRandom.setSeed(Random::deriveSeed(seed, 50 + s));
         v.gurgle = v.gurgleTarget = 0;
         v.gurgleCountdown = 0;
         v.splashEnv = 0;
-        v.splashWait = v.splashRandom.exponential(preset_.splash.rateHz) * sampleRateHz_;
+        v.splashWait = v.random.exponential(preset_.splash.rateHz) * sampleRateHz_;
         for (auto& g : v.gain) g.reset(0.0);
         for (auto& r : v.recording)
             if (!r.samples.empty()) r.pos = (s == 1) ? r.samples.size() / 2 : 0;
@@ -364,7 +363,7 @@ void WadingScene::process(const TimedGaitFrame* frames, int frameCount, float* l
         const int phase = static_cast<int>((sample_ + pos) % kChunk);
         if (phase == 0) chunkControls();
         const int len = std::min(end - pos, kChunk - phase);
-        renderChunk(left + pos, right + pos, len);
+        renderChunk(left + pos, right + pos, len, phase);
         pos += len;
     }
     while (fi < frameCount) applyFrame(frames[fi++].frame); // offsets >= n: at the block's end
@@ -396,11 +395,12 @@ void WadingScene::chunkControls() noexcept {
                     1, static_cast<int>(v.random.exponential(f.gurgleHz) * sampleRateHz_ / kChunk));
             }
             v.gurgle = v.gurgleTarget + std::pow(gurgleG_, kChunk) * (v.gurgle - v.gurgleTarget);
+            for (auto& w : v.flowNoise) w = v.random.bipolar();
         }
     }
 }
 
-void WadingScene::renderChunk(float* left, float* right, int n) noexcept {
+void WadingScene::renderChunk(float* left, float* right, int n, int phase) noexcept {
     // Rate scale per sample; the EQ ramp advances here, its coefficients change per chunk.
     for (int i = 0; i < n; ++i) eqDb_.next();
     const auto& m = preset_.mapping;
@@ -429,8 +429,8 @@ void WadingScene::renderChunk(float* left, float* right, int n) noexcept {
         } else {
             const double noiseGain = flowNoiseGain_ * dbToGain(v.gurgle);
             for (int i = 0; i < n; ++i)
-                a[i] = static_cast<float>(
-                    noiseGain * v.flowLp.processSample(v.flowHp.processSample(v.random.bipolar())));
+                a[i] = static_cast<float>(noiseGain * v.flowLp.processSample(v.flowHp.processSample(
+                                                          v.flowNoise[phase + i])));
             std::fill(b, b + n, 0.0f);
             v.flowBubbles.process(flowRates, ones_.data(), b, n);
             for (int i = 0; i < n; ++i) a[i] += static_cast<float>(flowBubbleGain_ * b[i]);
@@ -453,14 +453,14 @@ void WadingScene::renderChunk(float* left, float* right, int n) noexcept {
                 for (int i = 0; i < n; ++i) {
                     v.splashWait -= 1.0;
                     while (v.splashWait <= 0.0) {
-                        v.splashEnv += v.splashRandom.uniform(0.5, 1.0);
-                        v.splashWait += v.splashRandom.exponential(sp.rateHz) * sampleRateHz_;
+                        v.splashEnv += v.random.uniform(0.5, 1.0);
+                        v.splashWait += v.random.exponential(sp.rateHz) * sampleRateHz_;
                     }
                     v.splashEnv = snapToZero(v.splashEnv * splashDecayG_);
                     splashRates[i] = static_cast<float>(splashBubbleRate * v.splashEnv);
-                    c[i] = static_cast<float>(splashNoiseGain_ * v.splashEnv *
-                                              v.splashLp.processSample(v.splashHp.processSample(
-                                                  v.splashRandom.bipolar())));
+                    c[i] = static_cast<float>(
+                        splashNoiseGain_ * v.splashEnv *
+                        v.splashLp.processSample(v.splashHp.processSample(v.random.bipolar())));
                 }
                 float tmp[kChunk];
                 std::fill(tmp, tmp + n, 0.0f);
