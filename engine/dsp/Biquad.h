@@ -46,8 +46,16 @@ class Biquad {
         z2_ = c_.b2 * x - c_.a2 * y;
         return y;
     }
+    /// Filters n samples in place, then snaps a tiny state to zero (snapTinyState). The snap at
+    /// the end of each call makes the output depend on how the signal is cut into calls: code
+    /// whose output must not depend on the host's block size calls processSample() and snaps
+    /// on a fixed grid (engine/dsp/SleepGrid.h).
     void process(float* data, int n) noexcept {
         for (int i = 0; i < n; ++i) data[i] = static_cast<float>(processSample(data[i]));
+        snapTinyState();
+    }
+    /// Sets a state below 1e-30 to zero (no denormals in the feedback).
+    void snapTinyState() noexcept {
         z1_ = snapToZero(z1_);
         z2_ = snapToZero(z2_);
     }
@@ -74,6 +82,9 @@ class Butterworth {
     }
     void process(float* data, int n) noexcept {
         for (auto& s : sections_) s.process(data, n);
+    }
+    void snapTinyState() noexcept {
+        for (auto& s : sections_) s.snapTinyState();
     }
     double magnitudeAt(double sampleRateHz, double frequencyHz) const;
     int sectionCount() const noexcept { return static_cast<int>(sections_.size()); }

@@ -90,6 +90,9 @@ void HuntCrossleyImpactT<Real>::reset() noexcept {
     inContact_ = false;
     awake_ = false;
     quietSamples_ = 0;
+    sleepGrid_.reset();
+    pushedSinceGridPoint_ = false;
+    peakSinceGridPoint_ = 0.0;
     stats_ = {};
     time_ = contactStart_ = 0;
 }
@@ -310,10 +313,28 @@ bool HuntCrossleyImpactT<Real>::step(double fextNow, double fextNext, bool abort
 
 template <typename Real>
 void HuntCrossleyImpactT<Real>::process(const float* fext, float* out, int n) noexcept {
+    sleepGrid_.split(n, [&](int offset, int length, bool atGridPoint) {
+        processSpan(fext ? fext + offset : nullptr, out + offset, length);
+        if (atGridPoint) sleepDecision();
+    });
+}
+
+template <typename Real>
+void HuntCrossleyImpactT<Real>::advanceAsleep(int n) noexcept {
+    sleepGrid_.split(n, [&](int, int, bool atGridPoint) {
+        if (atGridPoint) sleepDecision();
+    });
+}
+
+template <typename Real>
+void HuntCrossleyImpactT<Real>::processSpan(const float* fext, float* out, int n) noexcept {
     bool pushed = false;
     if (fext)
         for (int i = 0; i < n; ++i) pushed |= fext[i] != 0.0f;
+    pushedSinceGridPoint_ |= pushed;
     if (!awake_ && !pushed) {
+        // Asleep: the state is the reset state, which stays exactly at rest without a push (so
+        // waking at the start of this span or at its first push gives the same samples).
         std::fill(out, out + n, 0.0f);
         return;
     }
@@ -345,9 +366,20 @@ void HuntCrossleyImpactT<Real>::process(const float* fext, float* out, int n) no
         out[i] = static_cast<float>(y);
         peak = std::max(peak, std::fabs(y));
     }
+    peakSinceGridPoint_ = std::max(peakSinceGridPoint_, peak);
+}
+
+template <typename Real>
+void HuntCrossleyImpactT<Real>::sleepDecision() noexcept {
+    const bool pushed = pushedSinceGridPoint_;
+    const double peak = peakSinceGridPoint_;
+    pushedSinceGridPoint_ = false;
+    peakSinceGridPoint_ = 0.0;
+    if (!awake_) return;
     resonator_.flushTinyState();
     // Sleep when there is no contact, no push, the exciter is not approaching the floor and
-    // the floor rings below the sleep velocity (layers set it to -120 dBFS at their output).
+    // the floor rings below the sleep velocity (layers set it to -120 dBFS at their output),
+    // judged over the grid span that ends here.
     const bool separating = exciterV_ - resonator_.contactVelocity() <= 1e-9;
     const bool still = !inContact_ && !pushed && separating &&
                        resonator_.peakModalVelocity() < sleepVelocity_ && peak < sleepVelocity_;

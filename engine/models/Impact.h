@@ -19,6 +19,7 @@
 /// discrete contact would create energy. The explicit variant computes the force from the state at
 /// n, as the Sound Design Toolkit does. Work per sample is bounded by the iteration cap.
 #include "engine/dsp/Biquad.h"
+#include "engine/dsp/SleepGrid.h"
 #include "engine/models/ModalResonator.h"
 
 #include <vector>
@@ -82,8 +83,13 @@ class HuntCrossleyImpactT {
     }
 
     /// Processes n samples: `externalForceN` (may be null = 0) pushes the exciter towards the
-    /// floor; writes the listen pickup's velocity (m/s) into `out` (overwrites).
+    /// floor; writes the listen pickup's velocity (m/s) into `out` (overwrites). Falling asleep
+    /// is decided on the sleep grid (engine/dsp/SleepGrid.h), so the output does not depend on
+    /// how the samples are cut into calls.
     void process(const float* externalForceN, float* out, int n) noexcept;
+    /// n samples of silence while asleep with no push (what process() would do, without the
+    /// output): keeps the sleep grid counting. Call only when isSleeping().
+    void advanceAsleep(int n) noexcept;
 
     /// Output velocity (m/s) below which a free, untouched floor is considered silent.
     void setSleepVelocity(double v) noexcept { sleepVelocity_ = v; }
@@ -107,6 +113,8 @@ class HuntCrossleyImpactT {
     bool step(double fextNow, double fextNext, bool abortOnContact, double& y) noexcept;
     void setFineRate(bool fine) noexcept;
     double solveForce(double ch, double dh) noexcept; // contact force at n+1
+    void processSpan(const float* externalForceN, float* out, int n) noexcept;
+    void sleepDecision() noexcept; // at a grid point
 
     ImpactParams params_;
     ModalResonatorT<Real> resonator_;
@@ -116,6 +124,9 @@ class HuntCrossleyImpactT {
     double contactEnergy_ = 0; // work absorbed by the open contact and not yet returned, J
     bool inContact_ = false, awake_ = false;
     int quietSamples_ = 0;
+    SleepGrid sleepGrid_;               // sleep decided on a fixed grid from reset
+    bool pushedSinceGridPoint_ = false; // an external force since the last grid point
+    double peakSinceGridPoint_ = 0.0;   // largest |output| since the last grid point
     double sleepVelocity_ = 1e-10;
     double kc_ = 0, kd_ = 0; // instantaneous compliance and mobility of the compression
     // Per-step constants of the current rate (setFineRate) and the contact law's (prepare).

@@ -63,6 +63,8 @@ void GrainsLayer::reset(std::uint64_t seed) noexcept {
     onsetArmed_ = true;
     sleeping_ = true;
     tailSamples_ = 0;
+    sleepGrid_.reset();
+    contactSinceGridPoint_ = false;
     heelAge_ = -1;
 }
 
@@ -81,25 +83,42 @@ double GrainsLayer::heelEnvelope() noexcept {
 void GrainsLayer::process(const float* grf, float* out, int n) noexcept {
     const int block = static_cast<int>(buffer_.size());
     if (block == 0) return; // not prepared
-    for (int done = 0; done < n; done += block)
-        processChunk(grf + done, out + done, std::min(block, n - done));
+    // Sleep is decided on the sleep grid, waking at the first sample in contact: the output does
+    // not depend on the host's block size (engine/dsp/SleepGrid.h).
+    sleepGrid_.split(n, [&](int offset, int length, bool atGridPoint) {
+        for (int done = 0; done < length; done += block)
+            processChunk(grf + offset + done, out + offset + done, std::min(block, length - done));
+        if (atGridPoint) sleepDecision();
+    });
 }
 
 void GrainsLayer::processChunk(const float* grf, float* out, int n) noexcept {
     const double threshold = control_.contactThresholdN;
     if (sleeping_) {
-        bool contact = false;
-        for (int i = 0; i < n && !contact; ++i) contact = sanitizeForce(grf[i]) > threshold;
-        if (!contact) {
-            previousF_ = sanitizeForce(grf[n - 1]);
-            return;
+        // The layer wakes at the first sample in contact. Until then only the load's smoothed
+        // derivative is tracked (as awake), so a landing's rise is the same whenever it wakes.
+        const double toKnPerS = sampleRateHz_ * 1e-3;
+        int first = 0;
+        for (; first < n; ++first) {
+            const double f = sanitizeForce(grf[first]);
+            if (f > threshold) break;
+            const double raw = (f - previousF_) * toKnPerS;
+            previousF_ = f;
+            derivative_ = raw + derivativeG_ * (derivative_ - raw);
         }
+        if (first == n) return;
         sleeping_ = false;
         tailSamples_ = 0;
+        grf += first;
+        out += first;
+        n -= first;
     }
     const double toKnPerS = sampleRateHz_ * 1e-3;
     const double g = derivativeG_;
     bool contactSeen = false;
+    float* buffer = buffer_.data();
+    std::fill(buffer, buffer + n, 0.0f);
+    int modelDone = 0; // samples the model has run
     for (int i = 0; i < n; ++i) {
         const double f = sanitizeForce(grf[i]);
         if (control_.heelRateHz > 0) // heel burst: starts at a landing, not at a cut (below)
@@ -148,9 +167,14 @@ void GrainsLayer::processChunk(const float* grf, float* out, int n) noexcept {
             scale_[u] = static_cast<float>(scale);
             if (onsetArmed_ && f >= control_.onsetForceN) {
                 onsetArmed_ = false;
-                if (control_.onsetEnergy > 0)
+                if (control_.onsetEnergy > 0) {
+                    // The onset event starts at this sample: run the model up to it first.
+                    model_.process(rate_.data() + modelDone, scale_.data() + modelDone,
+                                   buffer + modelDone, i - modelDone);
+                    modelDone = i;
                     model_.trigger(control_.onsetEnergy *
                                    std::clamp(loadRise / kDerivativeRefKnPerS, 0.1, 3.0));
+                }
             }
         } else {
             rate_[u] = 0.0f;
@@ -159,21 +183,33 @@ void GrainsLayer::processChunk(const float* grf, float* out, int n) noexcept {
             contactPeakN_ = 0.0;
         }
     }
-    float* buffer = buffer_.data();
-    std::fill(buffer, buffer + n, 0.0f);
-    model_.process(rate_.data(), scale_.data(), buffer, n);
-    if (useHighpass_) highpass_.process(buffer, n);
-    if (useLowpass_) lowpass_.process(buffer, n);
+    model_.process(rate_.data() + modelDone, scale_.data() + modelDone, buffer + modelDone,
+                   n - modelDone);
+    // (sample by sample: the filters' tiny state is snapped on the sleep grid, not per call)
+    if (useHighpass_)
+        for (int i = 0; i < n; ++i)
+            buffer[i] = static_cast<float>(highpass_.processSample(buffer[i]));
+    if (useLowpass_)
+        for (int i = 0; i < n; ++i)
+            buffer[i] = static_cast<float>(lowpass_.processSample(buffer[i]));
     const float gain = static_cast<float>(gain_);
     for (int i = 0; i < n; ++i) out[i] += gain * buffer[i];
+    contactSinceGridPoint_ |= contactSeen;
+}
+
+void GrainsLayer::sleepDecision() noexcept {
+    const bool contactSeen = contactSinceGridPoint_;
+    contactSinceGridPoint_ = false;
     derivative_ = snapToZero(derivative_);
+    if (sleeping_) return;
+    highpass_.snapTinyState();
+    lowpass_.snapTinyState();
     if (!contactSeen && model_.idle()) {
-        tailSamples_ += n;
+        tailSamples_ += kSleepGridSamples; // (awake for the whole span: no contact in it)
         if (tailSamples_ >= tailLength_) { // rung out: sleep with clean state
             lowpass_.reset();
             highpass_.reset();
-            derivative_ = 0.0;
-            sleeping_ = true;
+            sleeping_ = true; // (the load's derivative is still tracked while asleep)
         }
     } else {
         tailSamples_ = 0;

@@ -45,6 +45,7 @@
 /// The sum of the voices goes through an optional 2nd-order Butterworth high-pass and low-pass
 /// (tone) and the layer gain.
 #include "engine/dsp/Biquad.h"
+#include "engine/dsp/SleepGrid.h"
 #include "engine/models/Aggregate.h"
 #include "engine/surfaces/Layer.h"
 
@@ -65,10 +66,10 @@ struct GrainsControl {
     double lowpassHz = 0.0;  ///< 0: off
     double highpassHz = 0.0; ///< 0: off
     double gainDb = 0.0;
-    double heelRateHz = 0.0;   ///< heel burst: peak extra event rate (0: no burst)
-    double heelMs = 15.0;      ///< heel burst: time from contact to its peak
-    double heelDecayMs = 30.0; ///< heel burst: decay time constant after the peak
-    double heelEnergy = 1.0;   ///< heel burst: energy scale of its events at the peak
+    double heelRateHz = 0.0;    ///< heel burst: peak extra event rate (0: no burst)
+    double heelMs = 15.0;       ///< heel burst: time from contact to its peak
+    double heelDecayMs = 30.0;  ///< heel burst: decay time constant after the peak
+    double heelEnergy = 1.0;    ///< heel burst: energy scale of its events at the peak
     double felicityRatio = 0.0; ///< rise terms only while F >= ratio x the contact's peak; 0: off
 };
 
@@ -90,6 +91,7 @@ class GrainsLayer final : public SurfaceLayer {
     void processChunk(const float* grf, float* out, int n) noexcept;
     /// Heel burst: the envelope at this sample (advances it); 0 when no burst runs.
     double heelEnvelope() noexcept;
+    void sleepDecision() noexcept; // at a sleep grid point (engine/dsp/SleepGrid.h)
     AggregateModel model_;
     GrainsControl control_;
     int maxEventsPerSecond_;
@@ -106,6 +108,8 @@ class GrainsLayer final : public SurfaceLayer {
     int tailSamples_ = 0, tailLength_ = 0;
     std::int64_t heelAge_ = -1; ///< samples since the heel burst started; -1: none running
     std::int64_t heelEnd_ = 0;  ///< its length (heel_ms + 10 heel_decay_ms) in samples
+    SleepGrid sleepGrid_;
+    bool contactSinceGridPoint_ = false;
 };
 
 /// Factory for the layer table: reads every parameter of a grains layer (with unit and range).

@@ -70,26 +70,42 @@ void BubblesLayer::reset(std::uint64_t seed) noexcept {
     splashEnv_ = wakeEnv_ = motionEnv_ = 0.0;
     sleeping_ = true;
     tailSamples_ = 0;
+    sleepGrid_.reset();
+    contactSinceGridPoint_ = false;
 }
 
 void BubblesLayer::process(const float* grf, float* out, int n) noexcept {
     const int block = static_cast<int>(buffer_.size());
     if (block == 0) return;
-    for (int done = 0; done < n; done += block)
-        processChunk(grf + done, out + done, std::min(block, n - done));
+    // Sleep is decided on the sleep grid, waking at the first sample in contact: the output does
+    // not depend on the host's block size (engine/dsp/SleepGrid.h).
+    sleepGrid_.split(n, [&](int offset, int length, bool atGridPoint) {
+        for (int done = 0; done < length; done += block)
+            processChunk(grf + offset + done, out + offset + done, std::min(block, length - done));
+        if (atGridPoint) sleepDecision();
+    });
 }
 
 void BubblesLayer::processChunk(const float* grf, float* out, int n) noexcept {
     const double threshold = control_.contactThresholdN;
     if (sleeping_) {
-        bool contact = false;
-        for (int i = 0; i < n && !contact; ++i) contact = sanitizeForce(grf[i]) > threshold;
-        if (!contact) {
-            previousF_ = sanitizeForce(grf[n - 1]);
-            return;
+        // The layer wakes at the first sample in contact. Until then only the load's smoothed
+        // derivative is tracked (as awake), so a landing's rise is the same whenever it wakes.
+        const double toKnPerS = sampleRateHz_ * 1e-3;
+        int first = 0;
+        for (; first < n; ++first) {
+            const double f = sanitizeForce(grf[first]);
+            if (f > threshold) break;
+            const double raw = (f - previousF_) * toKnPerS;
+            previousF_ = f;
+            derivative_ = raw + derivativeG_ * (derivative_ - raw);
         }
+        if (first == n) return;
         sleeping_ = false;
         tailSamples_ = 0;
+        grf += first;
+        out += first;
+        n -= first;
     }
     const double toKnPerS = sampleRateHz_ * 1e-3;
     bool contactSeen = false;
@@ -151,18 +167,25 @@ void BubblesLayer::processChunk(const float* grf, float* out, int n) noexcept {
     stream_.process(rate_.data(), scale_.data(), buffer, n);
     const float gain = static_cast<float>(gain_);
     for (int i = 0; i < n; ++i) out[i] += gain * buffer[i];
+    contactSinceGridPoint_ |= contactSeen;
+}
+
+void BubblesLayer::sleepDecision() noexcept {
+    const bool contactSeen = contactSinceGridPoint_;
+    contactSinceGridPoint_ = false;
     derivative_ = snapToZero(derivative_);
+    if (sleeping_) return;
     wakeEnv_ = snapToZero(wakeEnv_);
     splashEnv_ = snapToZero(splashEnv_);
     motionEnv_ = snapToZero(motionEnv_);
     const bool quiet = wakeEnv_ < kQuiet && splashEnv_ < kQuiet && motionEnv_ < kQuiet;
     if (!contactSeen && quiet && stream_.idle()) {
-        tailSamples_ += n;
+        tailSamples_ += kSleepGridSamples; // (awake for the whole span: no contact in it)
         if (tailSamples_ >= tailLength_) {
             splashFilter_.reset();
             sloshFilter_.reset();
-            wakeEnv_ = splashEnv_ = motionEnv_ = derivative_ = 0.0;
-            sleeping_ = true;
+            wakeEnv_ = splashEnv_ = motionEnv_ = 0.0;
+            sleeping_ = true; // (the load's derivative is still tracked while asleep)
         }
     } else {
         tailSamples_ = 0;

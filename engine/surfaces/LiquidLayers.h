@@ -23,6 +23,7 @@
 /// With the GRF at zero from reset the layer is silent and sleeps; after a step it sleeps again
 /// once the bubbles, the wake and the noise have decayed.
 #include "engine/dsp/Biquad.h"
+#include "engine/dsp/SleepGrid.h"
 #include "engine/models/Bubbles.h"
 #include "engine/surfaces/Layer.h"
 
@@ -59,6 +60,7 @@ class BubblesLayer final : public SurfaceLayer {
 
   private:
     void processChunk(const float* grf, float* out, int n) noexcept;
+    void sleepDecision() noexcept; // at a sleep grid point (engine/dsp/SleepGrid.h)
     BubbleStream stream_;
     BubblesControl control_;
     int maxEventsPerSecond_;
@@ -75,6 +77,8 @@ class BubblesLayer final : public SurfaceLayer {
     double splashEnv_ = 0, wakeEnv_ = 0, motionEnv_ = 0;
     bool sleeping_ = true;
     int tailSamples_ = 0, tailLength_ = 0;
+    SleepGrid sleepGrid_;
+    bool contactSinceGridPoint_ = false;
 };
 
 std::unique_ptr<SurfaceLayer> makeBubblesLayer(PresetReader& reader,

@@ -11,6 +11,7 @@
 
 #include "engine/dsp/Envelope.h"
 #include "engine/dsp/Random.h"
+#include "engine/dsp/SleepGrid.h"
 #include "engine/models/Friction.h"
 #include "engine/models/Impact.h"
 
@@ -204,7 +205,10 @@ class ImpactLayer final : public SurfaceLayer {
                 start = i;
             }
         }
-        if (!anyLoad && impact_.isSleeping()) return; // nothing to do
+        if (!anyLoad && impact_.isSleeping()) { // nothing to do (the sleep grid still counts)
+            impact_.advanceAsleep(n - start);
+            return;
+        }
         run(start, n, out);
     }
     bool isSleeping() const noexcept override { return impact_.isSleeping(); }
@@ -274,8 +278,23 @@ class FrictionLayer final : public SurfaceLayer {
         friction_.reset(seed);
         last_ = rate_ = anchor_ = 0;
         quiet_ = 1 << 30;
+        sleepGrid_.reset();
     }
     void process(const float* grf, float* out, int n) noexcept override {
+        // The resonator's tiny state is flushed on the sleep grid (engine/dsp/SleepGrid.h), not
+        // at the end of each host block: the flush changes the next samples' last bits.
+        sleepGrid_.split(n, [&](int offset, int length, bool atGridPoint) {
+            processSpan(grf + offset, out + offset, length);
+            if (atGridPoint) friction_.resonator().flushTinyState();
+        });
+    }
+    bool isSleeping() const noexcept override {
+        return quiet_ > static_cast<long>(0.05 * fs_) && std::fabs(rate_) <= threshold_;
+    }
+    const char* kind() const noexcept override { return "friction"; }
+
+  private:
+    void processSpan(const float* grf, float* out, int n) noexcept {
         const float g = static_cast<float>(gain_);
         for (int i = 0; i < n; ++i) {
             const double load = std::max(0.0f, grf[i]);
@@ -300,15 +319,9 @@ class FrictionLayer final : public SurfaceLayer {
             const bool still = load <= 0.0 || std::fabs(friction_.relativeVelocity()) < 1e-6;
             quiet_ = (std::fabs(y) < sleepVelocity_ && still) ? quiet_ + 1 : 0;
         }
-        friction_.resonator().flushTinyState();
     }
-    bool isSleeping() const noexcept override {
-        return quiet_ > static_cast<long>(0.05 * fs_) && std::fabs(rate_) <= threshold_;
-    }
-    const char* kind() const noexcept override { return "friction"; }
-
-  private:
     ElastoPlasticFriction friction_;
+    SleepGrid sleepGrid_;
     double normalFraction_, driveStiffness_, driveDamping_, slipPerRate_, threshold_, gain_;
     double fs_ = 48000, smooth_ = 0, last_ = 0, rate_ = 0, anchor_ = 0, sleepVelocity_ = 1e-7;
     long quiet_ = 1 << 30;

@@ -19,7 +19,7 @@ namespace underfoot::engine {
 namespace fs = std::filesystem;
 
 namespace {
-constexpr int kChunk = 32; // control/EQ update granularity, samples
+constexpr int kChunk = WadingScene::kChunkSamples; // control/EQ update granularity, samples
 double dbToGain(double db) noexcept {
     return std::pow(10.0, db / 20.0);
 }
@@ -357,21 +357,53 @@ void WadingScene::process(const TimedGaitFrame* frames, int frameCount, float* l
         while (fi < frameCount && frames[fi].offset <= pos) applyFrame(frames[fi++].frame);
         int end = n;
         if (fi < frameCount) end = std::min(n, std::max(pos + 1, frames[fi].offset));
-        const int len = std::min(end - pos, kChunk);
-        renderChunk(left + pos, right + pos, len);
+        // The chunk controls are decided on a fixed grid of kChunk samples counted from reset,
+        // never where a host block starts, so the output does not depend on the block size
+        // (issue #18); a frame still takes effect at its own sample (the per-sample ramps).
+        const int phase = static_cast<int>((sample_ + pos) % kChunk);
+        if (phase == 0) chunkControls();
+        const int len = std::min(end - pos, kChunk - phase);
+        renderChunk(left + pos, right + pos, len, phase);
         pos += len;
     }
     while (fi < frameCount) applyFrame(frames[fi++].frame); // offsets >= n: at the block's end
     sample_ += n;
 }
 
-void WadingScene::renderChunk(float* left, float* right, int n) noexcept {
-    // EQ gain for this chunk (the C1 bands), rate scale per sample.
-    double eq = eqDb_.value();
-    for (int i = 0; i < n; ++i) eq = eqDb_.next();
+void WadingScene::chunkControls() noexcept {
+    // EQ gain of the next kChunk samples (the C1 bands): the ramp's value at the chunk's end,
+    // as far as the frames known now take it.
+    ControlRamp ahead = eqDb_;
+    double eq = ahead.value();
+    for (int i = 0; i < kChunk; ++i) eq = ahead.next();
     const auto& m = preset_.mapping;
     const bool eqChanged = std::fabs(eq - currentEqDb_) > 0.01;
     if (eqChanged) currentEqDb_ = eq;
+    const auto& f = preset_.flowing;
+    for (std::size_t s = 0; s < 2; ++s) {
+        Voice& v = voices_[s];
+        if (eqChanged) {
+            v.eqLow.setCoefficients(BiquadCoefficients::peaking(
+                sampleRateHz_, std::min(m.eqLowHz, 0.45 * sampleRateHz_), m.eqQ, eq));
+            v.eqHigh.setCoefficients(BiquadCoefficients::peaking(
+                sampleRateHz_, std::min(m.eqHighHz, 0.45 * sampleRateHz_), m.eqQ, eq));
+        }
+        if (v.recording[0].samples.empty()) { // the flow's gurgle, per chunk
+            if (--v.gurgleCountdown <= 0) {
+                v.gurgleTarget = f.gurgleDepthDb * (v.random.uniform() - 0.5);
+                v.gurgleCountdown = std::max(
+                    1, static_cast<int>(v.random.exponential(f.gurgleHz) * sampleRateHz_ / kChunk));
+            }
+            v.gurgle = v.gurgleTarget + std::pow(gurgleG_, kChunk) * (v.gurgle - v.gurgleTarget);
+            for (auto& w : v.flowNoise) w = v.random.bipolar();
+        }
+    }
+}
+
+void WadingScene::renderChunk(float* left, float* right, int n, int phase) noexcept {
+    // Rate scale per sample; the EQ ramp advances here, its coefficients change per chunk.
+    for (int i = 0; i < n; ++i) eqDb_.next();
+    const auto& m = preset_.mapping;
     const double bubbleRate =
         algorithm_ == WadingAlgorithm::V1 ? m.v1BubbleRateHz : preset_.bubbling.rateHz;
     for (int i = 0; i < n; ++i)
@@ -391,26 +423,14 @@ void WadingScene::renderChunk(float* left, float* right, int n) noexcept {
     std::fill(flowRates, flowRates + n, flowRate);
     for (std::size_t s = 0; s < 2; ++s) {
         Voice& v = voices_[s];
-        if (eqChanged) {
-            v.eqLow.setCoefficients(BiquadCoefficients::peaking(
-                sampleRateHz_, std::min(m.eqLowHz, 0.45 * sampleRateHz_), m.eqQ, eq));
-            v.eqHigh.setCoefficients(BiquadCoefficients::peaking(
-                sampleRateHz_, std::min(m.eqHighHz, 0.45 * sampleRateHz_), m.eqQ, eq));
-        }
         // Flowing.
         if (!v.recording[0].samples.empty()) {
             for (int i = 0; i < n; ++i) a[i] = v.recording[0].next();
         } else {
-            if (--v.gurgleCountdown <= 0) {
-                v.gurgleTarget = f.gurgleDepthDb * (v.random.uniform() - 0.5);
-                v.gurgleCountdown = std::max(
-                    1, static_cast<int>(v.random.exponential(f.gurgleHz) * sampleRateHz_ / kChunk));
-            }
-            v.gurgle = v.gurgleTarget + std::pow(gurgleG_, n) * (v.gurgle - v.gurgleTarget);
             const double noiseGain = flowNoiseGain_ * dbToGain(v.gurgle);
             for (int i = 0; i < n; ++i)
-                a[i] = static_cast<float>(
-                    noiseGain * v.flowLp.processSample(v.flowHp.processSample(v.random.bipolar())));
+                a[i] = static_cast<float>(noiseGain * v.flowLp.processSample(v.flowHp.processSample(
+                                                          v.flowNoise[phase + i])));
             std::fill(b, b + n, 0.0f);
             v.flowBubbles.process(flowRates, ones_.data(), b, n);
             for (int i = 0; i < n; ++i) a[i] += static_cast<float>(flowBubbleGain_ * b[i]);

@@ -94,6 +94,8 @@ struct TimedGaitFrame {
 
 class WadingScene {
   public:
+    /// Control/EQ update granularity: chunks on a fixed grid of this many samples from reset.
+    static constexpr int kChunkSamples = 32;
     /// Sets preset, algorithm and filter (allocates; throws on bad settings).
     void configure(const WadingPreset& preset, WadingAlgorithm algorithm, GyroFilter filter);
     /// Allocates voices and scratch buffers, loads recordings (throws FileError).
@@ -138,12 +140,17 @@ class WadingScene {
         double splashEnv = 0;
         double splashWait = 0;
         Random random;
+        // The flow noise of the current chunk, drawn at its grid point (before the splash's
+        // draws of the chunk, as when chunks were rendered whole), so the random sequence does
+        // not depend on how host blocks cut the chunk.
+        std::array<double, kChunkSamples> flowNoise{};
         Loop recording[kWadingLayerCount];
         Biquad eqLow, eqHigh;
         ControlRamp gain[kWadingLayerCount];
     };
     void applyFrame(const GaitFrame& frame) noexcept;
-    void renderChunk(float* left, float* right, int n) noexcept;
+    void chunkControls() noexcept; // at a chunk grid point: EQ coefficients, gurgle
+    void renderChunk(float* left, float* right, int n, int phase) noexcept;
     void loadRecording(int layer, const std::string& path);
 
     WadingPreset preset_;
