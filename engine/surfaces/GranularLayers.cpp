@@ -2,6 +2,7 @@
 #include "engine/surfaces/GranularLayers.h"
 
 #include "engine/dsp/Envelope.h"
+#include "engine/surfaces/LoadInput.h"
 
 #include <algorithm>
 #include <cmath>
@@ -10,17 +11,10 @@
 namespace underfoot::engine {
 
 namespace {
-constexpr double kMaxForceN = 1e5;    // GRF beyond this is clamped (no human produces it)
 constexpr double kTailSeconds = 0.25; // filters ring out this long before the layer sleeps
 constexpr double kDerivativeRefKnPerS = 10.0;
 constexpr double kJumpN = 100.0; // a rise from no contact by more than this in one sample is a cut
 
-/// GRF sample -> newtons, with NaN/Inf/negative read as 0 (no contact).
-inline double sanitizeForce(float v) noexcept {
-    const double f = static_cast<double>(v);
-    if (!(f > 0.0)) return 0.0;
-    return std::min(f, kMaxForceN);
-}
 } // namespace
 
 GrainsLayer::GrainsLayer(const AggregateParameters& model, const GrainsControl& control,
@@ -97,15 +91,8 @@ void GrainsLayer::processChunk(const float* grf, float* out, int n) noexcept {
     if (sleeping_) {
         // The layer wakes at the first sample in contact. Until then only the load's smoothed
         // derivative is tracked (as awake), so a landing's rise is the same whenever it wakes.
-        const double toKnPerS = sampleRateHz_ * 1e-3;
-        int first = 0;
-        for (; first < n; ++first) {
-            const double f = sanitizeForce(grf[first]);
-            if (f > threshold) break;
-            const double raw = (f - previousF_) * toKnPerS;
-            previousF_ = f;
-            derivative_ = raw + derivativeG_ * (derivative_ - raw);
-        }
+        const int first = trackLoadUntilContact(grf, n, threshold, sampleRateHz_ * 1e-3,
+                                                derivativeG_, previousF_, derivative_);
         if (first == n) return;
         sleeping_ = false;
         tailSamples_ = 0;

@@ -2,6 +2,7 @@
 #include "engine/surfaces/LiquidLayers.h"
 
 #include "engine/dsp/Envelope.h"
+#include "engine/surfaces/LoadInput.h"
 
 #include <algorithm>
 #include <cmath>
@@ -10,7 +11,6 @@
 namespace underfoot::engine {
 
 namespace {
-constexpr double kMaxForceN = 1e5;
 constexpr double kTailSeconds = 0.1;
 constexpr double kDerivativeRefKnPerS = 10.0;
 constexpr double kJumpN = 100.0;  // a rise from no contact by more than this in one sample is a cut
@@ -18,11 +18,6 @@ constexpr double kQuiet = 1e-6;   // envelopes below this are silent
 constexpr double kOffDb = -120.0; // noise levels at or below this are off
 constexpr double kWakeEnd = 1e-3; // the wake envelope ends 60 dB below its nominal start
 
-inline double sanitizeForce(float v) noexcept {
-    const double f = static_cast<double>(v);
-    if (!(f > 0.0)) return 0.0;
-    return std::min(f, kMaxForceN);
-}
 } // namespace
 
 BubblesLayer::BubblesLayer(const BubbleStreamParameters& stream, const BubblesControl& control,
@@ -91,15 +86,8 @@ void BubblesLayer::processChunk(const float* grf, float* out, int n) noexcept {
     if (sleeping_) {
         // The layer wakes at the first sample in contact. Until then only the load's smoothed
         // derivative is tracked (as awake), so a landing's rise is the same whenever it wakes.
-        const double toKnPerS = sampleRateHz_ * 1e-3;
-        int first = 0;
-        for (; first < n; ++first) {
-            const double f = sanitizeForce(grf[first]);
-            if (f > threshold) break;
-            const double raw = (f - previousF_) * toKnPerS;
-            previousF_ = f;
-            derivative_ = raw + derivativeG_ * (derivative_ - raw);
-        }
+        const int first = trackLoadUntilContact(grf, n, threshold, sampleRateHz_ * 1e-3,
+                                                derivativeG_, previousF_, derivative_);
         if (first == n) return;
         sleeping_ = false;
         tailSamples_ = 0;
