@@ -125,7 +125,21 @@ AudioBuffer readAudioFile(const std::string& path, double targetRateHz) {
                                     "would be {:.0f} samples; expected at most {}",
                                     path, in.frames(), in.channels, in.sampleRateHz, targetRateHz,
                                     resampled, kMaxAudioFileSamples));
-    return resample(in, targetRateHz);
+    AudioBuffer out = resample(in, targetRateHz);
+    // Finite samples near the float range (a damaged float file) can overflow in the
+    // resampler's filter sums: refused, naming the largest input sample (found by
+    // fuzz_audio_file; regression input
+    // tests/fuzz/regressions/audio_file/resample_overflow_huge_float_2000hz.wav).
+    if (!std::all_of(out.samples.begin(), out.samples.end(),
+                     [](float v) { return std::isfinite(v); })) {
+        float largest = 0.0f;
+        for (float v : in.samples) largest = std::max(largest, std::fabs(v));
+        throw FileError(fmt::format("{}: resampling {} Hz to {} Hz overflows (largest sample "
+                                    "{:g}); expected audio samples of a sensible magnitude "
+                                    "(full scale is 1)",
+                                    path, in.sampleRateHz, targetRateHz, largest));
+    }
+    return out;
 }
 
 AudioBuffer resample(const AudioBuffer& in, double targetRateHz) {

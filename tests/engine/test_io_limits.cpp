@@ -115,6 +115,36 @@ TEST(IoLimits, AudioFileTooSlowToResampleIsRefusedNamingTheFile) {
     EXPECT_EQ(a.frames(), 3072u);
 }
 
+TEST(IoLimits, FloatSamplesThatOverflowTheResamplerAreRefusedNamingTheFile) {
+    // Found by fuzz_audio_file: a 32-bit float WAV at 2 kHz whose finite samples lie near the
+    // float range; resampled to 48 kHz, the filter's sums overflowed to infinity.
+    std::string s = "RIFF";
+    const std::uint32_t frames = 256, bytes = frames * 4u;
+    put32(s, 36 + bytes);
+    s += "WAVEfmt ";
+    put32(s, 16);
+    put16(s, 3); // IEEE float
+    put16(s, 1);
+    put32(s, 2000);
+    put32(s, 2000 * 4u);
+    put16(s, 4);
+    put16(s, 32);
+    s += "data";
+    put32(s, bytes);
+    for (std::uint32_t i = 0; i < frames; ++i) put32(s, i % 2 ? 0x7f7fffffu : 0xff7fffffu);
+    const auto path = (underfoot::test::scratchDir("io_limits") / "huge_float.wav").string();
+    std::ofstream(path, std::ios::binary) << s;
+    EXPECT_EQ(readAudioFile(path).frames(), frames); // finite at its own rate: read as it is
+    try {
+        (void)readAudioFile(path, 48000.0);
+        FAIL() << "the resampled file was accepted";
+    } catch (const FileError& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find(path), std::string::npos) << what;
+        EXPECT_NE(what.find("overflows"), std::string::npos) << what;
+    }
+}
+
 TEST(IoLimits, GrfCsvWithHugeTimeStepIsRefusedBeforeResampling) {
     const auto path = (underfoot::test::scratchDir("io_limits") / "slow.csv").string();
     std::ofstream(path) << "time_s,left\n0,100\n1000000,200\n2000000,300\n";
