@@ -58,6 +58,12 @@ download() { # package -> path of the .deb in $work
     ls "$work"/"$1"_*.deb
 }
 
+keep() { # file source package version licence material recordist: into the cache, one manifest line
+    mkdir -p "$cache/$2/$6"
+    cp "$1" "$cache/$2/$6/"
+    echo "$2/$6/$(basename "$1"),$2,$3,$4,$5,$6,$7" >>"$manifest.tmp"
+}
+
 skipped() { # package -> true when UNDERFOOT_RECORDINGS_SKIP names it
     case " ${UNDERFOOT_RECORDINGS_SKIP:-} " in *" $1 "*) return 0 ;; esac
     return 1
@@ -85,11 +91,9 @@ dpkg-deb -x "$deb" "$work/minetest"
 snd="$work/minetest/usr/share/games/minetest/games/minetest_game/mods/default/sounds"
 # material  file-prefix  licence  recordist (mods/default/README.txt)
 while read -r material prefix licence recordist; do
-    mkdir -p "$cache/minetest/$material"
     for f in "$snd"/default_"${prefix}"_footstep*.ogg; do
         [ -f "$f" ] || continue
-        cp "$f" "$cache/minetest/$material/"
-        echo "minetest/$material/$(basename "$f"),minetest,minetest-data,$ver,$licence,$material,$recordist" >>"$manifest.tmp"
+        keep "$f" minetest minetest-data "$ver" "$licence" "$material" "$recordist"
     done
 done <<'LIST'
 wood wood CC-BY-SA-3.0 celeron55/minetest
@@ -120,11 +124,9 @@ for n in z.namelist():
         z.extract(n, sys.argv[2])
 PY
 while read -r material prefix; do
-    mkdir -p "$cache/openarena/$material"
     for f in "$work"/oa/sound/player/footsteps/"$prefix"[0-9].wav; do
         [ -f "$f" ] || continue
-        cp "$f" "$cache/openarena/$material/"
-        echo "openarena/$material/$(basename "$f"),openarena,openarena-data,$ver,GPL-2+,$material,OpenArena team" >>"$manifest.tmp"
+        keep "$f" openarena openarena-data "$ver" GPL-2+ "$material" "OpenArena team"
     done
 done <<'LIST'
 hard boot
@@ -147,12 +149,10 @@ PY
     unzip -q -o "$work/ufoai/usr/share/games/ufoai/base/0snd.pk3" 'sound/footsteps/*' -d "$work/ufo"
 # material  files  licence (debian/copyright of ufoai-sound)  recordist
 while read -r material files licence recordist; do
-    mkdir -p "$cache/ufoai/$material"
     for name in ${files//,/ }; do
         f="$work/ufo/sound/footsteps/$name.ogg"
         [ -f "$f" ] || continue
-        cp "$f" "$cache/ufoai/$material/"
-        echo "ufoai/$material/$name.ogg,ufoai,ufoai-sound,$ver,$licence,$material,${recordist//_/ }" >>"$manifest.tmp"
+        keep "$f" ufoai ufoai-sound "$ver" "$licence" "$material" "${recordist//_/ }"
     done
 done <<'LIST'
 carpet carpet1,carpet2,carpet3,carpet4 CC-BY-SA-3.0 UFO:AI_team
@@ -167,10 +167,8 @@ hard stone1,stone2,stone3,stone4,tile1,tile2,tile3,tile4 CC-BY-SA-3.0 UFO:AI_tea
 wood wood1,wood2,wood3,wood4 CC-BY-SA-3.0 UFO:AI_team
 LIST
 if skipped nexuiz-data; then # otherwise they come from nexuiz-data (metalfootstep01 and 05)
-    mkdir -p "$cache/ufoai/metal"
     for name in metal1 metal3; do
-        cp "$work/ufo/sound/footsteps/$name.ogg" "$cache/ufoai/metal/"
-        echo "ufoai/metal/$name.ogg,ufoai,ufoai-sound,$ver,GPL-2+,metal,UFO:AI team (Nexuiz GPL data)" >>"$manifest.tmp"
+        keep "$work/ufo/sound/footsteps/$name.ogg" ufoai ufoai-sound "$ver" GPL-2+ metal "UFO:AI team (Nexuiz GPL data)"
     done
 fi
 cp "$work/ufoai/usr/share/doc/ufoai-sound/copyright" "$cache/licences/ufoai-sound.copyright"
@@ -180,11 +178,9 @@ deb="$(download lugaru-data)"
 ver="$(dpkg-deb -f "$deb" Version)"
 dpkg-deb -x "$deb" "$work/lugaru"
 while read -r material prefix; do
-    mkdir -p "$cache/lugaru/$material"
     for f in "$work"/lugaru/usr/share/games/lugaru/Sounds/FootStep"$prefix"[0-9].ogg; do
         [ -f "$f" ] || continue
-        cp "$f" "$cache/lugaru/$material/"
-        echo "lugaru/$material/$(basename "$f"),lugaru,lugaru-data,$ver,CC-BY-SA-3.0,$material,Wolfire Games" >>"$manifest.tmp"
+        keep "$f" lugaru lugaru-data "$ver" CC-BY-SA-3.0 "$material" "Wolfire Games"
     done
 done <<'LIST'
 grass Grass
@@ -218,11 +214,9 @@ for n in z.namelist():
 PY
     rm -f "$pk3"
     while read -r material prefix; do
-        mkdir -p "$cache/nexuiz/$material"
         for f in "$work"/nx/sound/misc/"$prefix"0[1-6].wav; do
             [ -f "$f" ] || continue
-            cp "$f" "$cache/nexuiz/$material/"
-            echo "nexuiz/$material/$(basename "$f"),nexuiz,nexuiz-data,$ver,GPL-2+,$material,Alientrap (Nexuiz)" >>"$manifest.tmp"
+            keep "$f" nexuiz nexuiz-data "$ver" GPL-2+ "$material" "Alientrap (Nexuiz)"
         done
     done <<'LIST'
 hard footstep
@@ -247,11 +241,9 @@ if ! skipped openclonk-data; then
         exit 1
     }
     snd="$work/openclonk/usr/share/games/openclonk/Sound.ocg"
-    mkdir -p "$cache/openclonk/hard"
     for f in "$snd"/Clonk.ocg/Movement.ocg/StepHard[1-5].ogg; do
         [ -f "$f" ] || continue
-        cp "$f" "$cache/openclonk/hard/"
-        echo "openclonk/hard/$(basename "$f"),openclonk,openclonk-data,$ver,CC-BY-3.0,hard,HerbertBoland (freesound.org)" >>"$manifest.tmp"
+        keep "$f" openclonk openclonk-data "$ver" CC-BY-3.0 hard "HerbertBoland (freesound.org)"
     done
     cp "$work/openclonk/usr/share/doc/openclonk-data/copyright" "$cache/licences/openclonk-data.copyright"
     cp "$snd/authors.txt" "$cache/licences/openclonk-data-Sound-authors.txt"
@@ -267,11 +259,9 @@ if ! skipped redeclipse-data; then
         "$rd/readme.txt" ./usr/share/doc/redeclipse-data/copyright
     rm -f "$deb"
     while read -r material prefix; do
-        mkdir -p "$cache/redeclipse/$material"
         for f in "$work/redeclipse/$rd/player/$prefix"*.ogg; do
             [ -f "$f" ] || continue
-            cp "$f" "$cache/redeclipse/$material/"
-            echo "redeclipse/$material/$(basename "$f"),redeclipse,redeclipse-data,$ver,CC-BY-SA-3.0,$material,Red Eclipse Team" >>"$manifest.tmp"
+            keep "$f" redeclipse redeclipse-data "$ver" CC-BY-SA-3.0 "$material" "Red Eclipse Team"
         done
     done <<'LIST'
 hard concstep
