@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "tests/common/AllocationTrap.h"
+#include "tests/common/SurfaceBlocks.h"
 
 using namespace underfoot::engine;
 
@@ -64,12 +65,7 @@ std::vector<float> renderLayerSurface(const std::string& id, const std::vector<f
                                       int block, std::uint64_t seed,
                                       std::uint64_t* capped = nullptr) {
     auto s = Surface::loadById(id);
-    s->prepare({kFs, block});
-    s->reset(seed);
-    std::vector<float> out(grf.size(), 0.0f);
-    const int n = static_cast<int>(grf.size());
-    for (int done = 0; done < n; done += block)
-        s->process(grf.data() + done, out.data() + done, std::min(block, n - done));
+    auto out = underfoot::test::processInBlocks(*s, grf, kFs, block, seed);
     if (capped) {
         *capped = 0;
         for (int i = 0; i < s->layerCount(); ++i)

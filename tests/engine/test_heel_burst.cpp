@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "tests/common/AllocationTrap.h"
+#include "tests/common/SurfaceBlocks.h"
 
 using namespace underfoot::engine;
 
@@ -126,13 +127,7 @@ class HeelPresetFile : public ::testing::Test {
     std::vector<float> render(const std::string& file, const std::vector<float>& grf, int block,
                               std::uint64_t seed) {
         auto s = Surface::load(file);
-        s->prepare({kFs, block});
-        s->reset(seed);
-        std::vector<float> out(grf.size(), 0.0f);
-        const int n = static_cast<int>(grf.size());
-        for (int done = 0; done < n; done += block)
-            s->process(grf.data() + done, out.data() + done, std::min(block, n - done));
-        return out;
+        return underfoot::test::processInBlocks(*s, grf, kFs, block, seed);
     }
     std::filesystem::path dir_;
 };
