@@ -474,6 +474,13 @@ FitResult fitSurface(const std::string& presetFile, const std::vector<Recording>
                 ? fmt::format("{}: no impact, grains or bubbles layer to fit", presetFile)
                 : fmt::format("{}: every knob is kept: nothing to fit", presetFile));
 
+    // The render seeds of the objective (FitOptions::seeds): spec.seed alone by default.
+    std::vector<std::uint64_t> seeds = options.seeds;
+    if (seeds.empty()) seeds.push_back(options.spec.seed);
+    if (seeds.size() > 32)
+        throw std::invalid_argument(fmt::format(
+            "{} render seeds: at most 32 (each evaluation renders once per seed)", seeds.size()));
+
     AnalysisOptions ao;
     ao.maxHz = sharedMaxHz(real, options.spec.rateHz);
     std::vector<StepDescriptors> realSteps;
@@ -494,10 +501,13 @@ FitResult fitSurface(const std::string& presetFile, const std::vector<Recording>
         for (std::size_t i = 0; i < knobs.size(); ++i) knobs[i].apply(t, x[i], ranges);
         return t;
     };
-    auto render = [&](const toml::table& t) {
+    auto renderWithSeed = [&](const toml::table& t, std::uint64_t seed) {
         std::ofstream(tmpFile) << toText(t);
-        return renderForComparison(tmpFile, options.spec);
+        RenderSpec spec = options.spec;
+        spec.seed = seed;
+        return renderForComparison(tmpFile, spec);
     };
+    auto render = [&](const toml::table& t) { return renderWithSeed(t, options.spec.seed); };
     // Other materials (contrast): each compared on the band its recordings share with the
     // render, as `underfoot compare --all` does.
     struct Target {
@@ -521,11 +531,12 @@ FitResult fitSurface(const std::string& presetFile, const std::vector<Recording>
             if (!t.steps.empty()) others.push_back(std::move(t));
         }
     }
-    auto evaluate = [&](const toml::table& t) {
+    // Distances of one render seed (the single-seed fit's evaluation).
+    auto evaluateSeed = [&](const toml::table& t, std::uint64_t seed) {
         FitDistances d;
         bool failed = false;
         try {
-            const auto audio = render(t);
+            const auto audio = renderWithSeed(t, seed);
             std::map<double, std::vector<StepDescriptors>> described; // by band limit
             auto stepsAt = [&](const AnalysisOptions& o) -> const std::vector<StepDescriptors>& {
                 auto it = described.find(o.maxHz);
@@ -557,6 +568,26 @@ FitResult fitSurface(const std::string& presetFile, const std::vector<Recording>
         d.objective = contrastiveObjective(d.own, d.nearest, options.contrast, options.margin);
         if (d.nearest < 0) d.nearest = 0;
         return d;
+    };
+    auto evaluate = [&](const toml::table& t) {
+        if (seeds.size() == 1) return evaluateSeed(t, seeds.front());
+        FitDistances mean;
+        double thinnest = -1e300; // own - nearest of the seed with the thinnest margin
+        for (const auto seed : seeds) {
+            const FitDistances d = evaluateSeed(t, seed);
+            mean.own += d.own;
+            mean.nearest += d.nearest;
+            mean.objective += d.objective;
+            if (d.own - d.nearest > thinnest) {
+                thinnest = d.own - d.nearest;
+                mean.nearestMaterial = d.nearestMaterial;
+            }
+        }
+        const double n = static_cast<double>(seeds.size());
+        mean.own /= n;
+        mean.nearest /= n;
+        mean.objective /= n;
+        return mean;
     };
     auto distanceOf = [&](const toml::table& t) { return evaluate(t).objective; };
 
@@ -706,7 +737,13 @@ FitResult fitSurface(const std::string& presetFile, const std::vector<Recording>
     prov.insert("distance_after", std::round(result.distanceAfter * 1000) / 1000);
     prov.insert("walker", options.spec.walker);
     prov.insert("seconds", options.spec.seconds);
-    prov.insert("seed", static_cast<std::int64_t>(options.spec.seed));
+    if (seeds.size() == 1) {
+        prov.insert("seed", static_cast<std::int64_t>(seeds.front()));
+    } else {
+        toml::array seedList; // the objective is the mean over these renders (see Fit.h)
+        for (const auto seed : seeds) seedList.push_back(static_cast<std::int64_t>(seed));
+        prov.insert("seeds", seedList);
+    }
     prov.insert("evaluations", evals);
     toml::table kt;
     for (const auto& k : result.knobs) kt.insert(k.name, std::round(k.value * 1000) / 1000);

@@ -44,9 +44,19 @@
 /// the band its own recordings share with the render (as `underfoot compare --all` does), so
 /// the nearest other material of the fit is the one `compare --all` reports for the same
 /// render. LAMBDA = 0 (or no other recordings) is the plain fit, bit for bit.
+///
+/// Several render seeds (FitOptions::seeds; `underfoot fit --seeds 3,7,8,11`): a granular or
+/// liquid surface is a random process, and a preset fitted on one realisation can sit on the
+/// wrong side of a thin margin for another (beach sand own-closest with seeds 3, 8, 11, not 7).
+/// With seeds given, every evaluation renders the walker once per seed and J is the mean of the
+/// per-seed objectives (each with its own hinge, so every seed's margin counts); the reported
+/// own and nearest distances are the means over the seeds and the nearest material is the one
+/// of the seed with the thinnest margin. One seed (or none: spec.seed) is the single-seed fit,
+/// bit for bit.
 #include "realism/Compare.h"
 #include "realism/ModalSeed.h"
 
+#include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
@@ -80,6 +90,8 @@ struct FitOptions {
     /// the knobs' box; each is refined by BOBYQA with up to maxEvaluations renders and the best
     /// result is kept. 1 (the default) is the local fit from the preset, bit for bit.
     int starts = 1;
+    /// Render seeds the objective is averaged over (see above); empty = spec.seed alone.
+    std::vector<std::uint64_t> seeds;
 };
 
 /// Distance of a render to its own recordings and to the nearest other material.

@@ -5,6 +5,8 @@
 //   fit --surface wood -o wood.toml --no-modal-seed   refine the preset's own modes only
 //   fit --surface beach_sand -o s.toml --contrast 2 --margin 0.1   (the defaults) also push the
 //       render away from the nearest other material of the recordings cache (realism/Fit.h)
+//   fit --surface beach_sand -o s.toml --seeds 3,7,8,11   the objective averaged over one render
+//       per seed (a margin that must hold for every realisation of a random surface)
 //   fit --surface beach_sand -o s.toml --starts 8   global search: BOBYQA from the preset and
 //       from 7 Sobol points of the knobs' box, the best kept (realism/Fit.h)
 // Solids (impact layers) are first seeded with the recordings' modes (realism/ModalSeed.h).
@@ -16,6 +18,7 @@
 #include "realism/Modal.h"
 
 #include <fmt/core.h>
+#include <fmt/format.h>
 
 #include <cmath>
 #include <filesystem>
@@ -121,6 +124,10 @@ int runFit(FitArgs& a) {
     if (!(std::isfinite(a.options.margin) && a.options.margin >= 0 && a.options.margin <= 5))
         throw UserError(
             fmt::format("fit: --margin {}: expected a distance from 0 to 5", a.options.margin));
+    if (a.options.seeds.size() > 32)
+        throw UserError(fmt::format("fit: --seeds: {} seeds given, at most 32 (each evaluation "
+                                    "renders the walker once per seed)",
+                                    a.options.seeds.size()));
     if (a.options.contrast > 0) {
         a.options.ownMaterial = rl::materialOfSurface(a.surface);
         try {
@@ -174,6 +181,9 @@ int runFit(FitArgs& a) {
     fmt::print("{}: distance {:.3f} -> {:.3f} after {} evaluations ({}) in {:.1f} s -> {}\n",
                a.surface, r.distanceBefore, r.distanceAfter, r.evaluations, r.optimiser, r.seconds,
                a.output);
+    if (a.options.seeds.size() > 1)
+        fmt::print("render seeds: {} (distances are means over one render per seed)\n",
+                   fmt::join(a.options.seeds, ","));
     if (r.startPoints > 1) {
         fmt::print("starts: {} (best from {}):", r.startPoints,
                    r.bestStartPoint == 0 ? std::string("the preset")
@@ -211,8 +221,13 @@ CommandRegistrar reg("fit", [](CLI::App& app, int& exitCode) {
     cmd->add_option("--seconds", args->options.spec.seconds, "length of each render")
         ->capture_default_str()
         ->check(CLI::Range(2.0, 60.0));
-    cmd->add_option("--seed", args->options.spec.seed, "seed of the renders")
-        ->capture_default_str();
+    auto* seedOption = cmd->add_option("--seed", args->options.spec.seed, "seed of the renders")
+                           ->capture_default_str();
+    cmd->add_option("--seeds", args->options.seeds,
+                    "several render seeds, e.g. 3,7,8,11: the objective is the mean over one "
+                    "render per seed, so a thin margin must hold for every one (realism/Fit.h)")
+        ->delimiter(',')
+        ->excludes(seedOption);
     args->options.contrast = 2.0; // the CLI's defaults (the library's are 0: plain fit)
     args->options.margin = 0.1;
     cmd->add_option("--contrast", args->options.contrast,

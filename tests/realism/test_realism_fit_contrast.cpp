@@ -249,3 +249,59 @@ TEST_F(FitContrast, SeveralStartsAreDeterministicAndNoWorseThanOne) {
     // Same preset text twice: the same fitted preset.
     EXPECT_EQ(fitSurface(preset_, own_, o).presetText, multi.presetText);
 }
+
+// Several render seeds (FitOptions::seeds, `underfoot fit --seeds 3,7,8,11`): every evaluation
+// renders once per seed and the objective is the mean of the per-seed objectives, so a margin
+// must hold for each realisation of the random surface, not only for one.
+TEST_F(FitContrast, SeveralSeedsAverageThePerSeedObjectives) {
+    recordOthers(grainsPreset(std::exp2(0.6))); // slate between the preset and clay
+    auto o = options(2.0);
+    o.maxEvaluations = 6;
+    // One seed given is the single-seed fit with that seed, bit for bit.
+    auto one = o;
+    one.spec.seed = 5;
+    auto listed = o;
+    listed.seeds = {5};
+    const auto single = fitSurface(preset_, own_, one);
+    EXPECT_EQ(fitSurface(preset_, own_, listed).presetText, single.presetText);
+
+    // Before any knob moves, the multi-seed figures are the means of the single-seed ones.
+    std::vector<FitResult> per;
+    for (std::uint64_t seed : {5u, 9u, 13u}) {
+        auto s = o;
+        s.seeds = {seed};
+        s.maxEvaluations = 5; // (the "before" figures do not depend on the budget)
+        per.push_back(fitSurface(preset_, own_, s));
+    }
+    auto multi = o;
+    multi.seeds = {5, 9, 13};
+    const auto m = fitSurface(preset_, own_, multi);
+    double own = 0, nearest = 0, objective = 0, thinnest = -1e300;
+    std::string thinnestMaterial;
+    for (const auto& p : per) {
+        own += p.before.own / 3;
+        nearest += p.before.nearest / 3;
+        objective += p.before.objective / 3;
+        if (p.before.own - p.before.nearest > thinnest) {
+            thinnest = p.before.own - p.before.nearest;
+            thinnestMaterial = p.before.nearestMaterial;
+        }
+    }
+    EXPECT_NE(per[0].before.own, per[1].before.own) << "the seeds render the same steps";
+    EXPECT_NEAR(m.before.own, own, 1e-12);
+    EXPECT_NEAR(m.before.nearest, nearest, 1e-12);
+    EXPECT_NEAR(m.before.objective, objective, 1e-12);
+    EXPECT_EQ(m.before.nearestMaterial, thinnestMaterial);
+    EXPECT_LE(m.after.objective, m.before.objective + 1e-12); // BOBYQA starts at the preset
+    // Provenance lists the seeds instead of one seed; same input, same preset.
+    const auto root = toml::parse(m.presetText);
+    const auto* seeds = root["provenance"]["seeds"].as_array();
+    ASSERT_NE(seeds, nullptr);
+    ASSERT_EQ(seeds->size(), 3u);
+    EXPECT_EQ((*seeds)[1].value<std::int64_t>().value_or(0), 9);
+    EXPECT_FALSE(root["provenance"]["seed"]);
+    EXPECT_EQ(fitSurface(preset_, own_, multi).presetText, m.presetText);
+    // A bound on the work an option can ask for.
+    multi.seeds.assign(33, 1);
+    EXPECT_THROW(fitSurface(preset_, own_, multi), std::invalid_argument);
+}
