@@ -507,7 +507,8 @@ FitResult fitSurface(const std::string& presetFile, const std::vector<Recording>
         spec.seed = seed;
         return renderForComparison(tmpFile, spec);
     };
-    auto render = [&](const toml::table& t) { return renderWithSeed(t, options.spec.seed); };
+    // The loudness calibration's render: the first seed's (spec.seed when no seeds are given).
+    auto render = [&](const toml::table& t) { return renderWithSeed(t, seeds.front()); };
     // Other materials (contrast): each compared on the band its recordings share with the
     // render, as `underfoot compare --all` does.
     struct Target {

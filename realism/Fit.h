@@ -51,8 +51,8 @@
 /// With seeds given, every evaluation renders the walker once per seed and J is the mean of the
 /// per-seed objectives (each with its own hinge, so every seed's margin counts); the reported
 /// own and nearest distances are the means over the seeds and the nearest material is the one
-/// of the seed with the thinnest margin. One seed (or none: spec.seed) is the single-seed fit,
-/// bit for bit.
+/// of the seed with the thinnest margin; the loudness is re-calibrated on the first seed's
+/// render. One seed (or none: spec.seed) is the single-seed fit with that seed, bit for bit.
 #include "realism/Compare.h"
 #include "realism/ModalSeed.h"
 
