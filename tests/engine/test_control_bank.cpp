@@ -67,7 +67,6 @@ TEST(GrfBank, HeelShareHandsOverFromHeelToToe) {
 
 TEST(GrfBank, ShippedBankLoadsAsGrfFiles) {
     // engine/data/grf/README.md documents the command that made these files.
-    // (one literal: GCC 12 warns falsely, -Warray-bounds, on string(literal) + literal here)
     const std::string dir = UNDERFOOT_ENGINE_DATA_DIR "/grf";
     for (const char* kind : {"heel", "toe"})
         for (int i = 1; i <= 5; ++i) {
