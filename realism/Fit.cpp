@@ -501,14 +501,17 @@ FitResult fitSurface(const std::string& presetFile, const std::vector<Recording>
         for (std::size_t i = 0; i < knobs.size(); ++i) knobs[i].apply(t, x[i], ranges);
         return t;
     };
-    auto renderWithSeed = [&](const toml::table& t, std::uint64_t seed) {
-        std::ofstream(tmpFile) << toText(t);
+    auto write = [&](const toml::table& t) { std::ofstream(tmpFile) << toText(t); };
+    auto renderWritten = [&](std::uint64_t seed) { // the preset last written, with this seed
         RenderSpec spec = options.spec;
         spec.seed = seed;
         return renderForComparison(tmpFile, spec);
     };
     // The loudness calibration's render: the first seed's (spec.seed when no seeds are given).
-    auto render = [&](const toml::table& t) { return renderWithSeed(t, seeds.front()); };
+    auto render = [&](const toml::table& t) {
+        write(t);
+        return renderWritten(seeds.front());
+    };
     // Other materials (contrast): each compared on the band its recordings share with the
     // render, as `underfoot compare --all` does.
     struct Target {
@@ -532,12 +535,12 @@ FitResult fitSurface(const std::string& presetFile, const std::vector<Recording>
             if (!t.steps.empty()) others.push_back(std::move(t));
         }
     }
-    // Distances of one render seed (the single-seed fit's evaluation).
-    auto evaluateSeed = [&](const toml::table& t, std::uint64_t seed) {
+    // Distances of the written preset's render with one seed (the single-seed evaluation).
+    auto evaluateSeed = [&](std::uint64_t seed) {
         FitDistances d;
         bool failed = false;
         try {
-            const auto audio = renderWithSeed(t, seed);
+            const auto audio = renderWritten(seed);
             std::map<double, std::vector<StepDescriptors>> described; // by band limit
             auto stepsAt = [&](const AnalysisOptions& o) -> const std::vector<StepDescriptors>& {
                 auto it = described.find(o.maxHz);
@@ -571,11 +574,12 @@ FitResult fitSurface(const std::string& presetFile, const std::vector<Recording>
         return d;
     };
     auto evaluate = [&](const toml::table& t) {
-        if (seeds.size() == 1) return evaluateSeed(t, seeds.front());
+        write(t);
+        if (seeds.size() == 1) return evaluateSeed(seeds.front());
         FitDistances mean;
         double thinnest = -1e300; // own - nearest of the seed with the thinnest margin
         for (const auto seed : seeds) {
-            const FitDistances d = evaluateSeed(t, seed);
+            const FitDistances d = evaluateSeed(seed);
             mean.own += d.own;
             mean.nearest += d.nearest;
             mean.objective += d.objective;

@@ -124,10 +124,6 @@ int runFit(FitArgs& a) {
     if (!(std::isfinite(a.options.margin) && a.options.margin >= 0 && a.options.margin <= 5))
         throw UserError(
             fmt::format("fit: --margin {}: expected a distance from 0 to 5", a.options.margin));
-    if (a.options.seeds.size() > 32)
-        throw UserError(fmt::format("fit: --seeds: {} seeds given, at most 32 (each evaluation "
-                                    "renders the walker once per seed)",
-                                    a.options.seeds.size()));
     if (a.options.contrast > 0) {
         a.options.ownMaterial = rl::materialOfSurface(a.surface);
         try {
