@@ -2,7 +2,7 @@
 #pragma once
 /// High-resolution modal estimate of a struck solid: frequencies, decays and gains of a sum of
 /// exponentially damped sinusoids, by the matrix pencil method (Hua & Sarkar 1990, IEEE Trans.
-/// ASSP 38(5)), with Eigen's SVD and eigen-solvers.
+/// ASSP 38(5)), with LAPACK's SVD, eigenvalue and least-squares drivers.
 ///
 /// x[n] ~ sum_k a_k e^{-sigma_k n / fs} cos(2 pi f_k n / fs + phi_k). The Hankel matrix of the
 /// signal is reduced to its 2K strongest singular directions; the poles z = e^{(-sigma + i 2 pi

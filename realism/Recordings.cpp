@@ -138,15 +138,4 @@ std::string categoryOfMaterial(const std::string& material) {
     throw std::invalid_argument(fmt::format("unknown material \"{}\"", material));
 }
 
-std::vector<StepDescriptors> describeFile(const std::string& path, const AnalysisOptions& o) {
-    return describeSteps(engine::readAudioFile(path), o);
-}
-
-double sharedMaxHz(const std::vector<Recording>& recordings, double otherRateHz) {
-    double minRate = otherRateHz;
-    for (const auto& r : recordings)
-        minRate = std::min(minRate, engine::readAudioFile(r.path).sampleRateHz);
-    return std::min(16000.0, 0.95 * 0.5 * minRate);
-}
-
 } // namespace underfoot::realism

@@ -16,6 +16,8 @@ PACKAGES=(
   libboost-dev
   # mixed-effects models (analysis/stats/MixedModels): linear algebra and optimisation
   libeigen3-dev libnlopt-cxx-dev
+  # modal estimate of recorded strikes (realism/Modal.cpp): LAPACK's drivers
+  liblapacke-dev
   # storage
   libsqlite3-dev libsqlitecpp-dev sqlite3
   # SHA-256 of protocol texts (experiment/)
