@@ -3,6 +3,8 @@
 
 #include "engine/render/AudioFeatures.h"
 #include "engine/render/Renderer.h"
+#include "engine/reverb/Convolver.h"
+#include "engine/surfaces/Surface.h"
 
 #include <fmt/core.h>
 
@@ -22,6 +24,40 @@ engine::AudioBuffer renderForComparison(const std::string& surface, const Render
     return engine::renderSurface(surface, grf, o).audio;
 }
 
+engine::AudioBuffer throughRoom(const engine::AudioBuffer& recording,
+                                const engine::ReverbSpec& room) {
+    const auto ir = engine::readAudioFile(engine::findImpulseResponse(room.impulseResponse));
+    constexpr int kBlock = 4096;
+    engine::Convolver conv;
+    conv.prepare(ir, recording.sampleRateHz, kBlock);
+    const std::size_t frames = recording.frames() + conv.impulseLength();
+    const double dry = std::pow(10.0, room.dryDb / 20.0), wet = std::pow(10.0, room.wetDb / 20.0);
+    std::vector<float> mono(frames, 0.0f), wetL(frames), wetR(frames);
+    for (std::size_t f = 0; f < recording.frames(); ++f) {
+        double s = 0;
+        for (int c = 0; c < recording.channels; ++c) s += recording.at(f, c);
+        mono[f] = static_cast<float>(s / std::max(1, recording.channels));
+    }
+    for (std::size_t at = 0; at < frames; at += kBlock) {
+        const int n = int(std::min<std::size_t>(kBlock, frames - at));
+        conv.process(mono.data() + at, wetL.data() + at, wetR.data() + at, n);
+    }
+    engine::AudioBuffer out;
+    out.sampleRateHz = recording.sampleRateHz;
+    out.channels = 2;
+    out.samples.resize(2 * frames);
+    for (std::size_t f = 0; f < frames; ++f) {
+        const double d = dry * mono[f];
+        out.samples[2 * f] = static_cast<float>(d + wet * wetL[f]);
+        out.samples[2 * f + 1] = static_cast<float>(d + wet * wetR[f]);
+    }
+    return out;
+}
+
+std::optional<engine::ReverbSpec> roomOfSurface(const std::string& surface) {
+    return engine::Surface::loadById(surface)->info().reverb;
+}
+
 namespace {
 // The step whose descriptors are nearest the medians (a typical step), as samples.
 std::vector<float> typicalStep(const engine::AudioBuffer& audio, const AnalysisOptions& o) {
@@ -34,17 +70,20 @@ std::vector<float> typicalStep(const engine::AudioBuffer& audio, const AnalysisO
 } // namespace
 
 SurfaceComparison compareAudio(const std::string& surface, const engine::AudioBuffer& synthetic,
-                               const std::vector<Recording>& real) {
+                               const std::vector<Recording>& real,
+                               const std::optional<engine::ReverbSpec>& room) {
     SurfaceComparison c;
     c.surface = surface;
     c.material = materialOfSurface(surface);
     c.options.maxHz = sharedMaxHz(real, synthetic.sampleRateHz);
+    c.room = room;
     for (const auto& r : real) {
-        auto steps = describeFile(r.path, c.options);
+        const auto audio = room ? throughRoom(engine::readAudioFile(r.path), *room)
+                                : engine::readAudioFile(r.path);
+        auto steps = describeSteps(audio, c.options);
         c.realSteps.insert(c.realSteps.end(), steps.begin(), steps.end());
         c.realFiles.push_back(r.file);
-        if (c.realExample.empty())
-            c.realExample = typicalStep(engine::readAudioFile(r.path), c.options);
+        if (c.realExample.empty()) c.realExample = typicalStep(audio, c.options);
     }
     if (c.realSteps.empty())
         throw std::runtime_error("no footstep found in the recordings (all silent?)");
@@ -57,8 +96,9 @@ SurfaceComparison compareAudio(const std::string& surface, const engine::AudioBu
 }
 
 SurfaceComparison compareSurface(const std::string& surface, const std::vector<Recording>& real,
-                                 const RenderSpec& spec) {
-    return compareAudio(surface, renderForComparison(surface, spec), real);
+                                 const RenderSpec& spec,
+                                 const std::optional<engine::ReverbSpec>& room) {
+    return compareAudio(surface, renderForComparison(surface, spec), real, room);
 }
 
 namespace {

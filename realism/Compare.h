@@ -2,10 +2,12 @@
 #pragma once
 /// Comparing a surface's render with recordings, and the report (HTML with SVG pictures).
 #include "engine/io/AudioFile.h"
+#include "engine/surfaces/Surface.h"
 #include "realism/Distance.h"
 #include "realism/Recordings.h"
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -29,15 +31,35 @@ struct SurfaceComparison {
     Comparison comparison;
     std::vector<StepDescriptors> syntheticSteps, realSteps;
     std::vector<float> syntheticExample, realExample; ///< one step of each, for pictures
+    /// The room the recordings were heard through (the surface's own), if any.
+    std::optional<engine::ReverbSpec> room;
 };
 
-/// Renders the surface and compares it with the recordings, on the band both share.
+/// A (dry) recording as it would sound in `room`: its channels mixed to mono, then the
+/// renderer's mix of a surface with a [reverb], dry x gain_dry + the room's convolution x
+/// gain_wet (stereo when the impulse response is), with the impulse response's length of silence
+/// appended for the tail. The convolution runs at the recording's own rate (the impulse response
+/// resampled to it, as the renderer does at its rate). Throws engine::FileError for an unreadable
+/// impulse response.
+engine::AudioBuffer throughRoom(const engine::AudioBuffer& recording,
+                                const engine::ReverbSpec& room);
+
+/// The room a surface's render is heard in: its preset's [reverb], if it has one. Throws
+/// engine::PresetError for a bad preset.
+std::optional<engine::ReverbSpec> roomOfSurface(const std::string& surface);
+
+/// Renders the surface and compares it with the recordings, on the band both share. With a
+/// `room` (see roomOfSurface), every recording is first heard through it (throughRoom): a
+/// surface rendered in a room is compared with recordings in the same room, since the shipped
+/// recordings are dry; the room then weighs alike on every material.
 /// Throws std::runtime_error when the recordings hold no step or the render none.
 SurfaceComparison compareSurface(const std::string& surface, const std::vector<Recording>& real,
-                                 const RenderSpec& spec);
+                                 const RenderSpec& spec,
+                                 const std::optional<engine::ReverbSpec>& room = {});
 /// The same with an already rendered buffer.
 SurfaceComparison compareAudio(const std::string& surface, const engine::AudioBuffer& synthetic,
-                               const std::vector<Recording>& real);
+                               const std::vector<Recording>& real,
+                               const std::optional<engine::ReverbSpec>& room = {});
 
 /// Third-octave profiles (median over steps) of both sides as an SVG line plot.
 std::string bandPlotSvg(const SurfaceComparison& c);

@@ -19,6 +19,7 @@
 #include <fstream>
 #include <map>
 #include <memory>
+#include <optional>
 #include <set>
 
 namespace underfoot::cli {
@@ -38,6 +39,7 @@ struct CompareArgs {
     bool classicListener = false; ///< --classic-listener: no centring, bands, one centroid
     bool onsetListener = false;   ///< --onset-listener: onset features, configuration grid
     bool listenerGrid = false;    ///< --listener-grid: every configuration's figures
+    bool dryRecordings = false;   ///< --dry-recordings: no room on the recordings
     rl::RenderSpec spec;
 };
 
@@ -47,6 +49,19 @@ std::string featureLine(const rl::Example& e) {
         fmt::format("{},{},{}", e.name, e.source, e.material.empty() ? "-" : e.material);
     for (double v : e.features) s += fmt::format(",{:.6g}", v);
     return s + "\n";
+}
+
+// The room the recordings are heard through for this surface: its own (none without a
+// [reverb], or with --dry-recordings).
+std::optional<eng::ReverbSpec> recordingsRoom(const CompareArgs& a, const std::string& surface) {
+    return a.dryRecordings ? std::nullopt : rl::roomOfSurface(surface);
+}
+
+std::string roomNote(const std::optional<eng::ReverbSpec>& room) {
+    return room ? fmt::format("recordings heard through the surface's room ({}, wet {:+.1f} dB, "
+                              "dry {:+.1f} dB)",
+                              room->impulseResponse, room->wetDb, room->dryDb)
+                : std::string();
 }
 
 std::vector<rl::Recording> manifest(const CompareArgs& a) {
@@ -132,7 +147,7 @@ int runOne(const CompareArgs& a) {
     }
     rl::SurfaceComparison c;
     try {
-        c = rl::compareSurface(a.surface, real, a.spec);
+        c = rl::compareSurface(a.surface, real, a.spec, recordingsRoom(a, a.surface));
     } catch (const eng::PresetError& e) {
         throw UserError(e.what());
     } catch (const eng::FileError& e) {
@@ -143,10 +158,12 @@ int runOne(const CompareArgs& a) {
     fmt::print("{} vs {} recording(s) ({}), walker {}, {} s, seed {}\n", a.surface, real.size(),
                c.material.empty() ? "user files" : c.material, a.spec.walker, a.spec.seconds,
                a.spec.seed);
+    if (c.room) fmt::print("{}\n", roomNote(c.room));
     fmt::print("{}", rl::descriptorTableText(c));
     if (!a.output.empty()) {
         std::string body = definitionHtml() + "<p>Recordings: ";
         for (const auto& f : c.realFiles) body += f + " ";
+        if (c.room) body += "</p><p>" + roomNote(c.room) + ".";
         body += "</p>" + rl::descriptorTableHtml(c) + figures(c, figureDir(a.output));
         writeHtml(a.output, "Underfoot compare: " + a.surface, body);
     }
@@ -165,6 +182,7 @@ int runAll(const CompareArgs& a) {
     fmt::print("{:<22} {:<7} {:>9} {:>14} {:>9}  {}\n", "surface", "material", "distance",
                "nearest other", "distance", "own closest");
     int closer = 0, compared = 0;
+    std::vector<std::string> roomed; // surfaces compared with the recordings in their room
     for (const auto& info : eng::listSurfaces()) {
         const auto m = rl::materialOfSurface(info.id);
         if (m.empty() || !recorded.count(m)) {
@@ -173,10 +191,12 @@ int runAll(const CompareArgs& a) {
             continue;
         }
         const auto audio = rl::renderForComparison(info.id, a.spec);
+        const auto room = recordingsRoom(a, info.id);
+        if (room) roomed.push_back(info.id);
         std::map<std::string, double> dist;
         rl::SurfaceComparison own;
         for (const auto& mat : recorded) {
-            auto c = rl::compareAudio(info.id, audio, ofMaterial(recs, mat));
+            auto c = rl::compareAudio(info.id, audio, ofMaterial(recs, mat), room);
             dist[mat] = c.comparison.distance;
             if (mat == m) own = std::move(c);
         }
@@ -202,7 +222,20 @@ int runAll(const CompareArgs& a) {
     fmt::print("{} of {} compared surfaces are closer to their own material's recordings than to "
                "any other's\n",
                closer, compared);
-    body += "</table>\n" + figs;
+    std::string roomedList;
+    for (const auto& id : roomed) roomedList += (roomedList.empty() ? "" : ", ") + id;
+    if (!roomed.empty()) {
+        fmt::print("{} (rendered with a room) were compared with every material's recordings heard "
+                   "through the same room; --dry-recordings compares them with the dry "
+                   "recordings\n",
+                   roomedList);
+    }
+    body += "</table>\n";
+    if (!roomed.empty())
+        body += fmt::format("<p>{} (rendered with a room) were compared with every material's "
+                            "recordings heard through the same room.</p>\n",
+                            roomedList);
+    body += figs;
     if (!a.output.empty()) writeHtml(a.output, "Underfoot compare --all", body);
     return 0;
 }
@@ -468,6 +501,9 @@ CommandRegistrar reg("compare", [](CLI::App& app, int& exitCode) {
         "recordings cache of scripts/fetch-recordings.sh (default $UNDERFOOT_RECORDINGS "
         "or build/recordings)");
     cmd->add_flag("--all", args->all, "compare every surface that has recordings of its material");
+    cmd->add_flag("--dry-recordings", args->dryRecordings,
+                  "a surface with a room ([reverb]) is compared with the recordings as they are "
+                  "(dry) instead of with the recordings heard through the same room");
     cmd->add_flag("--listener", args->listener,
                   "the listener: leave-one-source-out baseline and its verdict on every surface");
     cmd->add_option("--walker", args->spec.walker, "virtual walker of the render")
