@@ -2,6 +2,7 @@
 #include "realism/Compare.h"
 
 #include "engine/render/AudioFeatures.h"
+#include "engine/render/FootstepScene.h"
 #include "engine/render/Renderer.h"
 #include "engine/reverb/Convolver.h"
 #include "engine/surfaces/Surface.h"
@@ -10,6 +11,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <stdexcept>
 
 namespace underfoot::realism {
@@ -31,7 +33,13 @@ engine::AudioBuffer throughRoom(const engine::AudioBuffer& recording,
     engine::Convolver conv;
     conv.prepare(ir, recording.sampleRateHz, kBlock);
     const std::size_t frames = recording.frames() + conv.impulseLength();
-    const double dry = std::pow(10.0, room.dryDb / 20.0), wet = std::pow(10.0, room.wetDb / 20.0);
+    // The recording stands for the render's channel mean (what the analysis hears). The renderer
+    // pans its two voices (feet) to +-panSpread with a constant-power law, so that mean holds
+    // each voice x cos(panSpread pi / 4), while the room is fed the voices' plain sum: the room's
+    // input is the recording / cos(panSpread pi / 4) (0.24 dB with the default spread 0.3).
+    const double panLaw = std::cos(engine::SceneOptions{}.panSpread * std::numbers::pi / 4);
+    const double dry = std::pow(10.0, room.dryDb / 20.0),
+                 wet = std::pow(10.0, room.wetDb / 20.0) / panLaw;
     std::vector<float> mono(frames, 0.0f), wetL(frames), wetR(frames);
     for (std::size_t f = 0; f < recording.frames(); ++f) {
         double s = 0;

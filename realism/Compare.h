@@ -38,9 +38,12 @@ struct SurfaceComparison {
 /// A (dry) recording as it would sound in `room`: its channels mixed to mono, then the
 /// renderer's mix of a surface with a [reverb], dry x gain_dry + the room's convolution x
 /// gain_wet (stereo when the impulse response is), with the impulse response's length of silence
-/// appended for the tail. The convolution runs at the recording's own rate (the impulse response
-/// resampled to it, as the renderer does at its rate). Throws engine::FileError for an unreadable
-/// impulse response.
+/// appended for the tail. The recording stands for the render's channel mean, whose two panned
+/// voices are each at cos(panSpread pi / 4) of the plain sum the renderer feeds the room: the
+/// room's input is scaled back by that factor, so that the channel mean of the result is the
+/// channel mean the renderer would give (tested against the wood and wood-with-reverb renders).
+/// The convolution runs at the recording's own rate (the impulse response resampled to it, as
+/// the renderer does at its rate). Throws engine::FileError for an unreadable impulse response.
 engine::AudioBuffer throughRoom(const engine::AudioBuffer& recording,
                                 const engine::ReverbSpec& room);
 

@@ -53,6 +53,10 @@
 /// own and nearest distances are the means over the seeds and the nearest material is the one
 /// of the seed with the thinnest margin; the loudness is re-calibrated on the first seed's
 /// render. One seed (or none: spec.seed) is the single-seed fit with that seed, bit for bit.
+///
+/// A preset with a room ([reverb]: the palette fits a derived preset such as wood with reverb
+/// through its flat copy) is fitted against the recordings, own and other materials', heard
+/// through that room (throughRoom, Compare.h), as `underfoot compare` compares it.
 #include "realism/Compare.h"
 #include "realism/ModalSeed.h"
 

@@ -398,28 +398,44 @@ void PaletteCompare::compareNow() {
                            : tr("Distance: computing…"));
     const std::string path =
         QDir(scratch_.path()).filePath(QString("compare_%1.toml").arg(generation)).toStdString();
-    compareJob_ =
-        QtConcurrent::run([this, generation, text, path, spec = renderSpec(), ref = reference_] {
-            PaletteComparison c;
-            c.generation = generation;
-            try {
-                writeText(path, text);
-                const auto audio = realism::renderForComparison(path, spec);
-                const auto steps = realism::describeSteps(audio, ref->options);
-                if (steps.empty())
-                    throw std::runtime_error("the render of the current settings holds no footstep "
-                                             "(silent? raise the gains or the walker's mass)");
+    compareJob_ = QtConcurrent::run([this, generation, text, path, spec = renderSpec(),
+                                     ref = reference_] {
+        PaletteComparison c;
+        c.generation = generation;
+        try {
+            writeText(path, text);
+            const auto audio = realism::renderForComparison(path, spec);
+            const auto steps = realism::describeSteps(audio, ref->options);
+            if (steps.empty())
+                throw std::runtime_error("the render of the current settings holds no footstep "
+                                         "(silent? raise the gains or the walker's mass)");
+            // Settings with a room ([reverb]): the reference is heard through the same
+            // room, as `underfoot compare` does (the recordings are dry).
+            if (const auto room = realism::roomOfSurface(path)) {
+                std::vector<realism::StepDescriptors> roomed;
+                for (const auto& r : ref->recordings) {
+                    const auto s = realism::describeSteps(
+                        realism::throughRoom(engine::readAudioFile(r.path), *room), ref->options);
+                    roomed.insert(roomed.end(), s.begin(), s.end());
+                }
+                if (roomed.empty())
+                    throw std::runtime_error("the reference heard through the settings' room "
+                                             "holds no footstep");
+                c.comparison = realism::compareSteps(steps, roomed);
+                c.room = QString::fromStdString(room->impulseResponse);
+            } else {
                 c.comparison = realism::compareSteps(steps, ref->steps);
-                c.example = stepSpectrogram(typicalStep(audio, ref->options),
-                                            ref->options.analysisRateHz, ref->options.maxHz);
-            } catch (const std::exception& e) {
-                c.error = q(e.what());
             }
-            std::error_code ec;
-            fs::remove(path, ec);
-            QMetaObject::invokeMethod(
-                this, [this, c] { comparisonDone(c); }, Qt::QueuedConnection);
-        });
+            c.example = stepSpectrogram(typicalStep(audio, ref->options),
+                                        ref->options.analysisRateHz, ref->options.maxHz);
+        } catch (const std::exception& e) {
+            c.error = q(e.what());
+        }
+        std::error_code ec;
+        fs::remove(path, ec);
+        QMetaObject::invokeMethod(
+            this, [this, c] { comparisonDone(c); }, Qt::QueuedConnection);
+    });
 }
 
 void PaletteCompare::comparisonDone(const PaletteComparison& c) {
@@ -448,12 +464,15 @@ void PaletteCompare::showComparison(const PaletteComparison& c) {
     distance_->setText(
         tr("<b>Distance to the reference: %1</b> (mean robust z over %2 descriptors: 0 = on the "
            "recorded medians, about 1 = one recorded spread away; level-invariant) · %3 steps "
-           "rendered (%4), %5 recorded")
+           "rendered (%4), %5 recorded%6")
             .arg(cmp.distance, 0, 'f', 2)
             .arg(static_cast<int>(realism::kDescriptorCount))
             .arg(cmp.syntheticSteps)
             .arg(q(renderSpec().walker))
-            .arg(cmp.realSteps));
+            .arg(cmp.realSteps)
+            .arg(c.room.isEmpty()
+                     ? QString()
+                     : tr(", heard through the settings' room (%1) like the render").arg(c.room)));
     std::vector<int> order(realism::kDescriptorCount);
     std::iota(order.begin(), order.end(), 0);
     std::stable_sort(order.begin(), order.end(), [&](int a, int b) {

@@ -63,6 +63,7 @@ struct PaletteComparison {
     QString error;
     realism::Comparison comparison;
     StepSpectrogram example; ///< a typical step of the render
+    QString room;            ///< the settings' room the reference was heard through (empty: none)
 };
 
 /// The outcome of a fit.

@@ -112,6 +112,30 @@ class PaletteCompareTest : public QObject {
         QVERIFY(c->distanceText().contains("Distance to the reference"));
     }
 
+    // Settings with a room: the reference is heard through it, as `underfoot compare` does. Wood
+    // with reverb is wood's layers in the wooden room, so its render is the wood render (the
+    // reference here) plus the room: in the room the distance is ~0, and the text says so.
+    void aSurfaceWithARoomIsComparedWithTheReferenceInThatRoom() {
+        auto palette = makePalette();
+        QVERIFY(palette->selectSurface("wood_reverb"));
+        auto* c = palette->compareView();
+        QVERIFY(useAndCompare(c, {woodWav_}));
+        const double inRoom = c->distance();
+        qInfo("wood with reverb vs the wood render in its room: %.4f", inRoom);
+        QVERIFY2(inRoom < 0.05, qPrintable(c->distanceText()));
+        QVERIFY(c->distanceText().contains("wooden_room"));
+        // The same reference without a room: charged to the sound.
+        const auto& ref = *c->reference();
+        const auto spec = c->renderSpec();
+        const double dry = realism::compareSteps(
+                               realism::describeSteps(
+                                   realism::renderForComparison("wood_reverb", spec), ref.options),
+                               ref.steps)
+                               .distance;
+        qInfo("wood with reverb vs the dry wood render: %.4f", dry);
+        QVERIFY(dry > inRoom + 0.2);
+    }
+
     void changingAParameterUpdatesTheDistanceAndStaleResultsAreDropped() {
         auto palette = makePalette();
         QVERIFY(palette->selectSurface("wood"));
