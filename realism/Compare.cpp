@@ -26,9 +26,14 @@ engine::AudioBuffer renderForComparison(const std::string& surface, const Render
     return engine::renderSurface(surface, grf, o).audio;
 }
 
-engine::AudioBuffer throughRoom(const engine::AudioBuffer& recording,
-                                const engine::ReverbSpec& room) {
-    const auto ir = engine::readAudioFile(engine::findImpulseResponse(room.impulseResponse));
+namespace {
+engine::AudioBuffer readRoomImpulse(const engine::ReverbSpec& room) {
+    return engine::readAudioFile(engine::findImpulseResponse(room.impulseResponse));
+}
+
+// throughRoom() with the room's impulse response already read.
+engine::AudioBuffer throughRoomWith(const engine::AudioBuffer& recording,
+                                    const engine::AudioBuffer& ir, const engine::ReverbSpec& room) {
     constexpr int kBlock = 4096;
     engine::Convolver conv;
     conv.prepare(ir, recording.sampleRateHz, kBlock);
@@ -61,6 +66,12 @@ engine::AudioBuffer throughRoom(const engine::AudioBuffer& recording,
     }
     return out;
 }
+} // namespace
+
+engine::AudioBuffer throughRoom(const engine::AudioBuffer& recording,
+                                const engine::ReverbSpec& room) {
+    return throughRoomWith(recording, readRoomImpulse(room), room);
+}
 
 std::optional<engine::ReverbSpec> roomOfSurface(const std::string& surface) {
     return engine::Surface::loadById(surface)->info().reverb;
@@ -85,8 +96,9 @@ SurfaceComparison compareAudio(const std::string& surface, const engine::AudioBu
     c.material = materialOfSurface(surface);
     c.options.maxHz = sharedMaxHz(real, synthetic.sampleRateHz);
     c.room = room;
+    const auto ir = room ? readRoomImpulse(*room) : engine::AudioBuffer{};
     for (const auto& r : real) {
-        const auto audio = room ? throughRoom(engine::readAudioFile(r.path), *room)
+        const auto audio = room ? throughRoomWith(engine::readAudioFile(r.path), ir, *room)
                                 : engine::readAudioFile(r.path);
         auto steps = describeSteps(audio, c.options);
         c.realSteps.insert(c.realSteps.end(), steps.begin(), steps.end());

@@ -5,6 +5,8 @@
 #include "realism/Distance.h"
 #include "realism/Recordings.h"
 
+#include <fmt/core.h>
+
 #include <QComboBox>
 #include <QDir>
 #include <QFile>
@@ -287,6 +289,24 @@ bool PaletteCompare::useFiles(const QStringList& paths) {
     return true;
 }
 
+std::shared_ptr<const std::vector<realism::StepDescriptors>>
+PaletteReference::stepsInRoom(const engine::ReverbSpec& room) const {
+    const auto key = fmt::format("{}|{}|{}", room.impulseResponse, room.wetDb, room.dryDb);
+    std::lock_guard lock(roomedMutex_);
+    if (auto it = roomed_.find(key); it != roomed_.end()) return it->second;
+    auto described = std::make_shared<std::vector<realism::StepDescriptors>>();
+    for (const auto& r : recordings) {
+        const auto s = realism::describeSteps(
+            realism::throughRoom(engine::readAudioFile(r.path), room), options);
+        described->insert(described->end(), s.begin(), s.end());
+    }
+    if (described->empty())
+        throw std::runtime_error(
+            "the reference heard through the settings' room holds no footstep");
+    roomed_[key] = described;
+    return described;
+}
+
 void PaletteCompare::startReference(std::vector<realism::Recording> recordings,
                                     const QString& label) {
     const quint64 generation = ++referenceGeneration_;
@@ -398,44 +418,35 @@ void PaletteCompare::compareNow() {
                            : tr("Distance: computing…"));
     const std::string path =
         QDir(scratch_.path()).filePath(QString("compare_%1.toml").arg(generation)).toStdString();
-    compareJob_ = QtConcurrent::run([this, generation, text, path, spec = renderSpec(),
-                                     ref = reference_] {
-        PaletteComparison c;
-        c.generation = generation;
-        try {
-            writeText(path, text);
-            const auto audio = realism::renderForComparison(path, spec);
-            const auto steps = realism::describeSteps(audio, ref->options);
-            if (steps.empty())
-                throw std::runtime_error("the render of the current settings holds no footstep "
-                                         "(silent? raise the gains or the walker's mass)");
-            // Settings with a room ([reverb]): the reference is heard through the same
-            // room, as `underfoot compare` does (the recordings are dry).
-            if (const auto room = realism::roomOfSurface(path)) {
-                std::vector<realism::StepDescriptors> roomed;
-                for (const auto& r : ref->recordings) {
-                    const auto s = realism::describeSteps(
-                        realism::throughRoom(engine::readAudioFile(r.path), *room), ref->options);
-                    roomed.insert(roomed.end(), s.begin(), s.end());
+    compareJob_ =
+        QtConcurrent::run([this, generation, text, path, spec = renderSpec(), ref = reference_] {
+            PaletteComparison c;
+            c.generation = generation;
+            try {
+                writeText(path, text);
+                const auto audio = realism::renderForComparison(path, spec);
+                const auto steps = realism::describeSteps(audio, ref->options);
+                if (steps.empty())
+                    throw std::runtime_error("the render of the current settings holds no footstep "
+                                             "(silent? raise the gains or the walker's mass)");
+                // Settings with a room ([reverb]): the reference is heard through the same
+                // room, as `underfoot compare` does (the recordings are dry).
+                if (const auto room = realism::roomOfSurface(path)) {
+                    c.comparison = realism::compareSteps(steps, *ref->stepsInRoom(*room));
+                    c.room = QString::fromStdString(room->impulseResponse);
+                } else {
+                    c.comparison = realism::compareSteps(steps, ref->steps);
                 }
-                if (roomed.empty())
-                    throw std::runtime_error("the reference heard through the settings' room "
-                                             "holds no footstep");
-                c.comparison = realism::compareSteps(steps, roomed);
-                c.room = QString::fromStdString(room->impulseResponse);
-            } else {
-                c.comparison = realism::compareSteps(steps, ref->steps);
+                c.example = stepSpectrogram(typicalStep(audio, ref->options),
+                                            ref->options.analysisRateHz, ref->options.maxHz);
+            } catch (const std::exception& e) {
+                c.error = q(e.what());
             }
-            c.example = stepSpectrogram(typicalStep(audio, ref->options),
-                                        ref->options.analysisRateHz, ref->options.maxHz);
-        } catch (const std::exception& e) {
-            c.error = q(e.what());
-        }
-        std::error_code ec;
-        fs::remove(path, ec);
-        QMetaObject::invokeMethod(
-            this, [this, c] { comparisonDone(c); }, Qt::QueuedConnection);
-    });
+            std::error_code ec;
+            fs::remove(path, ec);
+            QMetaObject::invokeMethod(
+                this, [this, c] { comparisonDone(c); }, Qt::QueuedConnection);
+        });
 }
 
 void PaletteCompare::comparisonDone(const PaletteComparison& c) {

@@ -21,7 +21,9 @@
 
 #include <atomic>
 #include <functional>
+#include <map>
 #include <memory>
+#include <mutex>
 #include <optional>
 
 class QComboBox;
@@ -55,6 +57,17 @@ struct PaletteReference {
     realism::AnalysisOptions options; ///< band limited to what the recordings and render share
     std::vector<realism::StepDescriptors> steps;
     StepSpectrogram example; ///< a typical recorded step
+
+    /// The recordings' steps heard through a room (realism::throughRoom), computed by the first
+    /// comparison in that room and reused by the next ones (comparison jobs share the reference).
+    /// Throws std::runtime_error when the recordings hold no step in the room.
+    std::shared_ptr<const std::vector<realism::StepDescriptors>>
+    stepsInRoom(const engine::ReverbSpec& room) const;
+
+  private:
+    mutable std::mutex roomedMutex_;
+    mutable std::map<std::string, std::shared_ptr<const std::vector<realism::StepDescriptors>>>
+        roomed_; ///< by impulse response, wet and dry level
 };
 
 /// The outcome of one comparison request.

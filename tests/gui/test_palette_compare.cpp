@@ -32,13 +32,19 @@ using namespace underfoot;
 namespace {
 constexpr double kSeconds = 3.0; // short renders keep the test within seconds
 
+// Distance of a surface's render (id or .toml) to the reference's dry steps.
+double dryDistance(const std::string& surface, const realism::RenderSpec& spec,
+                   const gui::PaletteReference& ref) {
+    const auto steps =
+        realism::describeSteps(realism::renderForComparison(surface, spec), ref.options);
+    return realism::compareSteps(steps, ref.steps).distance;
+}
+
 double directDistance(const QString& presetText, const realism::RenderSpec& spec,
                       const gui::PaletteReference& ref, const QString& scratch) {
     const std::string path = QDir(scratch).filePath("direct.toml").toStdString();
     std::ofstream(path) << presetText.toStdString();
-    const auto steps =
-        realism::describeSteps(realism::renderForComparison(path, spec), ref.options);
-    return realism::compareSteps(steps, ref.steps).distance;
+    return dryDistance(path, spec, ref);
 }
 } // namespace
 
@@ -124,14 +130,19 @@ class PaletteCompareTest : public QObject {
         qInfo("wood with reverb vs the wood render in its room: %.4f", inRoom);
         QVERIFY2(inRoom < 0.05, qPrintable(c->distanceText()));
         QVERIFY(c->distanceText().contains("wooden_room"));
+        // A second comparison in the same room (the reference's steps in the room are reused):
+        // a level change leaves the distance where it was.
+        double gain = 0;
+        for (const auto& p : engine::Surface::loadById("wood_reverb")->parameters())
+            if (p.path == "gain_db") gain = p.value;
+        QSignalSpy again(c, &gui::PaletteCompare::compared);
+        QVERIFY(palette->setParameter("gain_db", gain - 6));
+        QVERIFY(again.wait(60000));
+        qInfo("in the room again, 6 dB quieter: %.4f", c->distance());
+        QVERIFY(std::abs(c->distance() - inRoom) < 1e-3);
+        QVERIFY(c->distanceText().contains("wooden_room"));
         // The same reference without a room: charged to the sound.
-        const auto& ref = *c->reference();
-        const auto spec = c->renderSpec();
-        const double dry = realism::compareSteps(
-                               realism::describeSteps(
-                                   realism::renderForComparison("wood_reverb", spec), ref.options),
-                               ref.steps)
-                               .distance;
+        const double dry = dryDistance("wood_reverb", c->renderSpec(), *c->reference());
         qInfo("wood with reverb vs the dry wood render: %.4f", dry);
         QVERIFY(dry > inRoom + 0.2);
     }
