@@ -28,4 +28,9 @@ inline constexpr double kPi = 3.14159265358979323846;
 inline constexpr double kTwoPi = 2.0 * kPi;
 inline constexpr double kGravity = 9.80665; ///< standard gravity, m/s^2
 
+/// Linear gain from decibels.
+inline double dbToGain(double db) noexcept {
+    return std::pow(10.0, db / 20.0);
+}
+
 } // namespace underfoot::engine

@@ -63,9 +63,4 @@ inline std::pair<double, double> orderedPair(double a, double b) noexcept {
     return {std::min(a, b), std::max(a, b)};
 }
 
-/// Common helper: linear gain from decibels.
-inline double dbToGain(double db) noexcept {
-    return std::pow(10.0, db / 20.0);
-}
-
 } // namespace underfoot::engine

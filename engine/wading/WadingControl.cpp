@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "engine/wading/WadingControl.h"
+#include "engine/dsp/ProcessSpec.h"
 
 #include <cmath>
 #include <stdexcept>
@@ -7,9 +8,6 @@
 namespace underfoot::engine {
 
 namespace {
-double dbToGain(double db) noexcept {
-    return std::pow(10.0, db / 20.0);
-}
 std::size_t idx(Limb l) {
     return static_cast<std::size_t>(l);
 }

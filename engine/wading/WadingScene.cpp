@@ -2,6 +2,7 @@
 #include "engine/wading/WadingScene.h"
 
 #include "engine/dsp/Denormals.h"
+#include "engine/dsp/ProcessSpec.h"
 #include "engine/io/AudioFile.h"
 
 #include <fmt/core.h>
@@ -20,9 +21,6 @@ namespace fs = std::filesystem;
 
 namespace {
 constexpr int kChunk = WadingScene::kChunkSamples; // control/EQ update granularity, samples
-double dbToGain(double db) noexcept {
-    return std::pow(10.0, db / 20.0);
-}
 } // namespace
 
 // ---------------------------------------------------------------------------------------------

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // RealFft: FFTW plans made and destroyed under one lock, so analysis can run on several worker
 // threads at once (the console computes descriptors and costs off the UI thread).
+#include "engine/dsp/ProcessSpec.h"
 #include "engine/dsp/RealFft.h"
 
 #include <gtest/gtest.h>
@@ -13,7 +14,7 @@
 using underfoot::engine::RealFft;
 
 namespace {
-constexpr double kPi = 3.14159265358979323846;
+using underfoot::engine::kPi;
 
 /// Magnitude of bin k of a unit cosine at bin k (n / 2) and the round trip error.
 void transformCosine(int n, int k, double& peak, double& roundTrip) {

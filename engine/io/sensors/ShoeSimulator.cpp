@@ -1,14 +1,11 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "engine/io/sensors/ShoeSimulator.h"
+#include "engine/dsp/ProcessSpec.h"
 
 #include <algorithm>
 #include <cmath>
 
 namespace underfoot::engine {
-
-namespace {
-constexpr double kPi = 3.141592653589793;
-}
 
 ShoeScript::ShoeScript(ShoeWalkOptions options, std::uint64_t seed) : o_(options), jitter_(seed) {
     // Standing on both feet from before the start.
