@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "app/gui/PaletteCompare.h"
+#include "app/gui/QtText.h"
 
 #include "engine/surfaces/Surface.h"
 #include "realism/Distance.h"
@@ -33,10 +34,6 @@ namespace underfoot::gui {
 
 namespace {
 namespace fs = std::filesystem;
-
-QString q(const std::string& s) {
-    return QString::fromStdString(s);
-}
 
 constexpr double kRenderRateHz = 48000;
 constexpr std::uint64_t kRenderSeed = 11; // as `underfoot fit`

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "app/gui/PaletteView.h"
+#include "app/gui/QtText.h"
 
 #include <cstring>
 
@@ -37,9 +38,6 @@ namespace underfoot::gui {
 namespace eng = underfoot::engine;
 
 namespace {
-QString q(const std::string& s) {
-    return QString::fromStdString(s);
-}
 enum Column { PathCol, ValueCol, UnitCol, RangeCol };
 
 /// A parameter as people read it, from its declared path: "layer[1].modes[3].freq_hz" ->

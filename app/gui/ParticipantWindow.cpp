@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "app/gui/ParticipantWindow.h"
+#include "app/gui/QtText.h"
 
 #include "app/gui/ScaleRow.h"
 
@@ -23,9 +24,6 @@ namespace underfoot::gui {
 namespace exp = underfoot::experiment;
 
 namespace {
-QString q(const std::string& s) {
-    return QString::fromStdString(s);
-}
 QFont scaled(const QWidget* w, double factor) {
     QFont f = w->font();
     f.setPointSizeF(f.pointSizeF() * factor);

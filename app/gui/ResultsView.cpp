@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "app/gui/ResultsView.h"
+#include "app/gui/QtText.h"
 
 #include "analysis/io/TrialCsv.h"
 #include "analysis/report/Export.h"
@@ -46,9 +47,6 @@ namespace exp = underfoot::experiment;
 namespace an = underfoot::analysis;
 
 namespace {
-QString q(const std::string& s) {
-    return QString::fromStdString(s);
-}
 QString num(double v, int decimals = 1) {
     return std::isfinite(v) ? QString::number(v, 'f', decimals) : QString("—");
 }

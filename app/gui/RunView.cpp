@@ -1,5 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "app/gui/RunView.h"
+#include "app/gui/Figures.h"
+#include "app/gui/QtText.h"
 
 #include "app/gui/ConsolePlayer.h"
 
@@ -57,18 +59,6 @@ namespace underfoot::gui {
 namespace exp = underfoot::experiment;
 
 namespace {
-QString q(const std::string& s) {
-    return QString::fromStdString(s);
-}
-
-QString surfaceLabel(const std::string& id) {
-    if (const auto* e = exp::defaultCatalogue().surface(id)) return q(e->label);
-    return q(id);
-}
-QString soundscapeLabel(const std::string& id) {
-    if (const auto* e = exp::defaultCatalogue().soundscape(id)) return q(e->label);
-    return q(id);
-}
 
 enum Page { StartPage, BriefingPage, TrialPage, BreakPage, FinishedPage };
 

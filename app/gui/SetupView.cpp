@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "app/gui/SetupView.h"
+#include "app/gui/QtText.h"
 
 #include "app/gui/AudioOutput.h"
 #include "engine/control/StepDetector.h"
@@ -36,9 +37,6 @@ namespace underfoot::gui {
 namespace eng = underfoot::engine;
 
 namespace {
-QString q(const std::string& s) {
-    return QString::fromStdString(s);
-}
 
 QChart* makeChart(const QString& title, const QString& yTitle) {
     auto* chart = new QChart;

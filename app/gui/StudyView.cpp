@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "app/gui/StudyView.h"
+#include "app/gui/QtText.h"
 
 #include "app/gui/DemoStudy.h"
 #include "app/gui/StudyContext.h"
@@ -45,10 +46,6 @@ QTableWidget* makeTable(const QStringList& headers, const QString& name, QWidget
 
 void setRow(QTableWidget* t, int row, const QStringList& cells) {
     for (int c = 0; c < cells.size(); ++c) t->setItem(row, c, new QTableWidgetItem(cells[c]));
-}
-
-QString q(const std::string& s) {
-    return QString::fromStdString(s);
 }
 
 } // namespace
