@@ -27,6 +27,7 @@
 #include <sstream>
 #include <stdexcept>
 
+namespace underfoot::cli::analyze_command {
 namespace {
 
 using namespace underfoot;
@@ -304,3 +305,4 @@ const cli::CommandRegistrar registrar("analyze", [](CLI::App& app, int& exitCode
 });
 
 } // namespace
+} // namespace underfoot::cli::analyze_command

@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-namespace underfoot::cli {
+namespace underfoot::cli::bench_command {
 namespace {
 namespace eng = underfoot::engine;
 
@@ -231,4 +231,4 @@ CommandRegistrar reg("bench", [](CLI::App& app, int& exitCode) {
 });
 
 } // namespace
-} // namespace underfoot::cli
+} // namespace underfoot::cli::bench_command

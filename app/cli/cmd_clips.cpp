@@ -15,7 +15,7 @@
 #include <filesystem>
 #include <thread>
 
-namespace underfoot::cli {
+namespace underfoot::cli::clips_command {
 namespace {
 
 namespace eng = underfoot::engine;
@@ -141,4 +141,4 @@ const CommandRegistrar registrar{
     }};
 
 } // namespace
-} // namespace underfoot::cli
+} // namespace underfoot::cli::clips_command

@@ -22,7 +22,7 @@
 #include <optional>
 #include <set>
 
-namespace underfoot::cli {
+namespace underfoot::cli::compare_command {
 namespace {
 namespace eng = underfoot::engine;
 namespace rl = underfoot::realism;
@@ -531,4 +531,4 @@ CommandRegistrar reg("compare", [](CLI::App& app, int& exitCode) {
 });
 
 } // namespace
-} // namespace underfoot::cli
+} // namespace underfoot::cli::compare_command

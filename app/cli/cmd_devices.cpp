@@ -11,7 +11,7 @@
 #include <algorithm>
 #include <memory>
 
-namespace underfoot::cli {
+namespace underfoot::cli::devices_command {
 namespace {
 namespace eng = underfoot::engine;
 
@@ -100,4 +100,4 @@ CommandRegistrar reg("devices", [](CLI::App& app, int& exitCode) {
 });
 
 } // namespace
-} // namespace underfoot::cli
+} // namespace underfoot::cli::devices_command

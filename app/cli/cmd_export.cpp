@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 
+namespace underfoot::cli::export_command {
 namespace {
 
 using namespace underfoot::experiment;
@@ -80,3 +81,4 @@ const underfoot::cli::CommandRegistrar registrar{
     }};
 
 } // namespace
+} // namespace underfoot::cli::export_command

@@ -25,7 +25,7 @@
 #include <fstream>
 #include <memory>
 
-namespace underfoot::cli {
+namespace underfoot::cli::fit_command {
 namespace {
 namespace eng = underfoot::engine;
 namespace rl = underfoot::realism;
@@ -256,4 +256,4 @@ CommandRegistrar reg("fit", [](CLI::App& app, int& exitCode) {
 });
 
 } // namespace
-} // namespace underfoot::cli
+} // namespace underfoot::cli::fit_command

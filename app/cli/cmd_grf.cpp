@@ -18,6 +18,7 @@
 #include <cmath>
 #include <filesystem>
 
+namespace underfoot::cli::grf_command {
 namespace {
 
 using namespace underfoot::engine;
@@ -199,3 +200,4 @@ const underfoot::cli::CommandRegistrar registrar{
     }};
 
 } // namespace
+} // namespace underfoot::cli::grf_command

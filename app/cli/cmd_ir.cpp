@@ -20,6 +20,7 @@
 #include <cmath>
 #include <ctime>
 
+namespace underfoot::cli::ir_command {
 namespace {
 
 using namespace underfoot::engine;
@@ -204,3 +205,4 @@ const underfoot::cli::CommandRegistrar registrar{
     }};
 
 } // namespace
+} // namespace underfoot::cli::ir_command

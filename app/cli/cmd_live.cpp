@@ -17,7 +17,7 @@
 #include <memory>
 #include <thread>
 
-namespace underfoot::cli {
+namespace underfoot::cli::live_command {
 namespace {
 namespace eng = underfoot::engine;
 
@@ -192,4 +192,4 @@ CommandRegistrar reg("live", [](CLI::App& app, int& exitCode) {
 });
 
 } // namespace
-} // namespace underfoot::cli
+} // namespace underfoot::cli::live_command

@@ -22,6 +22,7 @@
 #include <memory>
 #include <thread>
 
+namespace underfoot::cli::protocol_command {
 namespace {
 
 using namespace underfoot::experiment;
@@ -720,3 +721,4 @@ const underfoot::cli::CommandRegistrar registrar{
     }};
 
 } // namespace
+} // namespace underfoot::cli::protocol_command

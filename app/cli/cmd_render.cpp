@@ -11,7 +11,7 @@
 #include <filesystem>
 #include <memory>
 
-namespace underfoot::cli {
+namespace underfoot::cli::render_command {
 namespace {
 namespace eng = underfoot::engine;
 
@@ -191,4 +191,4 @@ CommandRegistrar regSurfaces("surfaces", [](CLI::App& app, int& exitCode) {
 });
 
 } // namespace
-} // namespace underfoot::cli
+} // namespace underfoot::cli::render_command

@@ -9,7 +9,7 @@
 
 #include <memory>
 
-namespace underfoot::cli {
+namespace underfoot::cli::replay_command {
 namespace {
 
 struct ReplayArgs {
@@ -57,4 +57,4 @@ CommandRegistrar reg("replay", [](CLI::App& app, int& exitCode) {
 });
 
 } // namespace
-} // namespace underfoot::cli
+} // namespace underfoot::cli::replay_command

@@ -31,6 +31,7 @@
 #include <thread>
 #include <unistd.h>
 
+namespace underfoot::cli::sensors_command {
 namespace {
 
 using namespace underfoot::engine;
@@ -441,3 +442,4 @@ const underfoot::cli::CommandRegistrar registrar{
     }};
 
 } // namespace
+} // namespace underfoot::cli::sensors_command

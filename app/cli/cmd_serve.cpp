@@ -16,6 +16,7 @@
 #include <pthread.h>
 #include <thread>
 
+namespace underfoot::cli::serve_command {
 namespace {
 
 using underfoot::cli::UserError;
@@ -127,3 +128,4 @@ const underfoot::cli::CommandRegistrar registrar{
     }};
 
 } // namespace
+} // namespace underfoot::cli::serve_command

@@ -29,6 +29,7 @@
 #include <iostream>
 #include <memory>
 
+namespace underfoot::cli::session_command {
 namespace {
 
 using namespace underfoot::experiment;
@@ -579,3 +580,4 @@ const underfoot::cli::CommandRegistrar registrar{
     }};
 
 } // namespace
+} // namespace underfoot::cli::session_command

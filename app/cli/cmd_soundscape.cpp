@@ -14,6 +14,7 @@
 #include <cmath>
 #include <memory>
 
+namespace underfoot::cli::soundscape_command {
 namespace {
 
 using namespace underfoot;
@@ -179,3 +180,4 @@ const cli::CommandRegistrar registrar("soundscape", [](CLI::App& app, int& exitC
 });
 
 } // namespace
+} // namespace underfoot::cli::soundscape_command

@@ -13,6 +13,7 @@
 #include <memory>
 #include <string>
 
+namespace underfoot::cli::stats_command {
 namespace {
 
 using namespace underfoot;
@@ -48,3 +49,4 @@ const cli::CommandRegistrar registrar("stats", [](CLI::App& app, int& exitCode) 
 });
 
 } // namespace
+} // namespace underfoot::cli::stats_command

@@ -14,6 +14,7 @@
 #include <functional>
 #include <iostream>
 
+namespace underfoot::cli::study_command {
 namespace {
 
 using namespace underfoot::experiment;
@@ -304,3 +305,4 @@ const underfoot::cli::CommandRegistrar registrar{
     }};
 
 } // namespace
+} // namespace underfoot::cli::study_command

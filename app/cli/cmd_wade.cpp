@@ -28,7 +28,7 @@
 #include <cstdlib>
 #include <thread>
 
-namespace underfoot::cli {
+namespace underfoot::cli::wade_command {
 namespace {
 namespace eng = underfoot::engine;
 
@@ -350,4 +350,4 @@ const CommandRegistrar registrar{
     }};
 
 } // namespace
-} // namespace underfoot::cli
+} // namespace underfoot::cli::wade_command
