@@ -17,9 +17,9 @@
 
 namespace underfoot::engine {
 namespace {
-using Clock = std::chrono::steady_clock;
+using CostClock = std::chrono::steady_clock;
 constexpr double kRate = 48000.0;
-constexpr int kBlock = 64;
+constexpr int kCostBlock = 64;
 
 const std::vector<Mode>& benchModes() {
     static const std::vector<Mode> modes = {
@@ -49,13 +49,13 @@ template <typename Real>
 StrikeResult strikeOnce(const ImpactSetting& s) {
     HuntCrossleyImpactT<Real> impact;
     impact.configure(benchParams(s), benchModes(), {{1.0, 1.0, 1.0}});
-    impact.prepare({kRate, kBlock});
+    impact.prepare({kRate, kCostBlock});
     impact.strike(0.5);
     StrikeResult r;
     r.out.assign(static_cast<std::size_t>(0.25 * kRate), 0.0f);
-    for (std::size_t i = 0; i < r.out.size(); i += kBlock)
+    for (std::size_t i = 0; i < r.out.size(); i += kCostBlock)
         impact.process(nullptr, r.out.data() + i,
-                       static_cast<int>(std::min<std::size_t>(kBlock, r.out.size() - i)));
+                       static_cast<int>(std::min<std::size_t>(kCostBlock, r.out.size() - i)));
     r.contactTime = impact.stats().contactTimeSeconds;
     r.restitution = impact.stats().incomingVelocity != 0.0
                         ? -impact.stats().outgoingVelocity / impact.stats().incomingVelocity
@@ -83,9 +83,10 @@ BlockTimes timeBlocks(int blocks, int repeats, const std::function<TimedRun()>& 
         const TimedRun run = makeRun();
         for (int b = 0; b < blocks; ++b) {
             if (run.prepare) run.prepare(b);
-            const auto s0 = Clock::now();
+            const auto s0 = CostClock::now();
             run.block(b);
-            const double ns = std::chrono::duration<double, std::nano>(Clock::now() - s0).count();
+            const double ns =
+                std::chrono::duration<double, std::nano>(CostClock::now() - s0).count();
             best[static_cast<std::size_t>(b)] = std::min(best[static_cast<std::size_t>(b)], ns);
             if (run.check) run.check(b);
         }
@@ -93,7 +94,7 @@ BlockTimes timeBlocks(int blocks, int repeats, const std::function<TimedRun()>& 
     BlockTimes t;
     double total = 0;
     for (double ns : best) total += ns;
-    t.nsPerSample = total / (double(blocks) * kBlock);
+    t.nsPerSample = total / (double(blocks) * kCostBlock);
     std::sort(best.begin(), best.end());
     t.medianBlockNs = best[best.size() / 2];
     t.p99BlockNs = best[best.size() * 99 / 100];
@@ -104,17 +105,17 @@ BlockTimes timeBlocks(int blocks, int repeats, const std::function<TimedRun()>& 
 // Times a deterministic train of strikes (4 per second) block by block.
 template <typename Real>
 void timeStrikes(const ImpactSetting& s, double seconds, ImpactMeasurement& m, int repeats = 5) {
-    const int blocks = static_cast<int>(seconds * kRate / kBlock);
-    const int strikeEvery = static_cast<int>(0.25 * kRate / kBlock);
-    auto out = std::make_shared<std::vector<float>>(kBlock);
+    const int blocks = static_cast<int>(seconds * kRate / kCostBlock);
+    const int strikeEvery = static_cast<int>(0.25 * kRate / kCostBlock);
+    auto out = std::make_shared<std::vector<float>>(kCostBlock);
     const BlockTimes t = timeBlocks(blocks, repeats, [&] {
         auto impact = std::make_shared<HuntCrossleyImpactT<Real>>();
         impact->configure(benchParams(s), benchModes(), {{1.0, 1.0, 1.0}});
-        impact->prepare({kRate, kBlock});
+        impact->prepare({kRate, kCostBlock});
         TimedRun run;
         run.block = [impact, out, strikeEvery](int b) {
             if (b % strikeEvery == 0) impact->strike(0.5);
-            impact->process(nullptr, out->data(), kBlock);
+            impact->process(nullptr, out->data(), kCostBlock);
         };
         return run;
     });
@@ -276,7 +277,7 @@ struct Scenario {
 };
 
 Scenario makeScenario(const std::string& id) {
-    const int strikeEvery = static_cast<int>(0.25 * kRate / kBlock);
+    const int strikeEvery = static_cast<int>(0.25 * kRate / kCostBlock);
     if (id == "impact-strikes" || id == "impact-pressed" || id == "impact-metal") {
         auto impact = std::make_shared<HuntCrossleyImpact>();
         ImpactParams p = scenarioImpact();
@@ -289,12 +290,12 @@ Scenario makeScenario(const std::string& id) {
         } else {
             impact->configure(p, benchModes(), {{1.0, 1.0, 1.0}});
         }
-        impact->prepare({kRate, kBlock});
+        impact->prepare({kRate, kCostBlock});
         const bool pressed = id == "impact-pressed";
-        auto force = std::make_shared<std::vector<float>>(kBlock, pressed ? 300.0f : 0.0f);
+        auto force = std::make_shared<std::vector<float>>(kCostBlock, pressed ? 300.0f : 0.0f);
         return {impact, [impact, force, pressed, v, strikeEvery](int b, float* out) {
                     if (pressed ? b == 0 : b % strikeEvery == 0) impact->strike(v);
-                    impact->process(pressed ? force->data() : nullptr, out, kBlock);
+                    impact->process(pressed ? force->data() : nullptr, out, kCostBlock);
                 }};
     }
     if (id == "friction-creak") {
@@ -302,7 +303,7 @@ Scenario makeScenario(const std::string& id) {
         configureCreakScenario(*f);
         auto anchor = std::make_shared<double>(0.0);
         return {f, [f, anchor](int, float* out) {
-                    for (int i = 0; i < kBlock; ++i) {
+                    for (int i = 0; i < kCostBlock; ++i) {
                         *anchor += 0.05 / kRate;
                         out[i] += static_cast<float>(f->processSample(105.0, 0.0, *anchor, 0.05));
                     }
@@ -331,10 +332,10 @@ Scenario makeScenario(const std::string& id) {
         a->configure(p);
         a->prepare(kRate, 4000);
         a->reset(7);
-        auto rate = std::make_shared<std::vector<float>>(kBlock, 1000.0f);
-        auto scale = std::make_shared<std::vector<float>>(kBlock, 1.0f);
+        auto rate = std::make_shared<std::vector<float>>(kCostBlock, 1000.0f);
+        auto scale = std::make_shared<std::vector<float>>(kCostBlock, 1.0f);
         return {a, [a, rate, scale](int, float* out) {
-                    a->process(rate->data(), scale->data(), out, kBlock);
+                    a->process(rate->data(), scale->data(), out, kCostBlock);
                 }};
     }
     if (id == "bubbles") {
@@ -344,10 +345,10 @@ Scenario makeScenario(const std::string& id) {
         s->configure(p);
         s->prepare(kRate, 4000);
         s->reset(7);
-        auto rate = std::make_shared<std::vector<float>>(kBlock, 500.0f);
-        auto scale = std::make_shared<std::vector<float>>(kBlock, 1.0f);
+        auto rate = std::make_shared<std::vector<float>>(kCostBlock, 500.0f);
+        auto scale = std::make_shared<std::vector<float>>(kCostBlock, 1.0f);
         return {s, [s, rate, scale](int, float* out) {
-                    s->process(rate->data(), scale->data(), out, kBlock);
+                    s->process(rate->data(), scale->data(), out, kCostBlock);
                 }};
     }
     throw std::invalid_argument("unknown bench scenario '" + id + "'");
@@ -386,8 +387,8 @@ void configureCreakScenario(ElastoPlasticFriction& f, FrictionParams p) {
 }
 
 ScenarioMeasurement measureScenario(const std::string& id, double seconds, int repeats) {
-    const int blocks = static_cast<int>(seconds * kRate / kBlock);
-    auto out = std::make_shared<std::vector<float>>(kBlock);
+    const int blocks = static_cast<int>(seconds * kRate / kCostBlock);
+    auto out = std::make_shared<std::vector<float>>(kCostBlock);
     auto checksum = std::make_shared<double>(0.0);
     ScenarioMeasurement m;
     m.id = id;
@@ -407,14 +408,14 @@ ScenarioMeasurement measureScenario(const std::string& id, double seconds, int r
     m.medianBlockNs = t.medianBlockNs;
     m.p99BlockNs = t.p99BlockNs;
     m.maxBlockNs = t.maxBlockNs;
-    m.budgetShare = m.maxBlockNs / (1e9 * kBlock / kRate);
+    m.budgetShare = m.maxBlockNs / (1e9 * kCostBlock / kRate);
     return m;
 }
 
 std::vector<ScalingPoint> measureScaling(double seconds, int repeats) {
-    const int blocks = static_cast<int>(seconds * kRate / kBlock);
-    const int strikeEvery = static_cast<int>(0.25 * kRate / kBlock);
-    auto out = std::make_shared<std::vector<float>>(kBlock);
+    const int blocks = static_cast<int>(seconds * kRate / kCostBlock);
+    const int strikeEvery = static_cast<int>(0.25 * kRate / kCostBlock);
+    auto out = std::make_shared<std::vector<float>>(kCostBlock);
     std::vector<ScalingPoint> points;
     auto timeRuns = [&](const std::function<TimedRun()>& make) {
         return timeBlocks(blocks, repeats, make).nsPerSample;
@@ -426,14 +427,14 @@ std::vector<ScalingPoint> measureScaling(double seconds, int repeats) {
                 std::make_shared<std::vector<HuntCrossleyImpact>>(static_cast<std::size_t>(voices));
             for (auto& v : *pool) {
                 v.configure(scenarioImpact(), benchModes(), {{1.0, 1.0, 1.0}});
-                v.prepare({kRate, kBlock});
+                v.prepare({kRate, kCostBlock});
             }
             TimedRun run;
             run.block = [pool, out, strikeEvery](int b) {
                 for (std::size_t v = 0; v < pool->size(); ++v) {
                     auto& voice = (*pool)[v];
                     if ((b + static_cast<int>(v) * 7) % strikeEvery == 0) voice.strike(0.5);
-                    voice.process(nullptr, out->data(), kBlock);
+                    voice.process(nullptr, out->data(), kCostBlock);
                 }
             };
             return run;
@@ -449,11 +450,11 @@ std::vector<ScalingPoint> measureScaling(double seconds, int repeats) {
         const double ns = timeRuns([&] {
             auto impact = std::make_shared<HuntCrossleyImpact>();
             impact->configure(scenarioImpact(), m, {g});
-            impact->prepare({kRate, kBlock});
+            impact->prepare({kRate, kCostBlock});
             TimedRun run;
             run.block = [impact, out, strikeEvery](int b) {
                 if (b % strikeEvery == 0) impact->strike(0.5);
-                impact->process(nullptr, out->data(), kBlock);
+                impact->process(nullptr, out->data(), kCostBlock);
             };
             return run;
         });
@@ -466,12 +467,12 @@ std::vector<ScalingPoint> measureScaling(double seconds, int repeats) {
             auto a = std::static_pointer_cast<AggregateModel>(sc.state);
             a->prepare(kRate, 16000);
             a->reset(7);
-            auto rates = std::make_shared<std::vector<float>>(kBlock, float(rate));
-            auto scale = std::make_shared<std::vector<float>>(kBlock, 1.0f);
+            auto rates = std::make_shared<std::vector<float>>(kCostBlock, float(rate));
+            auto scale = std::make_shared<std::vector<float>>(kCostBlock, 1.0f);
             TimedRun run;
             run.prepare = [out](int) { std::fill(out->begin(), out->end(), 0.0f); };
             run.block = [a, rates, scale, out](int) {
-                a->process(rates->data(), scale->data(), out->data(), kBlock);
+                a->process(rates->data(), scale->data(), out->data(), kCostBlock);
             };
             return run;
         });
