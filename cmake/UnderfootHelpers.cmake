@@ -3,6 +3,12 @@
 # Warnings and (optionally) sanitizers for one of our own targets.
 function(underfoot_target_defaults target)
   target_compile_options(${target} PRIVATE -Wall -Wextra -Wshadow -Wconversion -Wno-sign-conversion)
+  if(UNDERFOOT_UNITY AND CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
+    # A unity batch #includes its .cpp files, and GCC then warns about every test fixture in an
+    # anonymous namespace ("has a base whose type uses the anonymous namespace"): each file is
+    # still its own part of the batch, so the warning says nothing there.
+    target_compile_options(${target} PRIVATE -Wno-subobject-linkage)
+  endif()
   if(UNDERFOOT_SANITIZE)
     target_compile_options(${target} PRIVATE -fsanitize=address,undefined -fno-omit-frame-pointer
                                              -fno-sanitize-recover=undefined)
@@ -23,6 +29,12 @@ function(underfoot_precompile target)
   if(UNDERFOOT_PCH)
     target_precompile_headers(${target} PRIVATE ${ARGN})
   endif()
+endfunction()
+
+# Sources compiled on their own in a unity build (UNDERFOOT_UNITY): their file-local helpers or
+# constants share a name with a neighbour's. Call it in the folder that creates the target.
+function(underfoot_no_unity)
+  set_source_files_properties(${ARGN} PROPERTIES SKIP_UNITY_BUILD_INCLUSION ON)
 endfunction()
 
 # A library made of every .cpp below one folder (each part of the project is one library).

@@ -9,12 +9,14 @@
 # targets of tests/fuzz) replays every regression input and fuzzes each target for
 # UNDERFOOT_FUZZ_SECONDS (20 s); it runs when no extra ctest arguments are given.
 # Long soaks carry the ctest label `soak` and run with: ctest --test-dir build -L soak
+# Every build uses -g1 (line tables: file:line in sanitizer reports) and unity batches
+# (UNDERFOOT_UNITY), which keep the three builds within CI's time.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 jobs="$(nproc)"
 
 if [ ! -f build/CMakeCache.txt ]; then
-  cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo
+  cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g1 -DNDEBUG"
 fi
 cmake --build build --parallel "$jobs"
 echo "== tests (release build)"
@@ -22,7 +24,7 @@ ctest --test-dir build --output-on-failure -j "$jobs" -LE soak "$@"
 
 if [ "${UNDERFOOT_SKIP_SANITIZE:-0}" != "1" ]; then
   if [ ! -f build-asan/CMakeCache.txt ]; then
-    cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g" \
+    cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g1" \
       -DUNDERFOOT_SANITIZE=ON -DUNDERFOOT_BUILD_BENCHMARKS=OFF -DUNDERFOOT_BUILD_GUI=OFF
   fi
   cmake --build build-asan --parallel "$jobs"
@@ -36,7 +38,7 @@ if [ "${UNDERFOOT_SKIP_FUZZ:-0}" != "1" ] && [ $# -eq 0 ]; then
     echo "== fuzz pass skipped: clang++-14 is not installed (bash scripts/setup.sh installs it)"
   else
     if [ ! -f build-fuzz/CMakeCache.txt ]; then
-      cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g" \
+      cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g1" \
         -DCMAKE_C_COMPILER=clang-14 -DCMAKE_CXX_COMPILER=clang++-14 -DUNDERFOOT_FUZZ=ON \
         -DUNDERFOOT_BUILD_BENCHMARKS=OFF -DUNDERFOOT_BUILD_GUI=OFF
     fi
