@@ -73,6 +73,20 @@ engine::AudioBuffer throughRoom(const engine::AudioBuffer& recording,
     return throughRoomWith(recording, readRoomImpulse(room), room);
 }
 
+std::vector<StepDescriptors> describeRecordings(const std::vector<Recording>& recordings,
+                                                const AnalysisOptions& options,
+                                                const std::optional<engine::ReverbSpec>& room) {
+    const auto ir = room ? readRoomImpulse(*room) : engine::AudioBuffer{};
+    std::vector<StepDescriptors> steps;
+    for (const auto& r : recordings) {
+        const auto s =
+            room ? describeSteps(throughRoomWith(engine::readAudioFile(r.path), ir, *room), options)
+                 : describeFile(r.path, options);
+        steps.insert(steps.end(), s.begin(), s.end());
+    }
+    return steps;
+}
+
 std::optional<engine::ReverbSpec> roomOfSurface(const std::string& surface) {
     return engine::Surface::loadById(surface)->info().reverb;
 }

@@ -47,6 +47,13 @@ struct SurfaceComparison {
 engine::AudioBuffer throughRoom(const engine::AudioBuffer& recording,
                                 const engine::ReverbSpec& room);
 
+/// Every recording's steps, in the recordings' order, each recording first heard through `room`
+/// when one is given (throughRoom; the room's impulse response is read once for all of them).
+/// Throws engine::FileError for an unreadable recording or impulse response.
+std::vector<StepDescriptors> describeRecordings(const std::vector<Recording>& recordings,
+                                                const AnalysisOptions& options,
+                                                const std::optional<engine::ReverbSpec>& room);
+
 /// The room a surface's render is heard in: its preset's [reverb], if it has one. Throws
 /// engine::PresetError for a bad preset.
 std::optional<engine::ReverbSpec> roomOfSurface(const std::string& surface);

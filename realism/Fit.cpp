@@ -482,19 +482,11 @@ FitResult fitSurface(const std::string& presetFile, const std::vector<Recording>
             "{} render seeds: at most 32 (each evaluation renders once per seed)", seeds.size()));
 
     // A preset with a room ([reverb]) is fitted against the recordings heard through that room,
-    // as `underfoot compare` compares it (throughRoom, realism/Compare.h).
+    // as `underfoot compare` compares it (describeRecordings, realism/Compare.h).
     const auto room = roomOfSurface(presetFile);
-    auto describeRecording = [&room](const Recording& r, const AnalysisOptions& o) {
-        return room ? describeSteps(throughRoom(engine::readAudioFile(r.path), *room), o)
-                    : describeFile(r.path, o);
-    };
     AnalysisOptions ao;
     ao.maxHz = sharedMaxHz(real, options.spec.rateHz);
-    std::vector<StepDescriptors> realSteps;
-    for (const auto& r : real) {
-        auto s = describeRecording(r, ao);
-        realSteps.insert(realSteps.end(), s.begin(), s.end());
-    }
+    const auto realSteps = describeRecordings(real, ao, room);
     if (realSteps.empty()) throw std::runtime_error("no footstep found in the recordings");
 
     const auto id = fs::path(presetFile).stem().string();
@@ -535,10 +527,7 @@ FitResult fitSurface(const std::string& presetFile, const std::vector<Recording>
         for (const auto& [material, recs] : byMaterial) {
             Target t{material, {}, {}};
             t.ao.maxHz = sharedMaxHz(recs, options.spec.rateHz);
-            for (const auto& r : recs) {
-                auto s = describeRecording(r, t.ao);
-                t.steps.insert(t.steps.end(), s.begin(), s.end());
-            }
+            t.steps = describeRecordings(recs, t.ao, room);
             if (!t.steps.empty()) others.push_back(std::move(t));
         }
     }

@@ -291,12 +291,8 @@ PaletteReference::stepsInRoom(const engine::ReverbSpec& room) const {
     const auto key = fmt::format("{}|{}|{}", room.impulseResponse, room.wetDb, room.dryDb);
     std::lock_guard lock(roomedMutex_);
     if (auto it = roomed_.find(key); it != roomed_.end()) return it->second;
-    auto described = std::make_shared<std::vector<realism::StepDescriptors>>();
-    for (const auto& r : recordings) {
-        const auto s = realism::describeSteps(
-            realism::throughRoom(engine::readAudioFile(r.path), room), options);
-        described->insert(described->end(), s.begin(), s.end());
-    }
+    auto described = std::make_shared<std::vector<realism::StepDescriptors>>(
+        realism::describeRecordings(recordings, options, room));
     if (described->empty())
         throw std::runtime_error(
             "the reference heard through the settings' room holds no footstep");
