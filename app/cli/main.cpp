@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The `underfoot` command line: subcommands register themselves (CommandRegistry.h).
 #include "app/cli/CommandRegistry.h"
+#include "engine/dsp/Simd.h"
 
 #include <fmt/core.h>
 
@@ -8,6 +9,12 @@
 #include <exception>
 
 int main(int argc, char** argv) {
+    if (!underfoot::engine::simdEnvironmentValid()) {
+        fmt::print(stderr,
+                   "underfoot: the environment variable UNDERFOOT_SIMD is set to an unknown "
+                   "value; expected sse2 or avx (or unset: the CPU's best)\n");
+        return 2;
+    }
     CLI::App app{"Underfoot: physically based footsteps and perception experiments"};
     app.set_version_flag("--version", std::string("underfoot ") + UNDERFOOT_VERSION);
     app.require_subcommand(1);

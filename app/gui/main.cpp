@@ -1,11 +1,19 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // underfoot-gui: the experimenter's console.
 #include "app/gui/MainWindow.h"
+#include "engine/dsp/Simd.h"
 
 #include <QApplication>
 #include <QCommandLineParser>
 
+#include <cstdio>
+
 int main(int argc, char** argv) {
+    if (!underfoot::engine::simdEnvironmentValid()) {
+        std::fprintf(stderr, "underfoot-gui: the environment variable UNDERFOOT_SIMD is set to an "
+                             "unknown value; expected sse2 or avx (or unset: the CPU's best)\n");
+        return 2;
+    }
     QApplication app(argc, argv);
     QApplication::setApplicationName("underfoot");
     QApplication::setOrganizationName("underfoot");

@@ -81,7 +81,7 @@ struct FrictionParams {
 /// y = (8k + j) ln2 / 8 + r with |r| <= ln2 / 16 (ln2 / 8 split in two so that the product is
 /// exact), e^r by its Taylor polynomial of degree 8 (remainder < 1.4e-18), 2^(j/8) from a table
 /// of correctly rounded values and 2^k put into the exponent bits.
-inline double frictionExpNeg(double y) noexcept {
+[[gnu::always_inline]] inline double frictionExpNeg(double y) noexcept {
     if (!(y > -708.0)) return 0.0;
     static constexpr double pow2Eighths[8] = {1.0,
                                               1.0905077326652577,
@@ -113,7 +113,7 @@ inline double frictionExpNeg(double y) noexcept {
 }
 
 /// sin(pi t / 2) for |t| <= 1, absolute error < 1e-15. Deterministic (no FMA, no libm).
-inline double frictionSinHalfPi(double t) noexcept {
+[[gnu::always_inline]] inline double frictionSinHalfPi(double t) noexcept {
     // sin(pi t / 2) for |t| <= 1: t P(t^2), P the degree-7 Chebyshev fit of
     // sin(pi sqrt(u) / 2) / sqrt(u) on [0, 1] (mpmath chebyfit, fit error 1.8e-16). Absolute
     // error below 1e-15.

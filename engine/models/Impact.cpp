@@ -123,24 +123,33 @@ inline double rootOf(double x) noexcept {
 } // namespace
 
 template <typename Real>
-inline double HuntCrossleyImpactT<Real>::contactForce(double c, double cdot) const noexcept {
+template <typename HuntCrossleyImpactT<Real>::Shape S>
+inline double HuntCrossleyImpactT<Real>::contactForceOf(double c, double cdot) const noexcept {
     if (c <= 0.0) return 0.0;
     double ca; // c^alpha: the shapes in use without pow (chosen once in prepare())
+    if constexpr (S == Shape::Linear)
+        ca = c;
+    else if constexpr (S == Shape::Hertz)
+        ca = c * rootOf(c);
+    else if constexpr (S == Shape::Square)
+        ca = c * c;
+    else
+        ca = std::pow(c, params_.alpha);
+    return std::max(0.0, stiffness_ * ca * (1.0 + dissipation_ * cdot));
+}
+
+template <typename Real>
+double HuntCrossleyImpactT<Real>::contactForce(double c, double cdot) const noexcept {
     switch (shape_) {
     case Shape::Linear:
-        ca = c;
-        break;
+        return contactForceOf<Shape::Linear>(c, cdot);
     case Shape::Hertz:
-        ca = c * rootOf(c);
-        break;
+        return contactForceOf<Shape::Hertz>(c, cdot);
     case Shape::Square:
-        ca = c * c;
-        break;
+        return contactForceOf<Shape::Square>(c, cdot);
     default:
-        ca = std::pow(c, params_.alpha);
-        break;
+        return contactForceOf<Shape::General>(c, cdot);
     }
-    return std::max(0.0, stiffness_ * ca * (1.0 + dissipation_ * cdot));
 }
 
 template <typename Real>
@@ -148,17 +157,44 @@ double HuntCrossleyImpactT<Real>::solveForce(double ch, double dh) noexcept {
     if (params_.solver == ImpactSolver::Explicit)
         return contactForce(exciterX_ - resonator_.position(0),
                             exciterV_ - resonator_.contactVelocity());
-    const double fMax = contactForce(ch, dh);
+    if (!(ch > 0.0)) return 0.0; // fMax = HC(ch, dh) = 0 (below): no contact (free flight)
+    switch (shape_) {            // the contact law's shape, once per solve
+    case Shape::Linear:
+        return solveShaped<Shape::Linear>(ch, dh);
+    case Shape::Hertz:
+        return solveShaped<Shape::Hertz>(ch, dh);
+    case Shape::Square:
+        return solveShaped<Shape::Square>(ch, dh);
+    default:
+        return solveShaped<Shape::General>(ch, dh);
+    }
+}
+
+template <typename Real>
+template <typename HuntCrossleyImpactT<Real>::Shape S>
+double HuntCrossleyImpactT<Real>::solveShaped(double ch, double dh) noexcept {
+    // g(F) = F - HC(ch - kc F, dh - kd F) is increasing in F; its root lies in [0, fMax],
+    // fMax = HC(ch, dh) (HC falls as F compresses less and slower). Newton from the last force.
+    double f = lastForce_;
+    double c = ch - kc_ * f, cd = dh - kd_ * f;
+    double hc = contactForceOf<S>(c, cd);
+    double g = f - hc;
+    // A contact at rest (a sole pressed on the floor) is usually solved by the last force
+    // already: |g| <= tol hc implies the criterion below, |g| <= tol fMax, as hc <= fMax; fMax is
+    // then not needed (the same result as the loop, which would stop at once).
+    if (f > 0.0 && std::fabs(g) <= 1e-10 * hc) return f;
+    const double fMax = f == 0.0 ? hc : contactForceOf<S>(ch, dh);
     if (!(fMax > 0.0)) return 0.0;
-    // g(F) = F - HC(ch - kc F, dh - kd F) is increasing in F; its root lies in [0, fMax].
     double lo = 0.0, hi = fMax;
-    double f = std::clamp(lastForce_, lo, hi);
+    if (f > hi) { // start inside the bracket
+        f = hi;
+        c = ch - kc_ * f, cd = dh - kd_ * f;
+        hc = contactForceOf<S>(c, cd);
+        g = f - hc;
+    }
     int it = 0;
     const int iterations = params_.newtonIterations;
-    for (; it < iterations; ++it) {
-        const double c = ch - kc_ * f, cd = dh - kd_ * f;
-        const double hc = contactForce(c, cd);
-        const double g = f - hc;
+    for (;;) { // g, hc, c, cd are at f
         if (g > 0)
             hi = f;
         else
@@ -174,6 +210,10 @@ double HuntCrossleyImpactT<Real>::solveForce(double ch, double dh) noexcept {
         double next = f - g / dg;
         if (!(next > lo && next < hi)) next = 0.5 * (lo + hi); // safeguard: bisect
         f = next;
+        if (++it == iterations) break; // (the last step is not evaluated)
+        c = ch - kc_ * f, cd = dh - kd_ * f;
+        hc = contactForceOf<S>(c, cd);
+        g = f - hc;
     }
     stats_.solverIterations += it;
     stats_.maxIterationsInOneSample = std::max(stats_.maxIterationsInOneSample, it);
@@ -330,7 +370,7 @@ template <typename Real>
 void HuntCrossleyImpactT<Real>::processSpan(const float* fext, float* out, int n) noexcept {
     bool pushed = false;
     if (fext)
-        for (int i = 0; i < n; ++i) pushed |= fext[i] != 0.0f;
+        for (int i = 0; i < n && !pushed; ++i) pushed = fext[i] != 0.0f;
     pushedSinceGridPoint_ |= pushed;
     if (!awake_ && !pushed) {
         // Asleep: the state is the reset state, which stays exactly at rest without a push (so

@@ -137,6 +137,10 @@ class HuntCrossleyImpactT {
     double stiffness_ = 0, dissipation_ = 0;
     enum class Shape { Linear, Hertz, Square, General };
     Shape shape_ = Shape::Hertz;
+    template <Shape S>
+    double contactForceOf(double c, double cdot) const noexcept;
+    template <Shape S>
+    double solveShaped(double ch, double dh) noexcept; // solveForce() for one contact law
     double coarseT_ = 0, coarseKc_ = 0, coarseKd_ = 0, fineT_ = 0, fineKc_ = 0, fineKd_ = 0;
     Butterworth decimator_;
     ContactStats stats_;

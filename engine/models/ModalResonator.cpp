@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "engine/models/ModalResonator.h"
 
+#include "engine/dsp/Simd.h"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -12,31 +14,48 @@
 namespace underfoot::engine {
 namespace {
 
-// Two modes per step: the per-mode loops below work on pairs of lanes with GCC/Clang vector
-// extensions (SSE2 on x86-64: every operation is the IEEE operation of each lane, as in scalar
-// code, so results do not depend on the machine), over arrays padded to an even length with
-// modes whose coefficients are all zero. The pickup sums keep one partial sum per lane (even and
-// odd modes) added at the end: a fixed order, so the output is bit-for-bit reproducible.
+// Four modes per step: the per-mode loops below work on quads of lanes with GCC/Clang vector
+// extensions, over arrays padded to a multiple of four with modes whose coefficients are all
+// zero. The same source is compiled twice (passGeneric, passAvx): without AVX, GCC splits each
+// four-lane operation into two SSE2 operations on pairs; with AVX (chosen at run time) it is one
+// 256-bit operation. Either way every lane does the IEEE operation of the scalar code (no FMA:
+// neither target enables it), and the pickup sums keep one partial sum per lane, added at the
+// end as (lane 0 + lane 2) + (lane 1 + lane 3): a fixed order, so the output is bit-for-bit the
+// same on every x86-64 machine and for both kernels. (For up to four modes this is also the
+// order of the earlier two-lane loops, whose lanes summed modes 0 + 2 and 1 + 3.)
 template <typename Real>
-struct Pair {
-    typedef Real type __attribute__((vector_size(2 * sizeof(Real))));
+struct Quad {
+    typedef Real type __attribute__((vector_size(4 * sizeof(Real))));
 };
 template <typename Real>
-using V2 = typename Pair<Real>::type;
-typedef double D2 __attribute__((vector_size(16)));
+using V4 = typename Quad<Real>::type;
+typedef double D4 __attribute__((vector_size(32)));
 
-template <typename T, typename V>
-inline V load2(const T* p) noexcept {
-    V v;
+// Loads and stores through references (no vector passed by value: no ABI change between the
+// SSE2 and AVX compilations of the same helper).
+template <typename V, typename T>
+[[gnu::always_inline]] inline void load4(V& v, const T* p) noexcept {
     std::memcpy(&v, p, sizeof v);
-    return v;
 }
 template <typename T, typename V>
-inline void store2(T* p, V v) noexcept {
+[[gnu::always_inline]] inline void store4(T* p, const V& v) noexcept {
     std::memcpy(p, &v, sizeof v);
 }
+typedef double D2 __attribute__((vector_size(16)));
+// (lane 0 + lane 2, lane 1 + lane 3)
+[[gnu::always_inline]] inline D2 halves(const D4& v) noexcept {
+    return D2{v[0], v[1]} + D2{v[2], v[3]};
+}
+// (a[0] + a[1], b[0] + b[1])
+[[gnu::always_inline]] inline D2 pairSum(const D2& a, const D2& b) noexcept {
+    return D2{a[0], b[0]} + D2{a[1], b[1]};
+}
+[[gnu::always_inline]] inline double laneSum(const D4& v) noexcept {
+    const D2 h = halves(v);
+    return h[0] + h[1];
+}
 inline std::size_t padded(std::size_t n) noexcept {
-    return (n + 1) & ~std::size_t(1);
+    return (n + 3) & ~std::size_t(3);
 }
 
 // 20-point Gauss–Legendre nodes/weights on [-1, 1] (Abramowitz & Stegun, Table 25.4).
@@ -161,15 +180,15 @@ void ModalResonatorT<Real>::fillBank(Bank& b, const std::vector<ModeCoefficients
             b.dv0[p] += g0[i] * (gamma * double(b.b1v[i]));
             b.dvo[p] += outGain_[i] * (gamma * double(b.b1v[i]));
         }
-    b.pairs.assign(n2 / 2, PairCoefficients{});
-    pairGains_.assign(n2 / 2, PairGains{});
+    b.quads.assign(n2 / 4, QuadCoefficients{});
+    quadGains_.assign(n2 / 4, QuadGains{});
     for (std::size_t i = 0; i < n2; ++i) {
-        auto& c = b.pairs[i / 2];
-        const std::size_t l = i % 2;
+        auto& c = b.quads[i / 4];
+        const std::size_t l = i % 4;
         c.a00[l] = b.a00[i], c.a01[l] = b.a01[i], c.a10[l] = b.a10[i], c.a11[l] = b.a11[i];
         c.b0x[l] = b.b0x[i], c.b0v[l] = b.b0v[i], c.b1x[l] = b.b1x[i], c.b1v[l] = b.b1v[i];
         c.lv[l] = b.lv[i], c.lx[l] = b.lx[i];
-        auto& gg = pairGains_[i / 2];
+        auto& gg = quadGains_[i / 4];
         gg.g0[l] = contactGain_[i], gg.go[l] = outGain_[i];
         gg.kin[l] = kinetic_[i], gg.pot[l] = potential_[i];
     }
@@ -179,6 +198,8 @@ template <typename Real>
 void ModalResonatorT<Real>::prepare(double sampleRateHz, int fineSubsteps) {
     pending_ = false; // the state is reset below
     sampleRateHz_ = sampleRateHz;
+    avx_ = avxAllowed_ && simdAllowsAvx();
+    passes_ = kPasses[avx_ ? 1 : 0];
     fine_ = false;
     const std::size_t n = modes_.size(), np = gains_.size(), n2 = padded(n);
     coefficients_.resize(n);
@@ -250,158 +271,177 @@ void ModalResonatorT<Real>::reset() noexcept {
 }
 
 template <typename Real>
-void ModalResonatorT<Real>::predict(double heldScale) noexcept {
-    using V = V2<Real>;
-    const std::size_t pairs = q_.size() / 2;
-    const PairCoefficients* c = bank().pairs.data();
-    const PairGains* gg = pairGains_.data();
-    D2 x0 = {0.0, 0.0}, v0 = {0.0, 0.0}, vo = {0.0, 0.0};
-    predictedEnergyValid_ = false;
-    if (pending_ && heldScale == 0.0) settle(); // (the passivity guard's trials; rare)
-    if (heldZero_ || heldScale == 0.0) {
-        // Free ringing (no force held from the last sample): the same values without the
-        // force terms (they would add exactly zero).
-        const Real *q = q_.data(), *v = v_.data();
-        Real *qh = qh_.data(), *vh = vh_.data();
-        for (std::size_t k = 0; k < pairs; ++k) {
-            const std::size_t i = 2 * k;
-            const V qi = load2<Real, V>(q + i), vi = load2<Real, V>(v + i);
-            const V x = load2<Real, V>(c[k].a00) * qi + load2<Real, V>(c[k].a01) * vi;
-            const V y = load2<Real, V>(c[k].a10) * qi + load2<Real, V>(c[k].a11) * vi;
-            store2(qh + i, x);
-            store2(vh + i, y);
-            const D2 xd = __builtin_convertvector(x, D2), yd = __builtin_convertvector(y, D2);
-            const D2 g0 = load2<double, D2>(gg[k].g0);
-            x0 += g0 * xd;
-            v0 += g0 * yd;
-            vo += load2<double, D2>(gg[k].go) * yd;
-        }
-    } else {
-        const Real h = static_cast<Real>(heldScale);
-        D2 e = {0.0, 0.0}, slope = {0.0, 0.0};
-        // One pass over the modes: with a commit pending (the last sample's force, see commit())
-        // the state is first completed from the last prediction, as a separate commit pass
-        // would (the same operations: the same values), then predicted. `held` is false when
-        // heldScale is 1 (1 x u is u: the multiplication is skipped, same values).
-        auto run = [&](auto withEnergy, auto fused, auto held) {
-            Real *q = q_.data(), *v = v_.data(), *u = u_.data();
-            Real *qh = qh_.data(), *vh = vh_.data();
-            const Real* gm = gainOverMass_.data() + pendingPickup_ * q_.size();
-            const Real f = pendingForce_;
-            for (std::size_t k = 0; k < pairs; ++k) {
-                const std::size_t i = 2 * k;
-                V qi, vi, uc;
-                if constexpr (decltype(fused)::value) {
-                    uc = load2<Real, V>(gm + i) * f;
-                    qi = load2<Real, V>(qh + i) + load2<Real, V>(c[k].b1x) * uc;
-                    vi = load2<Real, V>(vh + i) + load2<Real, V>(c[k].b1v) * uc;
-                    store2(q + i, qi);
-                    store2(v + i, vi);
-                    store2(u + i, uc);
-                } else {
-                    qi = load2<Real, V>(q + i);
-                    vi = load2<Real, V>(v + i);
-                    uc = load2<Real, V>(u + i);
-                }
-                V ui = uc;
-                if constexpr (decltype(held)::value) ui = h * uc;
-                const V x = load2<Real, V>(c[k].a00) * qi + load2<Real, V>(c[k].a01) * vi +
-                            load2<Real, V>(c[k].b0x) * ui;
-                const V y = load2<Real, V>(c[k].a10) * qi + load2<Real, V>(c[k].a11) * vi +
-                            load2<Real, V>(c[k].b0v) * ui;
-                store2(qh + i, x);
-                store2(vh + i, y);
-                const D2 xd = __builtin_convertvector(x, D2), yd = __builtin_convertvector(y, D2);
-                const D2 g0 = load2<double, D2>(gg[k].g0);
-                x0 += g0 * xd;
-                v0 += g0 * yd;
-                vo += load2<double, D2>(gg[k].go) * yd;
-                if constexpr (decltype(withEnergy)::value) {
-                    // The prediction's energy and the slope of E(F) (energyIfCommitted).
-                    e += load2<double, D2>(gg[k].kin) * (yd * yd) +
-                         load2<double, D2>(gg[k].pot) * (xd * xd);
-                    slope += load2<double, D2>(c[k].lv) * yd + load2<double, D2>(c[k].lx) * xd;
-                }
-            }
-        };
-        using T = std::true_type;
-        using F = std::false_type;
-        const bool fused = pending_, held = heldScale != 1.0;
-        pending_ = false;
-        if (trackEnergy_) {
-            if (fused)
-                held ? run(T{}, T{}, T{}) : run(T{}, T{}, F{});
-            else
-                held ? run(T{}, F{}, T{}) : run(T{}, F{}, F{});
-            predictedEnergy_ = e[0] + e[1];
-            predictedEnergySlope_ = slope[0] + slope[1];
-            predictedEnergyValid_ = true;
+void ModalResonatorT<Real>::allowAvx(bool on) noexcept {
+    avxAllowed_ = on;
+    avx_ = on && simdAllowsAvx();
+    passes_ = kPasses[avx_ ? 1 : 0];
+}
+
+// One pass over the modes, four per step (see the top of the file). With `Fused` (a commit
+// pending: the last sample's force, see commit()) the state is first completed from the last
+// prediction, as a separate commit pass would (the same operations: the same values), then
+// predicted. `Held` scales the held force by h (false when h is 1: 1 x u is u, the
+// multiplication is skipped, same values). `Free`: no force held (free ringing), the same values
+// without the force terms (they would add exactly zero). `Energy`: also the prediction's energy
+// and the slope of E(F) (energyIfCommitted).
+template <typename Real>
+template <bool Energy, bool Fused, bool Held, bool Free>
+[[gnu::always_inline]] inline void ModalResonatorT<Real>::passBody(Real h) noexcept {
+    using V = V4<Real>;
+    const std::size_t quads = q_.size() / 4;
+    const QuadCoefficients* c = bank().quads.data();
+    const QuadGains* gg = quadGains_.data();
+    Real *q = q_.data(), *v = v_.data(), *u = u_.data();
+    Real *qh = qh_.data(), *vh = vh_.data();
+    const Real* gm = gainOverMass_.data() + pendingPickup_ * q_.size();
+    const Real f = pendingForce_;
+    D4 x0 = {0.0, 0.0, 0.0, 0.0}, v0 = x0, vo = x0, e = x0, slope = x0;
+    for (std::size_t k = 0; k < quads; ++k) {
+        const std::size_t i = 4 * k;
+        const QuadCoefficients& ck = c[k];
+        V qi, vi, uc, a00, a01, a10, a11;
+        if constexpr (Fused) {
+            V g, qp, vp, b1x, b1v;
+            load4(g, gm + i);
+            load4(qp, qh + i);
+            load4(vp, vh + i);
+            load4(b1x, ck.b1x);
+            load4(b1v, ck.b1v);
+            uc = g * f;
+            qi = qp + b1x * uc;
+            vi = vp + b1v * uc;
+            store4(q + i, qi);
+            store4(v + i, vi);
+            store4(u + i, uc);
         } else {
-            if (fused)
-                held ? run(F{}, T{}, T{}) : run(F{}, T{}, F{});
-            else
-                held ? run(F{}, F{}, T{}) : run(F{}, F{}, F{});
+            load4(qi, q + i);
+            load4(vi, v + i);
+            if constexpr (!Free) load4(uc, u + i);
+        }
+        load4(a00, ck.a00);
+        load4(a01, ck.a01);
+        load4(a10, ck.a10);
+        load4(a11, ck.a11);
+        V x, y;
+        if constexpr (Free) {
+            x = a00 * qi + a01 * vi;
+            y = a10 * qi + a11 * vi;
+        } else {
+            V ui = uc, b0x, b0v;
+            if constexpr (Held) ui = h * uc;
+            load4(b0x, ck.b0x);
+            load4(b0v, ck.b0v);
+            x = a00 * qi + a01 * vi + b0x * ui;
+            y = a10 * qi + a11 * vi + b0v * ui;
+        }
+        store4(qh + i, x);
+        store4(vh + i, y);
+        D4 xd, yd, g0, go;
+        if constexpr (std::is_same_v<Real, double>) {
+            xd = x;
+            yd = y;
+        } else {
+            xd = __builtin_convertvector(x, D4);
+            yd = __builtin_convertvector(y, D4);
+        }
+        load4(g0, gg[k].g0);
+        load4(go, gg[k].go);
+        x0 += g0 * xd;
+        v0 += g0 * yd;
+        vo += go * yd;
+        if constexpr (Energy) {
+            D4 kin, pot, lv, lx;
+            load4(kin, gg[k].kin);
+            load4(pot, gg[k].pot);
+            load4(lv, ck.lv);
+            load4(lx, ck.lx);
+            e += kin * (yd * yd) + pot * (xd * xd);
+            slope += lv * yd + lx * xd;
         }
     }
-    predictedX0_ = x0[0] + x0[1];
-    predictedV0_ = v0[0] + v0[1];
-    predictedVo_ = vo[0] + vo[1];
+    // Each sum is (lane 0 + lane 2) + (lane 1 + lane 3), two sums per SIMD step.
+    const D2 x0h = halves(x0), v0h = halves(v0), voh = halves(vo);
+    const D2 a = pairSum(x0h, v0h);
+    predictedX0_ = a[0];
+    predictedV0_ = a[1];
+    if constexpr (Energy) {
+        const D2 b = pairSum(voh, halves(e));
+        predictedVo_ = b[0];
+        predictedEnergy_ = b[1];
+        predictedEnergySlope_ = laneSum(slope);
+        predictedEnergyValid_ = true;
+    } else {
+        predictedVo_ = voh[0] + voh[1];
+    }
 }
+
+template <typename Real>
+template <bool Energy, bool Fused, bool Held, bool Free>
+void ModalResonatorT<Real>::passGeneric(ModalResonatorT& r, Real h) noexcept {
+    r.passBody<Energy, Fused, Held, Free>(h);
+}
+
+template <typename Real>
+template <bool Energy, bool Fused, bool Held, bool Free>
+#if defined(__x86_64__) || defined(__i386__)
+__attribute__((target("avx")))
+#endif
+void ModalResonatorT<Real>::passAvx(ModalResonatorT& r, Real h) noexcept {
+    r.passBody<Energy, Fused, Held, Free>(h);
+}
+
+// [kernel][variant]: variant = 4 energy + 2 fused + held, or 8 for free ringing.
+template <typename Real>
+const typename ModalResonatorT<Real>::PassFn ModalResonatorT<Real>::kPasses[2][9] = {
+    {&passGeneric<false, false, false, false>, &passGeneric<false, false, true, false>,
+     &passGeneric<false, true, false, false>, &passGeneric<false, true, true, false>,
+     &passGeneric<true, false, false, false>, &passGeneric<true, false, true, false>,
+     &passGeneric<true, true, false, false>, &passGeneric<true, true, true, false>,
+     &passGeneric<false, false, false, true>},
+    {&passAvx<false, false, false, false>, &passAvx<false, false, true, false>,
+     &passAvx<false, true, false, false>, &passAvx<false, true, true, false>,
+     &passAvx<true, false, false, false>, &passAvx<true, false, true, false>,
+     &passAvx<true, true, false, false>, &passAvx<true, true, true, false>,
+     &passAvx<false, false, false, true>}};
 
 template <typename Real>
 void ModalResonatorT<Real>::applyPending() const noexcept {
-    using V = V2<Real>;
+    using V = V4<Real>;
     pending_ = false;
-    const std::size_t n2 = q_.size();
+    const std::size_t n4 = q_.size();
     const Real f = pendingForce_;
-    const Real* gm = gainOverMass_.data() + pendingPickup_ * n2;
-    const PairCoefficients* c = bank().pairs.data();
+    const Real* gm = gainOverMass_.data() + pendingPickup_ * n4;
+    const QuadCoefficients* c = bank().quads.data();
     const Real *qh = qh_.data(), *vh = vh_.data();
     Real *q = q_.data(), *v = v_.data(), *u = u_.data();
-    for (std::size_t i = 0; i < n2; i += 2) {
-        const PairCoefficients& ci = c[i / 2];
-        const V ui = load2<Real, V>(gm + i) * f;
-        store2(q + i, load2<Real, V>(qh + i) + load2<Real, V>(ci.b1x) * ui);
-        store2(v + i, load2<Real, V>(vh + i) + load2<Real, V>(ci.b1v) * ui);
-        store2(u + i, ui);
+    for (std::size_t i = 0; i < n4; i += 4) {
+        const QuadCoefficients& ci = c[i / 4];
+        V g, qp, vp, b1x, b1v;
+        load4(g, gm + i);
+        load4(qp, qh + i);
+        load4(vp, vh + i);
+        load4(b1x, ci.b1x);
+        load4(b1v, ci.b1v);
+        const V ui = g * f;
+        store4(q + i, qp + b1x * ui);
+        store4(v + i, vp + b1v * ui);
+        store4(u + i, ui);
     }
 }
 
 template <typename Real>
-void ModalResonatorT<Real>::commit(int p, double forceN) noexcept {
-    settle();
-    if (forceN == 0.0) {
-        // No new force: the state is the prediction (swapping the buffers does not allocate),
-        // and so are the pickup sums predict() computed.
-        q_.swap(qh_);
-        v_.swap(vh_);
-        if (!heldZero_) std::fill(u_.begin(), u_.end(), Real(0));
-        heldZero_ = true;
-        x0_ = predictedX0_;
-        v0_ = predictedV0_;
-        outputVelocity_ = predictedVo_;
-        energyValid_ = predictedEnergyValid_;
-        committedEnergy_ = predictedEnergy_;
-        predictedEnergyValid_ = false;
-        return;
-    }
-    heldZero_ = false;
-    const std::size_t pp = static_cast<std::size_t>(p);
-    const Bank& b = bank();
-    // The per-mode update q = qh + b1x u, v = vh + b1v u, u = F g / m is deferred into the next
-    // predict() (or settle()).
-    pending_ = true;
-    pendingForce_ = static_cast<Real>(forceN);
-    pendingPickup_ = pp;
-    // The pickup sums are linear in the force: the prediction's plus the force times the sums
-    // of the instantaneous responses (no pass over the modes).
-    x0_ = predictedX0_ + forceN * b.dx0[pp];
-    v0_ = predictedV0_ + forceN * b.dv0[pp];
-    outputVelocity_ = predictedVo_ + forceN * b.dvo[pp];
-    energyValid_ = p == 0 && predictedEnergyValid_;
-    if (energyValid_)
-        committedEnergy_ =
-            predictedEnergy_ + forceN * predictedEnergySlope_ + forceN * forceN * b.c2;
+void ModalResonatorT<Real>::commitWithoutForce() noexcept {
+    // No new force: the state is the prediction (swapping the buffers does not allocate), and so
+    // are the pickup sums predict() computed.
+    q_.swap(qh_);
+    v_.swap(vh_);
+    if (!heldZero_) std::fill(u_.begin(), u_.end(), Real(0));
+    heldZero_ = true;
+    x0_ = predictedX0_;
+    v0_ = predictedV0_;
+    outputVelocity_ = predictedVo_;
+    energyValid_ = predictedEnergyValid_;
+    committedEnergy_ = predictedEnergy_;
     predictedEnergyValid_ = false;
 }
 

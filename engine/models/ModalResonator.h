@@ -75,6 +75,12 @@ class ModalResonatorT {
     /// impact's passivity guard in sustained contact). Off by default (friction does not need it).
     void setEnergyTracking(bool on) noexcept { trackEnergy_ = on; }
     bool fineRate() const noexcept { return fine_; }
+    /// The per-mode loops run four modes per step: as one AVX vector where the CPU has AVX (chosen
+    /// in prepare()), else as two SSE2 pairs. Both do the same IEEE operations per mode (no FMA)
+    /// and add the four lanes' partial sums in the same order, so the samples are bit-identical;
+    /// allowAvx(false) selects the SSE2 kernels (tests compare the two).
+    void allowAvx(bool on) noexcept;
+    bool usesAvx() const noexcept { return avx_; }
     void reset() noexcept;
 
     int modeCount() const noexcept { return static_cast<int>(modes_.size()); }
@@ -88,7 +94,15 @@ class ModalResonatorT {
     /// force still acts through B0). Afterwards predictedPosition/Velocity(p) are valid.
     /// `heldScale` scales the force held from the previous sample (1 = as committed); the
     /// impact's passivity guard uses smaller values.
-    void predict(double heldScale = 1.0) noexcept;
+    void predict(double heldScale = 1.0) noexcept {
+        predictedEnergyValid_ = false;
+        if (pending_ && heldScale == 0.0) settle(); // (the passivity guard's trials; rare)
+        const bool free = heldZero_ || heldScale == 0.0;
+        const int variant =
+            free ? 8 : (trackEnergy_ ? 4 : 0) + (pending_ ? 2 : 0) + (heldScale != 1.0 ? 1 : 0);
+        pending_ = false;
+        passes_[variant](*this, static_cast<Real>(heldScale));
+    }
     double predictedPosition(int p) const noexcept {
         return p == 0 ? predictedX0_ : predictedSum(qh_, p);
     }
@@ -114,7 +128,28 @@ class ModalResonatorT {
     /// known at once; the per-mode update is deferred into the next predict(), which then makes
     /// one pass over the modes per sample (the same operations in the same order as a separate
     /// pass: the same values). Anything else that reads the modes completes it first.
-    void commit(int p, double forceN) noexcept;
+    void commit(int p, double forceN) noexcept {
+        settle();
+        if (forceN == 0.0) return commitWithoutForce();
+        heldZero_ = false;
+        const std::size_t pp = static_cast<std::size_t>(p);
+        const Bank& b = bank();
+        // The per-mode update q = qh + b1x u, v = vh + b1v u, u = F g / m is deferred into the
+        // next predict() (or settle()).
+        pending_ = true;
+        pendingForce_ = static_cast<Real>(forceN);
+        pendingPickup_ = pp;
+        // The pickup sums are linear in the force: the prediction's plus the force times the sums
+        // of the instantaneous responses (no pass over the modes).
+        x0_ = predictedX0_ + forceN * b.dx0[pp];
+        v0_ = predictedV0_ + forceN * b.dv0[pp];
+        outputVelocity_ = predictedVo_ + forceN * b.dvo[pp];
+        energyValid_ = p == 0 && predictedEnergyValid_;
+        if (energyValid_)
+            committedEnergy_ =
+                predictedEnergy_ + forceN * predictedEnergySlope_ + forceN * forceN * b.c2;
+        predictedEnergyValid_ = false;
+    }
 
     /// The pickup whose velocity velocity(p) returns fastest (computed during commit()).
     void setOutputPickup(int p);
@@ -155,18 +190,30 @@ class ModalResonatorT {
   private:
     // Coefficients of one rate as structure of arrays (contiguous per coefficient, so that the
     // per-mode loops are plain multiply-adds over arrays), stored in Real as the loops use them.
-    // The hot loops read two modes at a time from one aligned record per pair (few pointers, so
+    // The hot loops read four modes at a time from one aligned record per quad (few pointers, so
     // the loop keeps everything in registers, and aligned SIMD operands).
-    struct alignas(16) PairCoefficients {
-        Real a00[2], a01[2], a10[2], a11[2], b0x[2], b0v[2], b1x[2], b1v[2];
-        double lv[2], lx[2];
+    struct alignas(32) QuadCoefficients {
+        Real a00[4], a01[4], a10[4], a11[4], b0x[4], b0v[4], b1x[4], b1v[4];
+        double lv[4], lx[4];
     };
-    struct alignas(16) PairGains {
-        double g0[2], go[2], kin[2], pot[2]; // pickup 0, output pickup, 0.5 m, 0.5 m w0^2
+    struct alignas(32) QuadGains {
+        double g0[4], go[4], kin[4], pot[4]; // pickup 0, output pickup, 0.5 m, 0.5 m w0^2
     };
+    // The pass over the modes that predict() runs: 9 variants (see the .cpp) x 2 kernels (SSE2
+    // pairs, AVX), chosen per call from a table of plain function pointers.
+    using PassFn = void (*)(ModalResonatorT&, Real) noexcept;
+    template <bool Energy, bool Fused, bool Held, bool Free>
+    static void passGeneric(ModalResonatorT& r, Real h) noexcept;
+    template <bool Energy, bool Fused, bool Held, bool Free>
+    static void passAvx(ModalResonatorT& r, Real h) noexcept;
+    template <bool Energy, bool Fused, bool Held, bool Free>
+    void passBody(Real h) noexcept;
+    static const PassFn kPasses[2][9];
+    const PassFn* passes_ = kPasses[0]; // kPasses[avx_]
+    void commitWithoutForce() noexcept;
     struct Bank {
         std::vector<Real> a00, a01, a10, a11, b0x, b0v, b1x, b1v;
-        std::vector<PairCoefficients> pairs; // the same values, two modes per record
+        std::vector<QuadCoefficients> quads; // the same values, four modes per record
         // Energy of the modes after commit(0, F) as a quadratic in F around the prediction:
         // E(F) = E_h + F sum(lv vh + lx qh) + F^2 c2 (double, per mode; see energyIfCommitted).
         std::vector<double> lv, lx;
@@ -195,10 +242,11 @@ class ModalResonatorT {
     std::vector<ModeCoefficients> coefficients_;
     std::vector<ModeCoefficients> fineCoefficients_; // empty unless prepared with sub-steps
     Bank coarseBank_, fineBank_;
-    std::vector<PairGains> pairGains_;
+    std::vector<QuadGains> quadGains_;
+    bool avx_ = false, avxAllowed_ = true; // the kernels in use (see allowAvx)
     bool fine_ = false;
-    // Per-mode arrays are padded to an even length (two modes per SIMD step, see the .cpp) with
-    // modes whose coefficients and gains are zero.
+    // Per-mode arrays are padded to a multiple of four (four modes per SIMD step, see the .cpp)
+    // with modes whose coefficients and gains are zero.
     std::vector<Real> gainOverMass_; // [pickup * padded modes + mode] = g[p][i] / m_i
     // State, prediction, last generalized force. q_, v_, u_ may lag a commit() by one deferred
     // update (pending_): settle() completes it, also from const readers, hence mutable.

@@ -3,6 +3,7 @@
 
 #include "engine/dsp/Denormals.h"
 #include "engine/dsp/RealFft.h"
+#include "engine/dsp/Simd.h"
 
 #include <fftw3.h>
 #include <fmt/format.h>
@@ -239,9 +240,9 @@ UNDERFOOT_AVX512 void headAvx512(const float* hl, const float* hr, const float* 
 }
 #undef UNDERFOOT_AVX512
 
-Convolver::Simd cpuSimd() noexcept {
-    if (__builtin_cpu_supports("avx512f") != 0) return Convolver::Simd::Avx512;
-    if (__builtin_cpu_supports("avx") != 0) return Convolver::Simd::Avx;
+Convolver::Simd cpuSimd() noexcept { // (limited by UNDERFOOT_SIMD, engine/dsp/Simd.h)
+    if (simdAllowsAvx512()) return Convolver::Simd::Avx512;
+    if (simdAllowsAvx()) return Convolver::Simd::Avx;
     return Convolver::Simd::Sse;
 }
 
