@@ -173,8 +173,8 @@ std::vector<ImpactSetting> defaultImpactSettings() {
         {"Newton 6 it, 4x", ImpactSolver::Newton, 6, 4, false, 1},
         {"Newton 6 it, 1x, float state", ImpactSolver::Newton, 6, 1, true, 1},
         {"Newton 6 it, 1x, contact sub-steps 2", ImpactSolver::Newton, 6, 1, false, 2},
-        {"Newton 6 it, 1x, contact sub-steps 4", ImpactSolver::Newton, 6, 1, false, 4},
-        {"Newton 6 it, 1x, contact sub-steps 8 (default)", ImpactSolver::Newton, 6, 1, false, 8},
+        {"Newton 6 it, 1x, contact sub-steps 4 (default)", ImpactSolver::Newton, 6, 1, false, 4},
+        {"Newton 6 it, 1x, contact sub-steps 8", ImpactSolver::Newton, 6, 1, false, 8},
         {"Newton 6 it, 1x, contact sub-steps 16", ImpactSolver::Newton, 6, 1, false, 16},
     };
 }
