@@ -14,15 +14,16 @@
 namespace underfoot::engine {
 namespace {
 
-// Four modes per step: the per-mode loops below work on quads of lanes with GCC/Clang vector
-// extensions, over arrays padded to a multiple of four with modes whose coefficients are all
-// zero. The same source is compiled twice (passGeneric, passAvx): without AVX, GCC splits each
-// four-lane operation into two SSE2 operations on pairs; with AVX (chosen at run time) it is one
-// 256-bit operation. Either way every lane does the IEEE operation of the scalar code (no FMA:
-// neither target enables it), and the pickup sums keep one partial sum per lane, added at the
-// end as (lane 0 + lane 2) + (lane 1 + lane 3): a fixed order, so the output is bit-for-bit the
-// same on every x86-64 machine and for both kernels. (For up to four modes this is also the
-// order of the earlier two-lane loops, whose lanes summed modes 0 + 2 and 1 + 3.)
+// Four modes per step: the per-mode loops below work on quads of lanes over arrays padded to a
+// multiple of four with modes whose coefficients are all zero. The same source is compiled twice
+// (passGeneric, passAvx): with AVX (chosen at run time) a quad of doubles is one 256-bit vector
+// (GCC/Clang vector extensions); without it, a quad is written out as two SSE2 pairs (`Pairs`:
+// left to GCC's generic lowering, four-lane vectors of doubles kept their partial sums on the
+// stack). Either way every lane does the IEEE operation of the scalar code (no FMA: neither
+// target enables it), and the pickup sums keep one partial sum per lane, added at the end as
+// (lane 0 + lane 2) + (lane 1 + lane 3): a fixed order, so the output is bit-for-bit the same on
+// every x86-64 machine and for both kernels. (For up to four modes this is also the order of the
+// earlier two-lane loops, whose lanes summed modes 0 + 2 and 1 + 3.)
 template <typename Real>
 struct Quad {
     typedef Real type __attribute__((vector_size(4 * sizeof(Real))));
@@ -30,27 +31,85 @@ struct Quad {
 template <typename Real>
 using V4 = typename Quad<Real>::type;
 typedef double D4 __attribute__((vector_size(32)));
+typedef double D2 __attribute__((vector_size(16)));
+
+// Four doubles as two SSE2 pairs (lanes 0, 1 and 2, 3).
+struct Pairs {
+    D2 lo, hi;
+};
+[[gnu::always_inline]] inline Pairs operator+(const Pairs& a, const Pairs& b) noexcept {
+    return {a.lo + b.lo, a.hi + b.hi};
+}
+[[gnu::always_inline]] inline Pairs operator*(const Pairs& a, const Pairs& b) noexcept {
+    return {a.lo * b.lo, a.hi * b.hi};
+}
+[[gnu::always_inline]] inline Pairs operator*(const Pairs& a, double s) noexcept {
+    return {a.lo * s, a.hi * s};
+}
+[[gnu::always_inline]] inline Pairs operator*(double s, const Pairs& a) noexcept {
+    return {s * a.lo, s * a.hi};
+}
+[[gnu::always_inline]] inline Pairs& operator+=(Pairs& a, const Pairs& b) noexcept {
+    a.lo += b.lo;
+    a.hi += b.hi;
+    return a;
+}
+
+// The lane types of a kernel: R for the state's Real, D for the double sums.
+template <typename Real, bool Wide>
+struct Lanes {
+    using R = V4<Real>; // float: four lanes in one SSE register either way
+    using D = std::conditional_t<Wide, D4, Pairs>;
+};
+template <>
+struct Lanes<double, false> {
+    using R = Pairs;
+    using D = Pairs;
+};
 
 // Loads and stores through references (no vector passed by value: no ABI change between the
 // SSE2 and AVX compilations of the same helper).
 template <typename V, typename T>
 [[gnu::always_inline]] inline void load4(V& v, const T* p) noexcept {
-    std::memcpy(&v, p, sizeof v);
+    if constexpr (std::is_same_v<V, Pairs>) {
+        std::memcpy(&v.lo, p, sizeof v.lo);
+        std::memcpy(&v.hi, p + 2, sizeof v.hi);
+    } else {
+        std::memcpy(&v, p, sizeof v);
+    }
 }
 template <typename T, typename V>
 [[gnu::always_inline]] inline void store4(T* p, const V& v) noexcept {
-    std::memcpy(p, &v, sizeof v);
+    if constexpr (std::is_same_v<V, Pairs>) {
+        std::memcpy(p, &v.lo, sizeof v.lo);
+        std::memcpy(p + 2, &v.hi, sizeof v.hi);
+    } else {
+        std::memcpy(p, &v, sizeof v);
+    }
 }
-typedef double D2 __attribute__((vector_size(16)));
+// A quad of Real as a quad of doubles (the sums are in double); through a reference, as above.
+template <typename D, typename R>
+[[gnu::always_inline]] inline void toDouble(D& out, const R& x) noexcept {
+    if constexpr (std::is_same_v<D, R>)
+        out = x;
+    else if constexpr (std::is_same_v<D, Pairs>)
+        out = {D2{double(x[0]), double(x[1])}, D2{double(x[2]), double(x[3])}};
+    else
+        out = __builtin_convertvector(x, D4);
+}
 // (lane 0 + lane 2, lane 1 + lane 3)
 [[gnu::always_inline]] inline D2 halves(const D4& v) noexcept {
     return D2{v[0], v[1]} + D2{v[2], v[3]};
+}
+[[gnu::always_inline]] inline D2 halves(const Pairs& v) noexcept {
+    return v.lo + v.hi;
 }
 // (a[0] + a[1], b[0] + b[1])
 [[gnu::always_inline]] inline D2 pairSum(const D2& a, const D2& b) noexcept {
     return D2{a[0], b[0]} + D2{a[1], b[1]};
 }
-[[gnu::always_inline]] inline double laneSum(const D4& v) noexcept {
+template <typename D>
+[[gnu::always_inline]] inline double laneSum(const D& v) noexcept {
     const D2 h = halves(v);
     return h[0] + h[1];
 }
@@ -285,9 +344,10 @@ void ModalResonatorT<Real>::allowAvx(bool on) noexcept {
 // without the force terms (they would add exactly zero). `Energy`: also the prediction's energy
 // and the slope of E(F) (energyIfCommitted).
 template <typename Real>
-template <bool Energy, bool Fused, bool Held, bool Free>
+template <bool Wide, bool Energy, bool Fused, bool Held, bool Free>
 [[gnu::always_inline]] inline void ModalResonatorT<Real>::passBody(Real h) noexcept {
-    using V = V4<Real>;
+    using V = typename Lanes<Real, Wide>::R;
+    using D = typename Lanes<Real, Wide>::D;
     const std::size_t quads = q_.size() / 4;
     const QuadCoefficients* c = bank().quads.data();
     const QuadGains* gg = quadGains_.data();
@@ -295,7 +355,7 @@ template <bool Energy, bool Fused, bool Held, bool Free>
     Real *qh = qh_.data(), *vh = vh_.data();
     const Real* gm = gainOverMass_.data() + pendingPickup_ * q_.size();
     const Real f = pendingForce_;
-    D4 x0 = {0.0, 0.0, 0.0, 0.0}, v0 = x0, vo = x0, e = x0, slope = x0;
+    D x0{}, v0{}, vo{}, e{}, slope{};
     for (std::size_t k = 0; k < quads; ++k) {
         const std::size_t i = 4 * k;
         const QuadCoefficients& ck = c[k];
@@ -336,21 +396,16 @@ template <bool Energy, bool Fused, bool Held, bool Free>
         }
         store4(qh + i, x);
         store4(vh + i, y);
-        D4 xd, yd, g0, go;
-        if constexpr (std::is_same_v<Real, double>) {
-            xd = x;
-            yd = y;
-        } else {
-            xd = __builtin_convertvector(x, D4);
-            yd = __builtin_convertvector(y, D4);
-        }
+        D xd, yd, g0, go;
+        toDouble(xd, x);
+        toDouble(yd, y);
         load4(g0, gg[k].g0);
         load4(go, gg[k].go);
         x0 += g0 * xd;
         v0 += g0 * yd;
         vo += go * yd;
         if constexpr (Energy) {
-            D4 kin, pot, lv, lx;
+            D kin, pot, lv, lx;
             load4(kin, gg[k].kin);
             load4(pot, gg[k].pot);
             load4(lv, ck.lv);
@@ -378,7 +433,7 @@ template <bool Energy, bool Fused, bool Held, bool Free>
 template <typename Real>
 template <bool Energy, bool Fused, bool Held, bool Free>
 void ModalResonatorT<Real>::passGeneric(ModalResonatorT& r, Real h) noexcept {
-    r.passBody<Energy, Fused, Held, Free>(h);
+    r.passBody<false, Energy, Fused, Held, Free>(h);
 }
 
 template <typename Real>
@@ -387,7 +442,7 @@ template <bool Energy, bool Fused, bool Held, bool Free>
 __attribute__((target("avx")))
 #endif
 void ModalResonatorT<Real>::passAvx(ModalResonatorT& r, Real h) noexcept {
-    r.passBody<Energy, Fused, Held, Free>(h);
+    r.passBody<true, Energy, Fused, Held, Free>(h);
 }
 
 // [kernel][variant]: variant = 4 energy + 2 fused + held, or 8 for free ringing.
@@ -406,7 +461,7 @@ const typename ModalResonatorT<Real>::PassFn ModalResonatorT<Real>::kPasses[2][9
 
 template <typename Real>
 void ModalResonatorT<Real>::applyPending() const noexcept {
-    using V = V4<Real>;
+    using V = typename Lanes<Real, false>::R;
     pending_ = false;
     const std::size_t n4 = q_.size();
     const Real f = pendingForce_;

@@ -200,13 +200,13 @@ class ModalResonatorT {
         double g0[4], go[4], kin[4], pot[4]; // pickup 0, output pickup, 0.5 m, 0.5 m w0^2
     };
     // The pass over the modes that predict() runs: 9 variants (see the .cpp) x 2 kernels (SSE2
-    // pairs, AVX), chosen per call from a table of plain function pointers.
+    // pairs, AVX: passBody<Wide = true>), chosen per call from a table of plain function pointers.
     using PassFn = void (*)(ModalResonatorT&, Real) noexcept;
     template <bool Energy, bool Fused, bool Held, bool Free>
     static void passGeneric(ModalResonatorT& r, Real h) noexcept;
     template <bool Energy, bool Fused, bool Held, bool Free>
     static void passAvx(ModalResonatorT& r, Real h) noexcept;
-    template <bool Energy, bool Fused, bool Held, bool Free>
+    template <bool Wide, bool Energy, bool Fused, bool Held, bool Free>
     void passBody(Real h) noexcept;
     static const PassFn kPasses[2][9];
     const PassFn* passes_ = kPasses[0]; // kPasses[avx_]
