@@ -278,6 +278,10 @@ class ModalResonatorT {
     int quasiStaticCount_ = 0;
 };
 
+// Defined in ModalResonator.cpp (with the pass table kPasses the inline predict() reads).
+extern template class ModalResonatorT<double>;
+extern template class ModalResonatorT<float>;
+
 using ModalResonator = ModalResonatorT<double>;
 
 } // namespace underfoot::engine
