@@ -113,6 +113,25 @@ template <typename D>
     const D2 h = halves(v);
     return h[0] + h[1];
 }
+// Completes a deferred commit for modes i..i+3 (see commit()): u = F g / m, q = qh + b1x u,
+// v = vh + b1v u, stored, and returned in (q, v, u) for the pass that goes on from there.
+template <typename V, typename Real, typename Coefficients>
+[[gnu::always_inline]] inline void completeCommit(V& qi, V& vi, V& uc, const Coefficients& ck,
+                                                  const Real* gm, const Real* qh, const Real* vh,
+                                                  Real f, Real* q, Real* v, Real* u) noexcept {
+    V g, qp, vp, b1x, b1v;
+    load4(g, gm);
+    load4(qp, qh);
+    load4(vp, vh);
+    load4(b1x, ck.b1x);
+    load4(b1v, ck.b1v);
+    uc = g * f;
+    qi = qp + b1x * uc;
+    vi = vp + b1v * uc;
+    store4(q, qi);
+    store4(v, vi);
+    store4(u, uc);
+}
 inline std::size_t padded(std::size_t n) noexcept {
     return (n + 3) & ~std::size_t(3);
 }
@@ -361,18 +380,7 @@ template <bool Wide, bool Energy, bool Fused, bool Held, bool Free>
         const QuadCoefficients& ck = c[k];
         V qi, vi, uc, a00, a01, a10, a11;
         if constexpr (Fused) {
-            V g, qp, vp, b1x, b1v;
-            load4(g, gm + i);
-            load4(qp, qh + i);
-            load4(vp, vh + i);
-            load4(b1x, ck.b1x);
-            load4(b1v, ck.b1v);
-            uc = g * f;
-            qi = qp + b1x * uc;
-            vi = vp + b1v * uc;
-            store4(q + i, qi);
-            store4(v + i, vi);
-            store4(u + i, uc);
+            completeCommit(qi, vi, uc, ck, gm + i, qh + i, vh + i, f, q + i, v + i, u + i);
         } else {
             load4(qi, q + i);
             load4(vi, v + i);
@@ -470,17 +478,8 @@ void ModalResonatorT<Real>::applyPending() const noexcept {
     const Real *qh = qh_.data(), *vh = vh_.data();
     Real *q = q_.data(), *v = v_.data(), *u = u_.data();
     for (std::size_t i = 0; i < n4; i += 4) {
-        const QuadCoefficients& ci = c[i / 4];
-        V g, qp, vp, b1x, b1v;
-        load4(g, gm + i);
-        load4(qp, qh + i);
-        load4(vp, vh + i);
-        load4(b1x, ci.b1x);
-        load4(b1v, ci.b1v);
-        const V ui = g * f;
-        store4(q + i, qp + b1x * ui);
-        store4(v + i, vp + b1v * ui);
-        store4(u + i, ui);
+        V qi, vi, ui;
+        completeCommit(qi, vi, ui, c[i / 4], gm + i, qh + i, vh + i, f, q + i, v + i, u + i);
     }
 }
 
