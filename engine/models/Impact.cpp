@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <type_traits>
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
@@ -139,17 +140,24 @@ inline double HuntCrossleyImpactT<Real>::contactForceOf(double c, double cdot) c
 }
 
 template <typename Real>
-double HuntCrossleyImpactT<Real>::contactForce(double c, double cdot) const noexcept {
-    switch (shape_) {
-    case Shape::Linear:
-        return contactForceOf<Shape::Linear>(c, cdot);
-    case Shape::Hertz:
-        return contactForceOf<Shape::Hertz>(c, cdot);
-    case Shape::Square:
-        return contactForceOf<Shape::Square>(c, cdot);
+template <typename F>
+inline decltype(auto) HuntCrossleyImpactT<Real>::withShape(F&& f) const {
+    using S = Shape;
+    switch (shape_) { // the contact law's shape, as a compile-time constant for f
+    case S::Linear:
+        return f(std::integral_constant<S, S::Linear>{});
+    case S::Hertz:
+        return f(std::integral_constant<S, S::Hertz>{});
+    case S::Square:
+        return f(std::integral_constant<S, S::Square>{});
     default:
-        return contactForceOf<Shape::General>(c, cdot);
+        return f(std::integral_constant<S, S::General>{});
     }
+}
+
+template <typename Real>
+double HuntCrossleyImpactT<Real>::contactForce(double c, double cdot) const noexcept {
+    return withShape([&](auto s) { return contactForceOf<decltype(s)::value>(c, cdot); });
 }
 
 template <typename Real>
@@ -158,16 +166,7 @@ double HuntCrossleyImpactT<Real>::solveForce(double ch, double dh) noexcept {
         return contactForce(exciterX_ - resonator_.position(0),
                             exciterV_ - resonator_.contactVelocity());
     if (!(ch > 0.0)) return 0.0; // fMax = HC(ch, dh) = 0 (below): no contact (free flight)
-    switch (shape_) {            // the contact law's shape, once per solve
-    case Shape::Linear:
-        return solveShaped<Shape::Linear>(ch, dh);
-    case Shape::Hertz:
-        return solveShaped<Shape::Hertz>(ch, dh);
-    case Shape::Square:
-        return solveShaped<Shape::Square>(ch, dh);
-    default:
-        return solveShaped<Shape::General>(ch, dh);
-    }
+    return withShape([&](auto s) { return solveShaped<decltype(s)::value>(ch, dh); });
 }
 
 template <typename Real>

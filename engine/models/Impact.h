@@ -143,6 +143,8 @@ class HuntCrossleyImpactT {
     double contactForceOf(double c, double cdot) const noexcept;
     template <Shape S>
     double solveShaped(double ch, double dh) noexcept; // solveForce() for one contact law
+    template <typename F>
+    decltype(auto) withShape(F&& f) const; // f(std::integral_constant<Shape, shape_>)
     double coarseT_ = 0, coarseKc_ = 0, coarseKd_ = 0, fineT_ = 0, fineKc_ = 0, fineKd_ = 0;
     Butterworth decimator_;
     ContactStats stats_;

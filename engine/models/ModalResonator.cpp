@@ -276,8 +276,7 @@ template <typename Real>
 void ModalResonatorT<Real>::prepare(double sampleRateHz, int fineSubsteps) {
     pending_ = false; // the state is reset below
     sampleRateHz_ = sampleRateHz;
-    avx_ = avxAllowed_ && simdAllowsAvx();
-    passes_ = kPasses[avx_ ? 1 : 0];
+    allowAvx(avxAllowed_); // the kernels (the CPU's and UNDERFOOT_SIMD's limit are read once)
     fine_ = false;
     const std::size_t n = modes_.size(), np = gains_.size(), n2 = padded(n);
     coefficients_.resize(n);
@@ -351,8 +350,7 @@ void ModalResonatorT<Real>::reset() noexcept {
 template <typename Real>
 void ModalResonatorT<Real>::allowAvx(bool on) noexcept {
     avxAllowed_ = on;
-    avx_ = on && simdAllowsAvx();
-    passes_ = kPasses[avx_ ? 1 : 0];
+    passes_ = kPasses[on && simdAllowsAvx() ? 1 : 0];
 }
 
 // One pass over the modes, four per step (see the top of the file). With `Fused` (a commit

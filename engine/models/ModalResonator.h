@@ -80,7 +80,7 @@ class ModalResonatorT {
     /// and add the four lanes' partial sums in the same order, so the samples are bit-identical;
     /// allowAvx(false) selects the SSE2 kernels (tests compare the two).
     void allowAvx(bool on) noexcept;
-    bool usesAvx() const noexcept { return avx_; }
+    bool usesAvx() const noexcept { return passes_ == kPasses[1]; }
     void reset() noexcept;
 
     int modeCount() const noexcept { return static_cast<int>(modes_.size()); }
@@ -209,7 +209,7 @@ class ModalResonatorT {
     template <bool Wide, bool Energy, bool Fused, bool Held, bool Free>
     void passBody(Real h) noexcept;
     static const PassFn kPasses[2][9];
-    const PassFn* passes_ = kPasses[0]; // kPasses[avx_]
+    const PassFn* passes_ = kPasses[0]; // the kernel in use: kPasses[1] is AVX
     void commitWithoutForce() noexcept;
     struct Bank {
         std::vector<Real> a00, a01, a10, a11, b0x, b0v, b1x, b1v;
@@ -243,7 +243,7 @@ class ModalResonatorT {
     std::vector<ModeCoefficients> fineCoefficients_; // empty unless prepared with sub-steps
     Bank coarseBank_, fineBank_;
     std::vector<QuadGains> quadGains_;
-    bool avx_ = false, avxAllowed_ = true; // the kernels in use (see allowAvx)
+    bool avxAllowed_ = true; // allowAvx(false): the SSE2 kernels even where the CPU has AVX
     bool fine_ = false;
     // Per-mode arrays are padded to a multiple of four (four modes per SIMD step, see the .cpp)
     // with modes whose coefficients and gains are zero.
