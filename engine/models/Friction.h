@@ -19,11 +19,11 @@
 /// relative velocity at n+1 follows in closed form once the plastic rate p = alpha v / z_ss is
 /// fixed (a "plain pass"); the solution is the fixed point of p. Shipped (issue #18, perf5):
 /// safeguarded Newton on p with the analytic derivatives of the Stribeck curve and the raised
-/// sine, warm-started from the last two samples' p and kept in a bracket (bisection or a plain
+/// sine, warm-started from the last three samples' p and kept in a bracket (bisection or a plain
 /// pass when a step leaves it); it stops when the error left in v and z, estimated from the
 /// step and the steps' contraction, is within `tolerance` (the plain passes' criterion), at
 /// most `maxIterations` evaluations (bounded work; cap hits counted in `solveStats()`). On the
-/// creak: 2.06 evaluations a sample, none at the cap, and one plain pass from every returned
+/// creak: 1.99 evaluations a sample, none at the cap, and one plain pass from every returned
 /// solution moves it by < 1e-15 relative (4.4e-16 on 2 s; test
 /// ElastoPlasticFriction.NewtonSolutionMeetsThePlainPassCriterionOnEverySample).
 /// `newton = false` keeps the fixed-point passes (warm start, Aitken extrapolation; friction5:
@@ -77,39 +77,31 @@ struct FrictionParams {
 // instructions a sample in libm). Plain double arithmetic without FMA: the same values on every
 // x86-64 machine. Errors measured by test FrictionFunctions.ErrorsStayWithinTheirStatedBounds.
 
+/// 2^(j / 256) for j = 0 .. 255, correctly rounded (generated with 60-digit decimal arithmetic).
+extern const double kFrictionExp2Table[256];
+
 /// exp(y) for y <= 0, relative error < 1e-15 (0 below -708). Deterministic (no FMA, no libm):
-/// y = (8k + j) ln2 / 8 + r with |r| <= ln2 / 16 (ln2 / 8 split in two so that the product is
-/// exact), e^r by its Taylor polynomial of degree 8 (remainder < 1.4e-18), 2^(j/8) from a table
-/// of correctly rounded values and 2^k put into the exponent bits.
+/// y = (256 k + j) ln2 / 256 + r with |r| <= ln2 / 512 (ln2 / 256 split in two so that the
+/// product is exact for |k| < 2^18), e^r by its Taylor polynomial of degree 4 (remainder
+/// < 4e-17), 2^(j/256) from a table of correctly rounded values and 2^k put into the exponent
+/// bits.
 [[gnu::always_inline]] inline double frictionExpNeg(double y) noexcept {
     if (!(y > -708.0)) return 0.0;
-    static constexpr double pow2Eighths[8] = {1.0,
-                                              1.0905077326652577,
-                                              1.189207115002721,
-                                              1.2968395546510096,
-                                              1.4142135623730951,
-                                              1.5422108254079407,
-                                              1.681792830507429,
-                                              1.8340080864093424};
-    constexpr double eightOverLn2 = 11.541560327111707, ln2hi = 0.08664333820343018,
-                     ln2lo = 5.936656298789591e-08;
+    constexpr double nOverLn2 = 369.3299304675746, ln2hi = 0.0027076061741126978,
+                     ln2lo = -5.0411407304988844e-14;
     constexpr double shifter = 6755399441055744.0; // 1.5 * 2^52: adding it rounds to an integer
-    const double kd = (y * eightOverLn2 + shifter) - shifter;
+    const double kd = (y * nOverLn2 + shifter) - shifter;
     const double r = (y - kd * ln2hi) - kd * ln2lo;
-    double p = 1.0 / 40320.0;
-    p = p * r + 1.0 / 5040.0;
-    p = p * r + 1.0 / 720.0;
-    p = p * r + 1.0 / 120.0;
-    p = p * r + 1.0 / 24.0;
+    double p = 1.0 / 24.0;
     p = p * r + 1.0 / 6.0;
     p = p * r + 0.5;
     p = p * r + 1.0;
     p = p * r + 1.0;
     const std::int64_t k = static_cast<std::int64_t>(kd);
-    const std::int64_t bits = ((k >> 3) + 1023) << 52; // (arithmetic shift: floor(k / 8))
+    const std::int64_t bits = ((k >> 8) + 1023) << 52; // (arithmetic shift: floor(k / 256))
     double scale;
     std::memcpy(&scale, &bits, sizeof scale);
-    return p * (pow2Eighths[k & 7] * scale);
+    return p * (kFrictionExp2Table[k & 255] * scale);
 }
 
 /// sin(pi t / 2) for |t| <= 1, absolute error < 1e-15. Deterministic (no FMA, no libm).
@@ -151,10 +143,18 @@ class ElastoPlasticFrictionT {
     /// moving at `anchorVelocity` (integrated implicitly: an explicit stiff drag would delay its
     /// force by a sample and pump energy in). Returns the resonator's velocity at pickup 0 (m/s).
     double processSample(double normalForceN, double driveForceN, double anchorPosition = 0.0,
-                         double anchorVelocity = 0.0) noexcept;
+                         double anchorVelocity = 0.0) noexcept {
+        return kernel_(*this, normalForceN, driveForceN, anchorPosition, anchorVelocity);
+    }
+    /// allowAvx(false) selects the SSE2 build of the per-sample kernel (and of the resonator's);
+    /// with AVX (VEX-encoded scalar code, no FMA) the samples are the same bit for bit.
+    void allowAvx(bool on) noexcept;
+    bool usesAvx() const noexcept;
 
     /// Unloaded surfaces: the bristles relax and the rubbing mass stops (keeps the ringing).
-    void relax() noexcept { z_ = exciterV_ = force_ = lastExternal_ = v_ = p_ = pPrev_ = 0.0; }
+    void relax() noexcept {
+        z_ = exciterV_ = force_ = lastExternal_ = v_ = p_ = pPrev_ = pPrev2_ = 0.0;
+    }
     double frictionForce() const noexcept { return force_; }
     double bristle() const noexcept { return z_; }
     double relativeVelocity() const noexcept { return v_; }
@@ -175,6 +175,24 @@ class ElastoPlasticFrictionT {
     ModalResonatorT<Real>& resonator() noexcept { return resonator_; }
 
   private:
+    using Kernel = double (*)(ElastoPlasticFrictionT&, double, double, double, double) noexcept;
+    template <bool Libm>
+    double processBody(double normal, double drive, double anchorX, double anchorV) noexcept;
+    template <bool Libm>
+    static double kernelGeneric(ElastoPlasticFrictionT& f, double normal, double drive,
+                                double anchorX, double anchorV) noexcept;
+    template <bool Libm>
+    static double kernelAvx(ElastoPlasticFrictionT& f, double normal, double drive, double anchorX,
+                            double anchorV) noexcept;
+    void chooseKernel() noexcept;
+    /// The fixed-point passes (newton = false): the reference solve.
+    struct PassesResult {
+        double v, z, force;
+        int passes;
+        bool converged;
+    };
+    PassesResult solvePasses(double vRelPred, double z0, double noise, double fc, double fs,
+                             double zba) const noexcept;
     double alphaOf(double z, double v, double zss, double zba) const noexcept;
     /// The plastic rate p = alpha(z_c, v) v / z_ss(v) >= 0 at a trial (v, z) (z_c: z0 or z,
     /// see processSample) and its partial derivatives (for Newton).
@@ -206,10 +224,15 @@ class ElastoPlasticFrictionT {
     Random rng_;
     double T_ = 1.0 / 48000.0;
     double kd_ = 0.0;
-    double m11_ = 1, m12_ = 0, m21_ = 0, m22_ = 1, det_ = 1; // implicit drive (see .cpp)
+    Kernel kernel_ = &kernelGeneric<false>;
+    bool avxAllowed_ = true;
+    // The exciter's prediction without a new friction force (see prepare()): xePred =
+    // xX x + xV v + xH (lastExternal - force) + xE external, vePred likewise.
+    double xX_ = 1, xV_ = 0, xH_ = 0, xE_ = 0, vX_ = 0, vV_ = 1, vH_ = 0, vE_ = 0;
+    double zssPerN_ = 0, zssDiffPerN_ = 0, zbaPerN_ = 0; // mu_d / sigma0, ..., z_ba / N
     double px_ = 0, pv_ = 0; // exciter compliance / mobility to the friction force
     double stiffPlusDamp_ = 0, dampOverT_ = 0, stiffTPlusDamp_ = 0; // sigma0 + sigma1/T, ...
-    double p_ = 0, pPrev_ = 0; // plastic rate of the last two samples (Newton's warm start)
+    double p_ = 0, pPrev_ = 0, pPrev2_ = 0; // plastic rate of the last three samples (warm start)
     double z_ = 0, v_ = 0, force_ = 0, exciterX_ = 0, exciterV_ = 0, lastExternal_ = 0;
     FrictionSolveStats stats_;
 };
