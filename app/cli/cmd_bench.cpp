@@ -11,9 +11,19 @@
 
 #include <fmt/core.h>
 
+#include <algorithm>
+#include <cstdio>
 #include <memory>
 #include <string>
 #include <vector>
+
+// Callgrind's client requests (valgrind's headers, header only): no-ops outside valgrind.
+#if __has_include(<valgrind/callgrind.h>)
+#include <valgrind/callgrind.h>
+#define UNDERFOOT_HAVE_CALLGRIND 1
+#else
+#define UNDERFOOT_HAVE_CALLGRIND 0
+#endif
 
 namespace underfoot::cli::bench_command {
 namespace {
@@ -23,6 +33,8 @@ struct BenchArgs {
     std::string only = "all";
     double seconds = 5.0;
     int repeats = 5;
+    std::vector<std::string> scenes; ///< scene-instructions: these scenes only (empty: all)
+    bool listScenes = false;         ///< scene-instructions: print the scenes' ids, run nothing
 };
 
 bool isScenario(const std::string& id) {
@@ -48,6 +60,19 @@ class SoundscapeAmbience final : public eng::AmbienceSource {
 
 struct SceneRow {
     std::string surface, impulseResponse, soundscape;
+    /// As printed in the tables: "creaking_wood + hall + forest".
+    std::string name() const {
+        std::string n = surface;
+        if (!impulseResponse.empty()) n += " + " + impulseResponse;
+        if (!soundscape.empty()) n += " + " + soundscape;
+        return n;
+    }
+    /// As given to --scene: "creaking_wood+hall+forest".
+    std::string id() const {
+        std::string n = name();
+        std::erase(n, ' ');
+        return n;
+    }
 };
 
 /// The shipped scenes: every surface with its coherent soundscape (soundscapes/data/
@@ -62,6 +87,90 @@ std::vector<SceneRow> shippedScenes() {
         if (info.reverb) rows.push_back({info.id, "", ""});
     rows.push_back({"creaking_wood", "hall", "forest"});
     return rows;
+}
+
+/// The timed scene benchmark's spec of one shipped scene (`--seconds` s: a walk of twice that).
+eng::SceneBenchSpec sceneSpec(const SceneRow& row, const BenchArgs& a,
+                              std::unique_ptr<SoundscapeAmbience>& ambience) {
+    eng::SceneBenchSpec spec;
+    spec.surface = row.surface;
+    spec.impulseResponse = row.impulseResponse;
+    spec.voices = 2;
+    spec.seconds = 2.0 * a.seconds;
+    spec.repeats = a.repeats;
+    if (!row.soundscape.empty()) {
+        ambience = std::make_unique<SoundscapeAmbience>(row.soundscape);
+        spec.ambience = ambience.get();
+    }
+    return spec;
+}
+
+/// `--only scene-instructions` (issue #18): the instructions of every 64-frame block of the
+/// shipped scenes, counted by callgrind, so that worst / median does not depend on the machine's
+/// load. Each scene runs once on the timed benchmark's input and seed (scene and background
+/// reset as before its first repeat); after each block callgrind's counts are dumped (and so
+/// zeroed) with the label "<scene id> <block>": a dump's total is that block's instructions.
+/// scripts/scene_block_instructions.py runs this under callgrind and reads the dumps. Outside
+/// valgrind the client requests do nothing: refused (exit code 2).
+int runSceneInstructions(const BenchArgs& a) {
+    const auto all = shippedScenes();
+    if (a.listScenes) {
+        for (const auto& row : all) fmt::print("{}\n", row.id());
+        return 0;
+    }
+    std::vector<SceneRow> rows;
+    for (const auto& id : a.scenes) {
+        const auto it =
+            std::find_if(all.begin(), all.end(), [&](const SceneRow& r) { return r.id() == id; });
+        if (it == all.end()) {
+            std::string ids;
+            for (const auto& row : all) ids += (ids.empty() ? "" : ", ") + row.id();
+            throw UserError(fmt::format("bench: no shipped scene '{}' (scenes: {})", id, ids));
+        }
+        rows.push_back(*it);
+    }
+    if (rows.empty()) rows = all;
+#if UNDERFOOT_HAVE_CALLGRIND
+    const bool underValgrind = RUNNING_ON_VALGRIND != 0;
+#else
+    const bool underValgrind = false;
+#endif
+    if (!underValgrind)
+        throw UserError(
+            "bench --only scene-instructions counts each block's instructions through "
+            "callgrind's client requests, which do nothing outside valgrind" +
+            std::string(UNDERFOOT_HAVE_CALLGRIND ? ""
+                                                 : " (and this build has no valgrind headers)") +
+            ": run python3 scripts/scene_block_instructions.py (or this command under valgrind "
+            "--tool=callgrind --combine-dumps=yes --instr-atstart=no)");
+#if UNDERFOOT_HAVE_CALLGRIND
+    for (const auto& row : rows) {
+        std::unique_ptr<SoundscapeAmbience> ambience;
+        const auto spec = sceneSpec(row, a, ambience);
+        eng::SceneBlocks scene(spec);
+        std::vector<std::string> labels(scene.blocks());
+        for (std::size_t b = 0; b < labels.size(); ++b)
+            labels[b] = fmt::format("{} {}", row.id(), b);
+        scene.reset();
+        // Dumping zeroes the counts, so each dump holds one block and the loop's few
+        // instructions (the same for every block). Zeroing before every block as well made the
+        // run 1.7x slower (callgrind walks every cost centre to zero it).
+        CALLGRIND_START_INSTRUMENTATION; // the setup above runs uninstrumented (faster)
+        CALLGRIND_ZERO_STATS;
+        for (std::size_t b = 0; b < labels.size(); ++b) {
+            scene.process(b);
+            CALLGRIND_DUMP_STATS_AT(labels[b].c_str());
+        }
+        CALLGRIND_STOP_INSTRUMENTATION;
+        // One line per scene for the script: id, blocks, the IR's taps (0: no room), checksum.
+        fmt::print("scene {} blocks {} block_frames {} rate {} reverb_taps {} checksum {:.9g} "
+                   "name {}\n",
+                   row.id(), scene.blocks(), eng::kBenchBlock, eng::kBenchRateHz,
+                   scene.hasReverb() ? scene.reverbLength() : 0, scene.checksum(), row.name());
+        std::fflush(stdout);
+    }
+#endif
+    return 0;
 }
 
 void printSceneHeader(const char* what) {
@@ -83,6 +192,7 @@ void printSceneRow(const std::string& name, const eng::SceneBenchResult& r) {
 }
 
 int runBench(const BenchArgs& a) {
+    if (a.only == "scene-instructions") return runSceneInstructions(a);
     if (isScenario(a.only) && a.repeats == 1) {
         // One plain run, for instruction counting under callgrind (`--repeats 1`).
         const auto m = eng::measureScenario(a.only, a.seconds, 1);
@@ -160,21 +270,10 @@ int runBench(const BenchArgs& a) {
                    "median block | p99 block | worst block | worst / median | worst / 1333 us "
                    "budget |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
         for (const auto& row : shippedScenes()) {
-            eng::SceneBenchSpec spec;
-            spec.surface = row.surface;
-            spec.impulseResponse = row.impulseResponse;
-            spec.voices = 2;
-            spec.seconds = 2.0 * a.seconds;
-            spec.repeats = a.repeats;
             std::unique_ptr<SoundscapeAmbience> ambience;
-            if (!row.soundscape.empty()) {
-                ambience = std::make_unique<SoundscapeAmbience>(row.soundscape);
-                spec.ambience = ambience.get();
-            }
+            const auto spec = sceneSpec(row, a, ambience);
             const auto r = eng::measureScene(spec);
-            std::string name = row.surface;
-            if (!row.impulseResponse.empty()) name += " + " + row.impulseResponse;
-            if (!row.soundscape.empty()) name += " + " + row.soundscape;
+            const std::string name = row.name();
             const auto& st = r.stats;
             fmt::print("| {} | {} | {:.0f} | {:.0f} | {:.1f} | {:.2f} us | {:.2f} us | {:.2f} us | "
                        "{:.2f} | {:.2f} % |\n",
@@ -209,12 +308,15 @@ CommandRegistrar reg("bench", [](CLI::App& app, int& exitCode) {
     auto args = std::make_shared<BenchArgs>();
     auto* cmd = app.add_subcommand(
         "bench", "Measure what accuracy costs: error against a reference and CPU time per setting");
-    std::vector<std::string> choices = {"all",    "impact",         "knobs",     "surfaces",
-                                        "scenes", "impact-default", "scenarios", "scaling"};
+    std::vector<std::string> choices = {"all",       "impact",  "knobs",
+                                        "surfaces",  "scenes",  "impact-default",
+                                        "scenarios", "scaling", "scene-instructions"};
     for (const auto& id : eng::scenarioIds()) choices.push_back(id);
     cmd->add_option("--only", args->only,
                     "all, impact, knobs, surfaces, scenes, scenarios, scaling (not in all), "
-                    "impact-default (for callgrind), or one scenario: impact-strikes, "
+                    "impact-default (for callgrind), scene-instructions (instructions per block "
+                    "of the shipped scenes; under callgrind: scripts/scene_block_instructions.py), "
+                    "or one scenario: impact-strikes, "
                     "impact-pressed, impact-metal, friction-creak, aggregate-gravel, bubbles, "
                     "aggregate-gravel-1voice")
         ->check(CLI::IsMember(choices))
@@ -227,6 +329,11 @@ CommandRegistrar reg("bench", [](CLI::App& app, int& exitCode) {
     cmd->add_option("--seconds", args->seconds, "audio seconds per measurement")
         ->check(CLI::Range(0.5, 600.0))
         ->capture_default_str();
+    cmd->add_option("--scene", args->scenes,
+                    "with --only scene-instructions: this shipped scene only (repeatable; ids as "
+                    "--list-scenes prints them)");
+    cmd->add_flag("--list-scenes", args->listScenes,
+                  "with --only scene-instructions: print the shipped scenes' ids and stop");
     cmd->callback([args, &exitCode] { exitCode = runBench(*args); });
 });
 

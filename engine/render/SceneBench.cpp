@@ -57,47 +57,52 @@ BlockCostStats timeBlocks(std::size_t blocks, int repeats, int samplesPerBlock, 
     return s;
 }
 
-SceneBenchResult measureScene(const SceneBenchSpec& spec) {
+SceneBlocks::SceneBlocks(const SceneBenchSpec& spec) : spec_(spec) {
     if (spec.voices < 1 || spec.voices > 2)
         throw std::invalid_argument("measureScene: 1 or 2 voices (the walker's feet)");
-    FootstepScene scene;
     SceneOptions options;
     options.voices = spec.voices;
     options.reverb = spec.reverb;
     options.impulseResponse = spec.impulseResponse;
-    scene.build(spec.surface, options);
+    scene_.build(spec.surface, options);
     const ProcessSpec ps{double(kBenchRateHz), kBenchBlock};
-    scene.prepare(ps);
+    scene_.prepare(ps);
     if (spec.ambience) spec.ambience->prepare(ps);
-    const GrfSignal grf = walkerGrf(WalkerParameters{}, spec.seconds, kBenchRateHz, spec.seed);
-    const std::size_t blocks = grf.frames() / kBenchBlock;
-    std::vector<float> l(kBenchBlock), r(kBenchBlock), al(kBenchBlock), ar(kBenchBlock);
+    grf_ = walkerGrf(WalkerParameters{}, spec.seconds, kBenchRateHz, spec.seed);
+    blocks_ = grf_.frames() / kBenchBlock;
+    for (auto* v : {&l_, &r_, &al_, &ar_}) v->assign(kBenchBlock, 0.0f);
+}
+
+void SceneBlocks::reset() {
+    scene_.reset(spec_.seed);
+    if (spec_.ambience) spec_.ambience->reset(spec_.seed);
+    checksum_ = 0;
+}
+
+void SceneBlocks::process(std::size_t b) noexcept {
+    const float* g[2];
+    for (int v = 0; v < spec_.voices; ++v)
+        g[v] = grf_.channels[static_cast<std::size_t>(v)].data() + b * kBenchBlock;
+    scene_.process(g, l_.data(), r_.data(), kBenchBlock);
+    if (spec_.ambience) { // the live headphone mix: background at unity gain
+        spec_.ambience->process(al_.data(), ar_.data(), kBenchBlock);
+        for (std::size_t i = 0; i < std::size_t(kBenchBlock); ++i) {
+            l_[i] += al_[i];
+            r_[i] += ar_[i];
+        }
+    }
+    checksum_ += std::fabs(double(l_[0])) + std::fabs(double(r_[kBenchBlock - 1]));
+}
+
+SceneBenchResult measureScene(const SceneBenchSpec& spec) {
+    SceneBlocks scene(spec);
     SceneBenchResult result;
-    double checksum = 0;
     result.stats = timeBlocks(
-        blocks, spec.repeats, kBenchBlock, kBenchRateHz,
-        [&] {
-            scene.reset(spec.seed);
-            if (spec.ambience) spec.ambience->reset(spec.seed);
-            checksum = 0;
-        },
-        [&](std::size_t b) {
-            const float* g[2];
-            for (int v = 0; v < spec.voices; ++v)
-                g[v] = grf.channels[static_cast<std::size_t>(v)].data() + b * kBenchBlock;
-            scene.process(g, l.data(), r.data(), kBenchBlock);
-            if (spec.ambience) { // the live headphone mix: background at unity gain
-                spec.ambience->process(al.data(), ar.data(), kBenchBlock);
-                for (int i = 0; i < kBenchBlock; ++i) {
-                    l[static_cast<std::size_t>(i)] += al[static_cast<std::size_t>(i)];
-                    r[static_cast<std::size_t>(i)] += ar[static_cast<std::size_t>(i)];
-                }
-            }
-            checksum += std::fabs(double(l[0])) + std::fabs(double(r[kBenchBlock - 1]));
-        });
+        scene.blocks(), spec.repeats, kBenchBlock, kBenchRateHz, [&] { scene.reset(); },
+        [&](std::size_t b) { scene.process(b); });
     result.hasReverb = scene.hasReverb();
     result.irLength = scene.reverbLength();
-    result.checksum = checksum;
+    result.checksum = scene.checksum();
     return result;
 }
 

@@ -13,6 +13,7 @@
 ///    minimum is the block's own cost. Their mean ("per-block minima") is reported too: it is a
 ///    lower bound of the cost (it keeps, for every block, its luckiest repeat) and must not be
 ///    read as the real-time factor (issue #18: that was the 2x between the two harnesses).
+#include "engine/control/GrfFile.h"
 #include "engine/render/FootstepScene.h"
 
 #include <cstddef>
@@ -79,5 +80,37 @@ struct SceneBenchResult {
 /// Builds the scene of `spec` at 48 kHz / 64 frames and times it (see the file comment).
 /// Throws as FootstepScene::build does (unknown surface, missing IR).
 SceneBenchResult measureScene(const SceneBenchSpec& spec);
+
+/// The scene of `spec` with its walker input, built and prepared at 48 kHz / 64 frames: the work
+/// measureScene times, one 64-frame block at a time. `underfoot bench --only scene-instructions`
+/// runs it block by block under callgrind to count each block's instructions (issue #18).
+class SceneBlocks {
+  public:
+    /// Throws as FootstepScene::build does, std::invalid_argument for voices outside 1..2.
+    /// Prepares `spec.ambience` (not owned; must outlive this object).
+    explicit SceneBlocks(const SceneBenchSpec& spec);
+    SceneBlocks(const SceneBlocks&) = delete;
+    SceneBlocks& operator=(const SceneBlocks&) = delete;
+
+    /// 64-frame blocks of the walker's input.
+    std::size_t blocks() const noexcept { return blocks_; }
+    /// The scene (voices and reverb) and the ambience to `spec.seed`; the checksum to 0.
+    void reset();
+    /// Block b (b < blocks()): the scene, then the ambience added at unity gain (the live
+    /// headphone mix), then the checksum.
+    void process(std::size_t b) noexcept;
+    /// Sum over the blocks since the last reset of |first left| + |last right| output sample.
+    double checksum() const noexcept { return checksum_; }
+    bool hasReverb() const noexcept { return scene_.hasReverb(); }
+    std::size_t reverbLength() const noexcept { return scene_.reverbLength(); }
+
+  private:
+    SceneBenchSpec spec_;
+    FootstepScene scene_;
+    GrfSignal grf_;
+    std::size_t blocks_ = 0;
+    std::vector<float> l_, r_, al_, ar_;
+    double checksum_ = 0;
+};
 
 } // namespace underfoot::engine

@@ -104,6 +104,28 @@ TEST(SceneBench, MeasuresAReverbSurfaceAndReportsConsistentFigures) {
     EXPECT_ANY_THROW(measureScene(spec));
 }
 
+// `underfoot bench --only scene-instructions` runs SceneBlocks block by block under callgrind:
+// it must do the work measureScene times (the same blocks and samples; a reset starts over).
+TEST(SceneBench, SceneBlocksDoesTheWorkMeasureSceneTimes) {
+    SceneBenchSpec spec;
+    spec.surface = "wood_reverb";
+    spec.voices = 2;
+    spec.seconds = 1.0;
+    spec.repeats = 1;
+    const auto timed = measureScene(spec);
+    SceneBlocks scene(spec);
+    EXPECT_EQ(scene.blocks(), timed.stats.blocks);
+    EXPECT_TRUE(scene.hasReverb());
+    EXPECT_EQ(scene.reverbLength(), timed.irLength);
+    for (int run = 0; run < 2; ++run) {
+        scene.reset();
+        for (std::size_t b = 0; b < scene.blocks(); ++b) scene.process(b);
+        EXPECT_EQ(scene.checksum(), timed.checksum) << "run " << run;
+    }
+    spec.voices = 3;
+    EXPECT_THROW(SceneBlocks{spec}, std::invalid_argument);
+}
+
 // `underfoot bench --only surfaces` prints one row per surface from SceneBench, reverb presets
 // with their IR length.
 TEST(SceneBench, BenchCommandPrintsEverySurfaceWithItsBlockFigures) {
