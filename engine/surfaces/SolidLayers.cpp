@@ -6,7 +6,10 @@
 //  - further sharp rises of the load (the forefoot slapping down, or the micro-impacts that a
 //    microphone envelope carries) re-strike the floor while the foot is down;
 //  - a fraction of the GRF itself presses the sole onto the floor (the low "thud" of the
-//    floor's bending under the load, and the contact damping while standing).
+//    floor's bending under the load, and the contact damping while standing);
+//  - optionally (`heel_graze` > 0) the heel's rear edge touches first, lightly, and the heel lands
+//    flat `heel_graze_lead_s` later: recorded steps on wood rise to their peak over several
+//    milliseconds (docs/realism.md, "The heel's edge before the heel").
 #include "engine/surfaces/SolidLayers.h"
 
 #include "engine/dsp/Envelope.h"
@@ -66,6 +69,8 @@ class StepGestures {
     double referenceRate = 20000.0; ///< N/s giving the nominal strike velocity
     double toeDelayS = 0.07;        ///< forefoot lands this long after the heel (0 = never)
     double toeStrength = 0.6;       ///< forefoot strike velocity relative to the heel's
+    double grazeStrength = 0.0;     ///< heel edge's touch velocity relative to the heel's (0: none)
+    double grazeLeadS = 0.008;      ///< the heel lands flat this long after its edge touches
 
     void prepare(double fs) {
         fs_ = fs;
@@ -74,7 +79,7 @@ class StepGestures {
     }
     void reset(std::uint64_t seed = 1) {
         rng_.setSeed(seed);
-        toeCountdown_ = -1.0;
+        toeCountdown_ = heelCountdown_ = -1.0;
         last_ = rate_ = 0.0;
         offSeconds_ = sinceStrike_ = 1e9;
         down_ = false;
@@ -109,6 +114,13 @@ class StepGestures {
                         toeCountdown_ = toeDelayS * fs_ * (1.0 + 0.15 * rng_.bipolar());
                         toeLevel_ = toeStrength * strike;
                     }
+                    // The heel's edge first (the heel lands inclined, then rolls flat): a light
+                    // touch now, the heel's strike after the lead (+-25 % jitter).
+                    if (grazeStrength > 0.0) {
+                        heelCountdown_ = grazeLeadS * fs_ * (1.0 + 0.25 * rng_.bipolar());
+                        heelLevel_ = strike;
+                        strike *= grazeStrength;
+                    }
                 }
             }
         } else if (grf < releaseN) {
@@ -120,6 +132,10 @@ class StepGestures {
                 rearmed_ = false;
                 strike = 0.5 * strength(rate_);
             }
+        }
+        if (heelCountdown_ >= 0.0) {
+            heelCountdown_ -= 1.0;
+            if (heelCountdown_ < 0.0 && down_) strike = std::max(strike, heelLevel_);
         }
         if (toeCountdown_ >= 0.0) {
             toeCountdown_ -= 1.0;
@@ -135,8 +151,9 @@ class StepGestures {
         return std::clamp(std::sqrt(rate / referenceRate), 0.25, 3.0);
     }
     double fs_ = 48000, smooth_ = 0, last_ = 0, rate_ = 0;
-    double offSeconds_ = 1e9, sinceStrike_ = 1e9; // time off the floor, samples since a strike
-    double toeCountdown_ = -1.0, toeLevel_ = 0.0; // pending forefoot strike
+    double offSeconds_ = 1e9, sinceStrike_ = 1e9;   // time off the floor, samples since a strike
+    double toeCountdown_ = -1.0, toeLevel_ = 0.0;   // pending forefoot strike
+    double heelCountdown_ = -1.0, heelLevel_ = 0.0; // pending heel strike after its edge's touch
     Random rng_;
     bool down_ = false, rearmed_ = true, started_ = false;
 };
@@ -152,6 +169,11 @@ void readGestures(PresetReader& r, StepGestures& g) {
                                "load rise rate that re-strikes while the foot is down (0 = never)");
     g.retriggerGapS =
         r.number("retrigger_gap_s", 0.05, 0.005, 1.0, "s", "shortest time between strikes");
+    g.grazeStrength = r.number("heel_graze", 0.0, 0.0, 1.0, "",
+                               "the heel edge's first touch, as a share of the heel strike's "
+                               "velocity (0 = the heel lands flat at once)");
+    g.grazeLeadS = r.number("heel_graze_lead_s", 0.008, 0.001, 0.05, "s",
+                            "time from the heel edge's touch to the heel's strike");
 }
 
 class ImpactLayer final : public SurfaceLayer {

@@ -245,7 +245,8 @@ class OneSceneUnderCallgrind(unittest.TestCase):
                 lines = f.read().split()
             self.assertEqual(len(lines), blocks + 1)
             self.assertIn("`FootstepScene::process`", r.stdout)  # the worst block's functions
-            self.assertIn("Convolver", r.stdout)
+            self.assertIn("`Surface::process`", r.stdout)  # (which of the surface and the
+            # reverb leads the worst block depends on the presets: not asserted)
         finally:
             shutil.rmtree(out, ignore_errors=True)
 

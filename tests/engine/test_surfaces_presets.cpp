@@ -295,3 +295,52 @@ TEST(SurfacePresets, TheAllocationTrapSeesAnAllocation) {
     delete p;
     EXPECT_EQ(trap.count(), 1);
 }
+
+// heel_graze > 0: the heel's rear edge touches first, lightly, and the heel strikes
+// heel_graze_lead_s later (+-25 % jitter); without it the step peaks at once after the landing.
+TEST(SurfacePresets, HeelEdgeTouchesBeforeTheHeelStrikes) {
+    const std::string preset =
+        "id = \"x\"\nname = \"X\"\ncategory = \"solid\"\ndescription = \"a test preset\"\n"
+        "[[layer]]\ntype = \"impact\"\npurpose = \"strikes of the sole\"\nstiffness = 1e9\n"
+        "press_fraction = 0.0\n"
+        "modes = [{ freq_hz = 300, t60_s = 0.05 }, { freq_hz = 900, t60_s = 0.03 }]\n";
+    struct Step {
+        double onsetMs, peakMs, firstTouchShare;
+    };
+    auto step = [&](const std::string& extra, std::uint64_t seed) {
+        auto surface = loadSurfaceFromString(preset + extra, "graze.toml");
+        surface->prepare({48000.0, 256});
+        surface->reset(seed);
+        // 100 ms off the floor, then the load rises to 700 N in 20 ms and is held.
+        std::vector<float> grf(48000 * 3 / 10), out(grf.size(), 0.0f);
+        for (std::size_t i = 0; i < grf.size(); ++i) {
+            const double t = double(i) / 48000.0;
+            grf[i] = t < 0.1 ? 0.0f : static_cast<float>(std::min(700.0, 35000.0 * (t - 0.1)));
+        }
+        for (std::size_t i = 0; i + 256 <= grf.size(); i += 256)
+            surface->process(grf.data() + i, out.data() + i, 256);
+        // Up to 150 ms: before the forefoot's strike (70 ms after the landing, +-15 %).
+        const std::size_t end = 48000 * 15 / 100;
+        std::size_t peak = 0;
+        for (std::size_t i = 0; i < end; ++i)
+            if (std::fabs(out[i]) > std::fabs(out[peak])) peak = i;
+        const double top = std::fabs(out[peak]);
+        std::size_t onset = 0;
+        while (std::fabs(out[onset]) < 1e-3 * top) ++onset;
+        double first = 0.0; // the loudest sample of the first 2 ms after the onset
+        for (std::size_t i = onset; i < onset + 96; ++i)
+            first = std::max(first, double(std::fabs(out[i])));
+        return Step{double(onset) / 48.0, double(peak) / 48.0, first / top};
+    };
+    for (std::uint64_t seed : {1u, 2u, 3u}) {
+        const Step flat = step("", seed);
+        EXPECT_NEAR(flat.onsetMs, 100.0, 2.0);
+        EXPECT_LT(flat.peakMs - flat.onsetMs, 2.0) << seed;
+        const Step graze = step("heel_graze = 0.2\nheel_graze_lead_s = 0.006\n", seed);
+        EXPECT_NEAR(graze.onsetMs, flat.onsetMs, 0.1) << seed;
+        EXPECT_GE(graze.peakMs - graze.onsetMs, 0.75 * 6.0 - 0.5) << seed;
+        EXPECT_LE(graze.peakMs - graze.onsetMs, 1.25 * 6.0 + 2.0) << seed;
+        EXPECT_LT(graze.firstTouchShare, 0.5) << seed; // the edge's touch is the quieter one
+        EXPECT_GT(graze.firstTouchShare, 0.02) << seed;
+    }
+}
