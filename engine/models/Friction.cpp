@@ -137,7 +137,6 @@ void ElastoPlasticFrictionT<Real>::prepare(double fs) {
     stiffPlusDamp_ = params_.sigma0 + params_.sigma1 / T;
     dampOverT_ = params_.sigma1 / T;
     stiffTPlusDamp_ = params_.sigma0 * T + params_.sigma1;
-    invSigma0_ = 1.0 / params_.sigma0;
     invStribeck_ = 1.0 / params_.stribeckVelocity;
     minusTwoOverVs_ = -2.0 * invStribeck_;
     pMax_ = 1e18 / T;
@@ -286,7 +285,7 @@ ElastoPlasticFrictionT<Real>::solveNewton(const SolveInput& in, double vRelPred,
         const double dzdp = T * (dvdp - x.z) * x.invD;
         const double gp = P.dv * dvdp + P.dz * dzdp - 1.0;
         double next = pk - g / gp;
-        next = next < 0.0 ? 0.0 : next; // (p >= 0; a NaN step fails the bracket test below)
+        if (next < 0.0) next = 0.0; // (p >= 0; a NaN step fails the bracket test below)
         if (!(next > lo && next < hi)) next = hi < HUGE_VAL ? 0.5 * (std::max(lo, 0.0) + hi) : P.p;
         const double step = std::fabs(next - pk);
         // Contraction of this step against the last one: the error left after a step of a
@@ -417,7 +416,9 @@ ElastoPlasticFrictionT<Real>::processBody(double normal, double drive, double an
     resonator_.predict();
     const double vRelPred = vePred - resonator_.predictedVelocity(0);
 
-    // No load, no contact: no friction at all (z1 = 0, F = 0).
+    // No load, no contact: no friction at all (z1 = 0, F = 0). Without a Newton solve below
+    // there is no residual to report (lastSolveResidual() gives 0).
+    if (trackResidual_) in_.zssC = in_.zssD = 0.0;
     double force = 0.0, z1 = 0.0;
     if (N > 0.0) {
         // Roughness noise acts only while the surfaces are pressed together.
@@ -456,14 +457,11 @@ ElastoPlasticFrictionT<Real>::processBody(double normal, double drive, double an
             force = r.force;
             passes = r.passes;
             converged = r.converged;
-            if (trackResidual_) in_.zssC = in_.zssD = 0.0;
         }
         ++stats_.samples;
         stats_.passes += static_cast<std::uint64_t>(passes);
         if (!converged) ++stats_.capHits;
         stats_.maxPassesInOneSample = std::max(stats_.maxPassesInOneSample, passes);
-    } else if (trackResidual_) {
-        in_.zssC = in_.zssD = 0.0;
     }
     // Commit: friction acts against the exciter's relative motion, with it on the resonator.
     exciterX_ = xePred - px_ * force;

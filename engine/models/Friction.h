@@ -216,7 +216,7 @@ class ElastoPlasticFrictionT {
     Pass solveNewton(const SolveInput& in, double vRelPred, int& passes, bool& converged) noexcept;
     SolveInput in_;
     bool trackResidual_ = false;
-    double invSigma0_ = 1.0, invStribeck_ = 1.0, minusTwoOverVs_ = -2.0, d0_ = 1.0, d1_ = 0.0;
+    double invStribeck_ = 1.0, minusTwoOverVs_ = -2.0, d0_ = 1.0, d1_ = 0.0;
     double pMax_ = 1e18 * 48000.0; // cap of the plastic rate (T pMax = 1e18)
 
     FrictionParams params_;

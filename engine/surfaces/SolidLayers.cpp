@@ -62,6 +62,18 @@ void readModes(PresetReader& reader, const AccuracyOptions& options, std::vector
     }
 }
 
+/// A strike scheduled some samples ahead (the heel after its edge's touch, the forefoot after
+/// the heel).
+struct PendingStrike {
+    double countdown = -1.0, level = 0.0;
+    /// Counts one sample down: the strike's strength if it falls due at this sample, else 0.
+    double next() noexcept {
+        if (countdown < 0.0) return 0.0;
+        countdown -= 1.0;
+        return countdown < 0.0 ? level : 0.0;
+    }
+};
+
 /// Detects foot contacts and sharp load rises in a GRF, sample by sample (no allocation).
 class StepGestures {
   public:
@@ -79,7 +91,7 @@ class StepGestures {
     }
     void reset(std::uint64_t seed = 1) {
         rng_.setSeed(seed);
-        toeCountdown_ = heelCountdown_ = -1.0;
+        toe_ = heel_ = PendingStrike{};
         last_ = rate_ = 0.0;
         offSeconds_ = sinceStrike_ = 1e9;
         down_ = false;
@@ -111,14 +123,13 @@ class StepGestures {
                     // Heel then forefoot ("heel-toe" roll-over, Perry & Burnfield 2010): the
                     // forefoot lands about 70 ms later; +-15 % jitter so no two steps are alike.
                     if (toeStrength > 0.0 && toeDelayS > 0.0) {
-                        toeCountdown_ = toeDelayS * fs_ * (1.0 + 0.15 * rng_.bipolar());
-                        toeLevel_ = toeStrength * strike;
+                        toe_ = {toeDelayS * fs_ * (1.0 + 0.15 * rng_.bipolar()),
+                                toeStrength * strike};
                     }
                     // The heel's edge first (the heel lands inclined, then rolls flat): a light
                     // touch now, the heel's strike after the lead (+-25 % jitter).
                     if (grazeStrength > 0.0) {
-                        heelCountdown_ = grazeLeadS * fs_ * (1.0 + 0.25 * rng_.bipolar());
-                        heelLevel_ = strike;
+                        heel_ = {grazeLeadS * fs_ * (1.0 + 0.25 * rng_.bipolar()), strike};
                         strike *= grazeStrength;
                     }
                 }
@@ -133,14 +144,8 @@ class StepGestures {
                 strike = 0.5 * strength(rate_);
             }
         }
-        if (heelCountdown_ >= 0.0) {
-            heelCountdown_ -= 1.0;
-            if (heelCountdown_ < 0.0 && down_) strike = std::max(strike, heelLevel_);
-        }
-        if (toeCountdown_ >= 0.0) {
-            toeCountdown_ -= 1.0;
-            if (toeCountdown_ < 0.0 && down_) strike = std::max(strike, toeLevel_);
-        }
+        const double heel = heel_.next(), toe = toe_.next(); // (due only while the foot is down)
+        if (down_) strike = std::max({strike, heel, toe});
         if (strike > 0.0) sinceStrike_ = 0.0;
         return strike;
     }
@@ -151,9 +156,8 @@ class StepGestures {
         return std::clamp(std::sqrt(rate / referenceRate), 0.25, 3.0);
     }
     double fs_ = 48000, smooth_ = 0, last_ = 0, rate_ = 0;
-    double offSeconds_ = 1e9, sinceStrike_ = 1e9;   // time off the floor, samples since a strike
-    double toeCountdown_ = -1.0, toeLevel_ = 0.0;   // pending forefoot strike
-    double heelCountdown_ = -1.0, heelLevel_ = 0.0; // pending heel strike after its edge's touch
+    double offSeconds_ = 1e9, sinceStrike_ = 1e9; // time off the floor, samples since a strike
+    PendingStrike toe_, heel_; // the forefoot after the heel; the heel after its edge's touch
     Random rng_;
     bool down_ = false, rearmed_ = true, started_ = false;
 };
