@@ -2,17 +2,20 @@
 #include "engine/models/Aggregate.h"
 
 #include "engine/dsp/ProcessSpec.h"
+#include "engine/dsp/Simd.h"
 
 #include <fmt/core.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 
 namespace underfoot::engine {
 
 namespace {
 constexpr int kLanes = 8;                 // resonator slots summed in parallel lanes
+constexpr int kRunMax = 128;              // samples the resonators run at a time (laneSums_)
 constexpr int kMaxEventsPerSample = 8;    // bound on the work of one sample
 constexpr int kMaxBurstEvents = 256;      // bound on pending burst micro-events
 constexpr double kMaxVoiceSeconds = 30.0; // no voice rings longer than this
@@ -26,6 +29,82 @@ void require(bool ok, const char* name, const std::string& expected, double valu
 
 int roundUpLanes(int slots) {
     return (slots + kLanes - 1) / kLanes * kLanes;
+}
+
+// Eight resonator slots (one lane group) as one AVX vector, or as two SSE2 quads. Both do, lane
+// by lane, the IEEE float operations of the scalar recurrence (no FMA: neither target enables
+// it), so the samples do not depend on the kernel.
+typedef float F4 __attribute__((vector_size(16)));
+typedef float F8 __attribute__((vector_size(32)));
+
+// (Loaded through a reference, not returned: a 32-byte vector returned by value from code built
+// without AVX would change the calling convention.)
+template <typename V>
+[[gnu::always_inline]] inline void load(V& v, const float* p) noexcept {
+    std::memcpy(&v, p, sizeof v);
+}
+template <typename V>
+[[gnu::always_inline]] inline void store(float* p, const V& v) noexcept {
+    std::memcpy(p, &v, sizeof v);
+}
+
+// Runs the resonators of slots [s, s + lanes of V) over n samples from their state in c1..y2,
+// adding each sample's output to the lane sums at sums + t * kLanes + lane (lane = s % kLanes).
+// The first group of a run starts the sums at 0.0f + y, as the sample-by-sample loop did.
+template <typename V, bool First>
+[[gnu::always_inline]] inline void ringSlots(const float* c1, const float* c2, float* y1, float* y2,
+                                             int s, float* sums, int n) noexcept {
+    V a, b, x, y;
+    load(a, c1 + s);
+    load(b, c2 + s);
+    load(x, y1 + s);
+    load(y, y2 + s);
+    float* lane = sums + s % kLanes;
+    for (int t = 0; t < n; ++t, lane += kLanes) {
+        const V nx = a * x - b * y;
+        const V ny = b * x + a * y;
+        x = nx;
+        y = ny;
+        V sum{};
+        if constexpr (!First) load(sum, lane);
+        store(lane, sum + ny);
+    }
+    store(y1 + s, x);
+    store(y2 + s, y);
+}
+
+// Two groups of eight slots at once in one pass over the samples (two independent recurrences
+// in flight); group j's output is added to the sums before group j + 1's, as in a single pass.
+template <typename V, bool First>
+[[gnu::always_inline]] inline void ringTwoGroups(const float* c1, const float* c2, float* y1,
+                                                 float* y2, int s, float* sums, int n) noexcept {
+    V a0, b0, a1, b1, x0, y0, x1, y1v;
+    load(a0, c1 + s);
+    load(b0, c2 + s);
+    load(a1, c1 + s + kLanes);
+    load(b1, c2 + s + kLanes);
+    load(x0, y1 + s);
+    load(y0, y2 + s);
+    load(x1, y1 + s + kLanes);
+    load(y1v, y2 + s + kLanes);
+    float* lane = sums;
+    for (int t = 0; t < n; ++t, lane += kLanes) {
+        const V nx0 = a0 * x0 - b0 * y0;
+        const V ny0 = b0 * x0 + a0 * y0;
+        const V nx1 = a1 * x1 - b1 * y1v;
+        const V ny1 = b1 * x1 + a1 * y1v;
+        x0 = nx0;
+        y0 = ny0;
+        x1 = nx1;
+        y1v = ny1;
+        V sum{};
+        if constexpr (!First) load(sum, lane);
+        store(lane, (sum + ny0) + ny1);
+    }
+    store(y1 + s, x0);
+    store(y2 + s, y0);
+    store(y1 + s + kLanes, x1);
+    store(y2 + s + kLanes, y1v);
 }
 } // namespace
 
@@ -75,7 +154,73 @@ void AggregateModel::prepare(double sampleRateHz, int maxEventsPerSecond) {
     startAmplitude_.assign(v, 0.0);
     logDecay_.assign(v, 0.0);
     startSample_.assign(v, 0);
+    laneSums_.assign(static_cast<std::size_t>(kRunMax * kLanes), 0.0f);
+    allowAvx(avxAllowed_);
     reset(0);
+}
+
+void AggregateModel::allowAvx(bool on) noexcept {
+    avxAllowed_ = on;
+    ring_ = on && simdAllowsAvx() ? &ringAvx : &ringGeneric;
+}
+
+bool AggregateModel::usesAvx() const noexcept {
+    return ring_ == &ringAvx;
+}
+
+template <bool Avx>
+[[gnu::always_inline]] inline void AggregateModel::ringBody(float* out, int n) noexcept {
+    const int slots = roundUpLanes(activeVoices_ * stride_);
+    if (slots == 0) {
+        for (int t = 0; t < n; ++t) out[t] += 0.0f; // as the sum of no lanes
+        return;
+    }
+    float* c1 = c1_.data();
+    float* c2 = c2_.data();
+    float* y1 = y1_.data();
+    float* y2 = y2_.data();
+    float* sums = laneSums_.data();
+    if constexpr (Avx) {
+        int s = 0;
+        if (slots >= 2 * kLanes) {
+            ringTwoGroups<F8, true>(c1, c2, y1, y2, 0, sums, n);
+            for (s = 2 * kLanes; s + 2 * kLanes <= slots; s += 2 * kLanes)
+                ringTwoGroups<F8, false>(c1, c2, y1, y2, s, sums, n);
+        } else {
+            ringSlots<F8, true>(c1, c2, y1, y2, 0, sums, n);
+            s = kLanes;
+        }
+        if (s < slots) ringSlots<F8, false>(c1, c2, y1, y2, s, sums, n);
+    } else {
+        ringSlots<F4, true>(c1, c2, y1, y2, 0, sums, n);
+        ringSlots<F4, true>(c1, c2, y1, y2, 4, sums, n);
+        for (int s = kLanes; s < slots; s += kLanes) {
+            ringSlots<F4, false>(c1, c2, y1, y2, s, sums, n);
+            ringSlots<F4, false>(c1, c2, y1, y2, s + 4, sums, n);
+        }
+    }
+    for (int t = 0; t < n; ++t) {
+        const float* lane = sums + t * kLanes;
+        float sum = 0.0f;
+        for (int l = 0; l < kLanes; ++l) sum += lane[l];
+        out[t] += sum;
+    }
+}
+
+void AggregateModel::ringGeneric(AggregateModel& m, float* out, int n) noexcept {
+    m.ringBody<false>(out, n);
+}
+
+#if defined(__x86_64__) || defined(__i386__)
+__attribute__((target("avx")))
+#endif
+void AggregateModel::ringAvx(AggregateModel& m, float* out, int n) noexcept {
+    m.ringBody<true>(out, n);
+}
+
+void AggregateModel::ring(float* out, int n) noexcept {
+    for (int done = 0; done < n; done += kRunMax)
+        ring_(*this, out + done, std::min(kRunMax, n - done));
 }
 
 void AggregateModel::reset(std::uint64_t seed) noexcept {
@@ -238,22 +383,28 @@ void AggregateModel::process(const float* rateHz, const float* energyScale, floa
     const double burstExpected = dt * 1000.0 / params_.burstMs;
     const double burstP = meanBurst / (1.0 + meanBurst); // geometric: P(N = k) = (1-p) p^k
     const double logBurstP = burstP > 0 ? std::log(burstP) : 0.0;
-    float* c1 = c1_.data();
-    float* c2 = c2_.data();
-    float* y1 = y1_.data();
-    float* y2 = y2_.data();
+    // The resonators run in runs of samples between the samples where a voice starts or ends
+    // (ring()); the events, their random draws and their order are decided sample by sample.
+    int runStart = 0;
     for (int i = 0; i < n; ++i) {
         double rate = static_cast<double>(rateHz[i]);
         if (!(rate > 0)) rate = 0; // also NaN
         rate = std::min(rate, primaryCap);
         double scale = static_cast<double>(energyScale[i]);
         if (!(scale > 0) || !std::isfinite(scale)) scale = 0;
+        // Flushes the run before the first change of the voices at this sample.
+        auto flush = [&] {
+            if (runStart < i) ring(out + runStart, i - runStart);
+            runStart = i;
+        };
         if (pendingTrigger_ > 0) {
+            flush();
             spawn(pendingTrigger_, false);
             pendingTrigger_ = 0;
         }
         const int count = clock_.advance(rate * dt, random_, kMaxEventsPerSample);
         for (int e = 0; e < count; ++e) {
+            flush();
             spawn(scale * random_.powerLaw(params_.gamma, params_.energyMin, params_.energyMax),
                   false);
             if (burstP > 0) {
@@ -267,30 +418,21 @@ void AggregateModel::process(const float* rateHz, const float* energyScale, floa
             const int b =
                 std::min(burstRemaining_, burstClock_.advance(burstExpected * burstRemaining_,
                                                               random_, kMaxEventsPerSample));
-            for (int e = 0; e < b; ++e)
+            for (int e = 0; e < b; ++e) {
+                flush();
                 spawn(burstScale_ *
                           random_.powerLaw(params_.gamma, params_.energyMin, params_.energyMax),
                       true);
+            }
             burstRemaining_ -= b;
         }
-        if (sample_ >= nextDeath_) retireDeadVoices();
-        const int slots = roundUpLanes(activeVoices_ * stride_);
-        float acc[kLanes] = {};
-        for (int j = 0; j < slots; j += kLanes) {
-            for (int l = 0; l < kLanes; ++l) {
-                const int s = j + l;
-                const float x = c1[s] * y1[s] - c2[s] * y2[s];
-                const float y = c2[s] * y1[s] + c1[s] * y2[s];
-                y1[s] = x;
-                y2[s] = y;
-                acc[l] += y;
-            }
+        if (sample_ >= nextDeath_) {
+            flush();
+            retireDeadVoices();
         }
-        float sum = 0.0f;
-        for (float a : acc) sum += a;
-        out[i] += sum;
         ++sample_;
     }
+    if (runStart < n) ring(out + runStart, n - runStart);
 }
 
 } // namespace underfoot::engine

@@ -140,6 +140,10 @@ class AggregateModel {
     double peakSummedAmplitude() const noexcept { return peakSummed_; }
     /// Effective cap on the rate: min(maxRateHz, maxEventsPerSecond).
     double rateCapHz() const noexcept { return rateCapHz_; }
+    /// allowAvx(false) selects the SSE2 build of the resonator kernel even where the CPU has AVX
+    /// (tests compare the two; the samples are the same either way).
+    void allowAvx(bool on) noexcept;
+    bool usesAvx() const noexcept;
     /// Reports every event (from process(), on the audio thread: the observer must be cheap).
     void setEventObserver(EventObserver observer, void* user) noexcept {
         observer_ = observer;
@@ -147,6 +151,14 @@ class AggregateModel {
     }
 
   private:
+    /// Runs the ringing resonators over `n` samples (n <= kRunMax) in which no voice starts or
+    /// ends, adding their sum to `out`.
+    using RingFn = void (*)(AggregateModel& m, float* out, int n) noexcept;
+    static void ringGeneric(AggregateModel& m, float* out, int n) noexcept;
+    static void ringAvx(AggregateModel& m, float* out, int n) noexcept;
+    template <bool Avx>
+    void ringBody(float* out, int n) noexcept;
+    void ring(float* out, int n) noexcept;
     void spawn(double energy, bool burst) noexcept;
     void freeVoice(int v) noexcept;
     void retireDeadVoices() noexcept;
@@ -167,6 +179,12 @@ class AggregateModel {
     // Active voices are kept packed at the front. c1 = r cos(theta), c2 = r sin(theta); the
     // phasor is (y1, y2) and the output its imaginary part y2.
     std::vector<float> c1_, c2_, y1_, y2_;
+    // Per-lane partial sums of a run, [sample][lane]: the voices of a run are summed slot group by
+    // slot group over all its samples (the state stays in registers), in the same order per lane
+    // as a sample-by-sample loop would, so the output does not depend on where runs are cut.
+    std::vector<float> laneSums_;
+    RingFn ring_ = &ringGeneric;
+    bool avxAllowed_ = true;
     std::vector<std::int64_t> deathSample_;         // per voice
     std::vector<double> startAmplitude_, logDecay_; // per voice, for stealing the quietest
     std::vector<std::int64_t> startSample_;
