@@ -382,6 +382,13 @@ void HuntCrossleyImpactT<Real>::processSpan(const float* fext, float* out, int n
     const int sub = params_.contactSubsteps;
     double peak = 0.0;
     for (int i = 0; i < n; ++i) {
+        if (os == 1 && !inContact_ && lastForce_ == 0.0 && freeRuns_) { // (runFree's cheap tests)
+            const int ran = runFree(fext, i, n, out, peak);
+            if (ran > 0) {
+                i += ran - 1;
+                continue;
+            }
+        }
         const double fNext = fext ? double(fext[i]) : 0.0;
         double y = 0.0;
         // One step from force f0 to f1; when the bodies touch in it, `sub` exact sub-steps.
@@ -406,6 +413,56 @@ void HuntCrossleyImpactT<Real>::processSpan(const float* fext, float* out, int n
         peak = std::max(peak, std::fabs(y));
     }
     peakSinceGridPoint_ = std::max(peakSinceGridPoint_, peak);
+}
+
+// Free flight: between strikes the sole flies off the floor while the floor rings. A sample in
+// which the sole cannot touch the floor is, in step(): the sole's trajectory under the external
+// force alone (lastForce_ = 0), the floor's free prediction, no contact force (the compression
+// ch = xPred - x0 is not positive), commit(0, 0). Here such samples run at once: the sole's
+// trajectory first, with the same operations, for as long as it stays below -1.01 B, B a bound
+// on the floor's contact displacement over all later free samples (freeContactBound: its modes'
+// energies do not grow; the 1 % covers the rounding of the sums and of a run of at most
+// kFreeRunMax samples); then the floor's modes for those samples in one call (ringFree, bit for
+// bit the per-sample passes). The first sample that could touch goes through step() as before.
+// So the samples, the state and the statistics are exactly those of step() sample by sample.
+template <typename Real>
+int HuntCrossleyImpactT<Real>::runFree(const float* fext, int from, int n, float* out,
+                                       double& peak) noexcept {
+    if (inContact_ || lastForce_ != 0.0 || params_.solver == ImpactSolver::Explicit ||
+        !resonator_.ringsFree() || listen_ != resonator_.outputPickup())
+        return 0;
+    const double margin = 1.01 * resonator_.freeContactBound(); // (NaN: no run)
+    const double M = params_.exciterMassKg, T = T_;
+    const int most = std::min(n - from, ModalResonatorT<Real>::kFreeRunMax);
+    double x = exciterX_, v = exciterV_, last = lastExternal_, time = time_;
+    int count = 0;
+    for (; count < most; ++count) {
+        // As processSpan's advance() and step()'s trial(1, 1) for this sample.
+        const double fNext = fext ? double(fext[from + count]) : 0.0;
+        const double f0 = last, f1 = last + (fNext - last);
+        const double aNextExt = f1 / M;
+        const double aNow = (f0 - 1.0 * lastForce_) / M;
+        const double xPred = x + T * v + stepConstants_.tt * (aNow / 3.0 + aNextExt / 6.0);
+        const double vPred = v + stepConstants_.halfT * (aNow + aNextExt);
+        if (!(xPred < -margin)) break;
+        x = xPred;
+        v = vPred;
+        last = fNext;
+        time += T;
+    }
+    if (count == 0) return 0;
+    resonator_.ringFree(count, freePosition_, freeVelocity_);
+    exciterX_ = x;
+    exciterV_ = v;
+    lastExternal_ = last;
+    time_ = time;
+    contactEnergy_ = 0.0;
+    for (int t = 0; t < count; ++t) {
+        const double y = freeVelocity_[t];
+        out[from + t] = static_cast<float>(y);
+        peak = std::max(peak, std::fabs(y));
+    }
+    return count;
 }
 
 template <typename Real>

@@ -98,6 +98,9 @@ class HuntCrossleyImpactT {
     /// True when nothing moves and nothing pushes: process() then costs almost nothing.
     bool isSleeping() const noexcept { return !awake_; }
     const ContactStats& stats() const noexcept { return stats_; }
+    /// allowFreeRuns(false) steps free flight sample by sample, as before the runs (tests compare
+    /// the two: the samples, the state and the statistics are the same).
+    void allowFreeRuns(bool on) noexcept { freeRuns_ = on; }
     /// Kinetic energy of the exciter + modal energy of the floor + energy stored in the contact
     /// (the work it absorbed and has not yet returned), J.
     double totalEnergy() const noexcept;
@@ -116,6 +119,9 @@ class HuntCrossleyImpactT {
     void setFineRate(bool fine) noexcept;
     double solveForce(double ch, double dh) noexcept; // contact force at n+1
     void processSpan(const float* externalForceN, float* out, int n) noexcept;
+    // Samples [from, from + k) of a span as free flight over a ringing floor, run at once, when
+    // the sole cannot touch the floor in them (see the .cpp); returns k (0: step sample by sample).
+    int runFree(const float* externalForceN, int from, int n, float* out, double& peak) noexcept;
     void sleepDecision() noexcept; // at a grid point
 
     ImpactParams params_;
@@ -149,6 +155,9 @@ class HuntCrossleyImpactT {
     Butterworth decimator_;
     ContactStats stats_;
     double contactStart_ = 0, time_ = 0;
+    bool freeRuns_ = true;
+    double freePosition_[ModalResonatorT<Real>::kFreeRunMax]; // runFree's scratch
+    double freeVelocity_[ModalResonatorT<Real>::kFreeRunMax];
 };
 
 using HuntCrossleyImpact = HuntCrossleyImpactT<double>;

@@ -320,6 +320,7 @@ void ModalResonatorT<Real>::prepare(double sampleRateHz, int fineSubsteps) {
         }
     }
     setOutputPickup(std::min(outputPickup_, static_cast<int>(np) - 1)); // fills the banks
+    runSums_.assign(static_cast<std::size_t>(8 * kFreeRunMax), 0.0);
     q_.assign(n2, Real(0));
     v_.assign(n2, Real(0));
     qh_.assign(n2, Real(0));
@@ -351,6 +352,7 @@ template <typename Real>
 void ModalResonatorT<Real>::allowAvx(bool on) noexcept {
     avxAllowed_ = on;
     passes_ = kPasses[on && simdAllowsAvx() ? 1 : 0];
+    ring_ = passes_ == kPasses[1] ? &ringAvx : &ringGeneric;
 }
 
 // One pass over the modes, four per step (see the top of the file). With `Fused` (a commit
@@ -449,6 +451,103 @@ __attribute__((target("avx")))
 #endif
 void ModalResonatorT<Real>::passAvx(ModalResonatorT& r, Real h) noexcept {
     r.passBody<true, Energy, Fused, Held, Free>(h);
+}
+
+// Free ringing over a run of n samples, quad by quad: each quad's state stays in registers over
+// the run, and its contributions to the pickup sums are added to per-sample lane sums in
+// runSums_, quads in order, starting from zero: per lane the additions of the free pass
+// (passBody<..., Free>) in its order, and the lanes are added as it adds them, (lane 0 + lane 2)
+// + (lane 1 + lane 3). So every sample's sums, and the state after the run, are those of n
+// predict() / commit(p, 0) pairs, bit for bit.
+template <typename Real>
+template <bool Wide>
+[[gnu::always_inline]] inline void ModalResonatorT<Real>::ringBody(int n, double* x0Out,
+                                                                   double* voOut) noexcept {
+    using V = typename Lanes<Real, Wide>::R;
+    using D = typename Lanes<Real, Wide>::D;
+    const std::size_t quads = q_.size() / 4;
+    const QuadCoefficients* c = bank().quads.data();
+    const QuadGains* gg = quadGains_.data();
+    Real *q = q_.data(), *v = v_.data();
+    double* sums = runSums_.data();
+    D v0{};
+    for (std::size_t k = 0; k < quads; ++k) {
+        const std::size_t i = 4 * k;
+        const QuadCoefficients& ck = c[k];
+        V qi, vi, a00, a01, a10, a11;
+        load4(qi, q + i);
+        load4(vi, v + i);
+        load4(a00, ck.a00);
+        load4(a01, ck.a01);
+        load4(a10, ck.a10);
+        load4(a11, ck.a11);
+        D g0, go, yd{};
+        load4(g0, gg[k].g0);
+        load4(go, gg[k].go);
+        double* s = sums;
+        for (int t = 0; t < n; ++t, s += 8) {
+            const V x = a00 * qi + a01 * vi;
+            const V y = a10 * qi + a11 * vi;
+            qi = x;
+            vi = y;
+            D xd, sx{}, so{};
+            toDouble(xd, x);
+            toDouble(yd, y);
+            if (k > 0) {
+                load4(sx, s);
+                load4(so, s + 4);
+            }
+            sx += g0 * xd;
+            so += go * yd;
+            store4(s, sx);
+            store4(s + 4, so);
+        }
+        v0 += g0 * yd; // the last sample's contact velocity
+        store4(q + i, qi);
+        store4(v + i, vi);
+    }
+    const double* s = sums;
+    for (int t = 0; t < n; ++t, s += 8) {
+        D sx, so;
+        load4(sx, s);
+        load4(so, s + 4);
+        const D2 x0h = halves(sx), voh = halves(so);
+        x0Out[t] = x0h[0] + x0h[1];
+        voOut[t] = voh[0] + voh[1];
+    }
+    // As commitWithoutForce() after the last sample's predict().
+    const D2 v0h = halves(v0);
+    predictedX0_ = x0_ = x0Out[n - 1];
+    predictedV0_ = v0_ = v0h[0] + v0h[1];
+    predictedVo_ = outputVelocity_ = voOut[n - 1];
+    energyValid_ = false;
+    committedEnergy_ = predictedEnergy_;
+    predictedEnergyValid_ = false;
+}
+
+template <typename Real>
+void ModalResonatorT<Real>::ringGeneric(ModalResonatorT& r, int n, double* x0,
+                                        double* vo) noexcept {
+    r.ringBody<false>(n, x0, vo);
+}
+
+template <typename Real>
+#if defined(__x86_64__) || defined(__i386__)
+__attribute__((target("avx")))
+#endif
+void ModalResonatorT<Real>::ringAvx(ModalResonatorT& r, int n, double* x0, double* vo) noexcept {
+    r.ringBody<true>(n, x0, vo);
+}
+
+template <typename Real>
+double ModalResonatorT<Real>::freeContactBound() const noexcept {
+    settle();
+    double bound = 0.0;
+    for (std::size_t i = 0; i < modes_.size(); ++i) {
+        const double q = double(q_[i]), v = double(v_[i]);
+        bound += std::fabs(contactGain_[i]) * std::sqrt(q * q + v * v / w0sq_[i]);
+    }
+    return bound;
 }
 
 // [kernel][variant]: variant = 4 energy + 2 fused + held, or 8 for free ringing.

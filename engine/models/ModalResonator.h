@@ -174,6 +174,25 @@ class ModalResonatorT {
         return energyValid_ ? committedEnergy_ : energyLoop();
     }
 
+    // ---- free ringing over a run of samples ----
+    /// Most samples one ringFree() call runs.
+    static constexpr int kFreeRunMax = 64;
+    /// True when no force is held or pending and the coarse rate is selected: ringFree() may run.
+    bool ringsFree() const noexcept { return heldZero_ && !pending_ && !fine_; }
+    int outputPickup() const noexcept { return outputPickup_; }
+    /// n samples (1..kFreeRunMax) of free ringing: what n calls of predict() then commit(p, 0)
+    /// give, bit for bit (the same operations per mode, the pickup sums added in the same
+    /// order), with each quad of modes kept in registers over the run. contactPosition[t] is
+    /// sample t's predictedPosition(0) and outputVelocity[t] its velocity(outputPickup()) after
+    /// the commit. Requires ringsFree().
+    void ringFree(int n, double* contactPosition, double* outputVelocity) noexcept {
+        ring_(*this, n, contactPosition, outputVelocity);
+    }
+    /// A bound on |predictedPosition(0)| over every later sample of free ringing from the
+    /// current state: the sum over the modes of |g0| sqrt(q^2 + v^2 / w0^2) (a freely ringing
+    /// mode's energy never grows; the discretisation samples its trajectory exactly).
+    double freeContactBound() const noexcept;
+
     /// Convenience: one full sample with an external force at pickup `p`; returns velocity at
     /// pickup `listen`.
     double processSample(int p, double forceN, int listen) noexcept {
@@ -210,6 +229,19 @@ class ModalResonatorT {
     void passBody(Real h) noexcept;
     static const PassFn kPasses[2][9];
     const PassFn* passes_ = kPasses[0]; // the kernel in use: kPasses[1] is AVX
+    // Free ringing over a run (ringFree), in the same two kernels.
+    using RingFn = void (*)(ModalResonatorT&, int, double*, double*) noexcept;
+    static void ringGeneric(ModalResonatorT& r, int n, double* x0, double* vo) noexcept;
+#if defined(__x86_64__) || defined(__i386__)
+    // (the target is declared here too: GCC ignores it on the out-of-class definition of a
+    // class template's member that is not itself a template)
+    __attribute__((target("avx")))
+#endif
+    static void ringAvx(ModalResonatorT& r, int n, double* x0, double* vo) noexcept;
+    template <bool Wide>
+    void ringBody(int n, double* x0, double* vo) noexcept;
+    RingFn ring_ = &ringGeneric;
+    std::vector<double> runSums_; // a run's per-lane pickup sums: [sample][x0 x 4, output x 4]
     void commitWithoutForce() noexcept;
     struct Bank {
         std::vector<Real> a00, a01, a10, a11, b0x, b0v, b1x, b1v;

@@ -215,3 +215,84 @@ TEST(ModalResonatorFastPath, FreeRingingEqualsTheGeneralRecursion) {
         ASSERT_NEAR(y, ref, 1e-15 * (1.0 + std::fabs(ref)) + 1e-300) << n;
     }
 }
+
+namespace {
+// Strikes of several strengths, a sole pushed back onto the floor by an external force after
+// some of them (contacts that start from free flight), rendered in blocks of `block` samples.
+template <typename Real>
+std::vector<float> strikesAndPushes(const ImpactParams& p, const std::vector<Mode>& modes,
+                                    const std::vector<std::vector<double>>& gains, int listen,
+                                    bool freeRuns, int block, ContactStats& stats, double& energy) {
+    HuntCrossleyImpactT<Real> impact;
+    impact.configure(p, modes, gains, listen);
+    impact.prepare({kFs, 64});
+    impact.allowFreeRuns(freeRuns);
+    const int n = static_cast<int>(1.2 * kFs);
+    std::vector<float> out(static_cast<std::size_t>(n), 0.0f), push(out.size(), 0.0f);
+    for (int i = 0; i < n; ++i) { // 40 N pushes after the second and fourth strikes
+        const int t = i % 12000;
+        if ((i / 12000) % 2 == 1 && t > 3000 && t < 5000) push[static_cast<std::size_t>(i)] = 40.0f;
+    }
+    for (int start = 0; start < n; start += 2400) {
+        // a strike every 50 ms, processed in blocks of `block` between them
+        impact.strike(0.1 + 0.15 * ((start / 2400) % 5));
+        for (int i = start; i < std::min(n, start + 2400); i += block) {
+            const int k = std::min({block, n - i, start + 2400 - i});
+            impact.process(push.data() + i, out.data() + i, k);
+        }
+    }
+    stats = impact.stats();
+    energy = impact.totalEnergy();
+    return out;
+}
+
+template <typename Real>
+void expectFreeRunsEqualSteps(const ImpactParams& p, const std::vector<Mode>& modes,
+                              const std::vector<std::vector<double>>& gains, int listen) {
+    ContactStats refStats;
+    double refEnergy = 0.0;
+    const auto ref = strikesAndPushes<Real>(p, modes, gains, listen, false, 1, refStats, refEnergy);
+    double sum = 0.0;
+    for (float v : ref) sum += std::fabs(v);
+    ASSERT_GT(sum, 0.0);
+    for (int block : {1, 64, 777}) {
+        ContactStats stats;
+        double energy = 0.0;
+        const auto out =
+            strikesAndPushes<Real>(p, modes, gains, listen, true, block, stats, energy);
+        EXPECT_EQ(out, ref) << "block " << block << ", " << modes.size() << " modes, "
+                            << p.contactSubsteps << " sub-steps";
+        EXPECT_EQ(stats.contactTimeSeconds, refStats.contactTimeSeconds);
+        EXPECT_EQ(stats.peakForceN, refStats.peakForceN);
+        EXPECT_EQ(stats.incomingVelocity, refStats.incomingVelocity);
+        EXPECT_EQ(stats.outgoingVelocity, refStats.outgoingVelocity);
+        EXPECT_EQ(stats.solvedSamples, refStats.solvedSamples);
+        EXPECT_EQ(energy, refEnergy);
+    }
+}
+} // namespace
+
+// Free flight runs at once over the samples where the sole cannot touch the ringing floor
+// (HuntCrossleyImpactT::runFree, ModalResonatorT::ringFree). It must give exactly what stepping
+// sample by sample gives: samples, statistics and energy, for any block size, with one quad of
+// modes or several, a mode above Nyquist (quasi-static), two pickups, sub-steps or none, the
+// explicit solver (never run at once), and float state.
+TEST(ImpactFreeRuns, RunsGiveTheSampleBySampleSamples) {
+    const std::vector<Mode> many = {{83.6, 0.07, 6.0},   {120.8, 0.03, 6.0},  {203.3, 0.92, 2.5},
+                                    {238.8, 0.02, 2.5},  {363.1, 0.04, 1.2},  {441.1, 0.035, 1.2},
+                                    {667.3, 0.03, 0.9},  {1130.0, 0.02, 0.5}, {2650.0, 0.5, 0.3},
+                                    {30000.0, 0.01, 0.2}};
+    std::vector<double> g1(many.size()), g2(many.size());
+    for (std::size_t i = 0; i < many.size(); ++i) {
+        g1[i] = 1.0 - 0.15 * static_cast<double>(i);
+        g2[i] = 0.5 + 0.1 * static_cast<double>(i % 3);
+    }
+    for (int sub : {1, 4, 8}) {
+        expectFreeRunsEqualSteps<double>(benchImpact(sub), kModes, {{1.0, 1.0, 1.0}}, 0);
+        expectFreeRunsEqualSteps<double>(benchImpact(sub), many, {g1, g2}, 1);
+        expectFreeRunsEqualSteps<float>(benchImpact(sub), many, {g1, g2}, 1);
+    }
+    ImpactParams explicitSolver = benchImpact(1);
+    explicitSolver.solver = ImpactSolver::Explicit;
+    expectFreeRunsEqualSteps<double>(explicitSolver, kModes, {{1.0, 1.0, 1.0}}, 0);
+}
