@@ -84,6 +84,7 @@ void HuntCrossleyImpactT<Real>::setFineRate(bool fine) noexcept {
 
 template <typename Real>
 void HuntCrossleyImpactT<Real>::reset() noexcept {
+    freeRetryIn_ = 0;
     setFineRate(false);
     resonator_.reset();
     decimator_.reset();
@@ -383,10 +384,17 @@ void HuntCrossleyImpactT<Real>::processSpan(const float* fext, float* out, int n
     double peak = 0.0;
     for (int i = 0; i < n; ++i) {
         if (os == 1 && !inContact_ && lastForce_ == 0.0 && freeRuns_) { // (runFree's cheap tests)
-            const int ran = runFree(fext, i, n, out, peak);
-            if (ran > 0) {
-                i += ran - 1;
-                continue;
+            // Right after a contact the sole is still near the floor and runFree() would find no
+            // sample to run: after a failed try, the next samples step without trying.
+            if (freeRetryIn_ > 0) {
+                --freeRetryIn_;
+            } else {
+                const int ran = runFree(fext, i, n, out, peak);
+                if (ran > 0) {
+                    i += ran - 1;
+                    continue;
+                }
+                freeRetryIn_ = kFreeRetrySamples;
             }
         }
         const double fNext = fext ? double(fext[i]) : 0.0;

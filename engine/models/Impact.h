@@ -156,6 +156,8 @@ class HuntCrossleyImpactT {
     ContactStats stats_;
     double contactStart_ = 0, time_ = 0;
     bool freeRuns_ = true;
+    static constexpr int kFreeRetrySamples = 8; // samples stepped after a failed runFree()
+    int freeRetryIn_ = 0;
     double freePosition_[ModalResonatorT<Real>::kFreeRunMax]; // runFree's scratch
     double freeVelocity_[ModalResonatorT<Real>::kFreeRunMax];
 };
