@@ -373,6 +373,19 @@ void AggregateModel::retireDeadVoices() noexcept {
 
 void AggregateModel::process(const float* rateHz, const float* energyScale, float* out,
                              int n) noexcept {
+    processWith(
+        rateHz, [energyScale](int i) { return energyScale[i]; }, out, n);
+}
+
+void AggregateModel::process(const float* rateHz, ScaleFn scaleAt, void* user, float* out,
+                             int n) noexcept {
+    processWith(
+        rateHz, [scaleAt, user](int i) { return scaleAt(user, i); }, out, n);
+}
+
+template <typename ScaleAt>
+void AggregateModel::processWith(const float* rateHz, ScaleAt&& scaleAt, float* out,
+                                 int n) noexcept {
     if (c1_.empty()) return;
     const double dt = 1.0 / sampleRateHz_;
     const double meanBurst = params_.burstEvents;
@@ -390,8 +403,6 @@ void AggregateModel::process(const float* rateHz, const float* energyScale, floa
         double rate = static_cast<double>(rateHz[i]);
         if (!(rate > 0)) rate = 0; // also NaN
         rate = std::min(rate, primaryCap);
-        double scale = static_cast<double>(energyScale[i]);
-        if (!(scale > 0) || !std::isfinite(scale)) scale = 0;
         // Flushes the run before the first change of the voices at this sample.
         auto flush = [&] {
             if (runStart < i) ring(out + runStart, i - runStart);
@@ -403,6 +414,12 @@ void AggregateModel::process(const float* rateHz, const float* energyScale, floa
             pendingTrigger_ = 0;
         }
         const int count = clock_.advance(rate * dt, random_, kMaxEventsPerSample);
+        // The energy scale matters only where an event starts: read (or computed) there only.
+        double scale = 0.0;
+        if (count > 0) {
+            scale = static_cast<double>(scaleAt(i));
+            if (!(scale > 0) || !std::isfinite(scale)) scale = 0;
+        }
         for (int e = 0; e < count; ++e) {
             flush();
             spawn(scale * random_.powerLaw(params_.gamma, params_.energyMin, params_.energyMax),

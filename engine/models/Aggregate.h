@@ -120,6 +120,11 @@ class AggregateModel {
     /// `energyScale[i]` multiplies the energies of events starting there (both >= 0; NaN/Inf
     /// count as 0).
     void process(const float* rateHz, const float* energyScale, float* out, int n) noexcept;
+    /// Computes what energyScale[i] would hold (called only at samples where an event starts).
+    using ScaleFn = float (*)(void* user, int i) noexcept;
+    /// As process(), with the energy scale computed only at the samples where events start
+    /// (the same samples when scaleAt(user, i) returns energyScale[i]).
+    void process(const float* rateHz, ScaleFn scaleAt, void* user, float* out, int n) noexcept;
     /// Starts one event of energy `energy` (already scaled) at the next processed sample.
     void trigger(double energy) noexcept;
 
@@ -151,6 +156,8 @@ class AggregateModel {
     }
 
   private:
+    template <typename ScaleAt>
+    void processWith(const float* rateHz, ScaleAt&& scaleAt, float* out, int n) noexcept;
     /// Runs the ringing resonators over `n` samples (n <= kRunMax) in which no voice starts or
     /// ends, adding their sum to `out`.
     using RingFn = void (*)(AggregateModel& m, float* out, int n) noexcept;

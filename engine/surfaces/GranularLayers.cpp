@@ -39,7 +39,7 @@ void GrainsLayer::prepare(const ProcessSpec& spec) {
             sampleRateHz_, std::min(control_.highpassHz, nyquistGuard), 0.7071067811865476));
     const auto block = static_cast<std::size_t>(std::max(1, spec.maxBlockSize));
     rate_.assign(block, 0.0f);
-    scale_.assign(block, 0.0f);
+    loads_.assign(block, SampleLoad{});
     buffer_.assign(block, 0.0f);
     tailLength_ = static_cast<int>(kTailSeconds * sampleRateHz_);
     heelEnd_ = static_cast<std::int64_t>(
@@ -132,32 +132,23 @@ void GrainsLayer::processChunk(const float* grf, float* out, int n) noexcept {
             rate_[u] = static_cast<float>(control_.eventsPerSecondPerKn * kn +
                                           control_.eventsPerKnRise * rise +
                                           control_.eventsPerKnFall * fall);
-            const double load = control_.loadExponent == 1.0 ? kn
-                                : control_.loadExponent == 0.0
-                                    ? 1.0
-                                    : std::pow(kn, control_.loadExponent);
-            double scale = load * (1.0 + control_.riseEnergy * rise / kDerivativeRefKnPerS);
-            if (control_.energySaturation > 0) // soft saturation: linear below, bounded above
-                scale = control_.energySaturation * std::tanh(scale / control_.energySaturation);
-            if (heelAge_ >= 0) { // heel burst: one Poisson stream, rate-weighted energy scale
+            SampleLoad& sl = loads_[u];
+            sl.contact = true;
+            sl.kn = kn;
+            sl.rise = rise;
+            sl.heel = heelAge_ >= 0;
+            if (sl.heel) { // heel burst: one Poisson stream, rate-weighted energy scale
                 const double e = heelEnvelope();
                 const double heelRate = control_.heelRateHz * e;
-                double heelScale = control_.heelEnergy * e;
-                if (control_.energySaturation > 0)
-                    heelScale = control_.energySaturation *
-                                std::tanh(heelScale / control_.energySaturation);
-                const double base = static_cast<double>(rate_[u]);
-                if (base + heelRate > 0)
-                    scale = (base * scale + heelRate * heelScale) / (base + heelRate);
-                rate_[u] = static_cast<float>(base + heelRate);
+                sl.heelE = e;
+                sl.baseRate = rate_[u];
+                rate_[u] = static_cast<float>(static_cast<double>(rate_[u]) + heelRate);
             }
-            scale_[u] = static_cast<float>(scale);
             if (onsetArmed_ && f >= control_.onsetForceN) {
                 onsetArmed_ = false;
                 if (control_.onsetEnergy > 0) {
                     // The onset event starts at this sample: run the model up to it first.
-                    model_.process(rate_.data() + modelDone, scale_.data() + modelDone,
-                                   buffer + modelDone, i - modelDone);
+                    runModel(modelDone, i, buffer);
                     modelDone = i;
                     model_.trigger(control_.onsetEnergy *
                                    std::clamp(loadRise / kDerivativeRefKnPerS, 0.1, 3.0));
@@ -165,13 +156,12 @@ void GrainsLayer::processChunk(const float* grf, float* out, int n) noexcept {
             }
         } else {
             rate_[u] = 0.0f;
-            scale_[u] = 0.0f;
+            loads_[u].contact = false;
             onsetArmed_ = true;
             contactPeakN_ = 0.0;
         }
     }
-    model_.process(rate_.data() + modelDone, scale_.data() + modelDone, buffer + modelDone,
-                   n - modelDone);
+    runModel(modelDone, n, buffer);
     // (sample by sample: the filters' tiny state is snapped on the sleep grid, not per call)
     if (useHighpass_)
         for (int i = 0; i < n; ++i)
@@ -182,6 +172,41 @@ void GrainsLayer::processChunk(const float* grf, float* out, int n) noexcept {
     const float gain = static_cast<float>(gain_);
     for (int i = 0; i < n; ++i) out[i] += gain * buffer[i];
     contactSinceGridPoint_ |= contactSeen;
+}
+
+void GrainsLayer::runModel(int from, int to, float* buffer) noexcept {
+    scaleBase_ = static_cast<std::size_t>(from);
+    model_.process(rate_.data() + from, &GrainsLayer::scaleAt, this, buffer + from, to - from);
+}
+
+float GrainsLayer::scaleAt(void* self, int i) noexcept {
+    const auto* layer = static_cast<const GrainsLayer*>(self);
+    return layer->scaleOf(layer->scaleBase_ + static_cast<std::size_t>(i));
+}
+
+// The energy scale of sample u: the load (to load_exponent) raised by the load's rise, softly
+// saturated, and during a heel burst averaged with the burst's scale, weighted by the two rates.
+float GrainsLayer::scaleOf(std::size_t u) const noexcept {
+    const SampleLoad& sl = loads_[u];
+    if (!sl.contact) return 0.0f;
+    const double kn = sl.kn;
+    const double load = control_.loadExponent == 1.0   ? kn
+                        : control_.loadExponent == 0.0 ? 1.0
+                                                       : std::pow(kn, control_.loadExponent);
+    double scale = load * (1.0 + control_.riseEnergy * sl.rise / kDerivativeRefKnPerS);
+    if (control_.energySaturation > 0) // soft saturation: linear below, bounded above
+        scale = control_.energySaturation * std::tanh(scale / control_.energySaturation);
+    if (sl.heel) {
+        const double e = sl.heelE;
+        const double heelRate = control_.heelRateHz * e;
+        double heelScale = control_.heelEnergy * e;
+        if (control_.energySaturation > 0)
+            heelScale =
+                control_.energySaturation * std::tanh(heelScale / control_.energySaturation);
+        const double base = static_cast<double>(sl.baseRate);
+        if (base + heelRate > 0) scale = (base * scale + heelRate * heelScale) / (base + heelRate);
+    }
+    return static_cast<float>(scale);
 }
 
 void GrainsLayer::sleepDecision() noexcept {

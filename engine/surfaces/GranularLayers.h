@@ -100,7 +100,19 @@ class GrainsLayer final : public SurfaceLayer {
     double gain_ = 1.0;
     Biquad lowpass_, highpass_;
     bool useLowpass_ = false, useHighpass_ = false;
-    std::vector<float> rate_, scale_, buffer_;
+    std::vector<float> rate_, buffer_;
+    // What a sample's energy scale is computed from. The scale (a pow and up to two tanh) matters
+    // only where a grain starts, so the model asks for it there (scaleAt); the same values.
+    struct SampleLoad {
+        double kn, rise, heelE; // load (kN), rise term, heel burst envelope
+        float baseRate;         // the event rate before the heel burst's
+        bool contact, heel;     // in contact; the heel burst's branch taken
+    };
+    std::vector<SampleLoad> loads_;
+    std::size_t scaleBase_ = 0; // the sample of this chunk where the model's call starts
+    float scaleOf(std::size_t u) const noexcept;
+    static float scaleAt(void* self, int i) noexcept;
+    void runModel(int from, int to, float* buffer) noexcept;
     double previousF_ = 0.0, derivative_ = 0.0;
     double contactPeakN_ = 0.0; ///< highest load of this contact so far (felicity_ratio)
     bool onsetArmed_ = true;

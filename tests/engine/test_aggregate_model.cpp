@@ -314,6 +314,45 @@ TEST(AggregateModel, RunsAndKernelsGiveTheSampleBySampleSamples) {
     }
 }
 
+// The energy scale may be computed on demand (GrainsLayer: a pow and tanh per sample otherwise):
+// the model asks for it only at samples where events start, and the samples are those of the
+// array it would otherwise read.
+TEST(AggregateModel, EnergyScaleOnDemandGivesTheArraysSamples) {
+    AggregateParameters p;
+    p.burstEvents = 1.5;
+    const int n = static_cast<int>(0.5 * kFs);
+    std::vector<float> rate(static_cast<std::size_t>(n)), scale(rate.size());
+    for (int i = 0; i < n; ++i) {
+        rate[static_cast<std::size_t>(i)] = static_cast<float>(800.0 * (1.0 + std::sin(i * 1e-3)));
+        scale[static_cast<std::size_t>(i)] =
+            static_cast<float>(0.2 + 0.8 * std::fabs(std::cos(i * 7e-4)));
+    }
+    struct Source {
+        const float* scale;
+        int offset = 0, calls = 0;
+    } source{scale.data()};
+    auto fromArray = makeModel(p), onDemand = makeModel(p);
+    std::vector<float> a(rate.size(), 0.0f), b(rate.size(), 0.0f);
+    for (int done = 0; done < n; done += 300) {
+        const int k = std::min(300, n - done);
+        fromArray.process(rate.data() + done, scale.data() + done, a.data() + done, k);
+        source.offset = done;
+        onDemand.process(
+            rate.data() + done,
+            [](void* user, int i) noexcept {
+                auto* s = static_cast<Source*>(user);
+                ++s->calls;
+                return s->scale[s->offset + i];
+            },
+            &source, b.data() + done, k);
+    }
+    EXPECT_EQ(a, b);
+    EXPECT_GT(fromArray.eventCount(), 300u);
+    EXPECT_GT(source.calls, 0);
+    // asked once per sample with a primary event, never for a burst's micro-events alone
+    EXPECT_LT(static_cast<std::uint64_t>(source.calls), fromArray.eventCount());
+}
+
 TEST(AggregateModel, SilentAtZeroRateAndVoicesEnd) {
     auto m = makeModel();
     auto out = run(m, 1.0, [](double) { return 0.0; });
