@@ -379,19 +379,30 @@ void HuntCrossleyImpactT<Real>::processSpan(const float* fext, float* out, int n
         return;
     }
     awake_ = true;
-    const int os = params_.oversampling;
+    const double peak = params_.oversampling == 1 ? spanSamples<true>(fext, out, n)
+                                                  : spanSamples<false>(fext, out, n);
+    peakSinceGridPoint_ = std::max(peakSinceGridPoint_, peak);
+}
+
+template <typename Real>
+template <bool Single>
+double HuntCrossleyImpactT<Real>::spanSamples(const float* fext, float* out, int n) noexcept {
+    // (Single: no oversampling, the shipped setting, as its own loop without the decimator)
+    const int os = Single ? 1 : params_.oversampling;
     const int sub = params_.contactSubsteps;
     double peak = 0.0;
+    const bool freeRuns = Single && freeRuns_;
     for (int i = 0; i < n; ++i) {
-        if (os == 1 && !inContact_ && lastForce_ == 0.0 && freeRuns_) { // (runFree's cheap tests)
+        if (freeRuns && !inContact_ && lastForce_ == 0.0) { // (runFree's cheap tests)
             // Right after a contact the sole is still near the floor and runFree() would find no
             // sample to run: after a failed try, the next samples step without trying.
             if (freeRetryIn_ > 0) {
                 --freeRetryIn_;
             } else {
-                const int ran = runFree(fext, i, n, out, peak);
-                if (ran > 0) {
-                    i += ran - 1;
+                const FreeRun run = runFree(fext, i, n, out);
+                if (run.samples > 0) {
+                    peak = std::max(peak, run.peak);
+                    i += run.samples - 1;
                     continue;
                 }
                 freeRetryIn_ = kFreeRetrySamples;
@@ -408,19 +419,21 @@ void HuntCrossleyImpactT<Real>::processSpan(const float* fext, float* out, int n
                      y);
             setFineRate(false);
         };
-        if (os == 1) // (the same force values as the general interpolation below gives)
+        if constexpr (Single) { // (the same force values as the general interpolation below gives)
             advance(lastExternal_, lastExternal_ + (fNext - lastExternal_));
-        for (int k = 0; k < os && os > 1; ++k) {
-            // Linear interpolation of the external force inside the sample.
-            advance(lastExternal_ + (fNext - lastExternal_) * double(k) / os,
-                    lastExternal_ + (fNext - lastExternal_) * double(k + 1) / os);
-            y = decimator_.processSample(y);
+        } else {
+            for (int k = 0; k < os; ++k) {
+                // Linear interpolation of the external force inside the sample.
+                advance(lastExternal_ + (fNext - lastExternal_) * double(k) / os,
+                        lastExternal_ + (fNext - lastExternal_) * double(k + 1) / os);
+                y = decimator_.processSample(y);
+            }
         }
         lastExternal_ = fNext;
         out[i] = static_cast<float>(y);
         peak = std::max(peak, std::fabs(y));
     }
-    peakSinceGridPoint_ = std::max(peakSinceGridPoint_, peak);
+    return peak;
 }
 
 // Free flight: between strikes the sole flies off the floor while the floor rings. A sample in
@@ -434,11 +447,11 @@ void HuntCrossleyImpactT<Real>::processSpan(const float* fext, float* out, int n
 // bit the per-sample passes). The first sample that could touch goes through step() as before.
 // So the samples, the state and the statistics are exactly those of step() sample by sample.
 template <typename Real>
-int HuntCrossleyImpactT<Real>::runFree(const float* fext, int from, int n, float* out,
-                                       double& peak) noexcept {
+typename HuntCrossleyImpactT<Real>::FreeRun
+HuntCrossleyImpactT<Real>::runFree(const float* fext, int from, int n, float* out) noexcept {
     if (inContact_ || lastForce_ != 0.0 || params_.solver == ImpactSolver::Explicit ||
         !resonator_.ringsFree() || listen_ != resonator_.outputPickup())
-        return 0;
+        return {};
     const double margin = 1.01 * resonator_.freeContactBound(); // (NaN: no run)
     const double M = params_.exciterMassKg, T = T_;
     const int most = std::min(n - from, ModalResonatorT<Real>::kFreeRunMax);
@@ -458,19 +471,20 @@ int HuntCrossleyImpactT<Real>::runFree(const float* fext, int from, int n, float
         last = fNext;
         time += T;
     }
-    if (count == 0) return 0;
+    if (count == 0) return {};
     resonator_.ringFree(count, freePosition_, freeVelocity_);
     exciterX_ = x;
     exciterV_ = v;
     lastExternal_ = last;
     time_ = time;
     contactEnergy_ = 0.0;
+    double peak = 0.0;
     for (int t = 0; t < count; ++t) {
         const double y = freeVelocity_[t];
         out[from + t] = static_cast<float>(y);
         peak = std::max(peak, std::fabs(y));
     }
-    return count;
+    return {count, peak};
 }
 
 template <typename Real>

@@ -119,9 +119,16 @@ class HuntCrossleyImpactT {
     void setFineRate(bool fine) noexcept;
     double solveForce(double ch, double dh) noexcept; // contact force at n+1
     void processSpan(const float* externalForceN, float* out, int n) noexcept;
+    template <bool Single>
+    double spanSamples(const float* externalForceN, float* out, int n) noexcept; // its peak
     // Samples [from, from + k) of a span as free flight over a ringing floor, run at once, when
-    // the sole cannot touch the floor in them (see the .cpp); returns k (0: step sample by sample).
-    int runFree(const float* externalForceN, int from, int n, float* out, double& peak) noexcept;
+    // the sole cannot touch the floor in them (see the .cpp); returns k (0: step sample by
+    // sample) and the largest |output| of the run.
+    struct FreeRun {
+        int samples = 0;
+        double peak = 0.0;
+    };
+    FreeRun runFree(const float* externalForceN, int from, int n, float* out) noexcept;
     void sleepDecision() noexcept; // at a grid point
 
     ImpactParams params_;
