@@ -43,6 +43,9 @@
 ///  - Voices: a pool allocated in prepare(); a voice frees itself when its slowest resonance has
 ///    decayed 80 dB below the loudest possible event (computed at spawn, so no per-sample test);
 ///    when the pool is full the quietest voice is replaced. process() never allocates.
+///  - Cost: the events are decided sample by sample; the resonators run over the samples between
+///    voice starts and ends, eight slots at a time with their state in registers (AVX or SSE2),
+///    adding to per-lane sums in the sample-by-sample order: the same samples for any cut.
 #include "engine/dsp/Random.h"
 
 #include <cstdint>
