@@ -472,6 +472,7 @@ HuntCrossleyImpactT<Real>::runFree(const float* fext, int from, int n, float* ou
         time += T;
     }
     if (count == 0) return {};
+    stats_.freeRunSamples += count;
     resonator_.ringFree(count, freePosition_, freeVelocity_);
     exciterX_ = x;
     exciterV_ = v;

@@ -62,6 +62,7 @@ struct ContactStats {
     long long solvedSamples = 0;    ///< samples in contact since reset
     int maxIterationsInOneSample = 0;
     long long passivityCorrections = 0; ///< samples where the energy guard removed a gain
+    long long freeRunSamples = 0;       ///< samples of free flight run at once (runFree)
 };
 
 template <typename Real>
