@@ -8,6 +8,15 @@
 /// kernel to SSE2, the x86-64 baseline: rendering once with it and once without is how the
 /// identity is checked end to end (tests/engine/simd_identical.sh).
 
+/// Marks a kernel compiled for AVX (chosen at run time; nothing on other architectures). On a
+/// member of a class template that is not itself a template, put it on the declaration too: GCC
+/// ignores it on the out-of-class definition alone.
+#if defined(__x86_64__) || defined(__i386__)
+#define UNDERFOOT_TARGET_AVX __attribute__((target("avx")))
+#else
+#define UNDERFOOT_TARGET_AVX
+#endif
+
 namespace underfoot::engine {
 
 /// True when the CPU and the OS support AVX and UNDERFOOT_SIMD does not say "sse2". Read once.

@@ -211,9 +211,7 @@ void AggregateModel::ringGeneric(AggregateModel& m, float* out, int n) noexcept 
     m.ringBody<false>(out, n);
 }
 
-#if defined(__x86_64__) || defined(__i386__)
-__attribute__((target("avx")))
-#endif
+UNDERFOOT_TARGET_AVX
 void AggregateModel::ringAvx(AggregateModel& m, float* out, int n) noexcept {
     m.ringBody<true>(out, n);
 }

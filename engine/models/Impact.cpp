@@ -235,9 +235,8 @@ bool HuntCrossleyImpactT<Real>::step(double fextNow, double fextNext, bool abort
     };
     auto trial = [&](double held, double scale) {
         const double aNow = (fextNow - held * lastForce_) / M;
-        const double xPred =
-            exciterX_ + T * exciterV_ + stepConstants_.tt * (aNow / 3.0 + aNextExt / 6.0);
-        const double vPred = exciterV_ + stepConstants_.halfT * (aNow + aNextExt);
+        double xPred, vPred;
+        soleWithoutContact(stepConstants_, T, exciterX_, exciterV_, aNow, aNextExt, xPred, vPred);
         resonator_.predict(held);
         const double ch = xPred - resonator_.predictedPosition(0);
         const double dh = vPred - resonator_.predictedVelocity(0);
@@ -391,7 +390,8 @@ double HuntCrossleyImpactT<Real>::spanSamples(const float* fext, float* out, int
     const int os = Single ? 1 : params_.oversampling;
     const int sub = params_.contactSubsteps;
     double peak = 0.0;
-    const bool freeRuns = Single && freeRuns_;
+    const bool freeRuns = Single && freeRuns_ && params_.solver != ImpactSolver::Explicit &&
+                          listen_ == resonator_.outputPickup(); // (see runFree)
     for (int i = 0; i < n; ++i) {
         if (freeRuns && !inContact_ && lastForce_ == 0.0) { // (runFree's cheap tests)
             // Right after a contact the sole is still near the floor and runFree() would find no
@@ -449,22 +449,22 @@ double HuntCrossleyImpactT<Real>::spanSamples(const float* fext, float* out, int
 template <typename Real>
 typename HuntCrossleyImpactT<Real>::FreeRun
 HuntCrossleyImpactT<Real>::runFree(const float* fext, int from, int n, float* out) noexcept {
-    if (inContact_ || lastForce_ != 0.0 || params_.solver == ImpactSolver::Explicit ||
-        !resonator_.ringsFree() || listen_ != resonator_.outputPickup())
-        return {};
+    // (the caller checked no contact, no force held, a single rate, an implicit solver and the
+    // output pickup)
+    if (!resonator_.ringsFree()) return {};
     const double margin = 1.01 * resonator_.freeContactBound(); // (NaN: no run)
-    const double M = params_.exciterMassKg, T = T_;
     const int most = std::min(n - from, ModalResonatorT<Real>::kFreeRunMax);
+    const double M = params_.exciterMassKg, T = T_, held = lastForce_;
+    const StepConstants constants = stepConstants_;
     double x = exciterX_, v = exciterV_, last = lastExternal_, time = time_;
     int count = 0;
     for (; count < most; ++count) {
-        // As processSpan's advance() and step()'s trial(1, 1) for this sample.
+        // As spanSamples' advance() and step()'s trial(1, 1) for this sample.
         const double fNext = fext ? double(fext[from + count]) : 0.0;
-        const double f0 = last, f1 = last + (fNext - last);
-        const double aNextExt = f1 / M;
-        const double aNow = (f0 - 1.0 * lastForce_) / M;
-        const double xPred = x + T * v + stepConstants_.tt * (aNow / 3.0 + aNextExt / 6.0);
-        const double vPred = v + stepConstants_.halfT * (aNow + aNextExt);
+        const double f1 = last + (fNext - last);
+        const double aNow = (last - 1.0 * held) / M;
+        double xPred, vPred;
+        soleWithoutContact(constants, T, x, v, aNow, f1 / M, xPred, vPred);
         if (!(xPred < -margin)) break;
         x = xPred;
         v = vPred;

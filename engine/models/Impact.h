@@ -150,6 +150,16 @@ class HuntCrossleyImpactT {
         double tt, xPerForce, vPerForce, halfT; // T^2, T^2 / 6M, T / 2M, T / 2
     };
     StepConstants stepConstants_{}, coarseConstants_{}, fineConstants_{};
+    // The sole's position and velocity at n+1 from (x, v) under the accelerations aNow at n and
+    // aNext at n+1 (linear in between), with no new contact force: step()'s trials and
+    // runFree's flight, the same operations. (Written through references: returned as a pair,
+    // GCC packed the two into one vector and shuffled them every sample.)
+    static void soleWithoutContact(const StepConstants& c, double T, double x, double v,
+                                   double aNow, double aNext, double& xNext,
+                                   double& vNext) noexcept {
+        xNext = x + T * v + c.tt * (aNow / 3.0 + aNext / 6.0);
+        vNext = v + c.halfT * (aNow + aNext);
+    }
     double stiffness_ = 0, dissipation_ = 0;
     enum class Shape { Linear, Hertz, Square, General };
     Shape shape_ = Shape::Hertz;

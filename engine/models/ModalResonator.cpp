@@ -446,10 +446,7 @@ void ModalResonatorT<Real>::passGeneric(ModalResonatorT& r, Real h) noexcept {
 
 template <typename Real>
 template <bool Energy, bool Fused, bool Held, bool Free>
-#if defined(__x86_64__) || defined(__i386__)
-__attribute__((target("avx")))
-#endif
-void ModalResonatorT<Real>::passAvx(ModalResonatorT& r, Real h) noexcept {
+UNDERFOOT_TARGET_AVX void ModalResonatorT<Real>::passAvx(ModalResonatorT& r, Real h) noexcept {
     r.passBody<true, Energy, Fused, Held, Free>(h);
 }
 
@@ -468,7 +465,8 @@ template <bool Wide>
     const std::size_t quads = q_.size() / 4;
     const QuadCoefficients* c = bank().quads.data();
     const QuadGains* gg = quadGains_.data();
-    Real *q = q_.data(), *v = v_.data();
+    const Real *q = q_.data(), *v = v_.data();
+    Real *qh = qh_.data(), *vh = vh_.data();
     double* sums = runSums_.data();
     D v0{};
     for (std::size_t k = 0; k < quads; ++k) {
@@ -502,9 +500,9 @@ template <bool Wide>
             store4(s, sx);
             store4(s + 4, so);
         }
-        v0 += g0 * yd; // the last sample's contact velocity
-        store4(q + i, qi);
-        store4(v + i, vi);
+        v0 += g0 * yd;      // the last sample's contact velocity
+        store4(qh + i, qi); // the last sample's prediction
+        store4(vh + i, vi);
     }
     const double* s = sums;
     for (int t = 0; t < n; ++t, s += 8) {
@@ -515,14 +513,13 @@ template <bool Wide>
         x0Out[t] = x0h[0] + x0h[1];
         voOut[t] = voh[0] + voh[1];
     }
-    // As commitWithoutForce() after the last sample's predict().
+    // The last sample's predict() (its prediction is in qh, vh), then its commit(p, 0).
     const D2 v0h = halves(v0);
-    predictedX0_ = x0_ = x0Out[n - 1];
-    predictedV0_ = v0_ = v0h[0] + v0h[1];
-    predictedVo_ = outputVelocity_ = voOut[n - 1];
-    energyValid_ = false;
-    committedEnergy_ = predictedEnergy_;
+    predictedX0_ = x0Out[n - 1];
+    predictedV0_ = v0h[0] + v0h[1];
+    predictedVo_ = voOut[n - 1];
     predictedEnergyValid_ = false;
+    commitWithoutForce();
 }
 
 template <typename Real>
@@ -532,10 +529,8 @@ void ModalResonatorT<Real>::ringGeneric(ModalResonatorT& r, int n, double* x0,
 }
 
 template <typename Real>
-#if defined(__x86_64__) || defined(__i386__)
-__attribute__((target("avx")))
-#endif
-void ModalResonatorT<Real>::ringAvx(ModalResonatorT& r, int n, double* x0, double* vo) noexcept {
+UNDERFOOT_TARGET_AVX void ModalResonatorT<Real>::ringAvx(ModalResonatorT& r, int n, double* x0,
+                                                         double* vo) noexcept {
     r.ringBody<true>(n, x0, vo);
 }
 

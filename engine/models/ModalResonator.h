@@ -21,6 +21,7 @@
 /// exact response, so the contact still "sees" their stiffness. They do not radiate. Their count
 /// is reported by quasiStaticModeCount(); oversampling brings them back as ringing modes.
 #include "engine/dsp/ProcessSpec.h"
+#include "engine/dsp/Simd.h"
 
 #include <cstddef>
 #include <span>
@@ -232,12 +233,9 @@ class ModalResonatorT {
     // Free ringing over a run (ringFree), in the same two kernels.
     using RingFn = void (*)(ModalResonatorT&, int, double*, double*) noexcept;
     static void ringGeneric(ModalResonatorT& r, int n, double* x0, double* vo) noexcept;
-#if defined(__x86_64__) || defined(__i386__)
-    // (the target is declared here too: GCC ignores it on the out-of-class definition of a
-    // class template's member that is not itself a template)
-    __attribute__((target("avx")))
-#endif
-    static void ringAvx(ModalResonatorT& r, int n, double* x0, double* vo) noexcept;
+    // (the target on the declaration too: see UNDERFOOT_TARGET_AVX)
+    UNDERFOOT_TARGET_AVX static void ringAvx(ModalResonatorT& r, int n, double* x0,
+                                             double* vo) noexcept;
     template <bool Wide>
     void ringBody(int n, double* x0, double* vo) noexcept;
     RingFn ring_ = &ringGeneric;
