@@ -79,4 +79,22 @@ inline std::string writeInput(const std::string& name, const std::uint8_t* data,
     return path;
 }
 
+/// Copies a file through the stream buffers, which retry a read or write a signal interrupts.
+/// libFuzzer's -timeout watchdog raises SIGALRM every timeout/2 + 1 s with a handler installed
+/// without SA_RESTART; std::filesystem::copy_file (sendfile) then fails with "Interrupted system
+/// call" now and then (a CI run's fuzz_web_request failed so, 28 Nov 2026). Stops the run with
+/// a finding that names the files when the copy really fails.
+inline void copyFile(const std::string& from, const std::string& to) {
+    std::ifstream in(from, std::ios::binary);
+    if (!in) fail("cannot open " + from + " to copy it");
+    std::ofstream out(to, std::ios::binary | std::ios::trunc);
+    if (!out) fail("cannot create " + to);
+    if (in.peek() != std::ifstream::traits_type::eof()) out << in.rdbuf();
+    out.close();
+    if (in.bad() || !out) fail("cannot copy " + from + " to " + to);
+    std::error_code ec;
+    if (std::filesystem::file_size(from, ec) != std::filesystem::file_size(to, ec) || ec)
+        fail("the copy of " + from + " at " + to + " differs in size");
+}
+
 } // namespace underfoot::fuzz

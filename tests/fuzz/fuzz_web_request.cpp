@@ -180,8 +180,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const Template& t = templ();
     std::error_code ec;
     for (const char* suffix : {"", "-wal", "-shm"}) fs::remove(t.work + suffix, ec);
-    fs::copy_file(t.study, t.work, ec);
-    if (ec) fuzz::fail("cannot copy the template study: " + ec.message());
+    fuzz::copyFile(t.study, t.work);
     web::WebOptions wo;
     wo.clipsDir = t.clips;
     web::ServerOptions so;
