@@ -99,8 +99,9 @@ void ElastoPlasticFrictionT<Real>::configure(const FrictionParams& p, std::vecto
         throw std::invalid_argument("friction: break-away fraction must lie in (0, 1)");
     if (p.maxIterations < 1 || p.maxIterations > 1000)
         throw std::invalid_argument("friction: maxIterations must lie in [1, 1000]");
-    if (!nonNegative(p.tolerance))
-        throw std::invalid_argument("friction: tolerance must be finite and >= 0");
+    if (!nonNegative(p.tolerance) || !nonNegative(p.newtonStepTolerance))
+        throw std::invalid_argument(
+            "friction: tolerance and newtonStepTolerance must be finite and >= 0");
     params_ = p;
     resonator_.configure(std::move(modes), std::move(gains));
     chooseKernel();
@@ -256,7 +257,7 @@ ElastoPlasticFrictionT<Real>::solveNewton(const SolveInput& in, double vRelPred,
     // for large p (P(psi(p)) stays bounded as psi(p) tends to z1 = 0), so a root lies in
     // [lo, hi]; Newton steps with g' = grad P . psi'(p) - 1 stay inside the bracket or are
     // replaced by a bisection (or, before an upper end is known, by the plain pass p <- P).
-    const double T = T_, tol = params_.tolerance;
+    const double T = T_, tol = params_.tolerance, stepTol = params_.newtonStepTolerance;
     const double vScale = params_.stribeckVelocity, zScale = T * params_.stribeckVelocity;
     // Warm start: the last three samples' p extrapolated by a parabola (p varies smoothly while
     // slipping; 0 while sticking). On the creak it leaves 1.99 evaluations a sample against 2.06
@@ -302,8 +303,13 @@ ElastoPlasticFrictionT<Real>::solveNewton(const SolveInput& in, double vRelPred,
         // most tol relative to max(|v|, v_s) and max(|z|, T v_s): the plain passes' criterion
         // (a pass that moves by at most tol leaves an error of about theta / (1 - theta) tol,
         // theta up to ~0.5 there).
-        if (factor * std::fabs(x.v - vb) <= tol * std::max(std::fabs(x.v), vScale) &&
-            factor * std::fabs(x.z - zb) <= tol * std::max(std::fabs(x.z), zScale)) {
+        // Or, with newtonStepTolerance, when the step itself was at most stepTol: Newton's error
+        // after it is of the order of its square (see FrictionParams).
+        const double moveV = std::fabs(x.v - vb), moveZ = std::fabs(x.z - zb);
+        const double scaleV = std::max(std::fabs(x.v), vScale),
+                     scaleZ = std::max(std::fabs(x.z), zScale);
+        if ((factor * moveV <= tol * scaleV && factor * moveZ <= tol * scaleZ) ||
+            (moveV <= stepTol * scaleV && moveZ <= stepTol * scaleZ)) {
             converged = true;
             break;
         }

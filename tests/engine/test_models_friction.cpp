@@ -8,13 +8,25 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <string>
 #include <vector>
 
 using namespace underfoot::engine;
 
 namespace {
-ElastoPlasticFriction makeFriction(double sigma0, double fs, double sigma1 = -1.0) {
+// The plain-pass residual the shipped Newton stop (newtonStepTolerance 1e-3) may leave in a
+// sample: Newton's error after a step is of the order of the step squared, times a factor that
+// grows with the bristle stiffness. Measured: 3.0e-7 on the creak (sigma0 2e5); in the
+// stiffness sweep of StaysFiniteAndBoundedForBristleStiffnessUpTo1e8 at most 7.1e-8 up to
+// sigma0 1e5, 4.6e-6 at 1e7, 5.7e-5 at 1e8 (22.05 kHz).
+constexpr double kCreakResidual = 1e-6;
+constexpr double kSweepResidual = 1e-4;
+
+ElastoPlasticFriction
+makeFriction(double sigma0, double fs, double sigma1 = -1.0,
+             double newtonStepTolerance = FrictionParams{}.newtonStepTolerance) {
     FrictionParams p;
+    p.newtonStepTolerance = newtonStepTolerance;
     p.sigma0 = sigma0;
     // Critical-ish bristle damping for the rubbing mass: sigma1 ~ 2 sqrt(sigma0 m).
     p.sigma1 = sigma1 >= 0 ? sigma1 : 2.0 * std::sqrt(sigma0 * p.exciterMassKg);
@@ -44,33 +56,43 @@ TEST(ElastoPlasticFriction, SticksBelowTheBreakAwayForceAndSlidesAboveIt) {
 TEST(ElastoPlasticFriction, StaysFiniteAndBoundedForBristleStiffnessUpTo1e8) {
     // The Sound Design Toolkit's forward Euler blows up above sigma0 ~ 5e7; backward Euler does
     // not.
-    for (const double fs : {22050.0, 48000.0, 192000.0}) {
-        for (const double sigma0 : {1e3, 1e5, 1e7, 5e7, 1e8}) {
-            auto f = makeFriction(sigma0, fs);
-            f.setResidualTracking(true);
-            double maxForce = 0, maxElastic = 0, worstResidual = 0;
-            for (int i = 0; i < static_cast<int>(fs); ++i) {
-                // Alternating push: stick, slip, reversal.
-                const double t = i / fs;
-                const double drive = 70.0 * std::sin(kTwoPi * 3.0 * t);
-                const double y = f.processSample(100.0, drive);
-                ASSERT_TRUE(std::isfinite(y)) << sigma0 << " " << fs;
-                maxForce = std::max(maxForce, std::fabs(f.frictionForce()));
-                maxElastic = std::max(maxElastic, std::fabs(sigma0 * f.bristle()));
-                worstResidual = std::max(worstResidual, f.lastSolveResidual());
+    // Both stopping rules: the shipped one (the step of Newton, 1e-3) and the tight one (0: the
+    // plain passes' criterion only, tolerance 1e-12).
+    for (const double stepTol : {FrictionParams{}.newtonStepTolerance, 0.0})
+        for (const double fs : {22050.0, 48000.0, 192000.0}) {
+            for (const double sigma0 : {1e3, 1e5, 1e7, 5e7, 1e8}) {
+                auto f = makeFriction(sigma0, fs, -1.0, stepTol);
+                f.setResidualTracking(true);
+                double maxForce = 0, maxElastic = 0, worstResidual = 0;
+                for (int i = 0; i < static_cast<int>(fs); ++i) {
+                    // Alternating push: stick, slip, reversal.
+                    const double t = i / fs;
+                    const double drive = 70.0 * std::sin(kTwoPi * 3.0 * t);
+                    const double y = f.processSample(100.0, drive);
+                    ASSERT_TRUE(std::isfinite(y)) << sigma0 << " " << fs;
+                    maxForce = std::max(maxForce, std::fabs(f.frictionForce()));
+                    maxElastic = std::max(maxElastic, std::fabs(sigma0 * f.bristle()));
+                    worstResidual = std::max(worstResidual, f.lastSolveResidual());
+                }
+                // perf5: the Newton solve converges here too, every sample (tight: measured
+                // <= 1.5e-15, at most 6 evaluations in a sample, none at the cap).
+                const std::string where = "sigma0=" + std::to_string(sigma0) +
+                                          " fs=" + std::to_string(fs) +
+                                          " step tolerance=" + std::to_string(stepTol);
+                std::printf("%s: worst residual %.3g, %.3f evaluations/sample\n", where.c_str(),
+                            worstResidual,
+                            double(f.solveStats().passes) / double(f.solveStats().samples));
+                EXPECT_EQ(f.solveStats().capHits, 0u) << where;
+                EXPECT_LE(worstResidual,
+                          stepTol > 0.0 ? kSweepResidual : FrictionParams{}.tolerance)
+                    << where;
+                // The elastic bristle force never exceeds the static friction level f_s = 60 N (the
+                // model's defining property), and the total force (with the bristle damping
+                // sigma1 z', large for stiff bristles) stays of the order of the forces applied.
+                EXPECT_LT(maxElastic, 60.0 * 1.01) << "sigma0=" << sigma0 << " fs=" << fs;
+                EXPECT_LT(maxForce, 300.0) << "sigma0=" << sigma0 << " fs=" << fs;
             }
-            // perf5: the Newton solve converges here too, every sample (measured: <= 1.5e-15,
-            // at most 6 evaluations in a sample, none at the cap).
-            EXPECT_EQ(f.solveStats().capHits, 0u) << "sigma0=" << sigma0 << " fs=" << fs;
-            EXPECT_LE(worstResidual, FrictionParams{}.tolerance)
-                << "sigma0=" << sigma0 << " fs=" << fs;
-            // The elastic bristle force never exceeds the static friction level f_s = 60 N (the
-            // model's defining property), and the total force (with the bristle damping
-            // sigma1 z', large for stiff bristles) stays of the order of the forces applied.
-            EXPECT_LT(maxElastic, 60.0 * 1.01) << "sigma0=" << sigma0 << " fs=" << fs;
-            EXPECT_LT(maxForce, 300.0) << "sigma0=" << sigma0 << " fs=" << fs;
         }
-    }
 }
 
 TEST(ElastoPlasticFriction, NoLoadMeansNoFrictionAndRelaxedBristles) {
@@ -138,6 +160,7 @@ struct SolveOptions {
     bool extrapolate = true;
     int maxIterations = FrictionParams{}.maxIterations;
     double tolerance = FrictionParams{}.tolerance;
+    double newtonStepTolerance = FrictionParams{}.newtonStepTolerance;
 };
 // The bench's creaking-wood scenario (engine/render/AccuracyCost.cpp, friction-creak).
 CreakRender renderCreak(const SolveOptions& o, double seconds) {
@@ -148,6 +171,7 @@ CreakRender renderCreak(const SolveOptions& o, double seconds) {
     p.extrapolate = o.extrapolate;
     p.maxIterations = o.maxIterations;
     p.tolerance = o.tolerance;
+    p.newtonStepTolerance = o.newtonStepTolerance;
     ElastoPlasticFriction f;
     configureCreakScenario(f, p); // the bench's friction-creak scenario, 48 kHz, seed 7
     f.setResidualTracking(true);
@@ -186,31 +210,43 @@ TEST(ElastoPlasticFriction, PolynomialFunctionsKeepTheCreakSpectrumLevelAndEvent
     EXPECT_LE(std::fabs(fast.slips - ref.slips), 0.05 * ref.slips);
 }
 
-// perf5 (issue #18): the shipped solve is Newton on the plastic rate (see Friction.cpp). Its
-// output must meet the fixed-point passes' own criterion: one plain pass from the returned
-// solution moves v and z by at most the tolerance (relative), on every sample of the creak, with
-// no sample at the cap, in about two evaluations of the Stribeck / raised-sine functions a
-// sample (measured: 1.99 on 5 s, 2.06 with the linear warm start; the Aitken passes took 6.25).
+// perf5 (issue #18): the solve is Newton on the plastic rate (see Friction.cpp). With the tight
+// stop (newtonStepTolerance 0) its output meets the fixed-point passes' own criterion: one plain
+// pass from the returned solution moves v and z by at most the tolerance (relative), on every
+// sample of the creak, with no sample at the cap, in about two evaluations of the Stribeck /
+// raised-sine functions a sample (measured: 1.99 on 5 s, 2.06 with the linear warm start; the
+// Aitken passes took 6.25). The shipped stop (a Newton step of at most 1e-3) returns after one
+// evaluation on most samples (measured 1.08 a sample) with a residual of at most 3e-7.
 TEST(ElastoPlasticFriction, NewtonSolutionMeetsThePlainPassCriterionOnEverySample) {
-    const CreakRender r = renderCreak(SolveOptions{}, 2.0);
+    SolveOptions tight;
+    tight.newtonStepTolerance = 0.0;
+    const CreakRender r = renderCreak(tight, 2.0), shipped = renderCreak(SolveOptions{}, 2.0);
     const double perSample = double(r.stats.passes) / double(r.stats.samples);
-    std::printf("Newton, creak 2 s: worst plain-pass residual %.3g (tolerance 1e-12), %.3f "
-                "evaluations/sample, max %d, cap hits %llu\n",
+    const double shippedPerSample = double(shipped.stats.passes) / double(shipped.stats.samples);
+    std::printf("Newton, creak 2 s, tight stop: worst plain-pass residual %.3g (tolerance 1e-12), "
+                "%.3f evaluations/sample, max %d, cap hits %llu; shipped stop: residual %.3g, "
+                "%.3f evaluations/sample, max %d\n",
                 r.worstResidual, perSample, r.stats.maxPassesInOneSample,
-                static_cast<unsigned long long>(r.stats.capHits));
+                static_cast<unsigned long long>(r.stats.capHits), shipped.worstResidual,
+                shippedPerSample, shipped.stats.maxPassesInOneSample);
     ASSERT_GT(r.slips, 400);
     EXPECT_LE(r.worstResidual, FrictionParams{}.tolerance);
     EXPECT_GT(r.worstResidual, 0.0); // (the residual is measured, not a constant)
     EXPECT_EQ(r.stats.capHits, 0u);
     EXPECT_LE(perSample, 2.5);
+    EXPECT_LE(shipped.worstResidual, kCreakResidual);
+    EXPECT_GT(shipped.worstResidual, r.worstResidual); // (it does stop earlier)
+    EXPECT_EQ(shipped.stats.capHits, 0u);
+    EXPECT_LE(shippedPerSample, 1.2);
 }
 
 // Newton and the fixed-point passes solve the same equations to the same tolerance: before stick-
 // slip amplifies their last-bit differences, the two renders agree sample by sample.
 TEST(ElastoPlasticFriction, NewtonAgreesWithTheFixedPointPassesSampleBySample) {
-    SolveOptions passes;
+    SolveOptions passes, tight;
     passes.newton = false;
-    const CreakRender a = renderCreak(SolveOptions{}, 0.05), b = renderCreak(passes, 0.05);
+    tight.newtonStepTolerance = 0.0; // the same criterion as the passes
+    const CreakRender a = renderCreak(tight, 0.05), b = renderCreak(passes, 0.05);
     double peak = 0.0, worst = 0.0;
     for (std::size_t i = 0; i < a.out.size(); ++i) {
         peak = std::max(peak, double(std::fabs(b.out[i])));
@@ -225,10 +261,9 @@ TEST(ElastoPlasticFriction, NewtonAgreesWithTheFixedPointPassesSampleBySample) {
 // friction5 (issue #18): the shipped solve must be the solution of its equations, not an
 // artefact of an iteration cap. Reference: the same equations solved with libm and 50 passes
 // started from the prediction without friction, no extrapolation (the colleague's converged
-// reference), stopping only when a pass changes nothing. The shipped solver (warm start, Aitken,
-// tolerance 1e-12, cap 16) must give the same creak: third-octave spectrum and level within 0.5 dB,
-// slip onsets within 2
-// %.
+// reference), stopping only when a pass changes nothing. The shipped solver (Newton, warm start,
+// stopping after a step of at most 1e-3, cap 16) must give the same creak: third-octave spectrum
+// and level within 0.1 dB, slip onsets within 2 %.
 TEST(ElastoPlasticFriction, ShippedSolveEqualsTheFiftyPassReferenceOnTheCreak) {
     SolveOptions reference;
     reference.newton = false; // the plain fixed-point passes
@@ -250,8 +285,10 @@ TEST(ElastoPlasticFriction, ShippedSolveEqualsTheFiftyPassReferenceOnTheCreak) {
                 distance, perSample, shipped.stats.maxPassesInOneSample,
                 static_cast<unsigned long long>(shipped.stats.capHits),
                 static_cast<unsigned long long>(shipped.stats.samples));
-    EXPECT_LE(distance, 0.5);
-    EXPECT_LE(std::fabs(shipped.rmsDb - ref.rmsDb), 0.5);
+    // The reference's accuracy at the default cost (issue #18): within 0.1 dB, as the default
+    // impact (measured with the shipped Newton stop: 0.001 dB, the same slips).
+    EXPECT_LE(distance, 0.1);
+    EXPECT_LE(std::fabs(shipped.rmsDb - ref.rmsDb), 0.1);
     EXPECT_LE(std::fabs(shipped.slips - ref.slips), 0.02 * ref.slips);
     // Converged: the cap is an exception, not the rule (measured: 0.14 % of the samples, 1 s).
     EXPECT_LE(shipped.stats.capHits, shipped.stats.samples / 200);
