@@ -253,7 +253,8 @@ int runBench(const BenchArgs& a) {
         fmt::print("\n");
     }
     if (a.only == "all" || a.only == "knobs") {
-        fmt::print("### Modes and event cap: spectral distance to the most accurate setting, cost "
+        fmt::print("### Modes, event cap and the friction solve's Newton stop: spectral distance "
+                   "to the most accurate setting (the friction: to its 50-pass reference), cost "
                    "(one voice)\n\n");
         fmt::print("| knob | setting | spectral distance | ns/sample |\n|---|---:|---:|---:|\n");
         for (const auto& k : eng::measureKnobs(a.seconds))

@@ -14,6 +14,8 @@
 #include <functional>
 #include <memory>
 #include <stdexcept>
+#include <string>
+#include <utility>
 
 namespace underfoot::engine {
 namespace {
@@ -235,6 +237,53 @@ std::vector<KnobMeasurement> measureKnobs(double seconds) {
             out.push_back({"event cap (gravel, events/s per layer)", std::to_string(cap),
                            spectralDistanceDb(left(r), left(ref), kRate),
                            1e9 * r.cpuSeconds / double(r.audio.frames())});
+        }
+    }
+    // The friction solve's Newton stop on the bench's creak (friction-creak), against the
+    // converged reference: the fixed-point passes with libm, started without a warm start and
+    // run until a pass changes nothing (at most 50).
+    {
+        const int blocks = std::max(1, static_cast<int>(seconds * kRate / kCostBlock));
+        auto renderCreak = [blocks](const FrictionParams& p, double* nsPerSample) {
+            std::vector<float> audio(static_cast<std::size_t>(blocks) * kCostBlock, 0.0f);
+            const BlockTimes t = timeBlocks(blocks, 3, [&] { // (per-block minimum of 3 runs)
+                auto f = std::make_shared<ElastoPlasticFriction>();
+                configureCreakScenario(*f, p);
+                auto anchor = std::make_shared<double>(0.0);
+                TimedRun timed;
+                timed.block = [f, anchor, &audio](int b) {
+                    float* y = audio.data() + static_cast<std::size_t>(b) * kCostBlock;
+                    for (int i = 0; i < kCostBlock; ++i) {
+                        *anchor += 0.05 / kRate;
+                        y[i] = static_cast<float>(f->processSample(105.0, 0.0, *anchor, 0.05));
+                    }
+                    f->resonator().flushTinyState();
+                };
+                return timed;
+            });
+            if (nsPerSample) *nsPerSample = t.nsPerSample;
+            return audio;
+        };
+        FrictionParams reference;
+        reference.newton = false;
+        reference.libmFunctions = true;
+        reference.warmStart = false;
+        reference.extrapolate = false;
+        reference.maxIterations = 50;
+        reference.tolerance = 0.0;
+        const std::vector<float> ref = renderCreak(reference, nullptr);
+        const double shipped = FrictionParams{}.newtonStepTolerance;
+        const std::pair<double, const char*> settings[] = {
+            {0.0, "0 (tight)"}, {1e-4, "1e-4"}, {1e-3, "1e-3"}, {1e-2, "1e-2"}};
+        for (const auto& [stepTol, name] : settings) {
+            FrictionParams p;
+            p.newtonStepTolerance = stepTol;
+            double ns = 0.0;
+            const std::vector<float> y = renderCreak(p, &ns);
+            std::string setting = name;
+            if (stepTol == shipped) setting += " (default)";
+            out.push_back({"friction Newton stop (creak, newtonStepTolerance; vs 50 passes)",
+                           setting, spectralDistanceDb(y, ref, kRate), ns});
         }
     }
     return out;

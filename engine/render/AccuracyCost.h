@@ -42,7 +42,7 @@ struct ImpactMeasurement {
 
 struct KnobMeasurement {
     std::string knob, setting;
-    double spectralDistanceDb = 0; ///< against the knob's most accurate setting
+    double spectralDistanceDb = 0; ///< against the knob's most accurate setting (or reference)
     double nsPerSample = 0;
 };
 
@@ -59,7 +59,9 @@ ImpactMeasurement measureImpact(const ImpactSetting& setting, double strikesSeco
 double spectralDistanceDb(const std::vector<float>& a, const std::vector<float>& reference,
                           double sampleRateHz);
 
-/// Mode-count and event-cap knobs on bundled surfaces.
+/// Mode-count and event-cap knobs on bundled surfaces, and the friction solve's Newton stop
+/// (FrictionParams::newtonStepTolerance) on the friction-creak scenario against the converged
+/// 50-pass reference.
 std::vector<KnobMeasurement> measureKnobs(double seconds = 4.0);
 
 /// The six model scenarios of issue #18, each the model alone at 48 kHz in 64-sample blocks
