@@ -260,8 +260,10 @@ ElastoPlasticFrictionT<Real>::solveNewton(const SolveInput& in, double vRelPred,
     const double T = T_, tol = params_.tolerance, stepTol = params_.newtonStepTolerance;
     const double vScale = params_.stribeckVelocity, zScale = T * params_.stribeckVelocity;
     // Warm start: the last three samples' p extrapolated by a parabola (p varies smoothly while
-    // slipping; 0 while sticking). On the creak it leaves 1.99 evaluations a sample against 2.06
-    // from the last two samples' line.
+    // slipping; 0 while sticking). On the creak, with the tight stop (newtonStepTolerance 0), it
+    // leaves 1.99 evaluations a sample against 2.06 from the last two samples' line. The first
+    // step moves v and z (relative) by at most 1e-3 on ~92 % of the samples and by at most 1e-4
+    // on ~52 % (the shipped stop at 1e-3 takes 1.08 evaluations a sample, at 1e-4 1.48).
     double pk = params_.warmStart ? std::max(0.0, 3.0 * (p_ - pPrev_) + pPrev2_)
                                   : plasticRate<Libm>(in, vRelPred, in.z0).p;
     // lo: the largest trial with g > 0 (-1 before one: g(0) >= 0 anyway); hi: the smallest
