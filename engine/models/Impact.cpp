@@ -473,7 +473,7 @@ HuntCrossleyImpactT<Real>::runFree(const float* fext, int from, int n, float* ou
     }
     if (count == 0) return {};
     stats_.freeRunSamples += count;
-    resonator_.ringFree(count, freePosition_, freeVelocity_);
+    resonator_.ringFree(count, freeVelocity_);
     exciterX_ = x;
     exciterV_ = v;
     lastExternal_ = last;

@@ -176,8 +176,7 @@ class HuntCrossleyImpactT {
     bool freeRuns_ = true;
     static constexpr int kFreeRetrySamples = 8; // samples stepped after a failed runFree()
     int freeRetryIn_ = 0;
-    double freePosition_[ModalResonatorT<Real>::kFreeRunMax]; // runFree's scratch
-    double freeVelocity_[ModalResonatorT<Real>::kFreeRunMax];
+    double freeVelocity_[ModalResonatorT<Real>::kFreeRunMax]; // runFree's scratch
 };
 
 using HuntCrossleyImpact = HuntCrossleyImpactT<double>;

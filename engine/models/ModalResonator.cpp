@@ -320,7 +320,7 @@ void ModalResonatorT<Real>::prepare(double sampleRateHz, int fineSubsteps) {
         }
     }
     setOutputPickup(std::min(outputPickup_, static_cast<int>(np) - 1)); // fills the banks
-    runSums_.assign(static_cast<std::size_t>(8 * kFreeRunMax), 0.0);
+    runSums_.assign(static_cast<std::size_t>(4 * kFreeRunMax), 0.0);
     q_.assign(n2, Real(0));
     v_.assign(n2, Real(0));
     qh_.assign(n2, Real(0));
@@ -451,15 +451,15 @@ UNDERFOOT_TARGET_AVX void ModalResonatorT<Real>::passAvx(ModalResonatorT& r, Rea
 }
 
 // Free ringing over a run of n samples, quad by quad: each quad's state stays in registers over
-// the run, and its contributions to the pickup sums are added to per-sample lane sums in
+// the run, and its contributions to the output pickup's sum are added to per-sample lane sums in
 // runSums_, quads in order, starting from zero: per lane the additions of the free pass
 // (passBody<..., Free>) in its order, and the lanes are added as it adds them, (lane 0 + lane 2)
-// + (lane 1 + lane 3). So every sample's sums, and the state after the run, are those of n
-// predict() / commit(p, 0) pairs, bit for bit.
+// + (lane 1 + lane 3). The contact pickup's sums are needed only for the last sample (its
+// prediction), and are added quad by quad as the free pass adds them. So every sample's output,
+// and the state after the run, are those of n predict() / commit(p, 0) pairs, bit for bit.
 template <typename Real>
 template <bool Wide>
-[[gnu::always_inline]] inline void ModalResonatorT<Real>::ringBody(int n, double* x0Out,
-                                                                   double* voOut) noexcept {
+[[gnu::always_inline]] inline void ModalResonatorT<Real>::ringBody(int n, double* voOut) noexcept {
     using V = typename Lanes<Real, Wide>::R;
     using D = typename Lanes<Real, Wide>::D;
     const std::size_t quads = q_.size() / 4;
@@ -468,7 +468,7 @@ template <bool Wide>
     const Real *q = q_.data(), *v = v_.data();
     Real *qh = qh_.data(), *vh = vh_.data();
     double* sums = runSums_.data();
-    D v0{};
+    D x0{}, v0{};
     for (std::size_t k = 0; k < quads; ++k) {
         const std::size_t i = 4 * k;
         const QuadCoefficients& ck = c[k];
@@ -483,55 +483,49 @@ template <bool Wide>
         load4(g0, gg[k].g0);
         load4(go, gg[k].go);
         double* s = sums;
-        for (int t = 0; t < n; ++t, s += 8) {
+        for (int t = 0; t < n; ++t, s += 4) {
             const V x = a00 * qi + a01 * vi;
             const V y = a10 * qi + a11 * vi;
             qi = x;
             vi = y;
-            D xd, sx{}, so{};
-            toDouble(xd, x);
+            D so{};
             toDouble(yd, y);
-            if (k > 0) {
-                load4(sx, s);
-                load4(so, s + 4);
-            }
-            sx += g0 * xd;
+            if (k > 0) load4(so, s);
             so += go * yd;
-            store4(s, sx);
-            store4(s + 4, so);
+            store4(s, so);
         }
-        v0 += g0 * yd;      // the last sample's contact velocity
+        D xd;
+        toDouble(xd, qi);
+        x0 += g0 * xd;      // the last sample's contact position
+        v0 += g0 * yd;      // and velocity
         store4(qh + i, qi); // the last sample's prediction
         store4(vh + i, vi);
     }
     const double* s = sums;
-    for (int t = 0; t < n; ++t, s += 8) {
-        D sx, so;
-        load4(sx, s);
-        load4(so, s + 4);
-        const D2 x0h = halves(sx), voh = halves(so);
-        x0Out[t] = x0h[0] + x0h[1];
+    for (int t = 0; t < n; ++t, s += 4) {
+        D so;
+        load4(so, s);
+        const D2 voh = halves(so);
         voOut[t] = voh[0] + voh[1];
     }
     // The last sample's predict() (its prediction is in qh, vh), then its commit(p, 0).
-    const D2 v0h = halves(v0);
-    predictedX0_ = x0Out[n - 1];
-    predictedV0_ = v0h[0] + v0h[1];
+    const D2 a = pairSum(halves(x0), halves(v0));
+    predictedX0_ = a[0];
+    predictedV0_ = a[1];
     predictedVo_ = voOut[n - 1];
     predictedEnergyValid_ = false;
     commitWithoutForce();
 }
 
 template <typename Real>
-void ModalResonatorT<Real>::ringGeneric(ModalResonatorT& r, int n, double* x0,
-                                        double* vo) noexcept {
-    r.ringBody<false>(n, x0, vo);
+void ModalResonatorT<Real>::ringGeneric(ModalResonatorT& r, int n, double* vo) noexcept {
+    r.ringBody<false>(n, vo);
 }
 
 template <typename Real>
-UNDERFOOT_TARGET_AVX void ModalResonatorT<Real>::ringAvx(ModalResonatorT& r, int n, double* x0,
+UNDERFOOT_TARGET_AVX void ModalResonatorT<Real>::ringAvx(ModalResonatorT& r, int n,
                                                          double* vo) noexcept {
-    r.ringBody<true>(n, x0, vo);
+    r.ringBody<true>(n, vo);
 }
 
 template <typename Real>

@@ -183,12 +183,9 @@ class ModalResonatorT {
     int outputPickup() const noexcept { return outputPickup_; }
     /// n samples (1..kFreeRunMax) of free ringing: what n calls of predict() then commit(p, 0)
     /// give, bit for bit (the same operations per mode, the pickup sums added in the same
-    /// order), with each quad of modes kept in registers over the run. contactPosition[t] is
-    /// sample t's predictedPosition(0) and outputVelocity[t] its velocity(outputPickup()) after
-    /// the commit. Requires ringsFree().
-    void ringFree(int n, double* contactPosition, double* outputVelocity) noexcept {
-        ring_(*this, n, contactPosition, outputVelocity);
-    }
+    /// order), with each quad of modes kept in registers over the run. outputVelocity[t] is
+    /// sample t's velocity(outputPickup()) after the commit. Requires ringsFree().
+    void ringFree(int n, double* outputVelocity) noexcept { ring_(*this, n, outputVelocity); }
     /// A bound on |predictedPosition(0)| over every later sample of free ringing from the
     /// current state: the sum over the modes of |g0| sqrt(q^2 + v^2 / w0^2) (a freely ringing
     /// mode's energy never grows; the discretisation samples its trajectory exactly).
@@ -231,15 +228,14 @@ class ModalResonatorT {
     static const PassFn kPasses[2][9];
     const PassFn* passes_ = kPasses[0]; // the kernel in use: kPasses[1] is AVX
     // Free ringing over a run (ringFree), in the same two kernels.
-    using RingFn = void (*)(ModalResonatorT&, int, double*, double*) noexcept;
-    static void ringGeneric(ModalResonatorT& r, int n, double* x0, double* vo) noexcept;
+    using RingFn = void (*)(ModalResonatorT&, int, double*) noexcept;
+    static void ringGeneric(ModalResonatorT& r, int n, double* vo) noexcept;
     // (the target on the declaration too: see UNDERFOOT_TARGET_AVX)
-    UNDERFOOT_TARGET_AVX static void ringAvx(ModalResonatorT& r, int n, double* x0,
-                                             double* vo) noexcept;
+    UNDERFOOT_TARGET_AVX static void ringAvx(ModalResonatorT& r, int n, double* vo) noexcept;
     template <bool Wide>
-    void ringBody(int n, double* x0, double* vo) noexcept;
+    void ringBody(int n, double* vo) noexcept;
     RingFn ring_ = &ringGeneric;
-    std::vector<double> runSums_; // a run's per-lane pickup sums: [sample][x0 x 4, output x 4]
+    std::vector<double> runSums_; // a run's per-lane output-pickup sums: [sample][lane]
     void commitWithoutForce() noexcept;
     struct Bank {
         std::vector<Real> a00, a01, a10, a11, b0x, b0v, b1x, b1v;
