@@ -144,6 +144,16 @@ std::vector<double> thirdOctaveLevels(const std::vector<float>& x, double fs) {
     }
     return bands;
 }
+// One 64-sample block of the friction-creak scenario (the drag's anchor moving at 0.05 m/s
+// under a 105 N load), added into `out`: the scenario and the friction knob share it.
+void creakBlock(ElastoPlasticFriction& f, double& anchor, float* out) noexcept {
+    for (int i = 0; i < kCostBlock; ++i) {
+        anchor += 0.05 / kRate;
+        out[i] += static_cast<float>(f.processSample(105.0, 0.0, anchor, 0.05));
+    }
+    f.resonator().flushTinyState();
+}
+
 } // namespace
 
 double spectralDistanceDb(const std::vector<float>& a, const std::vector<float>& ref, double fs) {
@@ -251,14 +261,11 @@ std::vector<KnobMeasurement> measureKnobs(double seconds) {
                 configureCreakScenario(*f, p);
                 auto anchor = std::make_shared<double>(0.0);
                 TimedRun timed;
-                timed.block = [f, anchor, &audio](int b) {
-                    float* y = audio.data() + static_cast<std::size_t>(b) * kCostBlock;
-                    for (int i = 0; i < kCostBlock; ++i) {
-                        *anchor += 0.05 / kRate;
-                        y[i] = static_cast<float>(f->processSample(105.0, 0.0, *anchor, 0.05));
-                    }
-                    f->resonator().flushTinyState();
+                auto at = [&audio](int b) {
+                    return audio.data() + static_cast<std::size_t>(b) * kCostBlock;
                 };
+                timed.prepare = [at](int b) { std::fill(at(b), at(b) + kCostBlock, 0.0f); };
+                timed.block = [f, anchor, at](int b) { creakBlock(*f, *anchor, at(b)); };
                 return timed;
             });
             if (nsPerSample) *nsPerSample = t.nsPerSample;
@@ -351,13 +358,7 @@ Scenario makeScenario(const std::string& id) {
         auto f = std::make_shared<ElastoPlasticFriction>();
         configureCreakScenario(*f);
         auto anchor = std::make_shared<double>(0.0);
-        return {f, [f, anchor](int, float* out) {
-                    for (int i = 0; i < kCostBlock; ++i) {
-                        *anchor += 0.05 / kRate;
-                        out[i] += static_cast<float>(f->processSample(105.0, 0.0, *anchor, 0.05));
-                    }
-                    f->resonator().flushTinyState();
-                }};
+        return {f, [f, anchor](int, float* out) { creakBlock(*f, *anchor, out); }};
     }
     if (id == "aggregate-gravel" || id == "aggregate-gravel-1voice") {
         AggregateParameters p; // gravel.toml, first ("sharp clicks") grains layer

@@ -92,8 +92,10 @@ inline void copyFile(const std::string& from, const std::string& to) {
     if (in.peek() != std::ifstream::traits_type::eof()) out << in.rdbuf();
     out.close();
     if (in.bad() || !out) fail("cannot copy " + from + " to " + to);
-    std::error_code ec;
-    if (std::filesystem::file_size(from, ec) != std::filesystem::file_size(to, ec) || ec)
+    std::error_code ecFrom, ecTo;
+    const auto sizeFrom = std::filesystem::file_size(from, ecFrom);
+    const auto sizeTo = std::filesystem::file_size(to, ecTo);
+    if (ecFrom || ecTo || sizeFrom != sizeTo)
         fail("the copy of " + from + " at " + to + " differs in size");
 }
 
