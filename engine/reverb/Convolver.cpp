@@ -58,82 +58,93 @@ constexpr double kPiConvolver = 3.14159265358979323846;
 /// Stages with a partition of at least this many samples cut their FFTs into pieces.
 constexpr int kSplitPartition = 1024;
 
-/// Pointers of one multiply-add step: the spectra X0 (and X1) of two partitions' inputs and,
-/// per output channel c, their filter spectra H0[c] (H1[c]) and the accumulator.
-struct MacPtrs {
-    const float* x[4];    // x0 re, x0 im, x1 re, x1 im
-    const float* h[2][4]; // [c]: h0 re, h0 im, h1 re, h1 im
-    float* acc[2][2];     // [c]: re, im
+/// The partition spectra and the ring of input spectra are stored in blocks of kLanes bins:
+/// per block, one record per partition (input slot), holding per channel kLanes real parts then
+/// kLanes imaginary parts. A product over partitions [j0, j1) for a range of blocks then reads
+/// each block's records in one contiguous run, and keeps its sums in registers from the first
+/// partition to the last (one load and one store of the accumulators per block and run, instead
+/// of one per partition pair).
+constexpr int kRecord = 2 * kLanes; // floats of one channel's record: kLanes re, kLanes im
+
+/// One run of products: acc[c] (+)= sum over q < count of X[slot q] * H[c][j0 + q], per bin, in
+/// the order q = 0, 1, ... (per bin the same IEEE operations whatever the SIMD level).
+struct MacRun {
+    const float* x;     // block k0's records of the input ring: x + slot * kRecord
+    const float* h;     // block k0's record of partition j0, channel 0
+    const int* slotOff; // [count]: offset of the input record paired with partition j0 + q
+    int count = 0;      // partitions in the run
+    std::size_t xBlock; // floats from one block's input records to the next block's
+    std::size_t hBlock; // the same for the partition records
+    float* accRe;       // [c * accStride + bin]
+    float* accIm;
+    std::size_t accStride;
+    int blocks = 0;     // bin blocks k0 .. k0 + blocks - 1 (acc already offset to block k0)
+    bool first = false; // the period's first product: the sums start at 0 (as 0 + product)
 };
 
-// acc[c] = (acc[c] + X0 H0[c]) + X1 H1[c], bin by bin, for c < C. The SSE and AVX versions do
-// the same IEEE operations per bin in the same order (no FMA): identical results, so the output
-// does not depend on which one the CPU runs.
-#define UNDERFOOT_MAC_KERNEL(NAME, ATTR, V, W, LOAD, STORE, ADD, SUB, MUL)                         \
-    template <int C, bool Two>                                                                     \
-    ATTR void NAME(const MacPtrs& p, int stride) noexcept {                                        \
-        for (int b = 0; b < stride; b += W) {                                                      \
-            const V x0r = LOAD(p.x[0] + b), x0i = LOAD(p.x[1] + b);                                \
-            V x1r = x0r, x1i = x0i;                                                                \
-            if constexpr (Two) {                                                                   \
-                x1r = LOAD(p.x[2] + b);                                                            \
-                x1i = LOAD(p.x[3] + b);                                                            \
-            }                                                                                      \
-            for (int c = 0; c < C; ++c) {                                                          \
-                V sr = LOAD(p.acc[c][0] + b), si = LOAD(p.acc[c][1] + b);                          \
-                const V hr = LOAD(p.h[c][0] + b), hi = LOAD(p.h[c][1] + b);                        \
-                sr = ADD(sr, SUB(MUL(x0r, hr), MUL(x0i, hi)));                                     \
-                si = ADD(si, ADD(MUL(x0r, hi), MUL(x0i, hr)));                                     \
-                if constexpr (Two) {                                                               \
-                    const V gr = LOAD(p.h[c][2] + b), gi = LOAD(p.h[c][3] + b);                    \
-                    sr = ADD(sr, SUB(MUL(x1r, gr), MUL(x1i, gi)));                                 \
-                    si = ADD(si, ADD(MUL(x1r, gi), MUL(x1i, gr)));                                 \
+// Per bin: s = s + (xr hr - xi hi), t = t + (xr hi + xi hr), partition after partition, no FMA:
+// the SSE and AVX kernels (and so every CPU) give the same sums.
+#define UNDERFOOT_MAC_KERNEL(NAME, ATTR, V, W, LOAD, STORE, ADD, SUB, MUL, ZERO)                   \
+    template <int C>                                                                               \
+    ATTR void NAME(const MacRun& r) noexcept {                                                     \
+        for (int k = 0; k < r.blocks; ++k) {                                                       \
+            const float* xb = r.x + static_cast<std::size_t>(k) * r.xBlock;                        \
+            const float* hb = r.h + static_cast<std::size_t>(k) * r.hBlock;                        \
+            const std::size_t ab = static_cast<std::size_t>(k) * kLanes;                           \
+            for (int w = 0; w < kLanes; w += W) {                                                  \
+                V sr[C], si[C];                                                                    \
+                for (int c = 0; c < C; ++c) {                                                      \
+                    float* ar = r.accRe + c * r.accStride + ab + w;                                \
+                    float* ai = r.accIm + c * r.accStride + ab + w;                                \
+                    sr[c] = r.first ? ZERO() : LOAD(ar);                                           \
+                    si[c] = r.first ? ZERO() : LOAD(ai);                                           \
                 }                                                                                  \
-                STORE(p.acc[c][0] + b, sr);                                                        \
-                STORE(p.acc[c][1] + b, si);                                                        \
+                const float* hq = hb + w;                                                          \
+                for (int q = 0; q < r.count; ++q, hq += C * kRecord) {                             \
+                    const float* xq = xb + r.slotOff[q] + w;                                       \
+                    const V xr = LOAD(xq), xi = LOAD(xq + kLanes);                                 \
+                    for (int c = 0; c < C; ++c) {                                                  \
+                        const V hr = LOAD(hq + c * kRecord), hi = LOAD(hq + c * kRecord + kLanes); \
+                        sr[c] = ADD(sr[c], SUB(MUL(xr, hr), MUL(xi, hi)));                         \
+                        si[c] = ADD(si[c], ADD(MUL(xr, hi), MUL(xi, hr)));                         \
+                    }                                                                              \
+                }                                                                                  \
+                for (int c = 0; c < C; ++c) {                                                      \
+                    STORE(r.accRe + c * r.accStride + ab + w, sr[c]);                              \
+                    STORE(r.accIm + c * r.accStride + ab + w, si[c]);                              \
+                }                                                                                  \
             }                                                                                      \
         }                                                                                          \
     }
 
 UNDERFOOT_MAC_KERNEL(macSse, , __m128, 4, _mm_loadu_ps, _mm_storeu_ps, _mm_add_ps, _mm_sub_ps,
-                     _mm_mul_ps)
+                     _mm_mul_ps, _mm_setzero_ps)
 UNDERFOOT_MAC_KERNEL(macAvx, __attribute__((target("avx"))), __m256, 8, _mm256_loadu_ps,
-                     _mm256_storeu_ps, _mm256_add_ps, _mm256_sub_ps, _mm256_mul_ps)
-// AVX-512F has fused multiply-adds, into which GCC would contract the intrinsics' products and
-// sums (-ffp-contract=fast is its default): not in these kernels, whose results must be those of
-// the SSE and AVX ones (tested).
-#define UNDERFOOT_AVX512 __attribute__((target("avx512f"), optimize("fp-contract=off")))
-UNDERFOOT_MAC_KERNEL(macAvx512Body, UNDERFOOT_AVX512, __m512, 16, _mm512_loadu_ps, _mm512_storeu_ps,
-                     _mm512_add_ps, _mm512_sub_ps, _mm512_mul_ps)
+                     _mm256_storeu_ps, _mm256_add_ps, _mm256_sub_ps, _mm256_mul_ps,
+                     _mm256_setzero_ps)
 #undef UNDERFOOT_MAC_KERNEL
 
-/// AVX-512 over the multiples of 16 bins, AVX over the last 8 (stride is a multiple of 8).
-template <int C, bool Two>
-void macAvx512(const MacPtrs& p, int stride) noexcept {
-    const int body = stride / 16 * 16;
-    if (body > 0) macAvx512Body<C, Two>(p, body);
-    if (body == stride) return;
-    MacPtrs rest = p;
-    for (auto& x : rest.x) x += body;
-    for (auto& hc : rest.h)
-        for (auto& h : hc) h += body;
-    for (auto& ac : rest.acc)
-        for (auto& a : ac) a += body;
-    macAvx<C, Two>(rest, stride - body);
+/// A record is kLanes wide, so AVX-512 runs the AVX kernel (same sums).
+template <int C>
+void mac(Convolver::Simd simd, const MacRun& r) noexcept {
+    if (simd == Convolver::Simd::Sse)
+        macSse<C>(r);
+    else
+        macAvx<C>(r);
 }
 
-template <int C, bool Two>
-void mac(Convolver::Simd simd, const MacPtrs& p, int stride) noexcept {
-    switch (simd) {
-    case Convolver::Simd::Avx512:
-        macAvx512<C, Two>(p, stride);
-        break;
-    case Convolver::Simd::Avx:
-        macAvx<C, Two>(p, stride);
-        break;
-    default:
-        macSse<C, Two>(p, stride);
-        break;
+/// Copies bins [0, bins) of an interleaved complex spectrum z into the records of one slot:
+/// rec + k * recStep is bin block k's record.
+inline void storeRecords(const float* z, int bins, float* rec, std::size_t recStep) noexcept {
+    int b = 0;
+    for (; b + kLanes <= bins; b += kLanes, rec += recStep)
+        for (int l = 0; l < kLanes; ++l) {
+            rec[l] = z[2 * (b + l)];
+            rec[kLanes + l] = z[2 * (b + l) + 1];
+        }
+    for (int l = 0; b + l < bins; ++l) {
+        rec[l] = z[2 * (b + l)];
+        rec[kLanes + l] = z[2 * (b + l) + 1];
     }
 }
 
@@ -206,6 +217,10 @@ __attribute__((target("avx"))) void headAvx(const float* hl, const float* hr, co
     headScalar(hl, hr, line, t, m, yl, yr);
 }
 
+// AVX-512F has fused multiply-adds, into which GCC would contract the intrinsics' products and
+// sums (-ffp-contract=fast is its default): not in this kernel, whose results must be those of
+// the SSE and AVX ones (tested).
+#define UNDERFOOT_AVX512 __attribute__((target("avx512f"), optimize("fp-contract=off")))
 UNDERFOOT_AVX512 void headAvx512(const float* hl, const float* hr, const float* line, int m,
                                  float* yl, float* yr) noexcept {
     constexpr int q = Convolver::kHeadLength;
@@ -310,9 +325,9 @@ struct Convolver::Stage {
     struct Item {
         Kind kind;
         int j0 = 0, j1 = 0; // Mac: partitions [j0, j1); steps: rows / columns [j0, j1)
-        bool first = false; // Mac: the first product of the period (clears the accumulators)
+        bool first = false; // Mac: the first product of the period (its sums start from 0)
         int channel = 0;    // Inverse
-        int b0 = 0, b1 = 0; // Mac: bins [b0, b1) (multiples of kLanes; b1 = 0: all)
+        int b0 = 0, b1 = 0; // Mac: bins [b0, b1) (multiples of kLanes)
     };
 
     int P = 0, N = 0, T = 0, channels = 1, bins = 0, stride = 0;
@@ -321,11 +336,14 @@ struct Convolver::Stage {
     FftwFloats spectrum; // 2 (P + 1): interleaved complex, FFT output / inverse input
     FftwFloats time;     // 2P: inverse FFT output
     Plan forward, inverse;
-    std::vector<float> cur;                      // P: the input block being filled
-    std::vector<float> hRe, hIm;                 // [channel][partition][stride], scaled by 1 / 2P
-    std::vector<float> xRe, xIm;                 // [slot][stride], ring of the last N input spectra
-    std::vector<float> accRe, accIm;             // [channel][stride]
-    std::vector<float> out;                      // [channel][2][P]: playing and being computed
+    std::vector<float> cur; // P: the input block being filled
+    // Records (see kRecord): h[((k N + j) channels + c) kRecord] is bin block k of partition j,
+    // channel c, scaled by 1 / 2P; x[(k N + slot) kRecord] is bin block k of the input spectrum
+    // in that slot of the ring of the last N.
+    std::vector<float> h, x;
+    std::vector<float> accRe, accIm; // [channel][stride]
+    std::vector<int> slotOff;        // [N]: scratch of runMac (offsets of the input records)
+    std::vector<float> out;          // [channel][2][P]: playing and being computed
     Convolver::Simd simd = Convolver::Simd::Sse; // kernels (all give the same results)
     // Split transforms: a complex FFT of n = 2P = n1 x n2 points as n1 DFTs of n2 points over
     // the strided input (index i1 + n1 i2), a twiddle W_n^(i1 k2), and n2 DFTs of n1 points
@@ -350,8 +368,7 @@ struct Convolver::Stage {
     void clear() noexcept {
         std::fill(frame.p, frame.p + 2 * P, 0.0f);
         std::fill(cur.begin(), cur.end(), 0.0f);
-        std::fill(xRe.begin(), xRe.end(), 0.0f);
-        std::fill(xIm.begin(), xIm.end(), 0.0f);
+        std::fill(x.begin(), x.end(), 0.0f);
         std::fill(accRe.begin(), accRe.end(), 0.0f);
         std::fill(accIm.begin(), accIm.end(), 0.0f);
         std::fill(out.begin(), out.end(), 0.0f);
@@ -367,56 +384,40 @@ struct Convolver::Stage {
 
     void runForward() noexcept {
         fftwf_execute(forward.p);
-        const std::size_t base = static_cast<std::size_t>(slot(block)) * stride;
-        float* re = xRe.data() + base;
-        float* im = xIm.data() + base;
-        const float* z = spectrum.p;
-        for (int b = 0; b < bins; ++b) {
-            re[b] = z[2 * b];
-            im[b] = z[2 * b + 1];
-        }
+        storeInput(spectrum.p);
     }
 
-    /// acc[c] (+)= sum over j in [j0, j1) of X[block - j] * H[c][j], bin by bin, partitions in
-    /// pairs (one pass over the accumulators per pair).
-    /// Bins [b0, b1) only (the order of the operations per bin does not depend on the range).
+    /// The newest input spectrum (interleaved complex, bins 0..P) into the ring's slot.
+    void storeInput(const float* z) noexcept {
+        storeRecords(z, bins, x.data() + static_cast<std::size_t>(slot(block)) * kRecord,
+                     static_cast<std::size_t>(N) * kRecord);
+    }
+
+    /// acc[c] (+)= sum over j in [j0, j1) of X[block - j] * H[c][j], bin by bin, in the order of
+    /// j; `first`: the sums start from 0. Bins [b0, b1) only (multiples of kLanes): the order of
+    /// the operations per bin does not depend on the range.
     void runMac(int j0, int j1, bool first, int b0, int b1) noexcept {
-        if (b1 == 0) b1 = stride;
-        const int count = b1 - b0;
-        const auto st = static_cast<std::size_t>(stride);
-        const auto off = static_cast<std::size_t>(b0);
-        if (first)
-            for (int c = 0; c < channels; ++c) {
-                const std::size_t o = static_cast<std::size_t>(c) * st + off;
-                std::fill_n(accRe.data() + o, count, 0.0f);
-                std::fill_n(accIm.data() + o, count, 0.0f);
-            }
-        MacPtrs p{};
-        for (int c = 0; c < channels; ++c) {
-            p.acc[c][0] = accRe.data() + static_cast<std::size_t>(c) * st + off;
-            p.acc[c][1] = accIm.data() + static_cast<std::size_t>(c) * st + off;
-        }
-        for (int j = j0; j < j1; j += 2) {
-            const bool two = j + 1 < j1;
-            for (int k = 0; k < (two ? 2 : 1); ++k) {
-                const std::size_t o = static_cast<std::size_t>(slot(block - j - k)) * st + off;
-                p.x[2 * k] = xRe.data() + o;
-                p.x[2 * k + 1] = xIm.data() + o;
-                for (int c = 0; c < channels; ++c) {
-                    const std::size_t h =
-                        (static_cast<std::size_t>(c) * static_cast<std::size_t>(N) +
-                         static_cast<std::size_t>(j + k)) *
-                            st +
-                        off;
-                    p.h[c][2 * k] = hRe.data() + h;
-                    p.h[c][2 * k + 1] = hIm.data() + h;
-                }
-            }
-            if (channels == 2)
-                two ? mac<2, true>(simd, p, count) : mac<2, false>(simd, p, count);
-            else
-                two ? mac<1, true>(simd, p, count) : mac<1, false>(simd, p, count);
-        }
+        for (int j = j0; j < j1; ++j)
+            slotOff[static_cast<std::size_t>(j - j0)] = slot(block - j) * kRecord;
+        const auto k0 = static_cast<std::size_t>(b0 / kLanes);
+        const auto n = static_cast<std::size_t>(N);
+        const auto ch = static_cast<std::size_t>(channels);
+        MacRun r{};
+        r.x = x.data() + k0 * n * kRecord;
+        r.h = h.data() + (k0 * n + static_cast<std::size_t>(j0)) * ch * kRecord;
+        r.slotOff = slotOff.data();
+        r.count = j1 - j0;
+        r.xBlock = n * kRecord;
+        r.hBlock = n * ch * kRecord;
+        r.accRe = accRe.data() + static_cast<std::size_t>(b0);
+        r.accIm = accIm.data() + static_cast<std::size_t>(b0);
+        r.accStride = static_cast<std::size_t>(stride);
+        r.blocks = (b1 - b0) / kLanes;
+        r.first = first;
+        if (channels == 2)
+            mac<2>(simd, r);
+        else
+            mac<1>(simd, r);
     }
 
     void runInverse(int c) noexcept {
@@ -462,15 +463,10 @@ struct Convolver::Stage {
             runStep3(step3F, it.j0, it.j1);
             break;
         case Kind::FwdStore: {
-            const std::size_t base = static_cast<std::size_t>(slot(block)) * stride;
-            float* re = xRe.data() + base;
-            float* im = xIm.data() + base;
-            for (int b = 0; b < bins; ++b) {
-                re[b] = cA.p[2 * b];
-                im[b] = cA.p[2 * b + 1];
-            }
-            im[0] = 0.0f; // a real signal's DC and Nyquist bins are real (as FFTW's r2c gives)
-            im[bins - 1] = 0.0f;
+            // A real signal's DC and Nyquist bins are real (as FFTW's r2c gives).
+            cA.p[1] = 0.0f;
+            cA.p[2 * (bins - 1) + 1] = 0.0f;
+            storeInput(cA.p);
             break;
         }
         case Kind::InvLoad: {
@@ -581,22 +577,20 @@ struct Convolver::Stage {
             double cost;
         };
         std::vector<Atom> atoms;
-        // In the stages with split transforms the products are cut into bin ranges too, so that
-        // no piece of work is much larger than a slice's share.
-        const int chunks = split ? 4 : 1;
+        // The products are cut by bin ranges, each over all its partitions: a run reads its
+        // records contiguously and keeps its sums in registers. Fine ranges here; the ranges
+        // that fall in the same slice are merged below.
+        const int blockCount = stride / kLanes;
+        const int chunks = std::min(blockCount, 4 * slices);
         auto addMac = [&](int j0, int j1) {
             for (int k = 0; k < chunks; ++k) {
                 Item it{Kind::Mac, j0, j1, false, 0};
-                if (chunks > 1) {
-                    it.b0 = stride / kLanes * k / chunks * kLanes;
-                    it.b1 = k + 1 == chunks ? stride : stride / kLanes * (k + 1) / chunks * kLanes;
-                }
-                const double share = chunks > 1 ? double(it.b1 - it.b0) / stride : 1.0;
-                atoms.push_back({it, macCost * (j1 - j0) * share});
+                it.b0 = blockCount * k / chunks * kLanes;
+                it.b1 = blockCount * (k + 1) / chunks * kLanes;
+                atoms.push_back({it, macCost * (j1 - j0) * double(it.b1 - it.b0) / stride});
             }
         };
-        for (int j = 1; j < N; j += 2) // products in pairs (one pass over the accumulators)
-            addMac(j, std::min(j + 2, N));
+        if (N > 1) addMac(1, N); // the older spectra's products
         // Split transforms: pieces of a few DFTs (measured: a 64-point strided complex DFT
         // ~55 ns, its twiddles ~10 ns), and the passes over the buffers in ranges.
         auto splitFft = [&](bool forwardFft) {
@@ -648,11 +642,13 @@ struct Convolver::Stage {
             int s = static_cast<int>((cum + 0.5 * a.cost) / share);
             s = std::clamp(s, last, slices - 1); // monotone: the order is kept
             cum += a.cost;
-            // Merge a product with the previous one when both fall in the same slice.
+            // Merge a product with the previous one when both fall in the same slice: the same
+            // partitions over the next bins.
             if (!items.empty() && s == last && a.item.kind == Kind::Mac &&
-                items.back().kind == Kind::Mac && items.back().j1 == a.item.j0 && !a.item.first &&
-                a.item.b1 == 0 && items.back().b1 == 0) {
-                items.back().j1 = a.item.j1;
+                items.back().kind == Kind::Mac && items.back().j0 == a.item.j0 &&
+                items.back().j1 == a.item.j1 && items.back().first == a.item.first &&
+                items.back().b1 == a.item.b0) {
+                items.back().b1 = a.item.b1;
             } else {
                 items.push_back(a.item);
                 sliceOf.push_back(s);
@@ -810,10 +806,10 @@ void Convolver::prepare(const AudioBuffer& impulseResponse, double sampleRateHz,
             }
         }
         s->cur.assign(static_cast<std::size_t>(P), 0.0f);
-        s->hRe.assign(ch * N * stride, 0.0f);
-        s->hIm.assign(ch * N * stride, 0.0f);
-        s->xRe.assign(N * stride, 0.0f);
-        s->xIm.assign(N * stride, 0.0f);
+        const std::size_t blocks = stride / kLanes;
+        s->h.assign(blocks * N * ch * kRecord, 0.0f);
+        s->x.assign(blocks * N * kRecord, 0.0f);
+        s->slotOff.assign(N, 0);
         s->accRe.assign(ch * stride, 0.0f);
         s->accIm.assign(ch * stride, 0.0f);
         s->out.assign(ch * 2 * static_cast<std::size_t>(P), 0.0f);
@@ -830,12 +826,8 @@ void Convolver::prepare(const AudioBuffer& impulseResponse, double sampleRateHz,
                     if (t < end) s->frame.p[k] = taps[t] * scale;
                 }
                 fftwf_execute(s->forward.p);
-                float* re = s->hRe.data() + (c * N + j) * stride;
-                float* im = s->hIm.data() + (c * N + j) * stride;
-                for (int b = 0; b < s->bins; ++b) {
-                    re[b] = s->spectrum.p[2 * b];
-                    im[b] = s->spectrum.p[2 * b + 1];
-                }
+                storeRecords(s->spectrum.p, s->bins, s->h.data() + (j * ch + c) * kRecord,
+                             N * ch * kRecord);
             }
         }
         s->schedule();
