@@ -133,21 +133,6 @@ void mac(Convolver::Simd simd, const MacRun& r) noexcept {
         macAvx<C>(r);
 }
 
-/// Copies bins [0, bins) of an interleaved complex spectrum z into the records of one slot:
-/// rec + k * recStep is bin block k's record.
-inline void storeRecords(const float* z, int bins, float* rec, std::size_t recStep) noexcept {
-    int b = 0;
-    for (; b + kLanes <= bins; b += kLanes, rec += recStep)
-        for (int l = 0; l < kLanes; ++l) {
-            rec[l] = z[2 * (b + l)];
-            rec[kLanes + l] = z[2 * (b + l) + 1];
-        }
-    for (int l = 0; b + l < bins; ++l) {
-        rec[l] = z[2 * (b + l)];
-        rec[kLanes + l] = z[2 * (b + l) + 1];
-    }
-}
-
 /// The direct-form head over a run of m <= kTick outputs: y[t] = sum over k of h[k] x[t - k],
 /// with line[kHeadLength - 1 + t] = x[t] (the 63 inputs before the run in front). Vectorised
 /// across outputs: every output is the same float sum in the same order (k = 0, 1, ...) in the
@@ -304,6 +289,15 @@ inline void deinterleave(const float* z, float* re, float* im, std::size_t i0,
     }
 }
 
+/// Copies bins [0, bins) of an interleaved complex spectrum z into records: rec + k * recStep
+/// is bin block k's record (kLanes real parts, then kLanes imaginary parts).
+inline void storeRecords(const float* z, int bins, float* rec, std::size_t recStep) noexcept {
+    int b = 0;
+    for (; b + kLanes <= bins; b += kLanes, rec += recStep)
+        deinterleave(z + 2 * b, rec, rec + kLanes, 0, kLanes);
+    if (b < bins) deinterleave(z + 2 * b, rec, rec + kLanes, 0, static_cast<std::size_t>(bins - b));
+}
+
 } // namespace
 
 /// One uniformly partitioned overlap-save stage: partition P, N partitions, taps [T, T + N P).
@@ -337,10 +331,13 @@ struct Convolver::Stage {
     FftwFloats time;     // 2P: inverse FFT output
     Plan forward, inverse;
     std::vector<float> cur; // P: the input block being filled
-    // Records (see kRecord): h[((k N + j) channels + c) kRecord] is bin block k of partition j,
-    // channel c, scaled by 1 / 2P; x[(k N + slot) kRecord] is bin block k of the input spectrum
-    // in that slot of the ring of the last N.
-    std::vector<float> h, x;
+    // Records (see kRecord), the partitions' scaled by 1 / 2P. h0[(k channels + c) kRecord]: bin
+    // block k of partition 0, channel c; h[((k (N - 1) + j - 1) channels + c) kRecord]: of
+    // partition j >= 1; xNew[k kRecord]: of the newest input spectrum; x[(k N + slot) kRecord]: of
+    // the input spectrum of block b in slot(b), a ring of the older ones (block b's record of bin
+    // block k is copied there from xNew by period b + 1's products over bin block k, before they
+    // read it). The newest product reads h0 and xNew, the older ones h and x: contiguous runs.
+    std::vector<float> h0, h, x, xNew;
     std::vector<float> accRe, accIm; // [channel][stride]
     std::vector<int> slotOff;        // [N]: scratch of runMac (offsets of the input records)
     std::vector<float> out;          // [channel][2][P]: playing and being computed
@@ -369,6 +366,7 @@ struct Convolver::Stage {
         std::fill(frame.p, frame.p + 2 * P, 0.0f);
         std::fill(cur.begin(), cur.end(), 0.0f);
         std::fill(x.begin(), x.end(), 0.0f);
+        std::fill(xNew.begin(), xNew.end(), 0.0f);
         std::fill(accRe.begin(), accRe.end(), 0.0f);
         std::fill(accIm.begin(), accIm.end(), 0.0f);
         std::fill(out.begin(), out.end(), 0.0f);
@@ -387,28 +385,42 @@ struct Convolver::Stage {
         storeInput(spectrum.p);
     }
 
-    /// The newest input spectrum (interleaved complex, bins 0..P) into the ring's slot.
-    void storeInput(const float* z) noexcept {
-        storeRecords(z, bins, x.data() + static_cast<std::size_t>(slot(block)) * kRecord,
-                     static_cast<std::size_t>(N) * kRecord);
-    }
+    /// The newest input spectrum (interleaved complex, bins 0..P) into xNew. It reaches the ring
+    /// in the next period, bin range by bin range, in the older products' runs (runMac): the
+    /// scattered writes are spread over that period's slices.
+    void storeInput(const float* z) noexcept { storeRecords(z, bins, xNew.data(), kRecord); }
 
     /// acc[c] (+)= sum over j in [j0, j1) of X[block - j] * H[c][j], bin by bin, in the order of
     /// j; `first`: the sums start from 0. Bins [b0, b1) only (multiples of kLanes): the order of
     /// the operations per bin does not depend on the range.
+    /// (The schedule never mixes the newest partition, j = 0, with the older ones in a run.)
     void runMac(int j0, int j1, bool first, int b0, int b1) noexcept {
-        for (int j = j0; j < j1; ++j)
-            slotOff[static_cast<std::size_t>(j - j0)] = slot(block - j) * kRecord;
         const auto k0 = static_cast<std::size_t>(b0 / kLanes);
-        const auto n = static_cast<std::size_t>(N);
         const auto ch = static_cast<std::size_t>(channels);
         MacRun r{};
-        r.x = x.data() + k0 * n * kRecord;
-        r.h = h.data() + (k0 * n + static_cast<std::size_t>(j0)) * ch * kRecord;
+        if (j0 == 0) { // the newest spectrum
+            slotOff[0] = 0;
+            r.x = xNew.data() + k0 * kRecord;
+            r.h = h0.data() + k0 * ch * kRecord;
+            r.xBlock = kRecord;
+            r.hBlock = ch * kRecord;
+        } else {
+            for (int j = j0; j < j1; ++j)
+                slotOff[static_cast<std::size_t>(j - j0)] = slot(block - j) * kRecord;
+            const auto n = static_cast<std::size_t>(N);
+            r.x = x.data() + k0 * n * kRecord;
+            if (j0 == 1) { // the previous period's newest spectrum into the ring, these bins first
+                const auto previous = static_cast<std::size_t>(slot(block - 1));
+                for (std::size_t k = k0; k < static_cast<std::size_t>(b1 / kLanes); ++k)
+                    std::memcpy(x.data() + (k * n + previous) * kRecord, xNew.data() + k * kRecord,
+                                sizeof(float) * kRecord);
+            }
+            r.h = h.data() + (k0 * (n - 1) + static_cast<std::size_t>(j0 - 1)) * ch * kRecord;
+            r.xBlock = n * kRecord;
+            r.hBlock = (n - 1) * ch * kRecord;
+        }
         r.slotOff = slotOff.data();
         r.count = j1 - j0;
-        r.xBlock = n * kRecord;
-        r.hBlock = n * ch * kRecord;
         r.accRe = accRe.data() + static_cast<std::size_t>(b0);
         r.accIm = accIm.data() + static_cast<std::size_t>(b0);
         r.accStride = static_cast<std::size_t>(stride);
@@ -566,12 +578,18 @@ struct Convolver::Stage {
     /// keeping the order: older products, forward FFT, newest product, inverse FFTs.
     void schedule() {
         const int slices = slack ? P / kTick : 1;
-        // Estimated cost in ns (measured per item on a 2.1 GHz AMD EPYC with AVX, FFTW_ESTIMATE
-        // plans: a 512-point r2c with its deinterleaving ~0.4 us; a product ~0.2 ns per bin and
-        // channel). Only the relative costs matter: they decide where the slices are cut.
+        // Estimated cost in ns, fitted to every item timed alone on this machine's AMD EPYC (Zen
+        // 3, AVX; FFTW_ESTIMATE plans; issue #18, 28 Nov 2026): e.g. on the hall, 2048 stage, a
+        // run of the 49 older partitions over 96 bins ~3.4 us, the newest partition over all bins
+        // ~3.5 us (a run of one partition pays the accumulators' load and store per bin), a group
+        // of 8 strided 64-point DFTs 0.7-1.0 us. Only the relative costs matter: they decide
+        // where the slices are cut.
         const double n = 2.0 * P;
-        const double fftCost = 0.07 * n * std::log2(n) + 0.15 * n; // real FFT, (de)interleaving
-        const double macCost = 0.2 * channels * stride;            // per partition
+        const double fwdCost = 150.0 + 0.2 * n * std::log2(n);   // r2c and its records
+        const double invCost = 100.0 + 0.145 * n * std::log2(n); // c2r and its copy, per channel
+        auto macRunCost = [&](int count, int binCount) {
+            return binCount * channels * (0.37 * count + 0.47);
+        };
         struct Atom {
             Item item;
             double cost;
@@ -587,36 +605,38 @@ struct Convolver::Stage {
                 Item it{Kind::Mac, j0, j1, false, 0};
                 it.b0 = blockCount * k / chunks * kLanes;
                 it.b1 = blockCount * (k + 1) / chunks * kLanes;
-                atoms.push_back({it, macCost * (j1 - j0) * double(it.b1 - it.b0) / stride});
+                atoms.push_back({it, macRunCost(j1 - j0, it.b1 - it.b0)});
             }
         };
         if (N > 1) addMac(1, N); // the older spectra's products
-        // Split transforms: pieces of a few DFTs (measured: a 64-point strided complex DFT
-        // ~55 ns, its twiddles ~10 ns), and the passes over the buffers in ranges.
+        // Split transforms: pieces of a few DFTs with their twiddles, and the passes over the
+        // buffers in ranges.
         auto splitFft = [&](bool forwardFft) {
             const int n_ = static_cast<int>(n);
             if (forwardFft)
                 for (int i = 0; i < n_; i += P)
-                    atoms.push_back({{Kind::FwdLoad, i, i + P}, 0.15 * P});
+                    atoms.push_back({{Kind::FwdLoad, i, i + P}, 0.35 * P});
             else
-                for (int k = 0; k <= P; k += P / 4)
-                    atoms.push_back({{Kind::InvLoad, k, std::min(k + P / 4, P + 1)}, 0.3 * P / 4});
+                for (int k = 0; k <= P; k += P / 4) {
+                    const int k1 = std::min(k + P / 4, P + 1);
+                    atoms.push_back({{Kind::InvLoad, k, k1}, 0.8 * (k1 - k)});
+                }
             const Kind k1 = forwardFft ? Kind::FwdStep1 : Kind::InvStep1;
             const Kind k3 = forwardFft ? Kind::FwdStep3 : Kind::InvStep3;
             for (int r = 0; r < n1; r += group1)
-                atoms.push_back({{k1, r, r + group1},
-                                 group1 * (0.15 * n2 * std::log2(double(n2)) + 0.15 * n2)});
+                atoms.push_back(
+                    {{k1, r, r + group1}, group1 * n2 * (0.25 * std::log2(double(n2)) + 0.35)});
             for (int c = 0; c < n2; c += group3)
-                atoms.push_back({{k3, c, c + group3}, group3 * 0.1 * n1 * std::log2(double(n1))});
+                atoms.push_back({{k3, c, c + group3}, group3 * 0.23 * n1 * std::log2(double(n1))});
             if (forwardFft)
-                atoms.push_back({{Kind::FwdStore, 0, bins}, 0.15 * bins});
+                atoms.push_back({{Kind::FwdStore, 0, bins}, 0.35 * bins});
             else
-                atoms.push_back({{Kind::InvStore, 0, P}, 0.15 * P});
+                atoms.push_back({{Kind::InvStore, 0, P}, 0.44 * P});
         };
         if (split)
             splitFft(true);
         else
-            atoms.push_back({{Kind::Forward}, fftCost});
+            atoms.push_back({{Kind::Forward}, fwdCost});
         addMac(0, 1);
         // The first product of the period (all its bin ranges) clears the accumulators.
         int firstJ = -1;
@@ -629,7 +649,7 @@ struct Convolver::Stage {
             splitFft(false);
         else
             for (int c = 0; c < channels; ++c)
-                atoms.push_back({{Kind::Inverse, 0, 0, false, c}, fftCost});
+                atoms.push_back({{Kind::Inverse, 0, 0, false, c}, invCost});
         double total = 0;
         for (const auto& a : atoms) total += a.cost;
         const double share = total / slices;
@@ -807,8 +827,10 @@ void Convolver::prepare(const AudioBuffer& impulseResponse, double sampleRateHz,
         }
         s->cur.assign(static_cast<std::size_t>(P), 0.0f);
         const std::size_t blocks = stride / kLanes;
-        s->h.assign(blocks * N * ch * kRecord, 0.0f);
+        s->h0.assign(blocks * ch * kRecord, 0.0f);
+        s->h.assign(blocks * (N - 1) * ch * kRecord, 0.0f);
         s->x.assign(blocks * N * kRecord, 0.0f);
+        s->xNew.assign(blocks * kRecord, 0.0f);
         s->slotOff.assign(N, 0);
         s->accRe.assign(ch * stride, 0.0f);
         s->accIm.assign(ch * stride, 0.0f);
@@ -826,8 +848,11 @@ void Convolver::prepare(const AudioBuffer& impulseResponse, double sampleRateHz,
                     if (t < end) s->frame.p[k] = taps[t] * scale;
                 }
                 fftwf_execute(s->forward.p);
-                storeRecords(s->spectrum.p, s->bins, s->h.data() + (j * ch + c) * kRecord,
-                             N * ch * kRecord);
+                if (j == 0)
+                    storeRecords(s->spectrum.p, s->bins, s->h0.data() + c * kRecord, ch * kRecord);
+                else
+                    storeRecords(s->spectrum.p, s->bins, s->h.data() + ((j - 1) * ch + c) * kRecord,
+                                 (N - 1) * ch * kRecord);
             }
         }
         s->schedule();
