@@ -85,6 +85,7 @@ void HuntCrossleyImpactT<Real>::setFineRate(bool fine) noexcept {
 template <typename Real>
 void HuntCrossleyImpactT<Real>::reset() noexcept {
     freeRetryIn_ = 0;
+    substepNext_ = false;
     setFineRate(false);
     resonator_.reset();
     decimator_.reset();
@@ -411,13 +412,23 @@ double HuntCrossleyImpactT<Real>::spanSamples(const float* fext, float* out, int
         const double fNext = fext ? double(fext[i]) : 0.0;
         double y = 0.0;
         // One step from force f0 to f1; when the bodies touch in it, `sub` exact sub-steps.
+        // Inside a strike the single-step trial is discarded sample after sample (its force
+        // changes by far more than substepForceChange): after a sample whose force changed by
+        // more than kSubstepNextFactor times that, the next one is sub-stepped at once. (Sub-steps
+        // are never less accurate than the single step; where the trial would have been
+        // discarded, the samples are exactly those of trying it first.)
         const auto advance = [&](double f0, double f1) {
-            if (step(f0, f1, sub > 1, y)) return;
+            if (!substepNext_ && step(f0, f1, sub > 1, y)) return;
+            const double before = lastForce_;
             setFineRate(true);
             for (int j = 0; j < sub; ++j)
                 step(f0 + (f1 - f0) * double(j) / sub, f0 + (f1 - f0) * double(j + 1) / sub, false,
                      y);
             setFineRate(false);
+            substepNext_ =
+                sub > 1 && lastForce_ > 0.0 &&
+                std::fabs(lastForce_ - before) >
+                    kSubstepNextFactor * params_.substepForceChange * std::max(lastForce_, before);
         };
         if constexpr (Single) { // (the same force values as the general interpolation below gives)
             advance(lastExternal_, lastExternal_ + (fNext - lastExternal_));

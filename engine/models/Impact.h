@@ -48,7 +48,9 @@ struct ImpactParams {
     int contactSubsteps = 4;
     /// A sample in contact is sub-stepped only while the contact is a transient: it opens or
     /// closes in the sample, or the single step's force differs from the previous one by more
-    /// than this fraction of the larger. A sole resting on the floor stays single-stepped.
+    /// than this fraction of the larger. A sole resting on the floor stays single-stepped. After
+    /// a sample whose force changed by more than 4x this fraction (a strike), the next sample is
+    /// sub-stepped without trying the single step first.
     double substepForceChange = 0.02;
 };
 
@@ -176,6 +178,10 @@ class HuntCrossleyImpactT {
     bool freeRuns_ = true;
     static constexpr int kFreeRetrySamples = 8; // samples stepped after a failed runFree()
     int freeRetryIn_ = 0;
+    // A sample whose contact force changed by more than kSubstepNextFactor x the sub-step
+    // threshold is followed by a sub-stepped sample without its single-step trial (spanSamples).
+    static constexpr double kSubstepNextFactor = 4.0;
+    bool substepNext_ = false;
     double freeVelocity_[ModalResonatorT<Real>::kFreeRunMax]; // runFree's scratch
 };
 
