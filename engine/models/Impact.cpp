@@ -414,21 +414,11 @@ double HuntCrossleyImpactT<Real>::spanSamples(const float* fext, float* out, int
         // One step from force f0 to f1; when the bodies touch in it, `sub` exact sub-steps.
         // Inside a strike the single-step trial is discarded sample after sample (its force
         // changes by far more than substepForceChange): after a sample whose force changed by
-        // more than kSubstepNextFactor times that, the next one is sub-stepped at once. (Sub-steps
-        // are never less accurate than the single step; where the trial would have been
-        // discarded, the samples are exactly those of trying it first.)
+        // more than kSubstepNextFactor times that, the next one is sub-stepped at once (see
+        // substepSample). Sub-steps are never less accurate than the single step; where the
+        // trial would have been discarded, the samples are exactly those of trying it first.
         const auto advance = [&](double f0, double f1) {
-            if (!substepNext_ && step(f0, f1, sub > 1, y)) return;
-            const double before = lastForce_;
-            setFineRate(true);
-            for (int j = 0; j < sub; ++j)
-                step(f0 + (f1 - f0) * double(j) / sub, f0 + (f1 - f0) * double(j + 1) / sub, false,
-                     y);
-            setFineRate(false);
-            substepNext_ =
-                sub > 1 && lastForce_ > 0.0 &&
-                std::fabs(lastForce_ - before) >
-                    kSubstepNextFactor * params_.substepForceChange * std::max(lastForce_, before);
+            if (substepNext_ || !step(f0, f1, sub > 1, y)) substepSample(f0, f1, y);
         };
         if constexpr (Single) { // (the same force values as the general interpolation below gives)
             advance(lastExternal_, lastExternal_ + (fNext - lastExternal_));
@@ -445,6 +435,20 @@ double HuntCrossleyImpactT<Real>::spanSamples(const float* fext, float* out, int
         peak = std::max(peak, std::fabs(y));
     }
     return peak;
+}
+
+template <typename Real>
+void HuntCrossleyImpactT<Real>::substepSample(double f0, double f1, double& y) noexcept {
+    const int sub = params_.contactSubsteps;
+    const double before = lastForce_;
+    setFineRate(true);
+    for (int j = 0; j < sub; ++j)
+        step(f0 + (f1 - f0) * double(j) / sub, f0 + (f1 - f0) * double(j + 1) / sub, false, y);
+    setFineRate(false);
+    substepNext_ =
+        sub > 1 && lastForce_ > 0.0 &&
+        std::fabs(lastForce_ - before) >
+            kSubstepNextFactor * params_.substepForceChange * std::max(lastForce_, before);
 }
 
 // Free flight: between strikes the sole flies off the floor while the floor rings. A sample in

@@ -132,6 +132,9 @@ class HuntCrossleyImpactT {
         double peak = 0.0;
     };
     FreeRun runFree(const float* externalForceN, int from, int n, float* out) noexcept;
+    /// One sample from external force f0 to f1 as contactSubsteps exact sub-steps (the rare
+    /// path of spanSamples, kept out of its loop); y is the output after the last.
+    [[gnu::noinline]] void substepSample(double f0, double f1, double& y) noexcept;
     void sleepDecision() noexcept; // at a grid point
 
     ImpactParams params_;
