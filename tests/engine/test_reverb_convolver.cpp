@@ -65,7 +65,7 @@ Stereo run(Convolver& c, const std::vector<float>& x, int block) {
 } // namespace
 
 TEST(Convolver, MatchesDirectConvolutionForBlockSizesAndIrLengths) {
-    for (std::size_t irLen : {1u, 10u, 64u, 65u, 200u, 1024u, 1025u, 1500u, 2100u, 12000u}) {
+    for (std::size_t irLen : {1u, 10u, 64u, 65u, 200u, 1024u, 1025u, 1500u, 2100u, 5000u, 12000u}) {
         for (int channels : {1, 2}) {
             const AudioBuffer ir = noiseIr(irLen, channels, irLen * 3 + channels);
             // Input: noise followed by silence, so that the whole tail is compared.
