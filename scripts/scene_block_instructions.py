@@ -10,9 +10,11 @@ dumps callgrind's counts after every 64-frame block with the label "<scene> <blo
 zeroes the counts; client requests in app/cli/cmd_bench.cpp), so each dump's total is one
 block's instructions (plus the loop's few, the same for every block). The script reads the dumps
 and prints, per scene: median, p99 and worst instructions per block, p99 / median,
-worst / median and the worst block (its index and start time); then, per scene, what the worst
-block spends its instructions on beside a median block (inclusive and self instructions per
-function, from callgrind's call graph).
+worst / median and the worst block (its index and start time); for the scenes with a room, the
+same figures for the reverb's own instructions per block (`Convolver::process`, inclusive), so
+that what the reverb adds to a block is seen apart from the surfaces' strikes and grains; then,
+per scene, what the worst block spends its instructions on beside a median block (inclusive and
+self instructions per function, from callgrind's call graph).
 
     python3 scripts/scene_block_instructions.py             # every shipped scene, --seconds 5
     python3 scripts/scene_block_instructions.py --scene wood_reverb --seconds 1 --top 12
@@ -157,6 +159,61 @@ def read_functions(path, offset, names=None):
             elif key == "calls":
                 after_calls = True
     return funcs
+
+
+REVERB_FUNCTION = "underfoot::engine::Convolver::process("
+
+
+def function_per_part(path, prefix, names=None):
+    """Inclusive instructions of the functions whose name starts with `prefix`, per part of a
+    combined callgrind file, in one pass over it: {byte offset of the part: inclusive}. When
+    several functions match (GCC's `[clone .part.0]` of a function is called by the function
+    itself), a part's figure is the largest of their inclusive costs, i.e. the outer one's.
+    Parts where none runs are absent."""
+    if names is None:
+        names = read_names(path)
+    targets = {k for k, v in names["fn"].items() if v.startswith(prefix)}
+    result = {}
+    if not targets:
+        return result
+    npos = 1
+    part_offset = 0
+    per_fn = {}
+    current_is_target = False
+    current = None
+
+    def close_part():
+        if per_fn:
+            result[part_offset] = max(per_fn.values())
+
+    offset = 0
+    with open(path, "rb") as f:
+        for raw in f:
+            line_offset = offset
+            offset += len(raw)
+            if raw.startswith(b"part:"):
+                close_part()
+                per_fn = {}
+                part_offset = line_offset
+                current_is_target = False
+                continue
+            if raw.startswith(b"positions:"):
+                npos = len(raw.split(b":", 1)[1].split())
+                continue
+            if raw.startswith(b"fn="):
+                value = raw[3:].decode("utf-8", "replace").strip()
+                key = value[1:value.find(")")] if value.startswith("(") else None
+                if key is not None and key not in names["fn"]:
+                    key = None
+                current = key
+                current_is_target = key in targets
+                continue
+            if current_is_target and raw[:1] and (raw[:1].isdigit() or raw[:1] in b"+-*"):
+                fields = raw.split()
+                cost = int(fields[npos]) if len(fields) > npos else 0
+                per_fn[current] = per_fn.get(current, 0) + cost
+    close_part()
+    return result
 
 
 # --- figures ---------------------------------------------------------------------------------
@@ -311,6 +368,13 @@ def report_scene(out_file, info, top):
         excess.append((d, fn))
     excess.sort(reverse=True)
     st["excess"] = [(fn, d) for d, fn in excess[:top] if d > 0]
+    # The reverb's own instructions per block (the convolver called by the scene, inclusive).
+    if info["reverb_taps"]:
+        reverb = function_per_part(out_file, REVERB_FUNCTION, names)
+        per_block = [reverb.get(o, 0) for o in offsets]
+        if all(per_block):
+            st["reverb"] = block_stats(per_block)
+            st["reverb_at_scene_worst"] = per_block[st["worst_block"]]
     return st, counts
 
 
@@ -391,6 +455,21 @@ def main(argv=None):
               f"{st['worst_block']} ({t:.3f} s) | "
               f"{'yes' if st['worst'] <= 2 * st['median'] else 'no'} |")
     print()
+    with_reverb = [(info, st) for info, st, _, _ in results if "reverb" in st]
+    if with_reverb:
+        print("The reverb's own instructions per block (`Convolver::process`, inclusive), in the "
+              "same runs:\n")
+        print("| scene | reverb taps | median | p99 | worst | worst / median | worst block (start) "
+              "| the scene's worst block: reverb / the reverb's median |")
+        print("|---|---:|---:|---:|---:|---:|---|---:|")
+        for info, st in with_reverb:
+            r = st["reverb"]
+            t = r["worst_block"] * st["seconds_per_block"]
+            at_scene_worst = st["reverb_at_scene_worst"] / r["median"]
+            print(f"| {info['name']} | {info['reverb_taps']} | {r['median']:,} | {r['p99']:,} | "
+                  f"{r['worst']:,} | {r['worst_over_median']:.2f} | {r['worst_block']} "
+                  f"({t:.3f} s) | {at_scene_worst:.2f} |")
+        print()
     for info, st, _, elapsed in results:
         t = st["worst_block"] * st["seconds_per_block"]
         mt = st["median_block"] * st["seconds_per_block"]

@@ -165,6 +165,18 @@ class ReadingDumps(unittest.TestCase):
         self.assertEqual(sum(v[0] for v in fns.values()), 300)  # self costs add up to totals
         self.assertEqual(sbi.read_functions(self.path, parts[2][2]), {top: [200, 200]})
 
+    def test_one_function_inclusive_per_part_in_one_pass(self):
+        parts = sbi.read_parts(self.path)
+        offsets = [p[2] for p in parts]
+        # child(int) runs in parts 1 and 2 only: inclusive 90, then 250 + 45 (its memset call).
+        got = sbi.function_per_part(self.path, "underfoot::engine::child(")
+        self.assertEqual(got, {offsets[0]: 90, offsets[1]: 295})
+        # Two matching functions (an outer one and what it calls): the outer one's figure.
+        got = sbi.function_per_part(self.path, "")
+        self.assertEqual(got, {offsets[0]: 100, offsets[1]: 300, offsets[2]: 200,
+                               offsets[3]: 21})
+        self.assertEqual(sbi.function_per_part(self.path, "nothing("), {})
+
     def test_figures_as_scene_bench_computes_them(self):
         counts = list(range(1, 201))  # 200 blocks: median s[100], p99 s[198]
         st = sbi.block_stats(counts)
@@ -233,14 +245,21 @@ class OneSceneUnderCallgrind(unittest.TestCase):
                                capture_output=True, text=True, timeout=120)
             self.assertEqual(r.returncode, 0, r.stderr[-3000:])
             self.assertIn("--tool=callgrind", r.stderr)  # the command is named
+            # Two rows: the scene's blocks, then the reverb's own instructions per block.
             row = [ln for ln in r.stdout.splitlines() if ln.startswith("| wood_reverb |")]
-            self.assertEqual(len(row), 1, r.stdout)
+            self.assertEqual(len(row), 2, r.stdout)
             cells = [c.strip() for c in row[0].strip("|").split("|")]
+            reverb = [c.strip() for c in row[1].strip("|").split("|")]
+            self.assertEqual(reverb[1], "42240")
+            reverb_median, reverb_worst = (int(reverb[i].replace(",", "")) for i in (2, 4))
+            self.assertGreater(reverb_median, 1000)  # the convolver ran in every block
+            self.assertGreaterEqual(reverb_worst, reverb_median)
             self.assertEqual(cells[1], "42240")
             blocks = int(cells[2])
             median, worst = (int(cells[i].replace(",", "")) for i in (3, 5))
             self.assertGreater(median, 10000)  # a block of scene and reverb, not an empty dump
             self.assertGreaterEqual(worst, median)
+            self.assertLess(reverb_median, median)  # a part of the scene's block
             with open(csv, encoding="utf-8") as f:
                 lines = f.read().split()
             self.assertEqual(len(lines), blocks + 1)
