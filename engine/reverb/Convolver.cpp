@@ -393,7 +393,9 @@ struct Convolver::Stage {
     /// acc[c] (+)= sum over j in [j0, j1) of X[block - j] * H[c][j], bin by bin, in the order of
     /// j; `first`: the sums start from 0. Bins [b0, b1) only (multiples of kLanes): the order of
     /// the operations per bin does not depend on the range.
-    /// (The schedule never mixes the newest partition, j = 0, with the older ones in a run.)
+    /// (The schedule never mixes the newest partition, j = 0, with the older ones in a run, and
+    /// runs the older ones over all of [1, N) per bin range: such a run first copies that range
+    /// of the previous period's newest spectrum into the ring.)
     void runMac(int j0, int j1, bool first, int b0, int b1) noexcept {
         const auto k0 = static_cast<std::size_t>(b0 / kLanes);
         const auto ch = static_cast<std::size_t>(channels);
