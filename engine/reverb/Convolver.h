@@ -14,7 +14,8 @@
 ///  - taps [512, 4096) run in a stage with P = 256 and taps [4096, end) in one with P = 2048.
 ///    Such a stage starts at tap T = 2P: the output of input block k (samples [kP, (k+1)P)) is
 ///    first needed at sample kP + T = (k+2)P, so its work (one forward FFT of 2P points, one
-///    complex multiply-add per bin, partition and channel, one inverse FFT per channel) may take
+///    complex multiply-add per bin, partition and channel, the inverse FFT: for a stereo IR one
+///    complex FFT of L + i R, whose real and imaginary parts are l and r) may take
 ///    the whole next period. It is cut into P / 64 slices (a schedule fixed in prepare() by
 ///    estimated cost; order: the products of the older spectra, the forward FFT, the newest
 ///    product, the inverse FFTs), and one slice runs every 64 input samples.
