@@ -70,8 +70,9 @@ TEST(VirtualWalker, PeaksValleyAndTimingMatchTheParameters) {
             // Stance = duty factor x stride.
             const double stance = double(off - on) / fs;
             EXPECT_NEAR(stance, VirtualWalker::dutyFactor(cadence) * stride, 1.5 / fs);
-            const auto at = [&](double s) {
-                return on + static_cast<std::size_t>(s * stance * fs);
+            // (the onset copied: clang before 16 cannot capture a structured binding)
+            const auto at = [&, onset = on](double s) {
+                return onset + static_cast<std::size_t>(s * stance * fs);
             };
             // Heel peak: the maximum in s in [0.1, 0.4] is at s = 0.25 and equals F1.
             auto maxIn = [&](double a, double b) {
