@@ -802,17 +802,23 @@ void Convolver::prepare(const AudioBuffer& impulseResponse, double sampleRateHz,
         s->frame.allocate(P2);
         s->spectrum.allocate(2 * static_cast<std::size_t>(s->bins));
         s->time.allocate(P2);
+        // The inverse: split transforms in pieces, else one complex FFT for a stereo IR, else
+        // (mono) a real one. The real forward FFT also computes the partitions' spectra below.
+        const bool split = s->slack && P >= kSplitPartition;
+        const bool realInverse = !split && !stereoIr_;
         {
             std::lock_guard<std::mutex> lock(plannerMutex());
             s->forward.p = fftwf_plan_dft_r2c_1d(
                 2 * P, s->frame.p, reinterpret_cast<fftwf_complex*>(s->spectrum.p), FFTW_ESTIMATE);
-            s->inverse.p = fftwf_plan_dft_c2r_1d(
-                2 * P, reinterpret_cast<fftwf_complex*>(s->spectrum.p), s->time.p, FFTW_ESTIMATE);
+            if (realInverse)
+                s->inverse.p =
+                    fftwf_plan_dft_c2r_1d(2 * P, reinterpret_cast<fftwf_complex*>(s->spectrum.p),
+                                          s->time.p, FFTW_ESTIMATE);
         }
-        if (s->forward.p == nullptr || s->inverse.p == nullptr)
+        if (s->forward.p == nullptr || (realInverse && s->inverse.p == nullptr))
             throw std::runtime_error(
                 fmt::format("Convolver: FFTW could not plan a {}-point transform", 2 * P));
-        if (stereoIr_ && !(s->slack && P >= kSplitPartition)) {
+        if (!split && stereoIr_) {
             const auto n = static_cast<std::size_t>(2 * P);
             s->cA.allocate(2 * n);
             s->cB.allocate(2 * n);
@@ -824,7 +830,7 @@ void Convolver::prepare(const AudioBuffer& impulseResponse, double sampleRateHz,
                 throw std::runtime_error(fmt::format(
                     "Convolver: FFTW could not plan a {}-point complex transform", 2 * P));
         }
-        if (s->slack && P >= kSplitPartition) {
+        if (split) {
             s->split = true;
             s->n2 = 64;
             s->n1 = 2 * P / s->n2;
