@@ -64,8 +64,7 @@ void HuntCrossleyImpactT<Real>::prepare(const ProcessSpec& spec) {
     fineKd_ = fineT_ / (2.0 * M) + resonator_.mobility(0);
     for (auto* sc : {&coarseConstants_, &fineConstants_}) {
         const double t = sc == &fineConstants_ ? fineT_ : coarseT_;
-        // (the values the step used to compute inline, in the same order)
-        *sc = {t * t, t * t / (6.0 * M), 0.5 * t / M, 0.5 * t};
+        *sc = {t * t / 3.0, t * t / 6.0, t * t / (6.0 * M), 0.5 * t / M, 0.5 * t, 1.0 / M};
     }
     setFineRate(false);
     if (params_.oversampling > 1)
@@ -86,6 +85,8 @@ template <typename Real>
 void HuntCrossleyImpactT<Real>::reset() noexcept {
     freeRetryIn_ = 0;
     substepNext_ = false;
+    newtonStart_ = -1.0;
+    subForce1_ = subForce2_ = 0.0;
     setFineRate(false);
     resonator_.reset();
     decimator_.reset();
@@ -127,18 +128,33 @@ inline double rootOf(double x) noexcept {
 
 template <typename Real>
 template <typename HuntCrossleyImpactT<Real>::Shape S>
+inline double HuntCrossleyImpactT<Real>::contactForceOf(double c, double cdot, double& ca,
+                                                        double& slope) const noexcept {
+    // c^alpha and its derivative alpha c^(alpha - 1): the shapes in use without pow or a
+    // division (chosen once in prepare()), so that Newton's slope needs no division either.
+    if constexpr (S == Shape::Linear) {
+        ca = c;
+        slope = 1.0;
+    } else if constexpr (S == Shape::Hertz) {
+        const double root = rootOf(c);
+        ca = c * root;
+        slope = 1.5 * root;
+    } else if constexpr (S == Shape::Square) {
+        ca = c * c;
+        slope = 2.0 * c;
+    } else {
+        ca = std::pow(c, params_.alpha);
+        slope = params_.alpha * ca / c;
+    }
+    return std::max(0.0, stiffness_ * ca * (1.0 + dissipation_ * cdot));
+}
+
+template <typename Real>
+template <typename HuntCrossleyImpactT<Real>::Shape S>
 inline double HuntCrossleyImpactT<Real>::contactForceOf(double c, double cdot) const noexcept {
     if (c <= 0.0) return 0.0;
-    double ca; // c^alpha: the shapes in use without pow (chosen once in prepare())
-    if constexpr (S == Shape::Linear)
-        ca = c;
-    else if constexpr (S == Shape::Hertz)
-        ca = c * rootOf(c);
-    else if constexpr (S == Shape::Square)
-        ca = c * c;
-    else
-        ca = std::pow(c, params_.alpha);
-    return std::max(0.0, stiffness_ * ca * (1.0 + dissipation_ * cdot));
+    double ca, slope;
+    return contactForceOf<S>(c, cdot, ca, slope);
 }
 
 template <typename Real>
@@ -177,8 +193,15 @@ double HuntCrossleyImpactT<Real>::solveShaped(double ch, double dh) noexcept {
     // g(F) = F - HC(ch - kc F, dh - kd F) is increasing in F; its root lies in [0, fMax],
     // fMax = HC(ch, dh) (HC falls as F compresses less and slower). Newton from the last force.
     double f = lastForce_;
+    if (newtonStart_ >= 0.0) f = newtonStart_; // (a sub-step's: see substepSample)
     double c = ch - kc_ * f, cd = dh - kd_ * f;
-    double hc = contactForceOf<S>(c, cd);
+    // HC at (c, cd), and c^alpha and alpha c^(alpha - 1) there for Newton's slope (left as they
+    // were where c <= 0: HC is then 0 and the slope is not used).
+    double ca = 0.0, slope = 0.0;
+    auto law = [&](double cc, double ccd) {
+        return cc > 0.0 ? contactForceOf<S>(cc, ccd, ca, slope) : 0.0;
+    };
+    double hc = law(c, cd);
     double g = f - hc;
     // A contact at rest (a sole pressed on the floor) is usually solved by the last force
     // already: |g| <= tol hc implies the criterion below, |g| <= tol fMax, as hc <= fMax; fMax is
@@ -190,7 +213,7 @@ double HuntCrossleyImpactT<Real>::solveShaped(double ch, double dh) noexcept {
     if (f > hi) { // start inside the bracket
         f = hi;
         c = ch - kc_ * f, cd = dh - kd_ * f;
-        hc = contactForceOf<S>(c, cd);
+        hc = law(c, cd);
         g = f - hc;
     }
     int it = 0;
@@ -204,16 +227,20 @@ double HuntCrossleyImpactT<Real>::solveShaped(double ch, double dh) noexcept {
         double dg = 1.0;
         if (hc > 0.0) {
             // dHC/dF = -(k a c^(a-1) (1 + mu cd) kc + k c^a mu kd)
-            const double a = params_.alpha, k = stiffness_, mu = dissipation_;
-            const double ca = hc / (k * (1.0 + mu * cd)); // c^a, reused
-            dg += k * (a * ca / c * (1.0 + mu * cd) * kc_ + ca * mu * kd_);
+            const double k = stiffness_, mu = dissipation_;
+            dg += k * (slope * (1.0 + mu * cd) * kc_ + ca * mu * kd_);
         }
-        double next = f - g / dg;
-        if (!(next > lo && next < hi)) next = 0.5 * (lo + hi); // safeguard: bisect
+        const double delta = g / dg;
+        double next = f - delta;
+        const bool newton = next > lo && next < hi;
+        if (!newton) next = 0.5 * (lo + hi); // safeguard: bisect
         f = next;
         if (++it == iterations) break; // (the last step is not evaluated)
+        // A Newton step this small leaves an error of the order of its square (1e-12 fMax and
+        // below, far inside the tolerance): accepted without evaluating HC again.
+        if (newton && std::fabs(delta) <= 1e-6 * fMax) break;
         c = ch - kc_ * f, cd = dh - kd_ * f;
-        hc = contactForceOf<S>(c, cd);
+        hc = law(c, cd);
         g = f - hc;
     }
     stats_.solverIterations += it;
@@ -225,7 +252,7 @@ template <typename Real>
 bool HuntCrossleyImpactT<Real>::step(double fextNow, double fextNext, bool abortOnContact,
                                      double& y) noexcept {
     const double M = params_.exciterMassKg, T = T_;
-    const double aNextExt = fextNext / M;
+    const double aNextExt = fextNext * stepConstants_.perMass;
 
     // One trial of the sample: the contact force held from n is scaled by `held` (1 = as solved
     // at n) and the new force by `scale`. Both bodies are integrated exactly for the linear force
@@ -235,7 +262,7 @@ bool HuntCrossleyImpactT<Real>::step(double fextNow, double fextNext, bool abort
         double force, x, v, energy, work;
     };
     auto trial = [&](double held, double scale) {
-        const double aNow = (fextNow - held * lastForce_) / M;
+        const double aNow = (fextNow - held * lastForce_) * stepConstants_.perMass;
         double xPred, vPred;
         soleWithoutContact(stepConstants_, T, exciterX_, exciterV_, aNow, aNextExt, xPred, vPred);
         resonator_.predict(held);
@@ -441,14 +468,32 @@ template <typename Real>
 void HuntCrossleyImpactT<Real>::substepSample(double f0, double f1, double& y) noexcept {
     const int sub = params_.contactSubsteps;
     const double before = lastForce_;
-    setFineRate(true);
-    for (int j = 0; j < sub; ++j)
+    // (still at the fine rate when the sample before was sub-stepped and chose this one)
+    if (!resonator_.fineRate()) setFineRate(true);
+    for (int j = 0; j < sub; ++j) {
+        // Newton starts from the force extrapolated from the last sub-steps' (quadratically
+        // from three, linearly from two; inside a strike that saves about a third of the
+        // iterations); a resting contact's single steps start from the last force.
+        const double f = lastForce_;
+        newtonStart_ = f > 0.0 && subForce1_ > 0.0
+                           ? std::max(0.0, subForce2_ > 0.0 ? 3.0 * (f - subForce1_) + subForce2_
+                                                            : 2.0 * f - subForce1_)
+                           : f;
         step(f0 + (f1 - f0) * double(j) / sub, f0 + (f1 - f0) * double(j + 1) / sub, false, y);
-    setFineRate(false);
+        subForce2_ = subForce1_;
+        subForce1_ = f;
+    }
+    newtonStart_ = -1.0;
     substepNext_ =
         sub > 1 && lastForce_ > 0.0 &&
         std::fabs(lastForce_ - before) >
             kSubstepNextFactor * params_.substepForceChange * std::max(lastForce_, before);
+    // The next sample is sub-stepped too: stay at the fine rate (switching settles the deferred
+    // commit in a pass of its own; the next sub-step's pass then does it, with the same values).
+    if (!substepNext_) {
+        setFineRate(false);
+        subForce1_ = subForce2_ = 0.0; // (the next sub-steps start a new history)
+    }
 }
 
 // Free flight: between strikes the sole flies off the floor while the floor rings. A sample in
@@ -469,7 +514,7 @@ HuntCrossleyImpactT<Real>::runFree(const float* fext, int from, int n, float* ou
     if (!resonator_.ringsFree()) return {};
     const double margin = 1.01 * resonator_.freeContactBound(); // (NaN: no run)
     const int most = std::min(n - from, ModalResonatorT<Real>::kFreeRunMax);
-    const double M = params_.exciterMassKg, T = T_, held = lastForce_;
+    const double T = T_, held = lastForce_;
     const StepConstants constants = stepConstants_;
     double x = exciterX_, v = exciterV_, last = lastExternal_, time = time_;
     int count = 0;
@@ -477,9 +522,9 @@ HuntCrossleyImpactT<Real>::runFree(const float* fext, int from, int n, float* ou
         // As spanSamples' advance() and step()'s trial(1, 1) for this sample.
         const double fNext = fext ? double(fext[from + count]) : 0.0;
         const double f1 = last + (fNext - last);
-        const double aNow = (last - 1.0 * held) / M;
+        const double aNow = (last - 1.0 * held) * constants.perMass;
         double xPred, vPred;
-        soleWithoutContact(constants, T, x, v, aNow, f1 / M, xPred, vPred);
+        soleWithoutContact(constants, T, x, v, aNow, f1 * constants.perMass, xPred, vPred);
         if (!(xPred < -margin)) break;
         x = xPred;
         v = vPred;

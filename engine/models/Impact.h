@@ -152,17 +152,22 @@ class HuntCrossleyImpactT {
     double kc_ = 0, kd_ = 0; // instantaneous compliance and mobility of the compression
     // Per-step constants of the current rate (setFineRate) and the contact law's (prepare).
     struct StepConstants {
-        double tt, xPerForce, vPerForce, halfT; // T^2, T^2 / 6M, T / 2M, T / 2
+        // T^2 / 3, T^2 / 6, T^2 / 6M, T / 2M, T / 2, 1 / M: multiplications only, as the step's
+        // chain from one contact force to the next runs through them (a division's latency is
+        // several multiplications').
+        double ttThird, ttSixth, xPerForce, vPerForce, halfT, perMass;
     };
     StepConstants stepConstants_{}, coarseConstants_{}, fineConstants_{};
     // The sole's position and velocity at n+1 from (x, v) under the accelerations aNow at n and
     // aNext at n+1 (linear in between), with no new contact force: step()'s trials and
-    // runFree's flight, the same operations. (Written through references: returned as a pair,
-    // GCC packed the two into one vector and shuffled them every sample.)
+    // runFree's flight, the same operations. In the position aNow (which holds the last contact
+    // force) is added last, so that the rest is computed while that force is solved. (Written
+    // through references: returned as a pair, GCC packed the two into one vector and shuffled them
+    // every sample.)
     static void soleWithoutContact(const StepConstants& c, double T, double x, double v,
                                    double aNow, double aNext, double& xNext,
                                    double& vNext) noexcept {
-        xNext = x + T * v + c.tt * (aNow / 3.0 + aNext / 6.0);
+        xNext = (x + T * v + c.ttSixth * aNext) + c.ttThird * aNow;
         vNext = v + c.halfT * (aNow + aNext);
     }
     double stiffness_ = 0, dissipation_ = 0;
@@ -170,6 +175,9 @@ class HuntCrossleyImpactT {
     Shape shape_ = Shape::Hertz;
     template <Shape S>
     double contactForceOf(double c, double cdot) const noexcept;
+    // For c > 0: also c^alpha (ca) and alpha c^(alpha - 1) (slope), for Newton's derivative.
+    template <Shape S>
+    double contactForceOf(double c, double cdot, double& ca, double& slope) const noexcept;
     template <Shape S>
     double solveShaped(double ch, double dh) noexcept; // solveForce() for one contact law
     template <typename F>
@@ -185,6 +193,9 @@ class HuntCrossleyImpactT {
     // threshold is followed by a sub-stepped sample without its single-step trial (spanSamples).
     static constexpr double kSubstepNextFactor = 4.0;
     bool substepNext_ = false;
+    // Sub-steps: Newton's start (negative: the last force) and the forces of the two sub-steps
+    // before the last one (0: none), for the extrapolation in substepSample.
+    double newtonStart_ = -1.0, subForce1_ = 0.0, subForce2_ = 0.0;
     double freeVelocity_[ModalResonatorT<Real>::kFreeRunMax]; // runFree's scratch
 };
 
