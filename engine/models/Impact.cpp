@@ -422,8 +422,8 @@ double HuntCrossleyImpactT<Real>::spanSamples(const float* fext, float* out, int
                           listen_ == resonator_.outputPickup(); // (see runFree)
     for (int i = 0; i < n; ++i) {
         if (freeRuns && !inContact_ && lastForce_ == 0.0) { // (runFree's cheap tests)
-            // Right after a contact the sole is still near the floor and runFree() would find no
-            // sample to run: after a failed try, the next samples step without trying.
+            // When the next sample would touch, runFree() finds no sample to run: after a failed
+            // try, the next samples step without trying.
             if (freeRetryIn_ > 0) {
                 --freeRetryIn_;
             } else {
@@ -504,8 +504,11 @@ void HuntCrossleyImpactT<Real>::substepSample(double f0, double f1, double& y) n
 // on the floor's contact displacement over all later free samples (freeContactBound: its modes'
 // energies do not grow; the 1 % covers the rounding of the sums and of a run of at most
 // kFreeRunMax samples); then the floor's modes for those samples in one call (ringFree, bit for
-// bit the per-sample passes). The first sample that could touch goes through step() as before.
-// So the samples, the state and the statistics are exactly those of step() sample by sample.
+// bit the per-sample passes). Right after a contact the sole is still within B of the floor for
+// a few hundred samples; then the floor's modes run sample by sample with step()'s own contact
+// test on the same values (ringFreeUntilContact), up to the first sample that would touch. The
+// first sample that could touch goes through step() as before. So the samples, the state and the
+// statistics are exactly those of step() sample by sample.
 template <typename Real>
 typename HuntCrossleyImpactT<Real>::FreeRun
 HuntCrossleyImpactT<Real>::runFree(const float* fext, int from, int n, float* out) noexcept {
@@ -531,18 +534,61 @@ HuntCrossleyImpactT<Real>::runFree(const float* fext, int from, int n, float* ou
         last = fNext;
         time += T;
     }
-    if (count == 0) return {};
-    stats_.freeRunSamples += count;
+    if (count == 0) return runFreeTested(fext, from, most, out);
     resonator_.ringFree(count, freeVelocity_);
+    return commitFreeRun(count, x, v, last, time, out + from);
+}
+
+// Right after a contact the bound (every later sample of the floor's ringing) is far looser
+// than the floor's next samples: runFree() then runs the floor's modes while its contact point,
+// computed sample by sample, stays clear of the sole (step()'s own test on the same values). The
+// first sample alone first: where it would touch (a contact under way), the try costs one
+// sample's flight and pass. (Out of runFree()'s loop, which it made slower.)
+template <typename Real>
+typename HuntCrossleyImpactT<Real>::FreeRun
+HuntCrossleyImpactT<Real>::runFreeTested(const float* fext, int from, int most,
+                                         float* out) noexcept {
+    const double T = T_, held = lastForce_;
+    const StepConstants constants = stepConstants_;
+    double last = lastExternal_;
+    const auto fly = [&](int t0, int t1) { // the sole's flight for samples [t0, t1), as runFree's
+        for (int t = t0; t < t1; ++t) {
+            const double fNext = fext ? double(fext[from + t]) : 0.0;
+            const double f1 = last + (fNext - last);
+            const double aNow = (last - 1.0 * held) * constants.perMass;
+            soleWithoutContact(constants, T, t == 0 ? exciterX_ : soleX_[t - 1],
+                               t == 0 ? exciterV_ : soleV_[t - 1], aNow, f1 * constants.perMass,
+                               soleX_[t], soleV_[t]);
+            last = fNext;
+        }
+    };
+    fly(0, 1);
+    if (resonator_.ringFreeUntilContact(1, soleX_, freeVelocity_) == 0) return {};
+    fly(1, most);
+    const int count = 1 + resonator_.ringFreeUntilContact(most - 1, soleX_ + 1, freeVelocity_ + 1);
+    stats_.testedRunSamples += count;
+    double time = time_;
+    for (int t = 0; t < count; ++t) time += T;
+    return commitFreeRun(count, soleX_[count - 1], soleV_[count - 1],
+                         fext ? double(fext[from + count - 1]) : 0.0, time, out + from);
+}
+
+// The end of a free run of `count` samples: the sole's state, the external force, the time,
+// the statistics and the output (the floor's velocities in freeVelocity_).
+template <typename Real>
+typename HuntCrossleyImpactT<Real>::FreeRun
+HuntCrossleyImpactT<Real>::commitFreeRun(int count, double x, double v, double last, double time,
+                                         float* out) noexcept {
     exciterX_ = x;
     exciterV_ = v;
     lastExternal_ = last;
+    stats_.freeRunSamples += count;
     time_ = time;
     contactEnergy_ = 0.0;
     double peak = 0.0;
     for (int t = 0; t < count; ++t) {
         const double y = freeVelocity_[t];
-        out[from + t] = static_cast<float>(y);
+        out[t] = static_cast<float>(y);
         peak = std::max(peak, std::fabs(y));
     }
     return {count, peak};

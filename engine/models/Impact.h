@@ -65,6 +65,9 @@ struct ContactStats {
     int maxIterationsInOneSample = 0;
     long long passivityCorrections = 0; ///< samples where the energy guard removed a gain
     long long freeRunSamples = 0;       ///< samples of free flight run at once (runFree)
+    /// of those, samples run with the floor's contact point tested sample by sample (right after
+    /// a contact, where the bound on the floor's ringing is too loose: ringFreeUntilContact)
+    long long testedRunSamples = 0;
 };
 
 template <typename Real>
@@ -132,6 +135,13 @@ class HuntCrossleyImpactT {
         double peak = 0.0;
     };
     FreeRun runFree(const float* externalForceN, int from, int n, float* out) noexcept;
+    [[gnu::noinline]] FreeRun runFreeTested(const float* externalForceN, int from, int most,
+                                            float* out) noexcept;
+    // (Out of line: inlined, its stores of the sole's neighbouring position and velocity made
+    // GCC keep the two packed in one vector through runFree()'s loop, unpacking and repacking
+    // them every sample.)
+    [[gnu::noinline]] FreeRun commitFreeRun(int count, double x, double v, double last, double time,
+                                            float* out) noexcept;
     /// One sample from external force f0 to f1 as contactSubsteps exact sub-steps (the rare
     /// path of spanSamples, kept out of its loop); y is the output after the last.
     [[gnu::noinline]] void substepSample(double f0, double f1, double& y) noexcept;
@@ -196,7 +206,9 @@ class HuntCrossleyImpactT {
     // Sub-steps: Newton's start (negative: the last force) and the forces of the two sub-steps
     // before the last one (0: none), for the extrapolation in substepSample.
     double newtonStart_ = -1.0, subForce1_ = 0.0, subForce2_ = 0.0;
-    double freeVelocity_[ModalResonatorT<Real>::kFreeRunMax]; // runFree's scratch
+    // runFree's scratch: the floor's output velocity, the sole's position and velocity
+    double freeVelocity_[ModalResonatorT<Real>::kFreeRunMax];
+    double soleX_[ModalResonatorT<Real>::kFreeRunMax], soleV_[ModalResonatorT<Real>::kFreeRunMax];
 };
 
 using HuntCrossleyImpact = HuntCrossleyImpactT<double>;

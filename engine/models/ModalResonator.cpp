@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <string>
 #include <type_traits>
+#include <utility>
 
 namespace underfoot::engine {
 namespace {
@@ -353,6 +354,7 @@ void ModalResonatorT<Real>::allowAvx(bool on) noexcept {
     avxAllowed_ = on;
     passes_ = kPasses[on && simdAllowsAvx() ? 1 : 0];
     ring_ = passes_ == kPasses[1] ? &ringAvx : &ringGeneric;
+    ringChecked_ = passes_ == kPasses[1] ? &ringCheckedAvx : &ringCheckedGeneric;
 }
 
 // One pass over the modes, four per step (see the top of the file). With `Fused` (a commit
@@ -515,6 +517,88 @@ template <bool Wide>
     predictedVo_ = voOut[n - 1];
     predictedEnergyValid_ = false;
     commitWithoutForce();
+}
+
+// Free ringing sample by sample with the contact test (ringFreeUntilContact): each sample is
+// the free pass (passBody<Wide, false, false, false, true>) into the prediction buffers, its
+// pickup sums added as that pass adds them; when the contact test passes, the commit(p, 0) that
+// follows it (the buffers swap roles). So the samples run, and the state after them, are those
+// of predict() / commit(p, 0) pairs, bit for bit, and x0 is the x0 step() would test.
+template <typename Real>
+template <bool Wide>
+[[gnu::always_inline]] inline int ModalResonatorT<Real>::ringCheckedBody(int n, const double* soleX,
+                                                                         double* voOut) noexcept {
+    using V = typename Lanes<Real, Wide>::R;
+    using D = typename Lanes<Real, Wide>::D;
+    const std::size_t quads = q_.size() / 4;
+    const QuadCoefficients* c = bank().quads.data();
+    const QuadGains* gg = quadGains_.data();
+    Real *q = q_.data(), *v = v_.data(), *qh = qh_.data(), *vh = vh_.data();
+    double x0Last = 0.0, v0Last = 0.0;
+    int t = 0;
+    for (; t < n; ++t) {
+        D x0{}, v0{}, vo{};
+        for (std::size_t k = 0; k < quads; ++k) {
+            const std::size_t i = 4 * k;
+            const QuadCoefficients& ck = c[k];
+            V qi, vi, a00, a01, a10, a11;
+            load4(qi, q + i);
+            load4(vi, v + i);
+            load4(a00, ck.a00);
+            load4(a01, ck.a01);
+            load4(a10, ck.a10);
+            load4(a11, ck.a11);
+            const V x = a00 * qi + a01 * vi;
+            const V y = a10 * qi + a11 * vi;
+            store4(qh + i, x);
+            store4(vh + i, y);
+            D xd, yd, g0, go;
+            toDouble(xd, x);
+            toDouble(yd, y);
+            load4(g0, gg[k].g0);
+            load4(go, gg[k].go);
+            x0 += g0 * xd;
+            v0 += g0 * yd;
+            vo += go * yd;
+        }
+        const D2 a = pairSum(halves(x0), halves(v0));
+        if (!(soleX[t] - a[0] <= 0.0)) break; // step() would find contact here: not run
+        const D2 voh = halves(vo);
+        voOut[t] = voh[0] + voh[1];
+        x0Last = a[0];
+        v0Last = a[1];
+        std::swap(q, qh); // commit(p, 0): the prediction is the state
+        std::swap(v, vh);
+    }
+    if (t == 0) return 0; // (the state is untouched: only the prediction buffers were written)
+    if (q != q_.data()) { // an odd number of swaps: the state is in the prediction buffers
+        q_.swap(qh_);
+        v_.swap(vh_);
+    }
+    // What the last sample's predict() left, then its commitWithoutForce() (buffers done above).
+    predictedX0_ = x0Last;
+    predictedV0_ = v0Last;
+    predictedVo_ = voOut[t - 1];
+    predictedEnergyValid_ = false;
+    x0_ = predictedX0_;
+    v0_ = predictedV0_;
+    outputVelocity_ = predictedVo_;
+    energyValid_ = false;
+    committedEnergy_ = predictedEnergy_;
+    return t;
+}
+
+template <typename Real>
+int ModalResonatorT<Real>::ringCheckedGeneric(ModalResonatorT& r, int n, const double* soleX,
+                                              double* vo) noexcept {
+    return r.ringCheckedBody<false>(n, soleX, vo);
+}
+
+template <typename Real>
+UNDERFOOT_TARGET_AVX int ModalResonatorT<Real>::ringCheckedAvx(ModalResonatorT& r, int n,
+                                                               const double* soleX,
+                                                               double* vo) noexcept {
+    return r.ringCheckedBody<true>(n, soleX, vo);
 }
 
 template <typename Real>

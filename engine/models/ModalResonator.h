@@ -186,6 +186,16 @@ class ModalResonatorT {
     /// order), with each quad of modes kept in registers over the run. outputVelocity[t] is
     /// sample t's velocity(outputPickup()) after the commit. Requires ringsFree().
     void ringFree(int n, double* outputVelocity) noexcept { ring_(*this, n, outputVelocity); }
+    /// Free ringing sample by sample while a body at soleX[t] (t = 0 .. n - 1, n <= kFreeRunMax)
+    /// stays clear of the contact point: stops before the first sample t whose predicted contact
+    /// position x0 gives !(soleX[t] - x0 <= 0), the test the impact's step makes (compression
+    /// soleX - x0 > 0: contact) on the same x0, bit for bit. Returns the samples run, each what
+    /// predict() then commit(p, 0) gives (as ringFree, outputVelocity[t] likewise); 0 when the
+    /// first sample would touch. Requires ringsFree(). For the samples right after a contact,
+    /// where freeContactBound() is too loose to allow a run.
+    int ringFreeUntilContact(int n, const double* soleX, double* outputVelocity) noexcept {
+        return ringChecked_(*this, n, soleX, outputVelocity);
+    }
     /// A bound on |predictedPosition(0)| over every later sample of free ringing from the
     /// current state: the sum over the modes of |g0| sqrt(q^2 + v^2 / w0^2) (a freely ringing
     /// mode's energy never grows; the discretisation samples its trajectory exactly).
@@ -235,6 +245,15 @@ class ModalResonatorT {
     template <bool Wide>
     void ringBody(int n, double* vo) noexcept;
     RingFn ring_ = &ringGeneric;
+    // ringFreeUntilContact, in the same two kernels.
+    using RingCheckedFn = int (*)(ModalResonatorT&, int, const double*, double*) noexcept;
+    static int ringCheckedGeneric(ModalResonatorT& r, int n, const double* soleX,
+                                  double* vo) noexcept;
+    UNDERFOOT_TARGET_AVX static int ringCheckedAvx(ModalResonatorT& r, int n, const double* soleX,
+                                                   double* vo) noexcept;
+    template <bool Wide>
+    int ringCheckedBody(int n, const double* soleX, double* vo) noexcept;
+    RingCheckedFn ringChecked_ = &ringCheckedGeneric;
     std::vector<double> runSums_; // a run's per-lane output-pickup sums: [sample][lane]
     void commitWithoutForce() noexcept;
     struct Bank {

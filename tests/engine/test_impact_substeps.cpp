@@ -268,17 +268,22 @@ void expectFreeRunsEqualSteps(const ImpactParams& p, const std::vector<Mode>& mo
         EXPECT_EQ(stats.outgoingVelocity, refStats.outgoingVelocity);
         EXPECT_EQ(stats.solvedSamples, refStats.solvedSamples);
         EXPECT_EQ(energy, refEnergy);
-        if (p.solver != ImpactSolver::Explicit) // most of the walk is free flight, run at once
+        if (p.solver != ImpactSolver::Explicit) { // most of the walk is free flight, run at once
             EXPECT_GT(stats.freeRunSamples, static_cast<long long>(ref.size()) * 4 / 5);
-        else
+            // the samples right after the contacts too, with the per-sample contact test
+            EXPECT_GT(stats.testedRunSamples, 0);
+        } else {
             EXPECT_EQ(stats.freeRunSamples, 0);
+        }
     }
     EXPECT_EQ(refStats.freeRunSamples, 0);
+    EXPECT_EQ(refStats.testedRunSamples, 0);
 }
 } // namespace
 
 // Free flight runs at once over the samples where the sole cannot touch the ringing floor
-// (HuntCrossleyImpactT::runFree, ModalResonatorT::ringFree). It must give exactly what stepping
+// (HuntCrossleyImpactT::runFree, ModalResonatorT::ringFree, and right after a contact
+// ModalResonatorT::ringFreeUntilContact). It must give exactly what stepping
 // sample by sample gives: samples, statistics and energy, for any block size, with one quad of
 // modes or several, a mode above Nyquist (quasi-static), two pickups, sub-steps or none, the
 // explicit solver (never run at once), and float state.

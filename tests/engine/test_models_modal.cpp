@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -276,4 +277,67 @@ TEST(ModalResonatorFastPath, AvxAndSse2KernelsGiveTheSameSamples) {
     ModalResonator probe;
     configureBank(probe, 3);
     RecordProperty("avx_kernel_used", probe.usesAvx() ? "yes" : "no (this CPU has no AVX)");
+}
+
+// issue #18: ringFreeUntilContact runs free ringing sample by sample while a body at soleX[t]
+// stays clear of the contact point, and must stop exactly where predict() / commit(0, 0) pairs
+// would first find soleX[t] - predictedPosition(0) > 0, with the same samples and state, in both
+// kernels (AVX and SSE2), for mode counts below, at and across multiples of four; runs of any
+// length, a body that never touches, and one that would touch at once.
+TEST(ModalResonatorFastPath, RingingUntilContactStopsWhereTheSampleBySampleTestDoes) {
+    for (const bool avx : {true, false})
+        for (int n : {1, 3, 4, 5, 12, 14}) {
+            ModalResonator run, ref;
+            configureBank(run, n);
+            configureBank(ref, n);
+            run.allowAvx(avx);
+            ref.allowAvx(avx);
+            for (auto* r : {&run, &ref}) { // ring: a force, then none
+                for (int i = 0; i < 40; ++i) {
+                    r->predict();
+                    r->commit(0, i < 20 ? 30.0 : 0.0);
+                }
+            }
+            ASSERT_TRUE(run.ringsFree());
+            // (one mode is quasi-static here, at rest without a force: a bound of 0)
+            const double a = std::max(1e-9, 1.2 * run.freeContactBound());
+            int total = 0, stops = 0;
+            for (int call = 0; call < 60; ++call) {
+                // a body that swings about the contact point's range (and sometimes far away)
+                double sole[ModalResonator::kFreeRunMax];
+                const int len = 1 + (call * 7) % ModalResonator::kFreeRunMax;
+                for (int t = 0; t < len; ++t)
+                    sole[t] = call % 5 == 4
+                                  ? -10.0 * a
+                                  : a * std::sin(0.05 * (total + t) + 0.3 * call) - 0.6 * a;
+                double vo[ModalResonator::kFreeRunMax];
+                const int k = run.ringFreeUntilContact(len, sole, vo);
+                ASSERT_GE(k, 0);
+                ASSERT_LE(k, len);
+                // the reference: sample by sample, stopping where the test finds contact
+                int expected = 0;
+                for (; expected < len; ++expected) {
+                    ref.predict();
+                    if (!(sole[expected] - ref.predictedPosition(0) <= 0.0)) break;
+                    ref.commit(0, 0.0);
+                    ASSERT_EQ(vo[expected], ref.velocity(ref.outputPickup())) << n << " " << call;
+                }
+                ASSERT_EQ(k, expected) << n << " " << call;
+                if (k < len) {
+                    ++stops;
+                    // the reference predicted the touching sample: step it with no force, as the
+                    // caller's contact step would with a force, then both go on alike
+                    ref.commit(0, 0.0);
+                    run.predict();
+                    run.commit(0, 0.0);
+                }
+                EXPECT_EQ(run.contactVelocity(), ref.contactVelocity()) << n << " " << call;
+                EXPECT_EQ(run.position(0), ref.position(0)) << n << " " << call;
+                EXPECT_EQ(run.velocity(1), ref.velocity(1)) << n << " " << call;
+                EXPECT_EQ(run.energy(), ref.energy()) << n << " " << call;
+                total += k;
+            }
+            EXPECT_GT(stops, 5) << n;   // the test did stop runs
+            EXPECT_GT(total, 200) << n; // and ran samples
+        }
 }
