@@ -114,6 +114,37 @@ template <typename D>
     const D2 h = halves(v);
     return h[0] + h[1];
 }
+// Loads modes i..i+3's state (q, v) and the free transition's coefficients: the start of the
+// free-ringing kernels (ringBody, ringCheckedBody).
+template <typename V, typename Real, typename Coefficients>
+[[gnu::always_inline]] inline void loadFreeQuad(V& qi, V& vi, V& a00, V& a01, V& a10, V& a11,
+                                                const Coefficients& ck, const Real* q,
+                                                const Real* v) noexcept {
+    load4(qi, q);
+    load4(vi, v);
+    load4(a00, ck.a00);
+    load4(a01, ck.a01);
+    load4(a10, ck.a10);
+    load4(a11, ck.a11);
+}
+// Stores modes i..i+3's prediction (x, y) and adds it to the pickup sums as the passes add it:
+// the contact pickup's position x0 and velocity v0, the output pickup's velocity vo; (xd, yd)
+// is the prediction in double.
+template <typename V, typename D, typename Real, typename Gains>
+[[gnu::always_inline]] inline void storeAndSum(const V& x, const V& y, const Gains& g, Real* qh,
+                                               Real* vh, D& xd, D& yd, D& x0, D& v0,
+                                               D& vo) noexcept {
+    store4(qh, x);
+    store4(vh, y);
+    toDouble(xd, x);
+    toDouble(yd, y);
+    D g0, go;
+    load4(g0, g.g0);
+    load4(go, g.go);
+    x0 += g0 * xd;
+    v0 += g0 * yd;
+    vo += go * yd;
+}
 // Completes a deferred commit for modes i..i+3 (see commit()): u = F g / m, q = qh + b1x u,
 // v = vh + b1v u, stored, and returned in (q, v, u) for the pass that goes on from there.
 template <typename V, typename Real, typename Coefficients>
@@ -404,16 +435,8 @@ template <bool Wide, bool Energy, bool Fused, bool Held, bool Free>
             x = a00 * qi + a01 * vi + b0x * ui;
             y = a10 * qi + a11 * vi + b0v * ui;
         }
-        store4(qh + i, x);
-        store4(vh + i, y);
-        D xd, yd, g0, go;
-        toDouble(xd, x);
-        toDouble(yd, y);
-        load4(g0, gg[k].g0);
-        load4(go, gg[k].go);
-        x0 += g0 * xd;
-        v0 += g0 * yd;
-        vo += go * yd;
+        D xd, yd;
+        storeAndSum(x, y, gg[k], qh + i, vh + i, xd, yd, x0, v0, vo);
         if constexpr (Energy) {
             D kin, pot, lv, lx;
             load4(kin, gg[k].kin);
@@ -473,14 +496,8 @@ template <bool Wide>
     D x0{}, v0{};
     for (std::size_t k = 0; k < quads; ++k) {
         const std::size_t i = 4 * k;
-        const QuadCoefficients& ck = c[k];
         V qi, vi, a00, a01, a10, a11;
-        load4(qi, q + i);
-        load4(vi, v + i);
-        load4(a00, ck.a00);
-        load4(a01, ck.a01);
-        load4(a10, ck.a10);
-        load4(a11, ck.a11);
+        loadFreeQuad(qi, vi, a00, a01, a10, a11, c[k], q + i, v + i);
         D g0, go, yd{};
         load4(g0, gg[k].g0);
         load4(go, gg[k].go);
@@ -540,26 +557,12 @@ template <bool Wide>
         D x0{}, v0{}, vo{};
         for (std::size_t k = 0; k < quads; ++k) {
             const std::size_t i = 4 * k;
-            const QuadCoefficients& ck = c[k];
             V qi, vi, a00, a01, a10, a11;
-            load4(qi, q + i);
-            load4(vi, v + i);
-            load4(a00, ck.a00);
-            load4(a01, ck.a01);
-            load4(a10, ck.a10);
-            load4(a11, ck.a11);
+            loadFreeQuad(qi, vi, a00, a01, a10, a11, c[k], q + i, v + i);
             const V x = a00 * qi + a01 * vi;
             const V y = a10 * qi + a11 * vi;
-            store4(qh + i, x);
-            store4(vh + i, y);
-            D xd, yd, g0, go;
-            toDouble(xd, x);
-            toDouble(yd, y);
-            load4(g0, gg[k].g0);
-            load4(go, gg[k].go);
-            x0 += g0 * xd;
-            v0 += g0 * yd;
-            vo += go * yd;
+            D xd, yd;
+            storeAndSum(x, y, gg[k], qh + i, vh + i, xd, yd, x0, v0, vo);
         }
         const D2 a = pairSum(halves(x0), halves(v0));
         if (!(soleX[t] - a[0] <= 0.0)) break; // step() would find contact here: not run
@@ -571,20 +574,17 @@ template <bool Wide>
         std::swap(v, vh);
     }
     if (t == 0) return 0; // (the state is untouched: only the prediction buffers were written)
-    if (q != q_.data()) { // an odd number of swaps: the state is in the prediction buffers
+    // The last sample's predict() left its prediction in the prediction buffers, then its
+    // commit(p, 0) swaps them in (an even number of swaps above left it in the state's).
+    if (q == q_.data()) {
         q_.swap(qh_);
         v_.swap(vh_);
     }
-    // What the last sample's predict() left, then its commitWithoutForce() (buffers done above).
     predictedX0_ = x0Last;
     predictedV0_ = v0Last;
     predictedVo_ = voOut[t - 1];
     predictedEnergyValid_ = false;
-    x0_ = predictedX0_;
-    v0_ = predictedV0_;
-    outputVelocity_ = predictedVo_;
-    energyValid_ = false;
-    committedEnergy_ = predictedEnergy_;
+    commitWithoutForce();
     return t;
 }
 
