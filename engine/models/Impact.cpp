@@ -522,12 +522,9 @@ HuntCrossleyImpactT<Real>::runFree(const float* fext, int from, int n, float* ou
     double x = exciterX_, v = exciterV_, last = lastExternal_, time = time_;
     int count = 0;
     for (; count < most; ++count) {
-        // As spanSamples' advance() and step()'s trial(1, 1) for this sample.
         const double fNext = fext ? double(fext[from + count]) : 0.0;
-        const double f1 = last + (fNext - last);
-        const double aNow = (last - 1.0 * held) * constants.perMass;
         double xPred, vPred;
-        soleWithoutContact(constants, T, x, v, aNow, f1 * constants.perMass, xPred, vPred);
+        soleInFreeRun(constants, T, held, last, fNext, x, v, xPred, vPred);
         if (!(xPred < -margin)) break;
         x = xPred;
         v = vPred;
@@ -551,14 +548,11 @@ HuntCrossleyImpactT<Real>::runFreeTested(const float* fext, int from, int most,
     const double T = T_, held = lastForce_;
     const StepConstants constants = stepConstants_;
     double last = lastExternal_;
-    const auto fly = [&](int t0, int t1) { // the sole's flight for samples [t0, t1), as runFree's
+    const auto fly = [&](int t0, int t1) { // the sole's flight for samples [t0, t1)
         for (int t = t0; t < t1; ++t) {
             const double fNext = fext ? double(fext[from + t]) : 0.0;
-            const double f1 = last + (fNext - last);
-            const double aNow = (last - 1.0 * held) * constants.perMass;
-            soleWithoutContact(constants, T, t == 0 ? exciterX_ : soleX_[t - 1],
-                               t == 0 ? exciterV_ : soleV_[t - 1], aNow, f1 * constants.perMass,
-                               soleX_[t], soleV_[t]);
+            soleInFreeRun(constants, T, held, last, fNext, t == 0 ? exciterX_ : soleX_[t - 1],
+                          t == 0 ? exciterV_ : soleV_[t - 1], soleX_[t], soleV_[t]);
             last = fNext;
         }
     };

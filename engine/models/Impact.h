@@ -180,6 +180,16 @@ class HuntCrossleyImpactT {
         xNext = (x + T * v + c.ttSixth * aNext) + c.ttThird * aNow;
         vNext = v + c.halfT * (aNow + aNext);
     }
+    // One sample of a free run's flight (runFree, runFreeTested): what spanSamples' advance()
+    // and step()'s trial(1, 1) compute for it, the external force going from `last` to fNext
+    // and the held force `held` (0 in a free run).
+    static void soleInFreeRun(const StepConstants& c, double T, double held, double last,
+                              double fNext, double x, double v, double& xNext,
+                              double& vNext) noexcept {
+        const double f1 = last + (fNext - last);
+        const double aNow = (last - 1.0 * held) * c.perMass;
+        soleWithoutContact(c, T, x, v, aNow, f1 * c.perMass, xNext, vNext);
+    }
     double stiffness_ = 0, dissipation_ = 0;
     enum class Shape { Linear, Hertz, Square, General };
     Shape shape_ = Shape::Hertz;

@@ -801,11 +801,13 @@ void Convolver::prepare(const AudioBuffer& impulseResponse, double sampleRateHz,
         const auto ch = static_cast<std::size_t>(s->channels);
         s->frame.allocate(P2);
         s->spectrum.allocate(2 * static_cast<std::size_t>(s->bins));
-        s->time.allocate(P2);
         // The inverse: split transforms in pieces, else one complex FFT for a stereo IR, else
         // (mono) a real one. The real forward FFT also computes the partitions' spectra below.
+        // `time` only for a mono IR: the real inverse's output, or the split inverse's unused
+        // imaginary part.
         const bool split = s->slack && P >= kSplitPartition;
         const bool realInverse = !split && !stereoIr_;
+        if (!stereoIr_) s->time.allocate(P2);
         {
             std::lock_guard<std::mutex> lock(plannerMutex());
             s->forward.p = fftwf_plan_dft_r2c_1d(
