@@ -51,6 +51,7 @@ void HuntCrossleyImpactT<Real>::prepare(const ProcessSpec& spec) {
     const double M = params_.exciterMassKg;
     stiffness_ = params_.stiffness;
     dissipation_ = params_.dissipation;
+    stiffMu_ = stiffness_ * dissipation_;
     shape_ = params_.alpha == 1.0   ? Shape::Linear
              : params_.alpha == 1.5 ? Shape::Hertz
              : params_.alpha == 2.0 ? Shape::Square
@@ -78,6 +79,8 @@ void HuntCrossleyImpactT<Real>::setFineRate(bool fine) noexcept {
     T_ = fine ? fineT_ : coarseT_;
     kc_ = fine ? fineKc_ : coarseKc_;
     kd_ = fine ? fineKd_ : coarseKd_;
+    hertzKc_ = 1.5 * kc_;
+    hertzKd_ = stiffMu_ * kd_;
     stepConstants_ = fine ? fineConstants_ : coarseConstants_;
 }
 
@@ -136,9 +139,12 @@ inline double HuntCrossleyImpactT<Real>::contactForceOf(double c, double cdot, d
         ca = c;
         slope = 1.0;
     } else if constexpr (S == Shape::Hertz) {
+        // k c^1.5 (1 + mu cdot) as sqrt(c) (c (k + k mu cdot)): the root comes last, the rest
+        // is computed while it is taken (solveShaped's Newton slope likewise).
         const double root = rootOf(c);
         ca = c * root;
         slope = 1.5 * root;
+        return std::max(0.0, root * (c * (stiffness_ + stiffMu_ * cdot)));
     } else if constexpr (S == Shape::Square) {
         ca = c * c;
         slope = 2.0 * c;
@@ -198,8 +204,17 @@ double HuntCrossleyImpactT<Real>::solveShaped(double ch, double dh) noexcept {
     // HC at (c, cd), and c^alpha and alpha c^(alpha - 1) there for Newton's slope (left as they
     // were where c <= 0: HC is then 0 and the slope is not used).
     double ca = 0.0, slope = 0.0;
+    // Hertz: sqrt(c) and k (1 + mu cd) at the last evaluation, for the slope below.
+    double root = 0.0, stiff = 0.0;
     auto law = [&](double cc, double ccd) {
-        return cc > 0.0 ? contactForceOf<S>(cc, ccd, ca, slope) : 0.0;
+        if constexpr (S == Shape::Hertz) {
+            if (!(cc > 0.0)) return 0.0;
+            root = rootOf(cc);
+            stiff = stiffness_ + stiffMu_ * ccd;
+            return std::max(0.0, root * (cc * stiff));
+        } else {
+            return cc > 0.0 ? contactForceOf<S>(cc, ccd, ca, slope) : 0.0;
+        }
     };
     double hc = law(c, cd);
     double g = f - hc;
@@ -226,9 +241,14 @@ double HuntCrossleyImpactT<Real>::solveShaped(double ch, double dh) noexcept {
         if (std::fabs(g) <= 1e-10 * fMax) break;
         double dg = 1.0;
         if (hc > 0.0) {
-            // dHC/dF = -(k a c^(a-1) (1 + mu cd) kc + k c^a mu kd)
-            const double k = stiffness_, mu = dissipation_;
-            dg += k * (slope * (1.0 + mu * cd) * kc_ + ca * mu * kd_);
+            // dHC/dF = -(k a c^(a-1) (1 + mu cd) kc + k c^a mu kd); for Hertz
+            // sqrt(c) (1.5 kc k (1 + mu cd) + c k mu kd): one multiplication after the root.
+            if constexpr (S == Shape::Hertz) {
+                dg += root * (hertzKc_ * stiff + c * hertzKd_);
+            } else {
+                const double k = stiffness_, mu = dissipation_;
+                dg += k * (slope * (1.0 + mu * cd) * kc_ + ca * mu * kd_);
+            }
         }
         const double delta = g / dg;
         double next = f - delta;

@@ -160,6 +160,8 @@ class HuntCrossleyImpactT {
     double peakSinceGridPoint_ = 0.0;   // largest |output| since the last grid point
     double sleepVelocity_ = 1e-10;
     double kc_ = 0, kd_ = 0; // instantaneous compliance and mobility of the compression
+    // The Hertz law's Newton terms (see solveShaped): k mu; 1.5 kc and k mu kd at the current rate.
+    double stiffMu_ = 0, hertzKc_ = 0, hertzKd_ = 0;
     // Per-step constants of the current rate (setFineRate) and the contact law's (prepare).
     struct StepConstants {
         // T^2 / 3, T^2 / 6, T^2 / 6M, T / 2M, T / 2, 1 / M: multiplications only, as the step's
