@@ -130,6 +130,17 @@ inline double rootOf(double x) noexcept {
 } // namespace
 
 template <typename Real>
+[[gnu::always_inline]] inline double
+HuntCrossleyImpactT<Real>::hertzLaw(double c, double cdot, double& root,
+                                    double& stiff) const noexcept {
+    // k c^1.5 (1 + mu cdot) as sqrt(c) (c (k + k mu cdot)): the root comes last, the rest is
+    // computed while it is taken (solveShaped's Newton slope likewise).
+    root = rootOf(c);
+    stiff = stiffness_ + stiffMu_ * cdot;
+    return std::max(0.0, root * (c * stiff));
+}
+
+template <typename Real>
 template <typename HuntCrossleyImpactT<Real>::Shape S>
 inline double HuntCrossleyImpactT<Real>::contactForceOf(double c, double cdot, double& ca,
                                                         double& slope) const noexcept {
@@ -139,12 +150,11 @@ inline double HuntCrossleyImpactT<Real>::contactForceOf(double c, double cdot, d
         ca = c;
         slope = 1.0;
     } else if constexpr (S == Shape::Hertz) {
-        // k c^1.5 (1 + mu cdot) as sqrt(c) (c (k + k mu cdot)): the root comes last, the rest
-        // is computed while it is taken (solveShaped's Newton slope likewise).
-        const double root = rootOf(c);
+        double root, stiff;
+        const double force = hertzLaw(c, cdot, root, stiff);
         ca = c * root;
         slope = 1.5 * root;
-        return std::max(0.0, root * (c * (stiffness_ + stiffMu_ * cdot)));
+        return force;
     } else if constexpr (S == Shape::Square) {
         ca = c * c;
         slope = 2.0 * c;
@@ -208,10 +218,7 @@ double HuntCrossleyImpactT<Real>::solveShaped(double ch, double dh) noexcept {
     double root = 0.0, stiff = 0.0;
     auto law = [&](double cc, double ccd) {
         if constexpr (S == Shape::Hertz) {
-            if (!(cc > 0.0)) return 0.0;
-            root = rootOf(cc);
-            stiff = stiffness_ + stiffMu_ * ccd;
-            return std::max(0.0, root * (cc * stiff));
+            return cc > 0.0 ? hertzLaw(cc, ccd, root, stiff) : 0.0;
         } else {
             return cc > 0.0 ? contactForceOf<S>(cc, ccd, ca, slope) : 0.0;
         }

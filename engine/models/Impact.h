@@ -202,6 +202,8 @@ class HuntCrossleyImpactT {
     double contactForceOf(double c, double cdot, double& ca, double& slope) const noexcept;
     template <Shape S>
     double solveShaped(double ch, double dh) noexcept; // solveForce() for one contact law
+    // The Hertz law at c > 0; also sqrt(c) and k (1 + mu cdot), for Newton's slope.
+    double hertzLaw(double c, double cdot, double& root, double& stiff) const noexcept;
     template <typename F>
     decltype(auto) withShape(F&& f) const; // f(std::integral_constant<Shape, shape_>)
     double coarseT_ = 0, coarseKc_ = 0, coarseKd_ = 0, fineT_ = 0, fineKc_ = 0, fineKd_ = 0;
