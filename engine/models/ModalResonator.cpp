@@ -114,19 +114,6 @@ template <typename D>
     const D2 h = halves(v);
     return h[0] + h[1];
 }
-// Loads modes i..i+3's state (q, v) and the free transition's coefficients: the start of the
-// free-ringing kernels (ringBody, ringCheckedBody).
-template <typename V, typename Real, typename Coefficients>
-[[gnu::always_inline]] inline void loadFreeQuad(V& qi, V& vi, V& a00, V& a01, V& a10, V& a11,
-                                                const Coefficients& ck, const Real* q,
-                                                const Real* v) noexcept {
-    load4(qi, q);
-    load4(vi, v);
-    load4(a00, ck.a00);
-    load4(a01, ck.a01);
-    load4(a10, ck.a10);
-    load4(a11, ck.a11);
-}
 // Stores modes i..i+3's prediction (x, y) and adds it to the pickup sums as the passes add it:
 // the contact pickup's position x0 and velocity v0, the output pickup's velocity vo; (xd, yd)
 // is the prediction in double.
@@ -353,6 +340,7 @@ void ModalResonatorT<Real>::prepare(double sampleRateHz, int fineSubsteps) {
     }
     setOutputPickup(std::min(outputPickup_, static_cast<int>(np) - 1)); // fills the banks
     runSums_.assign(static_cast<std::size_t>(4 * kFreeRunMax), 0.0);
+    runSums0_.assign(static_cast<std::size_t>(4 * kFreeRunMax), 0.0);
     q_.assign(n2, Real(0));
     v_.assign(n2, Real(0));
     qh_.assign(n2, Real(0));
@@ -482,9 +470,14 @@ UNDERFOOT_TARGET_AVX void ModalResonatorT<Real>::passAvx(ModalResonatorT& r, Rea
 // + (lane 1 + lane 3). The contact pickup's sums are needed only for the last sample (its
 // prediction), and are added quad by quad as the free pass adds them. So every sample's output,
 // and the state after the run, are those of n predict() / commit(p, 0) pairs, bit for bit.
+// With Check (ringFreeUntilContact) the contact pickup's sums are kept per sample too (runSums0_,
+// added likewise: the x0 step() would test, bit for bit), and the run is committed only when the
+// body at soleX stays clear of every one; otherwise it returns the samples before the first
+// touch with the state untouched (the run only read it and wrote the prediction buffers).
 template <typename Real>
-template <bool Wide>
-[[gnu::always_inline]] inline void ModalResonatorT<Real>::ringBody(int n, double* voOut) noexcept {
+template <bool Wide, bool Check>
+[[gnu::always_inline]] inline int ModalResonatorT<Real>::ringBody(int n, const double* soleX,
+                                                                  double* voOut) noexcept {
     using V = typename Lanes<Real, Wide>::R;
     using D = typename Lanes<Real, Wide>::D;
     const std::size_t quads = q_.size() / 4;
@@ -493,16 +486,23 @@ template <bool Wide>
     const Real *q = q_.data(), *v = v_.data();
     Real *qh = qh_.data(), *vh = vh_.data();
     double* sums = runSums_.data();
+    double* sums0 = runSums0_.data();
     D x0{}, v0{};
     for (std::size_t k = 0; k < quads; ++k) {
         const std::size_t i = 4 * k;
         V qi, vi, a00, a01, a10, a11;
-        loadFreeQuad(qi, vi, a00, a01, a10, a11, c[k], q + i, v + i);
+        load4(qi, q + i);
+        load4(vi, v + i);
+        load4(a00, c[k].a00);
+        load4(a01, c[k].a01);
+        load4(a10, c[k].a10);
+        load4(a11, c[k].a11);
         D g0, go, yd{};
         load4(g0, gg[k].g0);
         load4(go, gg[k].go);
         double* s = sums;
-        for (int t = 0; t < n; ++t, s += 4) {
+        double* s0 = sums0;
+        for (int t = 0; t < n; ++t, s += 4, s0 += 4) {
             const V x = a00 * qi + a01 * vi;
             const V y = a10 * qi + a11 * vi;
             qi = x;
@@ -512,6 +512,13 @@ template <bool Wide>
             if (k > 0) load4(so, s);
             so += go * yd;
             store4(s, so);
+            if constexpr (Check) {
+                D sx{}, xd;
+                toDouble(xd, x);
+                if (k > 0) load4(sx, s0);
+                sx += g0 * xd;
+                store4(s0, sx);
+            }
         }
         D xd;
         toDouble(xd, qi);
@@ -519,6 +526,14 @@ template <bool Wide>
         v0 += g0 * yd;      // and velocity
         store4(qh + i, qi); // the last sample's prediction
         store4(vh + i, vi);
+    }
+    if constexpr (Check) {
+        const double* s0 = sums0;
+        for (int t = 0; t < n; ++t, s0 += 4) {
+            D sx;
+            load4(sx, s0);
+            if (!(soleX[t] - laneSum(sx) <= 0.0)) return t; // step() would find contact here
+        }
     }
     const double* s = sums;
     for (int t = 0; t < n; ++t, s += 4) {
@@ -534,82 +549,31 @@ template <bool Wide>
     predictedVo_ = voOut[n - 1];
     predictedEnergyValid_ = false;
     commitWithoutForce();
-}
-
-// Free ringing sample by sample with the contact test (ringFreeUntilContact): each sample is
-// the free pass (passBody<Wide, false, false, false, true>) into the prediction buffers, its
-// pickup sums added as that pass adds them; when the contact test passes, the commit(p, 0) that
-// follows it (the buffers swap roles). So the samples run, and the state after them, are those
-// of predict() / commit(p, 0) pairs, bit for bit, and x0 is the x0 step() would test.
-template <typename Real>
-template <bool Wide>
-[[gnu::always_inline]] inline int ModalResonatorT<Real>::ringCheckedBody(int n, const double* soleX,
-                                                                         double* voOut) noexcept {
-    using V = typename Lanes<Real, Wide>::R;
-    using D = typename Lanes<Real, Wide>::D;
-    const std::size_t quads = q_.size() / 4;
-    const QuadCoefficients* c = bank().quads.data();
-    const QuadGains* gg = quadGains_.data();
-    Real *q = q_.data(), *v = v_.data(), *qh = qh_.data(), *vh = vh_.data();
-    double x0Last = 0.0, v0Last = 0.0;
-    int t = 0;
-    for (; t < n; ++t) {
-        D x0{}, v0{}, vo{};
-        for (std::size_t k = 0; k < quads; ++k) {
-            const std::size_t i = 4 * k;
-            V qi, vi, a00, a01, a10, a11;
-            loadFreeQuad(qi, vi, a00, a01, a10, a11, c[k], q + i, v + i);
-            const V x = a00 * qi + a01 * vi;
-            const V y = a10 * qi + a11 * vi;
-            D xd, yd;
-            storeAndSum(x, y, gg[k], qh + i, vh + i, xd, yd, x0, v0, vo);
-        }
-        const D2 a = pairSum(halves(x0), halves(v0));
-        if (!(soleX[t] - a[0] <= 0.0)) break; // step() would find contact here: not run
-        const D2 voh = halves(vo);
-        voOut[t] = voh[0] + voh[1];
-        x0Last = a[0];
-        v0Last = a[1];
-        std::swap(q, qh); // commit(p, 0): the prediction is the state
-        std::swap(v, vh);
-    }
-    if (t == 0) return 0; // (the state is untouched: only the prediction buffers were written)
-    // The last sample's predict() left its prediction in the prediction buffers, then its
-    // commit(p, 0) swaps them in (an even number of swaps above left it in the state's).
-    if (q == q_.data()) {
-        q_.swap(qh_);
-        v_.swap(vh_);
-    }
-    predictedX0_ = x0Last;
-    predictedV0_ = v0Last;
-    predictedVo_ = voOut[t - 1];
-    predictedEnergyValid_ = false;
-    commitWithoutForce();
-    return t;
+    return n;
 }
 
 template <typename Real>
 int ModalResonatorT<Real>::ringCheckedGeneric(ModalResonatorT& r, int n, const double* soleX,
                                               double* vo) noexcept {
-    return r.ringCheckedBody<false>(n, soleX, vo);
+    return r.ringBody<false, true>(n, soleX, vo);
 }
 
 template <typename Real>
 UNDERFOOT_TARGET_AVX int ModalResonatorT<Real>::ringCheckedAvx(ModalResonatorT& r, int n,
                                                                const double* soleX,
                                                                double* vo) noexcept {
-    return r.ringCheckedBody<true>(n, soleX, vo);
+    return r.ringBody<true, true>(n, soleX, vo);
 }
 
 template <typename Real>
 void ModalResonatorT<Real>::ringGeneric(ModalResonatorT& r, int n, double* vo) noexcept {
-    r.ringBody<false>(n, vo);
+    r.ringBody<false, false>(n, nullptr, vo);
 }
 
 template <typename Real>
 UNDERFOOT_TARGET_AVX void ModalResonatorT<Real>::ringAvx(ModalResonatorT& r, int n,
                                                          double* vo) noexcept {
-    r.ringBody<true>(n, vo);
+    r.ringBody<true, false>(n, nullptr, vo);
 }
 
 template <typename Real>

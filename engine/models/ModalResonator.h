@@ -192,10 +192,25 @@ class ModalResonatorT {
     /// soleX - x0 > 0: contact) on the same x0, bit for bit. Returns the samples run, each what
     /// predict() then commit(p, 0) gives (as ringFree, outputVelocity[t] likewise); 0 when the
     /// first sample would touch. Requires ringsFree(). For the samples right after a contact,
-    /// where freeContactBound() is too loose to allow a run.
+    /// where freeContactBound() is too loose to allow a run. Runs in chunks of kTestedChunk
+    /// samples, each as ringFree runs (every quad of modes in registers over the chunk) with the
+    /// contact positions summed per sample: a chunk in which the body touches is not committed
+    /// and its samples before the touch are run again by ringFree.
     int ringFreeUntilContact(int n, const double* soleX, double* outputVelocity) noexcept {
-        return ringChecked_(*this, n, soleX, outputVelocity);
+        int done = 0;
+        while (done < n) {
+            const int m = n - done < kTestedChunk ? n - done : kTestedChunk;
+            const int t = ringChecked_(*this, m, soleX + done, outputVelocity + done);
+            if (t < m) {
+                if (t > 0) ring_(*this, t, outputVelocity + done);
+                return done + t;
+            }
+            done += m;
+        }
+        return done;
     }
+    /// Samples per chunk of ringFreeUntilContact: a touch wastes at most this many.
+    static constexpr int kTestedChunk = 16;
     /// A bound on |predictedPosition(0)| over every later sample of free ringing from the
     /// current state: the sum over the modes of |g0| sqrt(q^2 + v^2 / w0^2) (a freely ringing
     /// mode's energy never grows; the discretisation samples its trajectory exactly).
@@ -242,19 +257,20 @@ class ModalResonatorT {
     static void ringGeneric(ModalResonatorT& r, int n, double* vo) noexcept;
     // (the target on the declaration too: see UNDERFOOT_TARGET_AVX)
     UNDERFOOT_TARGET_AVX static void ringAvx(ModalResonatorT& r, int n, double* vo) noexcept;
-    template <bool Wide>
-    void ringBody(int n, double* vo) noexcept;
+    // Check: also the contact positions per sample, tested against soleX; a run in which the
+    // body would touch returns the samples before the touch and commits nothing.
+    template <bool Wide, bool Check>
+    int ringBody(int n, const double* soleX, double* vo) noexcept;
     RingFn ring_ = &ringGeneric;
-    // ringFreeUntilContact, in the same two kernels.
+    // One chunk of ringFreeUntilContact (ringBody<Wide, true>), in the same two kernels.
     using RingCheckedFn = int (*)(ModalResonatorT&, int, const double*, double*) noexcept;
     static int ringCheckedGeneric(ModalResonatorT& r, int n, const double* soleX,
                                   double* vo) noexcept;
     UNDERFOOT_TARGET_AVX static int ringCheckedAvx(ModalResonatorT& r, int n, const double* soleX,
                                                    double* vo) noexcept;
-    template <bool Wide>
-    int ringCheckedBody(int n, const double* soleX, double* vo) noexcept;
     RingCheckedFn ringChecked_ = &ringCheckedGeneric;
-    std::vector<double> runSums_; // a run's per-lane output-pickup sums: [sample][lane]
+    std::vector<double> runSums_;  // a run's per-lane output-pickup sums: [sample][lane]
+    std::vector<double> runSums0_; // and contact-pickup sums (ringFreeUntilContact's chunks)
     void commitWithoutForce() noexcept;
     struct Bank {
         std::vector<Real> a00, a01, a10, a11, b0x, b0v, b1x, b1v;
