@@ -532,10 +532,10 @@ void HuntCrossleyImpactT<Real>::substepSample(double f0, double f1, double& y) n
 // energies do not grow; the 1 % covers the rounding of the sums and of a run of at most
 // kFreeRunMax samples); then the floor's modes for those samples in one call (ringFree, bit for
 // bit the per-sample passes). Right after a contact the sole is still within B of the floor for
-// a few hundred samples; then the floor's modes run sample by sample with step()'s own contact
-// test on the same values (ringFreeUntilContact), up to the first sample that would touch. The
-// first sample that could touch goes through step() as before. So the samples, the state and the
-// statistics are exactly those of step() sample by sample.
+// a few hundred samples; then the floor's modes run with step()'s own contact test on each
+// sample's contact position, the same values (ringFreeUntilContact), up to the first sample
+// that would touch. The first sample that could touch goes through step() as before. So the
+// samples, the state and the statistics are exactly those of step() sample by sample.
 template <typename Real>
 typename HuntCrossleyImpactT<Real>::FreeRun
 HuntCrossleyImpactT<Real>::runFree(const float* fext, int from, int n, float* out) noexcept {
@@ -564,8 +564,8 @@ HuntCrossleyImpactT<Real>::runFree(const float* fext, int from, int n, float* ou
 }
 
 // Right after a contact the bound (every later sample of the floor's ringing) is far looser
-// than the floor's next samples: runFree() then runs the floor's modes while its contact point,
-// computed sample by sample, stays clear of the sole (step()'s own test on the same values). The
+// than the floor's next samples: runFree() then runs the floor's modes while their contact point,
+// computed for every sample, stays clear of the sole (step()'s own test on the same values). The
 // first sample alone first: where it would touch (a contact under way), the try costs one
 // sample's flight and pass. (Out of runFree()'s loop, which it made slower.)
 template <typename Real>

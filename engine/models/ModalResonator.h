@@ -186,10 +186,10 @@ class ModalResonatorT {
     /// order), with each quad of modes kept in registers over the run. outputVelocity[t] is
     /// sample t's velocity(outputPickup()) after the commit. Requires ringsFree().
     void ringFree(int n, double* outputVelocity) noexcept { ring_(*this, n, outputVelocity); }
-    /// Free ringing sample by sample while a body at soleX[t] (t = 0 .. n - 1, n <= kFreeRunMax)
-    /// stays clear of the contact point: stops before the first sample t whose predicted contact
-    /// position x0 gives !(soleX[t] - x0 <= 0), the test the impact's step makes (compression
-    /// soleX - x0 > 0: contact) on the same x0, bit for bit. Returns the samples run, each what
+    /// Free ringing while a body at soleX[t] (t = 0 .. n - 1, n <= kFreeRunMax) stays clear of
+    /// the contact point: stops before the first sample t whose predicted contact position x0
+    /// gives !(soleX[t] - x0 <= 0), the test the impact's step makes (compression soleX - x0 > 0:
+    /// contact) on the same x0, bit for bit. Returns the samples run, each what
     /// predict() then commit(p, 0) gives (as ringFree, outputVelocity[t] likewise); 0 when the
     /// first sample would touch. Requires ringsFree(). For the samples right after a contact,
     /// where freeContactBound() is too loose to allow a run. Runs in chunks of kTestedChunk
