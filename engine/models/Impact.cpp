@@ -146,15 +146,11 @@ inline double HuntCrossleyImpactT<Real>::contactForceOf(double c, double cdot, d
                                                         double& slope) const noexcept {
     // c^alpha and its derivative alpha c^(alpha - 1): the shapes in use without pow or a
     // division (chosen once in prepare()), so that Newton's slope needs no division either.
+    // (Hertz has its own form, hertzLaw, with the slope's terms it needs.)
+    static_assert(S != Shape::Hertz);
     if constexpr (S == Shape::Linear) {
         ca = c;
         slope = 1.0;
-    } else if constexpr (S == Shape::Hertz) {
-        double root, stiff;
-        const double force = hertzLaw(c, cdot, root, stiff);
-        ca = c * root;
-        slope = 1.5 * root;
-        return force;
     } else if constexpr (S == Shape::Square) {
         ca = c * c;
         slope = 2.0 * c;
@@ -169,8 +165,13 @@ template <typename Real>
 template <typename HuntCrossleyImpactT<Real>::Shape S>
 inline double HuntCrossleyImpactT<Real>::contactForceOf(double c, double cdot) const noexcept {
     if (c <= 0.0) return 0.0;
-    double ca, slope;
-    return contactForceOf<S>(c, cdot, ca, slope);
+    if constexpr (S == Shape::Hertz) {
+        double root, stiff;
+        return hertzLaw(c, cdot, root, stiff);
+    } else {
+        double ca, slope;
+        return contactForceOf<S>(c, cdot, ca, slope);
+    }
 }
 
 template <typename Real>

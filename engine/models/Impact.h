@@ -197,7 +197,8 @@ class HuntCrossleyImpactT {
     Shape shape_ = Shape::Hertz;
     template <Shape S>
     double contactForceOf(double c, double cdot) const noexcept;
-    // For c > 0: also c^alpha (ca) and alpha c^(alpha - 1) (slope), for Newton's derivative.
+    // For c > 0: also c^alpha (ca) and alpha c^(alpha - 1) (slope), for Newton's derivative
+    // (not Hertz: hertzLaw).
     template <Shape S>
     double contactForceOf(double c, double cdot, double& ca, double& slope) const noexcept;
     template <Shape S>

@@ -114,24 +114,6 @@ template <typename D>
     const D2 h = halves(v);
     return h[0] + h[1];
 }
-// Stores modes i..i+3's prediction (x, y) and adds it to the pickup sums as the passes add it:
-// the contact pickup's position x0 and velocity v0, the output pickup's velocity vo; (xd, yd)
-// is the prediction in double.
-template <typename V, typename D, typename Real, typename Gains>
-[[gnu::always_inline]] inline void storeAndSum(const V& x, const V& y, const Gains& g, Real* qh,
-                                               Real* vh, D& xd, D& yd, D& x0, D& v0,
-                                               D& vo) noexcept {
-    store4(qh, x);
-    store4(vh, y);
-    toDouble(xd, x);
-    toDouble(yd, y);
-    D g0, go;
-    load4(g0, g.g0);
-    load4(go, g.go);
-    x0 += g0 * xd;
-    v0 += g0 * yd;
-    vo += go * yd;
-}
 // Completes a deferred commit for modes i..i+3 (see commit()): u = F g / m, q = qh + b1x u,
 // v = vh + b1v u, stored, and returned in (q, v, u) for the pass that goes on from there.
 template <typename V, typename Real, typename Coefficients>
@@ -423,8 +405,16 @@ template <bool Wide, bool Energy, bool Fused, bool Held, bool Free>
             x = a00 * qi + a01 * vi + b0x * ui;
             y = a10 * qi + a11 * vi + b0v * ui;
         }
-        D xd, yd;
-        storeAndSum(x, y, gg[k], qh + i, vh + i, xd, yd, x0, v0, vo);
+        store4(qh + i, x);
+        store4(vh + i, y);
+        D xd, yd, g0, go;
+        toDouble(xd, x);
+        toDouble(yd, y);
+        load4(g0, gg[k].g0);
+        load4(go, gg[k].go);
+        x0 += g0 * xd;
+        v0 += g0 * yd;
+        vo += go * yd;
         if constexpr (Energy) {
             D kin, pot, lv, lx;
             load4(kin, gg[k].kin);
@@ -490,13 +480,14 @@ template <bool Wide, bool Check>
     D x0{}, v0{};
     for (std::size_t k = 0; k < quads; ++k) {
         const std::size_t i = 4 * k;
+        const QuadCoefficients& ck = c[k];
         V qi, vi, a00, a01, a10, a11;
         load4(qi, q + i);
         load4(vi, v + i);
-        load4(a00, c[k].a00);
-        load4(a01, c[k].a01);
-        load4(a10, c[k].a10);
-        load4(a11, c[k].a11);
+        load4(a00, ck.a00);
+        load4(a01, ck.a01);
+        load4(a10, ck.a10);
+        load4(a11, ck.a11);
         D g0, go, yd{};
         load4(g0, gg[k].g0);
         load4(go, gg[k].go);
