@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "engine/models/Impact.h"
 
+#include "engine/models/ModalKernels.h"
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -118,11 +120,21 @@ void HuntCrossleyImpactT<Real>::strike(double velocity) noexcept {
 }
 
 namespace {
+// Newton's start in a sub-step: the force extrapolated from the last sub-steps' (quadratically
+// from three, linearly from two; inside a strike that saves about a third of the iterations);
+// f the last force, f1 and f2 the two before it (0: none).
+inline double newtonStartOf(double f, double f1, double f2) noexcept {
+    return f > 0.0 && f1 > 0.0 ? std::max(0.0, f2 > 0.0 ? 3.0 * (f - f1) + f2 : 2.0 * f - f1) : f;
+}
+
 // IEEE square root without the errno branch std::sqrt keeps for negative arguments (the
-// contact only takes roots of positive compressions): the same correctly rounded value.
+// contact only takes roots of positive compressions): the same correctly rounded value. (x in
+// both lanes: _mm_set_sd's zeroed upper lane compiles, with AVX, to a register form of vmovq
+// that valgrind 3.19 cannot execute, and the project counts instructions with callgrind.)
 inline double rootOf(double x) noexcept {
 #if defined(__SSE2__)
-    return _mm_cvtsd_f64(_mm_sqrt_sd(_mm_setzero_pd(), _mm_set_sd(x)));
+    const __m128d v = _mm_set1_pd(x);
+    return _mm_cvtsd_f64(_mm_sqrt_sd(v, v));
 #else
     return std::sqrt(x);
 #endif
@@ -201,16 +213,17 @@ double HuntCrossleyImpactT<Real>::solveForce(double ch, double dh) noexcept {
         return contactForce(exciterX_ - resonator_.position(0),
                             exciterV_ - resonator_.contactVelocity());
     if (!(ch > 0.0)) return 0.0; // fMax = HC(ch, dh) = 0 (below): no contact (free flight)
-    return withShape([&](auto s) { return solveShaped<decltype(s)::value>(ch, dh); });
+    // Newton from the last force, or from a sub-step's extrapolated start (see substepSample)
+    const double start = newtonStart_ >= 0.0 ? newtonStart_ : lastForce_;
+    return withShape([&](auto s) { return solveShaped<decltype(s)::value>(ch, dh, start); });
 }
 
 template <typename Real>
 template <typename HuntCrossleyImpactT<Real>::Shape S>
-double HuntCrossleyImpactT<Real>::solveShaped(double ch, double dh) noexcept {
+inline double HuntCrossleyImpactT<Real>::solveShaped(double ch, double dh, double start) noexcept {
     // g(F) = F - HC(ch - kc F, dh - kd F) is increasing in F; its root lies in [0, fMax],
-    // fMax = HC(ch, dh) (HC falls as F compresses less and slower). Newton from the last force.
-    double f = lastForce_;
-    if (newtonStart_ >= 0.0) f = newtonStart_; // (a sub-step's: see substepSample)
+    // fMax = HC(ch, dh) (HC falls as F compresses less and slower). Newton from `start`.
+    double f = start;
     double c = ch - kc_ * f, cd = dh - kd_ * f;
     // HC at (c, cd), and c^alpha and alpha c^(alpha - 1) there for Newton's slope (left as they
     // were where c <= 0: HC is then 0 and the slope is not used).
@@ -277,43 +290,88 @@ double HuntCrossleyImpactT<Real>::solveShaped(double ch, double dh) noexcept {
 }
 
 template <typename Real>
+inline typename HuntCrossleyImpactT<Real>::Trial
+HuntCrossleyImpactT<Real>::trialAt(double fextNow, double fextNext, double held,
+                                   double scale) noexcept {
+    const double aNextExt = fextNext * stepConstants_.perMass;
+    const double aNow = (fextNow - held * lastForce_) * stepConstants_.perMass;
+    double xPred, vPred;
+    soleWithoutContact(stepConstants_, T_, exciterX_, exciterV_, aNow, aNextExt, xPred, vPred);
+    resonator_.predict(held);
+    const double ch = xPred - resonator_.predictedPosition(0);
+    const double dh = vPred - resonator_.predictedVelocity(0);
+    Trial t{};
+    t.force = scale * solveForce(ch, dh);
+    t.x = xPred - stepConstants_.xPerForce * t.force;
+    t.v = vPred - stepConstants_.vPerForce * t.force;
+    return t;
+}
+
+// Energy of the bodies after a trial (the resonator's prediction must be the trial's).
+template <typename Real>
+inline void HuntCrossleyImpactT<Real>::evaluateTrial(Trial& t, double fextNow,
+                                                     double fextNext) const noexcept {
+    t.energy = 0.5 * params_.exciterMassKg * t.v * t.v + resonator_.energyIfCommitted(0, t.force);
+    t.work = 0.5 * (fextNow + fextNext) * (t.x - exciterX_);
+}
+
+template <typename Real>
+typename HuntCrossleyImpactT<Real>::Trial
+HuntCrossleyImpactT<Real>::correctPassivity(double fextNow, double fextNext, double bodiesBefore,
+                                            double tolerance) noexcept {
+    // The force held from the previous sample, and if needed the new force, is bisected until
+    // the sample is passive; no force at all always is (see step()).
+    auto evaluated = [&](double held, double scale) {
+        Trial t = trialAt(fextNow, fextNext, held, scale);
+        evaluateTrial(t, fextNow, fextNext);
+        return t;
+    };
+    auto passive = [&](const Trial& x) {
+        return contactEnergy_ + (bodiesBefore + x.work - x.energy) >= -tolerance;
+    };
+    ++stats_.passivityCorrections;
+    double held = 1.0;
+    Trial best = evaluated(0.0, 1.0);
+    if (passive(best)) {
+        double lo = 0.0, hi = 1.0; // held-force scale: lo passive, hi not
+        for (int k = 0; k < 16; ++k) {
+            const double mid = 0.5 * (lo + hi);
+            const Trial m = evaluated(mid, 1.0);
+            if (passive(m)) {
+                lo = mid;
+                best = m;
+            } else {
+                hi = mid;
+            }
+        }
+        held = lo;
+    } else {
+        held = 0.0;
+        double lo = 0.0, hi = 1.0;  // new-force scale
+        best = evaluated(0.0, 0.0); // no force at all: the floor only loses energy
+        for (int k = 0; k < 16; ++k) {
+            const double mid = 0.5 * (lo + hi);
+            const Trial m = evaluated(0.0, mid);
+            if (passive(m)) {
+                lo = mid;
+                best = m;
+            } else {
+                hi = mid;
+            }
+        }
+    }
+    resonator_.predict(held);
+    return best;
+}
+
+template <typename Real>
 bool HuntCrossleyImpactT<Real>::step(double fextNow, double fextNext, bool abortOnContact,
                                      double& y) noexcept {
     const double M = params_.exciterMassKg, T = T_;
-    const double aNextExt = fextNext * stepConstants_.perMass;
-
-    // One trial of the sample: the contact force held from n is scaled by `held` (1 = as solved
-    // at n) and the new force by `scale`. Both bodies are integrated exactly for the linear force
-    // ramp, so their energy change is exactly the ramp's work: the check below is then exactly
-    // "the contact returns no more energy than it stored".
-    struct Trial {
-        double force, x, v, energy, work;
-    };
-    auto trial = [&](double held, double scale) {
-        const double aNow = (fextNow - held * lastForce_) * stepConstants_.perMass;
-        double xPred, vPred;
-        soleWithoutContact(stepConstants_, T, exciterX_, exciterV_, aNow, aNextExt, xPred, vPred);
-        resonator_.predict(held);
-        const double ch = xPred - resonator_.predictedPosition(0);
-        const double dh = vPred - resonator_.predictedVelocity(0);
-        Trial t{};
-        t.force = scale * solveForce(ch, dh);
-        t.x = xPred - stepConstants_.xPerForce * t.force;
-        t.v = vPred - stepConstants_.vPerForce * t.force;
-        return t;
-    };
-    // Energy of the bodies after a trial (the resonator's prediction must be the trial's).
-    auto evaluate = [&](Trial& t) {
-        t.energy = 0.5 * M * t.v * t.v + resonator_.energyIfCommitted(0, t.force);
-        t.work = 0.5 * (fextNow + fextNext) * (t.x - exciterX_);
-    };
-    auto evaluated = [&](double held, double scale) {
-        Trial t = trial(held, scale);
-        evaluate(t);
-        return t;
-    };
-
-    Trial t = trial(1.0, 1.0);
+    // Both bodies are integrated exactly for the linear force ramp, so their energy change is
+    // exactly the ramp's work: the check below is then exactly "the contact returns no more
+    // energy than it stored".
+    Trial t = trialAt(fextNow, fextNext, 1.0, 1.0);
     if (abortOnContact && (t.force > 0.0 || lastForce_ > 0.0)) {
         // A transient (the contact opens, closes or its force changes fast) is sub-stepped:
         // return before anything is committed.
@@ -322,7 +380,6 @@ bool HuntCrossleyImpactT<Real>::step(double fextNow, double fextNext, bool abort
             change > params_.substepForceChange * std::max(t.force, lastForce_))
             return false;
     }
-    double held = 1.0;
     double absorbed = 0.0;
     if (t.force > 0.0 || lastForce_ > 0.0) {
         // Passivity guard. Both bodies are integrated exactly for the linear force ramp, so the
@@ -332,49 +389,16 @@ bool HuntCrossleyImpactT<Real>::step(double fextNow, double fextNext, bool abort
         // budget `contactEnergy_` must stay >= 0. A contact resolved by too few samples (stiff,
         // light, fast) can violate that in discrete time, mostly when the bodies separate while
         // the held force still ramps down (the Sound Design Toolkit bisects its force for the
-        // same reason). Then the force held from the previous sample, and if needed the new force,
-        // is bisected until the sample is passive; no force at all always is. Bounded work: at
-        // most 2 + 2 x 16 extra trials, in rare samples (counted in stats().passivityCorrections).
+        // same reason). Then correctPassivity() bisects the force held from the previous sample,
+        // and if needed the new force, until the sample is passive; no force at all always is.
+        // Bounded work: at most 2 + 2 x 16 extra trials, in rare samples (counted in
+        // stats().passivityCorrections).
         const double bodiesBefore = 0.5 * M * exciterV_ * exciterV_ + resonator_.energy();
         const double tolerance = 1e-13 * bodiesBefore;
-        auto absorbedBy = [&](const Trial& x) { return bodiesBefore + x.work - x.energy; };
-        auto passive = [&](const Trial& x) { return contactEnergy_ + absorbedBy(x) >= -tolerance; };
-        evaluate(t);
-        if (!passive(t)) {
-            ++stats_.passivityCorrections;
-            Trial best = evaluated(0.0, 1.0);
-            if (passive(best)) {
-                double lo = 0.0, hi = 1.0; // held-force scale: lo passive, hi not
-                for (int k = 0; k < 16; ++k) {
-                    const double mid = 0.5 * (lo + hi);
-                    const Trial m = evaluated(mid, 1.0);
-                    if (passive(m)) {
-                        lo = mid;
-                        best = m;
-                    } else {
-                        hi = mid;
-                    }
-                }
-                held = lo;
-            } else {
-                held = 0.0;
-                double lo = 0.0, hi = 1.0;  // new-force scale
-                best = evaluated(0.0, 0.0); // no force at all: the floor only loses energy
-                for (int k = 0; k < 16; ++k) {
-                    const double mid = 0.5 * (lo + hi);
-                    const Trial m = evaluated(0.0, mid);
-                    if (passive(m)) {
-                        lo = mid;
-                        best = m;
-                    } else {
-                        hi = mid;
-                    }
-                }
-            }
-            t = best;
-            resonator_.predict(held);
-        }
-        absorbed = absorbedBy(t);
+        evaluateTrial(t, fextNow, fextNext);
+        if (!(contactEnergy_ + (bodiesBefore + t.work - t.energy) >= -tolerance)) [[unlikely]]
+            t = correctPassivity(fextNow, fextNext, bodiesBefore, tolerance);
+        absorbed = bodiesBefore + t.work - t.energy;
     }
 
     // Commit the sample with the contact force at n+1.
@@ -498,18 +522,19 @@ void HuntCrossleyImpactT<Real>::substepSample(double f0, double f1, double& y) n
     const double before = lastForce_;
     // (still at the fine rate when the sample before was sub-stepped and chose this one)
     if (!resonator_.fineRate()) setFineRate(true);
-    for (int j = 0; j < sub; ++j) {
-        // Newton starts from the force extrapolated from the last sub-steps' (quadratically
-        // from three, linearly from two; inside a strike that saves about a third of the
-        // iterations); a resting contact's single steps start from the last force.
-        const double f = lastForce_;
-        newtonStart_ = f > 0.0 && subForce1_ > 0.0
-                           ? std::max(0.0, subForce2_ > 0.0 ? 3.0 * (f - subForce1_) + subForce2_
-                                                            : 2.0 * f - subForce1_)
-                           : f;
-        step(f0 + (f1 - f0) * double(j) / sub, f0 + (f1 - f0) * double(j + 1) / sub, false, y);
-        subForce2_ = subForce1_;
-        subForce1_ = f;
+    if (substepLoop_ && shape_ == Shape::Hertz && params_.solver == ImpactSolver::Newton) {
+        if (resonator_.usesAvx())
+            substepsAvx(f0, f1, y);
+        else
+            substepsGeneric(f0, f1, y);
+    } else {
+        for (int j = 0; j < sub; ++j) {
+            const double f = lastForce_;
+            newtonStart_ = newtonStartOf(f, subForce1_, subForce2_);
+            step(f0 + (f1 - f0) * double(j) / sub, f0 + (f1 - f0) * double(j + 1) / sub, false, y);
+            subForce2_ = subForce1_;
+            subForce1_ = f;
+        }
     }
     newtonStart_ = -1.0;
     substepNext_ =
@@ -522,6 +547,104 @@ void HuntCrossleyImpactT<Real>::substepSample(double f0, double f1, double& y) n
         setFineRate(false);
         subForce1_ = subForce2_ = 0.0; // (the next sub-steps start a new history)
     }
+}
+
+// substepSample's loop for the Hertz law with Newton: per sub-step exactly what step(f_j,
+// f_j+1, false, y) does with newtonStart_ set as above (the same operations in the same order:
+// the same samples, state and statistics), with the sole's state, the contact's stored energy
+// and the time kept in registers over the sub-steps, the resonator's pass (predictInline) and
+// the Newton solve inline, and the passivity correction out of line (rare). One compact loop:
+// a strike's block runs some forty of these sub-steps, after hundreds of blocks of other work.
+template <typename Real>
+template <bool Wide>
+[[gnu::always_inline]] inline void HuntCrossleyImpactT<Real>::substepLoop(double f0, double f1,
+                                                                          double& y) noexcept {
+    const int sub = params_.contactSubsteps;
+    const StepConstants c = stepConstants_;
+    const double M = params_.exciterMassKg, T = T_;
+    double x = exciterX_, v = exciterV_, last = lastForce_, stored = contactEnergy_;
+    double time = time_, s1 = subForce1_, s2 = subForce2_;
+    bool inContact = inContact_;
+    double fextNext = f0 + (f1 - f0) * double(0) / sub;
+    for (int j = 0; j < sub; ++j) {
+        // (substepSample's external forces: sub-step j + 1 starts where sub-step j ends)
+        const double fextNow = fextNext;
+        fextNext = f0 + (f1 - f0) * double(j + 1) / sub;
+        const double f = last;
+        const double start = newtonStartOf(f, s1, s2);
+        // trialAt(fextNow, fextNext, 1, 1)
+        const double aNextExt = fextNext * c.perMass;
+        const double aNow = (fextNow - last) * c.perMass; // (held 1: 1 x F is F)
+        double xPred, vPred;
+        soleWithoutContact(c, T, x, v, aNow, aNextExt, xPred, vPred);
+        resonator_.template predictInline<Wide>();
+        const double ch = xPred - resonator_.predictedPosition(0);
+        const double dh = vPred - resonator_.predictedVelocity(0);
+        Trial t{};
+        t.force = ch > 0.0 ? solveShaped<Shape::Hertz>(ch, dh, start) : 0.0; // (solveForce)
+        t.x = xPred - c.xPerForce * t.force;
+        t.v = vPred - c.vPerForce * t.force;
+        double absorbed = 0.0;
+        if (t.force > 0.0 || last > 0.0) { // step()'s passivity guard
+            const double bodiesBefore = 0.5 * M * v * v + resonator_.energy();
+            const double tolerance = 1e-13 * bodiesBefore;
+            t.energy = 0.5 * M * t.v * t.v + resonator_.energyIfCommitted(0, t.force);
+            t.work = 0.5 * (fextNow + fextNext) * (t.x - x);
+            if (!(stored + (bodiesBefore + t.work - t.energy) >= -tolerance)) [[unlikely]] {
+                exciterX_ = x;
+                exciterV_ = v;
+                lastForce_ = last;
+                contactEnergy_ = stored;
+                newtonStart_ = start;
+                t = correctPassivity(fextNow, fextNext, bodiesBefore, tolerance);
+            }
+            absorbed = bodiesBefore + t.work - t.energy;
+        }
+        // step()'s commit
+        const double force = t.force;
+        const double approach = v - resonator_.contactVelocity();
+        x = t.x;
+        v = t.v;
+        resonator_.commit(0, force);
+        last = force;
+        stored = force > 0.0 ? std::max(0.0, stored + absorbed) : 0.0;
+        time += T;
+        if (force > 0.0) {
+            ++stats_.solvedSamples;
+            if (!inContact) {
+                contactStart_ = time;
+                stats_.peakForceN = 0;
+                stats_.incomingVelocity = approach;
+            }
+            stats_.peakForceN = std::max(stats_.peakForceN, force);
+        } else if (inContact) {
+            stats_.contactTimeSeconds = time - contactStart_;
+            stats_.outgoingVelocity = v - resonator_.contactVelocity();
+        }
+        inContact = force > 0.0;
+        s2 = s1;
+        s1 = f;
+    }
+    exciterX_ = x;
+    exciterV_ = v;
+    lastForce_ = last;
+    contactEnergy_ = stored;
+    time_ = time;
+    inContact_ = inContact;
+    subForce1_ = s1;
+    subForce2_ = s2;
+    y = resonator_.velocity(listen_); // (the last sub-step's; the others' are not used)
+}
+
+template <typename Real>
+void HuntCrossleyImpactT<Real>::substepsGeneric(double f0, double f1, double& y) noexcept {
+    substepLoop<false>(f0, f1, y);
+}
+
+template <typename Real>
+UNDERFOOT_TARGET_AVX void HuntCrossleyImpactT<Real>::substepsAvx(double f0, double f1,
+                                                                 double& y) noexcept {
+    substepLoop<true>(f0, f1, y);
 }
 
 // Free flight: between strikes the sole flies off the floor while the floor rings. A sample in

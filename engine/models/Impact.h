@@ -107,6 +107,13 @@ class HuntCrossleyImpactT {
     /// allowFreeRuns(false) steps free flight sample by sample, as before the runs (tests compare
     /// the two: the samples, the state and the statistics are the same).
     void allowFreeRuns(bool on) noexcept { freeRuns_ = on; }
+    /// allowSubstepLoop(false) runs a sample's contact sub-steps through the general step one by
+    /// one instead of the loop that keeps the state in registers (the Hertz law with Newton);
+    /// tests compare the two: the samples, the state and the statistics are the same.
+    void allowSubstepLoop(bool on) noexcept { substepLoop_ = on; }
+    /// allowAvx(false): the SSE2 kernels (the resonator's and the sub-step loop's) even where the
+    /// CPU has AVX; the samples are the same (tests).
+    void allowAvx(bool on) noexcept { resonator_.allowAvx(on); }
     /// Kinetic energy of the exciter + modal energy of the floor + energy stored in the contact
     /// (the work it absorbed and has not yet returned), J.
     double totalEnergy() const noexcept;
@@ -122,6 +129,20 @@ class HuntCrossleyImpactT {
     // One internal step. With `abortOnContact`, returns false and commits nothing when the step
     // would touch (the caller then sub-steps it); otherwise commits and writes the output to y.
     bool step(double fextNow, double fextNext, bool abortOnContact, double& y) noexcept;
+    // One trial of a step: the contact force held from n scaled by `held` (1 = as solved at n),
+    // the new force at n+1 by `scale`; the sole's state at n+1, and (evaluateTrial) the bodies'
+    // energy after it and the external force's work over the step.
+    struct Trial {
+        double force, x, v, energy, work;
+    };
+    Trial trialAt(double fextNow, double fextNext, double held, double scale) noexcept;
+    void evaluateTrial(Trial& t, double fextNow, double fextNext) const noexcept;
+    // The passivity guard's correction of a step whose trial (1, 1) would return more energy than
+    // the contact stored (rare: see step()); returns the passive trial, the resonator predicted
+    // for it.
+    [[gnu::noinline, gnu::cold]] Trial correctPassivity(double fextNow, double fextNext,
+                                                        double bodiesBefore,
+                                                        double tolerance) noexcept;
     void setFineRate(bool fine) noexcept;
     double solveForce(double ch, double dh) noexcept; // contact force at n+1
     void processSpan(const float* externalForceN, float* out, int n) noexcept;
@@ -145,6 +166,14 @@ class HuntCrossleyImpactT {
     /// One sample from external force f0 to f1 as contactSubsteps exact sub-steps (the rare
     /// path of spanSamples, kept out of its loop); y is the output after the last.
     [[gnu::noinline]] void substepSample(double f0, double f1, double& y) noexcept;
+    // The sub-steps of substepSample for the Hertz law with Newton (the shipped contact): what
+    // step() does for each, with the sole's state in registers and the resonator's pass and the
+    // Newton solve inline, as one compact loop (a strike's hot path); Wide: the AVX kernel.
+    template <bool Wide>
+    void substepLoop(double f0, double f1, double& y) noexcept;
+    [[gnu::flatten]] void substepsGeneric(double f0, double f1, double& y) noexcept;
+    [[gnu::flatten]] UNDERFOOT_TARGET_AVX void substepsAvx(double f0, double f1,
+                                                           double& y) noexcept;
     void sleepDecision() noexcept; // at a grid point
 
     ImpactParams params_;
@@ -202,7 +231,7 @@ class HuntCrossleyImpactT {
     template <Shape S>
     double contactForceOf(double c, double cdot, double& ca, double& slope) const noexcept;
     template <Shape S>
-    double solveShaped(double ch, double dh) noexcept; // solveForce() for one contact law
+    double solveShaped(double ch, double dh, double start) noexcept; // solveForce(), one law
     // The Hertz law at c > 0; also sqrt(c) and k (1 + mu cdot), for Newton's slope.
     double hertzLaw(double c, double cdot, double& root, double& stiff) const noexcept;
     template <typename F>
@@ -212,6 +241,7 @@ class HuntCrossleyImpactT {
     ContactStats stats_;
     double contactStart_ = 0, time_ = 0;
     bool freeRuns_ = true;
+    bool substepLoop_ = true;
     static constexpr int kFreeRetrySamples = 8; // samples stepped after a failed runFree()
     int freeRetryIn_ = 0;
     // A sample whose contact force changed by more than kSubstepNextFactor x the sub-step

@@ -219,14 +219,20 @@ TEST(ModalResonatorFastPath, FreeRingingEqualsTheGeneralRecursion) {
 namespace {
 // Strikes of several strengths, a sole pushed back onto the floor by an external force after
 // some of them (contacts that start from free flight), rendered in blocks of `block` samples.
+// (substepLoop, avx: HuntCrossleyImpactT::allowSubstepLoop, allowAvx; velocityScale scales the
+// strikes' velocities)
 template <typename Real>
 std::vector<float> strikesAndPushes(const ImpactParams& p, const std::vector<Mode>& modes,
                                     const std::vector<std::vector<double>>& gains, int listen,
-                                    bool freeRuns, int block, ContactStats& stats, double& energy) {
+                                    bool freeRuns, int block, ContactStats& stats, double& energy,
+                                    bool substepLoop = true, bool avx = true,
+                                    double velocityScale = 1.0) {
     HuntCrossleyImpactT<Real> impact;
     impact.configure(p, modes, gains, listen);
+    impact.allowAvx(avx);
     impact.prepare({kFs, 64});
     impact.allowFreeRuns(freeRuns);
+    impact.allowSubstepLoop(substepLoop);
     const int n = static_cast<int>(1.2 * kFs);
     std::vector<float> out(static_cast<std::size_t>(n), 0.0f), push(out.size(), 0.0f);
     for (int i = 0; i < n; ++i) { // 40 N pushes after the second and fourth strikes
@@ -235,7 +241,7 @@ std::vector<float> strikesAndPushes(const ImpactParams& p, const std::vector<Mod
     }
     for (int start = 0; start < n; start += 2400) {
         // a strike every 50 ms, processed in blocks of `block` between them
-        impact.strike(0.1 + 0.15 * ((start / 2400) % 5));
+        impact.strike(velocityScale * (0.1 + 0.15 * ((start / 2400) % 5)));
         for (int i = start; i < std::min(n, start + 2400); i += block) {
             const int k = std::min({block, n - i, start + 2400 - i});
             impact.process(push.data() + i, out.data() + i, k);
@@ -305,4 +311,79 @@ TEST(ImpactFreeRuns, RunsGiveTheSampleBySampleSamples) {
     ImpactParams explicitSolver = benchImpact(1);
     explicitSolver.solver = ImpactSolver::Explicit;
     expectFreeRunsEqualSteps<double>(explicitSolver, kModes, {{1.0, 1.0, 1.0}}, 0);
+}
+
+namespace {
+// The loop of a sample's sub-steps against step() sub-step by sub-step (allowSubstepLoop):
+// samples, every statistic and the energy; returns the passivity corrections of the runs.
+template <typename Real>
+long long expectSubstepLoopEqualsSteps(const ImpactParams& p, const std::vector<Mode>& modes,
+                                       const std::vector<std::vector<double>>& gains, int listen,
+                                       double velocityScale) {
+    long long corrections = 0;
+    for (bool avx : {true, false}) {
+        ContactStats refStats, stats;
+        double refEnergy = 0.0, energy = 0.0;
+        const auto ref = strikesAndPushes<Real>(p, modes, gains, listen, true, 64, refStats,
+                                                refEnergy, false, avx, velocityScale);
+        const auto out = strikesAndPushes<Real>(p, modes, gains, listen, true, 64, stats, energy,
+                                                true, avx, velocityScale);
+        const auto where = ::testing::Message()
+                           << (avx ? "AVX" : "SSE2") << ", " << p.contactSubsteps
+                           << " sub-steps, k " << p.stiffness << ", sole " << p.exciterMassKg
+                           << " kg, " << modes.size() << " modes";
+        EXPECT_GT(refStats.solvedSamples, 0) << where;
+        EXPECT_EQ(out, ref) << where;
+        EXPECT_EQ(energy, refEnergy) << where;
+        EXPECT_EQ(stats.contactTimeSeconds, refStats.contactTimeSeconds) << where;
+        EXPECT_EQ(stats.peakForceN, refStats.peakForceN) << where;
+        EXPECT_EQ(stats.incomingVelocity, refStats.incomingVelocity) << where;
+        EXPECT_EQ(stats.outgoingVelocity, refStats.outgoingVelocity) << where;
+        EXPECT_EQ(stats.solverIterations, refStats.solverIterations) << where;
+        EXPECT_EQ(stats.solvedSamples, refStats.solvedSamples) << where;
+        EXPECT_EQ(stats.maxIterationsInOneSample, refStats.maxIterationsInOneSample) << where;
+        EXPECT_EQ(stats.passivityCorrections, refStats.passivityCorrections) << where;
+        EXPECT_EQ(stats.freeRunSamples, refStats.freeRunSamples) << where;
+        EXPECT_EQ(stats.testedRunSamples, refStats.testedRunSamples) << where;
+        corrections += stats.passivityCorrections;
+    }
+    return corrections;
+}
+} // namespace
+
+// A sample's contact sub-steps under the Hertz law run as one loop with the sole's state in
+// registers and the resonator's pass and the Newton solve inline
+// (HuntCrossleyImpactT::substepLoop). It must give exactly what step() sub-step by sub-step
+// gives: the samples, every statistic (solver iterations and passivity corrections included) and
+// the energy, with both kernels, in double and float state, with two pickups, and in contacts
+// stiff, light and fast enough for the passivity guard to correct sub-steps (its bisection runs
+// out of the loop, from the loop's state).
+TEST(ImpactContactSubsteps, SubstepLoopGivesTheStepBySubstepSamples) {
+    const std::vector<Mode> many = {{83.6, 0.07, 6.0},   {120.8, 0.03, 6.0},  {203.3, 0.92, 2.5},
+                                    {238.8, 0.02, 2.5},  {363.1, 0.04, 1.2},  {441.1, 0.035, 1.2},
+                                    {667.3, 0.03, 0.9},  {1130.0, 0.02, 0.5}, {2650.0, 0.5, 0.3},
+                                    {30000.0, 0.01, 0.2}};
+    std::vector<double> g1(many.size()), g2(many.size());
+    for (std::size_t i = 0; i < many.size(); ++i) {
+        g1[i] = 1.0 - 0.15 * static_cast<double>(i);
+        g2[i] = 0.5 + 0.1 * static_cast<double>(i % 3);
+    }
+    for (int sub : {2, 4, 16}) {
+        expectSubstepLoopEqualsSteps<double>(benchImpact(sub), kModes, {{1.0, 1.0, 1.0}}, 0, 1.0);
+        expectSubstepLoopEqualsSteps<double>(benchImpact(sub), many, {g1, g2}, 1, 1.0);
+        expectSubstepLoopEqualsSteps<float>(benchImpact(sub), many, {g1, g2}, 1, 1.0);
+    }
+    long long corrections = 0;
+    for (double stiffness : {1e9, 1e11}) {
+        for (double mass : {1e-6, 1e-4}) {
+            ImpactParams hard = benchImpact(4);
+            hard.stiffness = stiffness;
+            hard.exciterMassKg = mass;
+            hard.dissipation = 0.3;
+            corrections +=
+                expectSubstepLoopEqualsSteps<double>(hard, kModes, {{1.0, 1.0, 1.0}}, 0, 10.0);
+            corrections += expectSubstepLoopEqualsSteps<float>(hard, many, {g1, g2}, 1, 10.0);
+        }
+    }
+    EXPECT_GT(corrections, 0); // the correction ran from the loop
 }
