@@ -487,6 +487,10 @@ double HuntCrossleyImpactT<Real>::spanSamples(const float* fext, float* out, int
                 }
                 freeRetryIn_ = kFreeRetrySamples;
             }
+        } else {
+            // The touch came (or a force is held): once the sole leaves, free runs are tried at
+            // once (a wait left over from before a strike would step its first samples after it).
+            freeRetryIn_ = 0;
         }
         const double fNext = fext ? double(fext[i]) : 0.0;
         double y = 0.0;

@@ -313,6 +313,32 @@ TEST(ImpactFreeRuns, RunsGiveTheSampleBySampleSamples) {
     expectFreeRunsEqualSteps<double>(explicitSolver, kModes, {{1.0, 1.0, 1.0}}, 0);
 }
 
+// A strike's first sample finds the sole on the floor, so its free-run try fails and the next
+// samples would step without trying (HuntCrossleyImpactT::kFreeRetrySamples). That wait must not
+// outlast the contact: once the sole leaves, the samples after it run free at once (right after a
+// contact, the run tested sample by sample; issue #18: a wood strike's block stepped eight more
+// samples one by one).
+TEST(ImpactFreeRuns, RunsStartRightAfterAContact) {
+    HuntCrossleyImpact impact;
+    impact.configure(benchImpact(4), kModes, {{1.0, 1.0, 1.0}});
+    impact.prepare({kFs, 64});
+    impact.strike(0.5);
+    float y = 0.0f;
+    int contactSamples = 0;
+    while (contactSamples == 0 || impact.lastContactForce() > 0.0) { // up to the contact's end
+        impact.process(nullptr, &y, 1);
+        if (impact.lastContactForce() > 0.0) ++contactSamples;
+        ASSERT_LT(contactSamples, 1000);
+    }
+    ASSERT_GT(contactSamples, 5);
+    int stepped = 0; // samples after the contact stepped before a free run starts
+    for (const long long before = impact.stats().freeRunSamples; stepped < 100; ++stepped) {
+        impact.process(nullptr, &y, 1);
+        if (impact.stats().freeRunSamples > before) break;
+    }
+    EXPECT_EQ(stepped, 0);
+}
+
 namespace {
 // The loop of a sample's sub-steps against step() sub-step by sub-step (allowSubstepLoop):
 // samples, every statistic and the energy; returns the passivity corrections of the runs.
