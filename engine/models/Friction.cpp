@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "engine/models/Friction.h"
 
+#include "engine/models/ModalKernels.h"
+
 #include "engine/dsp/Simd.h"
 
 #include <algorithm>
@@ -408,7 +410,7 @@ ElastoPlasticFrictionT<Real>::solvePasses(double vRelPred, double z0, double noi
 }
 
 template <typename Real>
-template <bool Libm>
+template <bool Libm, bool Wide>
 [[gnu::always_inline]] inline double
 ElastoPlasticFrictionT<Real>::processBody(double normal, double drive, double anchorX,
                                           double anchorV) noexcept {
@@ -421,7 +423,7 @@ ElastoPlasticFrictionT<Real>::processBody(double normal, double drive, double an
     const double held = lastExternal_ - force_;
     const double xePred = xX_ * exciterX_ + xV_ * exciterV_ + xH_ * held + xE_ * external;
     const double vePred = vX_ * exciterX_ + vV_ * exciterV_ + vH_ * held + vE_ * external;
-    resonator_.predict();
+    resonator_.template predictInline<Wide>(); // (predict(), the pass inline)
     const double vRelPred = vePred - resonator_.predictedVelocity(0);
 
     // No load, no contact: no friction at all (z1 = 0, F = 0). Without a Newton solve below
@@ -487,7 +489,7 @@ template <bool Libm>
 double ElastoPlasticFrictionT<Real>::kernelGeneric(ElastoPlasticFrictionT& f, double normal,
                                                    double drive, double anchorX,
                                                    double anchorV) noexcept {
-    return f.processBody<Libm>(normal, drive, anchorX, anchorV);
+    return f.processBody<Libm, false>(normal, drive, anchorX, anchorV);
 }
 
 // The same code compiled with VEX encoding (three-operand scalar instructions: fewer register
@@ -497,7 +499,7 @@ template <bool Libm>
 [[gnu::target("avx")]] double
 ElastoPlasticFrictionT<Real>::kernelAvx(ElastoPlasticFrictionT& f, double normal, double drive,
                                         double anchorX, double anchorV) noexcept {
-    return f.processBody<Libm>(normal, drive, anchorX, anchorV);
+    return f.processBody<Libm, true>(normal, drive, anchorX, anchorV);
 }
 
 template <typename Real>

@@ -189,7 +189,8 @@ class ElastoPlasticFrictionT {
 
   private:
     using Kernel = double (*)(ElastoPlasticFrictionT&, double, double, double, double) noexcept;
-    template <bool Libm>
+    // (Wide: the resonator's pass inline with its AVX kernel, for kernelAvx)
+    template <bool Libm, bool Wide>
     double processBody(double normal, double drive, double anchorX, double anchorV) noexcept;
     template <bool Libm>
     static double kernelGeneric(ElastoPlasticFrictionT& f, double normal, double drive,
