@@ -487,10 +487,6 @@ double HuntCrossleyImpactT<Real>::spanSamples(const float* fext, float* out, int
                 }
                 freeRetryIn_ = kFreeRetrySamples;
             }
-        } else {
-            // The touch came (or a force is held): once the sole leaves, free runs are tried at
-            // once (a wait left over from before a strike would step its first samples after it).
-            freeRetryIn_ = 0;
         }
         const double fNext = fext ? double(fext[i]) : 0.0;
         double y = 0.0;
@@ -524,6 +520,10 @@ template <typename Real>
 void HuntCrossleyImpactT<Real>::substepSample(double f0, double f1, double& y) noexcept {
     const int sub = params_.contactSubsteps;
     const double before = lastForce_;
+    // A contact's transient ends the wait before the next free-run try (spanSamples): once the
+    // sole leaves, free runs are tried at once (a wait left over from the failed try at the
+    // strike's first sample would step the samples after the contact one by one).
+    freeRetryIn_ = 0;
     // (still at the fine rate when the sample before was sub-stepped and chose this one)
     if (!resonator_.fineRate()) setFineRate(true);
     if (substepLoop_ && shape_ == Shape::Hertz && params_.solver == ImpactSolver::Newton) {
