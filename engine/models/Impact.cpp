@@ -557,8 +557,8 @@ void HuntCrossleyImpactT<Real>::substepSample(double f0, double f1, double& y) n
 // f_j+1, false, y) does with newtonStart_ set as above (the same operations in the same order:
 // the same samples, state and statistics), with the sole's state, the contact's stored energy
 // and the time kept in registers over the sub-steps, the resonator's pass (predictInline) and
-// the Newton solve inline, and the passivity correction out of line (rare). One compact loop:
-// a strike's block runs some forty of these sub-steps, after hundreds of blocks of other work.
+// the Newton solve inline, and the passivity correction out of line (rare): a strike's block
+// runs some forty of these sub-steps (about 550 instructions each instead of 735 through step()).
 template <typename Real>
 template <bool Wide>
 [[gnu::always_inline]] inline void HuntCrossleyImpactT<Real>::substepLoop(double f0, double f1,

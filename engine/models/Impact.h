@@ -168,7 +168,7 @@ class HuntCrossleyImpactT {
     [[gnu::noinline]] void substepSample(double f0, double f1, double& y) noexcept;
     // The sub-steps of substepSample for the Hertz law with Newton (the shipped contact): what
     // step() does for each, with the sole's state in registers and the resonator's pass and the
-    // Newton solve inline, as one compact loop (a strike's hot path); Wide: the AVX kernel.
+    // Newton solve inline (a strike's hot path); Wide: the AVX kernel.
     template <bool Wide>
     void substepLoop(double f0, double f1, double& y) noexcept;
     [[gnu::flatten]] void substepsGeneric(double f0, double f1, double& y) noexcept;
