@@ -315,6 +315,27 @@ inline void HuntCrossleyImpactT<Real>::evaluateTrial(Trial& t, double fextNow,
     t.work = 0.5 * (fextNow + fextNext) * (t.x - exciterX_);
 }
 
+// The contact statistics of a committed step: `force` its contact force, `wasInContact` whether
+// the step before touched, `approach` the relative velocity before the step, `time` and
+// `exciterV` the time and the sole's velocity after it (the resonator committed).
+template <typename Real>
+inline void HuntCrossleyImpactT<Real>::countContact(double force, bool wasInContact,
+                                                    double approach, double time,
+                                                    double exciterV) noexcept {
+    if (force > 0.0) {
+        ++stats_.solvedSamples;
+        if (!wasInContact) {
+            contactStart_ = time;
+            stats_.peakForceN = 0;
+            stats_.incomingVelocity = approach;
+        }
+        stats_.peakForceN = std::max(stats_.peakForceN, force);
+    } else if (wasInContact) {
+        stats_.contactTimeSeconds = time - contactStart_;
+        stats_.outgoingVelocity = exciterV - resonator_.contactVelocity();
+    }
+}
+
 template <typename Real>
 typename HuntCrossleyImpactT<Real>::Trial
 HuntCrossleyImpactT<Real>::correctPassivity(double fextNow, double fextNext, double bodiesBefore,
@@ -412,20 +433,8 @@ bool HuntCrossleyImpactT<Real>::step(double fextNow, double fextNext, bool abort
     contactEnergy_ = force > 0.0 ? std::max(0.0, contactEnergy_ + absorbed) : 0.0;
     time_ += T;
 
-    const bool contactNow = force > 0.0;
-    if (contactNow) {
-        ++stats_.solvedSamples;
-        if (!inContact_) {
-            contactStart_ = time_;
-            stats_.peakForceN = 0;
-            stats_.incomingVelocity = approach;
-        }
-        stats_.peakForceN = std::max(stats_.peakForceN, force);
-    } else if (inContact_) {
-        stats_.contactTimeSeconds = time_ - contactStart_;
-        stats_.outgoingVelocity = exciterV_ - resonator_.contactVelocity();
-    }
-    inContact_ = contactNow;
+    countContact(force, inContact_, approach, time_, exciterV_);
+    inContact_ = force > 0.0;
     y = resonator_.velocity(listen_);
     return true;
 }
@@ -613,18 +622,7 @@ template <bool Wide>
         last = force;
         stored = force > 0.0 ? std::max(0.0, stored + absorbed) : 0.0;
         time += T;
-        if (force > 0.0) {
-            ++stats_.solvedSamples;
-            if (!inContact) {
-                contactStart_ = time;
-                stats_.peakForceN = 0;
-                stats_.incomingVelocity = approach;
-            }
-            stats_.peakForceN = std::max(stats_.peakForceN, force);
-        } else if (inContact) {
-            stats_.contactTimeSeconds = time - contactStart_;
-            stats_.outgoingVelocity = v - resonator_.contactVelocity();
-        }
+        countContact(force, inContact, approach, time, v);
         inContact = force > 0.0;
         s2 = s1;
         s1 = f;

@@ -137,6 +137,8 @@ class HuntCrossleyImpactT {
     };
     Trial trialAt(double fextNow, double fextNext, double held, double scale) noexcept;
     void evaluateTrial(Trial& t, double fextNow, double fextNext) const noexcept;
+    void countContact(double force, bool wasInContact, double approach, double time,
+                      double exciterV) noexcept; // stats() after a committed step
     // The passivity guard's correction of a step whose trial (1, 1) would return more energy than
     // the contact stored (rare: see step()); returns the passive trial, the resonator predicted
     // for it.

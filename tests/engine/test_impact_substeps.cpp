@@ -217,6 +217,26 @@ TEST(ModalResonatorFastPath, FreeRingingEqualsTheGeneralRecursion) {
 }
 
 namespace {
+// Ten modes (three quads, one of them part padding), one above Nyquist (quasi-static), and the
+// gains of two pickups.
+struct ManyModes {
+    std::vector<Mode> modes;
+    std::vector<double> g1, g2;
+};
+ManyModes manyModes() {
+    ManyModes m;
+    m.modes = {{83.6, 0.07, 6.0},  {120.8, 0.03, 6.0},  {203.3, 0.92, 2.5}, {238.8, 0.02, 2.5},
+               {363.1, 0.04, 1.2}, {441.1, 0.035, 1.2}, {667.3, 0.03, 0.9}, {1130.0, 0.02, 0.5},
+               {2650.0, 0.5, 0.3}, {30000.0, 0.01, 0.2}};
+    m.g1.resize(m.modes.size());
+    m.g2.resize(m.modes.size());
+    for (std::size_t i = 0; i < m.modes.size(); ++i) {
+        m.g1[i] = 1.0 - 0.15 * static_cast<double>(i);
+        m.g2[i] = 0.5 + 0.1 * static_cast<double>(i % 3);
+    }
+    return m;
+}
+
 // Strikes of several strengths, a sole pushed back onto the floor by an external force after
 // some of them (contacts that start from free flight), rendered in blocks of `block` samples.
 // (substepLoop, avx: HuntCrossleyImpactT::allowSubstepLoop, allowAvx; velocityScale scales the
@@ -294,19 +314,13 @@ void expectFreeRunsEqualSteps(const ImpactParams& p, const std::vector<Mode>& mo
 // modes or several, a mode above Nyquist (quasi-static), two pickups, sub-steps or none, the
 // explicit solver (never run at once), and float state.
 TEST(ImpactFreeRuns, RunsGiveTheSampleBySampleSamples) {
-    const std::vector<Mode> many = {{83.6, 0.07, 6.0},   {120.8, 0.03, 6.0},  {203.3, 0.92, 2.5},
-                                    {238.8, 0.02, 2.5},  {363.1, 0.04, 1.2},  {441.1, 0.035, 1.2},
-                                    {667.3, 0.03, 0.9},  {1130.0, 0.02, 0.5}, {2650.0, 0.5, 0.3},
-                                    {30000.0, 0.01, 0.2}};
-    std::vector<double> g1(many.size()), g2(many.size());
-    for (std::size_t i = 0; i < many.size(); ++i) {
-        g1[i] = 1.0 - 0.15 * static_cast<double>(i);
-        g2[i] = 0.5 + 0.1 * static_cast<double>(i % 3);
-    }
+    const ManyModes m = manyModes();
+    const std::vector<Mode>& many = m.modes;
+    const std::vector<std::vector<double>> gains = {m.g1, m.g2};
     for (int sub : {1, 4, 8}) {
         expectFreeRunsEqualSteps<double>(benchImpact(sub), kModes, {{1.0, 1.0, 1.0}}, 0);
-        expectFreeRunsEqualSteps<double>(benchImpact(sub), many, {g1, g2}, 1);
-        expectFreeRunsEqualSteps<float>(benchImpact(sub), many, {g1, g2}, 1);
+        expectFreeRunsEqualSteps<double>(benchImpact(sub), many, gains, 1);
+        expectFreeRunsEqualSteps<float>(benchImpact(sub), many, gains, 1);
     }
     ImpactParams explicitSolver = benchImpact(1);
     explicitSolver.solver = ImpactSolver::Explicit;
@@ -385,19 +399,13 @@ long long expectSubstepLoopEqualsSteps(const ImpactParams& p, const std::vector<
 // stiff, light and fast enough for the passivity guard to correct sub-steps (its bisection runs
 // out of the loop, from the loop's state).
 TEST(ImpactContactSubsteps, SubstepLoopGivesTheStepBySubstepSamples) {
-    const std::vector<Mode> many = {{83.6, 0.07, 6.0},   {120.8, 0.03, 6.0},  {203.3, 0.92, 2.5},
-                                    {238.8, 0.02, 2.5},  {363.1, 0.04, 1.2},  {441.1, 0.035, 1.2},
-                                    {667.3, 0.03, 0.9},  {1130.0, 0.02, 0.5}, {2650.0, 0.5, 0.3},
-                                    {30000.0, 0.01, 0.2}};
-    std::vector<double> g1(many.size()), g2(many.size());
-    for (std::size_t i = 0; i < many.size(); ++i) {
-        g1[i] = 1.0 - 0.15 * static_cast<double>(i);
-        g2[i] = 0.5 + 0.1 * static_cast<double>(i % 3);
-    }
+    const ManyModes m = manyModes();
+    const std::vector<Mode>& many = m.modes;
+    const std::vector<std::vector<double>> gains = {m.g1, m.g2};
     for (int sub : {2, 4, 16}) {
         expectSubstepLoopEqualsSteps<double>(benchImpact(sub), kModes, {{1.0, 1.0, 1.0}}, 0, 1.0);
-        expectSubstepLoopEqualsSteps<double>(benchImpact(sub), many, {g1, g2}, 1, 1.0);
-        expectSubstepLoopEqualsSteps<float>(benchImpact(sub), many, {g1, g2}, 1, 1.0);
+        expectSubstepLoopEqualsSteps<double>(benchImpact(sub), many, gains, 1, 1.0);
+        expectSubstepLoopEqualsSteps<float>(benchImpact(sub), many, gains, 1, 1.0);
     }
     long long corrections = 0;
     for (double stiffness : {1e9, 1e11}) {
@@ -408,7 +416,7 @@ TEST(ImpactContactSubsteps, SubstepLoopGivesTheStepBySubstepSamples) {
             hard.dissipation = 0.3;
             corrections +=
                 expectSubstepLoopEqualsSteps<double>(hard, kModes, {{1.0, 1.0, 1.0}}, 0, 10.0);
-            corrections += expectSubstepLoopEqualsSteps<float>(hard, many, {g1, g2}, 1, 10.0);
+            corrections += expectSubstepLoopEqualsSteps<float>(hard, many, gains, 1, 10.0);
         }
     }
     EXPECT_GT(corrections, 0); // the correction ran from the loop
