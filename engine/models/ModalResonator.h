@@ -105,9 +105,9 @@ class ModalResonatorT {
         passes_[variant](*this, static_cast<Real>(heldScale));
     }
     /// predict() (held scale 1) with the pass inlined into the caller, for a loop that runs it
-    /// many times in a row (the impact's contact sub-steps): Wide = true for a caller compiled
-    /// with AVX (usesAvx()), false otherwise. The same values as predict(). Defined in
-    /// engine/models/ModalKernels.h.
+    /// many times in a row (the impact's contact sub-steps, friction's per-sample kernel): Wide
+    /// = true for a caller compiled with AVX (usesAvx()), false otherwise. The same values as
+    /// predict(). Defined in engine/models/ModalKernels.h.
     template <bool Wide>
     void predictInline() noexcept;
     double predictedPosition(int p) const noexcept {
