@@ -2,8 +2,8 @@
 #pragma once
 /// The modal resonator's per-mode SIMD kernel (ModalResonatorT::passBody) and its lane helpers,
 /// for the translation units that inline it: ModalResonator.cpp (the pass table behind
-/// predict()) and Impact.cpp (the contact sub-steps, which run the pass inline: see
-/// ModalResonatorT::predictInline). Not a public header.
+/// predict()), Impact.cpp (the contact sub-steps) and Friction.cpp (its per-sample kernel), which
+/// run the pass inline (ModalResonatorT::predictInline). Not a public header.
 #include "engine/models/ModalResonator.h"
 
 #include <cstddef>
@@ -15,14 +15,14 @@ namespace modal_simd {
 
 // Four modes per step: the per-mode loops below work on quads of lanes over arrays padded to a
 // multiple of four with modes whose coefficients are all zero. The same source is compiled twice
-// (passGeneric, passAvx): with AVX (chosen at run time) a quad of doubles is one 256-bit vector
-// (GCC/Clang vector extensions); without it, a quad is written out as two SSE2 pairs (`Pairs`:
-// left to GCC's generic lowering, four-lane vectors of doubles kept their partial sums on the
-// stack). Either way every lane does the IEEE operation of the scalar code (no FMA: neither
-// target enables it), and the pickup sums keep one partial sum per lane, added at the end as
-// (lane 0 + lane 2) + (lane 1 + lane 3): a fixed order, so the output is bit-for-bit the same on
-// every x86-64 machine and for both kernels. (For up to four modes this is also the order of the
-// earlier two-lane loops, whose lanes summed modes 0 + 2 and 1 + 3.)
+// (passGeneric, passAvx, and likewise where it is inlined): with AVX (chosen at run time) a quad of
+// doubles is one 256-bit vector (GCC/Clang vector extensions); without it, a quad is written out as
+// two SSE2 pairs (`Pairs`: left to GCC's generic lowering, four-lane vectors of doubles kept their
+// partial sums on the stack). Either way every lane does the IEEE operation of the scalar code (no
+// FMA: neither target enables it), and the pickup sums keep one partial sum per lane, added at the
+// end as (lane 0 + lane 2) + (lane 1 + lane 3): a fixed order, so the output is bit-for-bit the
+// same on every x86-64 machine and for both kernels. (For up to four modes this is also the order
+// of the earlier two-lane loops, whose lanes summed modes 0 + 2 and 1 + 3.)
 template <typename Real>
 struct Quad {
     typedef Real type __attribute__((vector_size(4 * sizeof(Real))));
@@ -218,22 +218,27 @@ template <bool Wide, bool Energy, bool Fused, bool Held, bool Free>
     }
 }
 
-// predict() with the pass inline: the variant predict(1.0) selects (see predict()), for a caller
-// compiled for the kernel's instruction set (Wide: AVX).
+// predict(1.0) with its pass inline, for a caller compiled for the kernel's instruction set
+// (Wide: AVX): the variant predict() selects (passVariant; with a held scale of 1 the held
+// variants, the odd ones, do not occur), as kPasses lists them.
 template <typename Real>
 template <bool Wide>
 [[gnu::always_inline]] inline void ModalResonatorT<Real>::predictInline() noexcept {
     predictedEnergyValid_ = false;
-    const bool pending = pending_;
+    const int variant = passVariant(1.0);
     pending_ = false;
-    if (heldZero_)
-        passBody<Wide, false, false, false, true>(Real(1));
-    else if (trackEnergy_)
-        pending ? passBody<Wide, true, true, false, false>(Real(1))
-                : passBody<Wide, true, false, false, false>(Real(1));
-    else
-        pending ? passBody<Wide, false, true, false, false>(Real(1))
-                : passBody<Wide, false, false, false, false>(Real(1));
+    switch (variant) {
+    case 8:
+        return passBody<Wide, false, false, false, true>(Real(1));
+    case 6:
+        return passBody<Wide, true, true, false, false>(Real(1));
+    case 4:
+        return passBody<Wide, true, false, false, false>(Real(1));
+    case 2:
+        return passBody<Wide, false, true, false, false>(Real(1));
+    default:
+        return passBody<Wide, false, false, false, false>(Real(1));
+    }
 }
 
 } // namespace underfoot::engine

@@ -98,9 +98,7 @@ class ModalResonatorT {
     void predict(double heldScale = 1.0) noexcept {
         predictedEnergyValid_ = false;
         if (pending_ && heldScale == 0.0) settle(); // (the passivity guard's trials; rare)
-        const bool free = heldZero_ || heldScale == 0.0;
-        const int variant =
-            free ? 8 : (trackEnergy_ ? 4 : 0) + (pending_ ? 2 : 0) + (heldScale != 1.0 ? 1 : 0);
+        const int variant = passVariant(heldScale);
         pending_ = false;
         passes_[variant](*this, static_cast<Real>(heldScale));
     }
@@ -250,6 +248,12 @@ class ModalResonatorT {
     // The pass over the modes that predict() runs: 9 variants (see the .cpp) x 2 kernels (SSE2
     // pairs, AVX: passBody<Wide = true>), chosen per call from a table of plain function pointers.
     using PassFn = void (*)(ModalResonatorT&, Real) noexcept;
+    // The pass predict(heldScale) runs: 4 energy + 2 fused + held, or 8 for free ringing (the
+    // index into kPasses[kernel]; predictInline selects the same pass by it).
+    int passVariant(double heldScale) const noexcept {
+        if (heldZero_ || heldScale == 0.0) return 8;
+        return (trackEnergy_ ? 4 : 0) + (pending_ ? 2 : 0) + (heldScale != 1.0 ? 1 : 0);
+    }
     template <bool Energy, bool Fused, bool Held, bool Free>
     static void passGeneric(ModalResonatorT& r, Real h) noexcept;
     template <bool Energy, bool Fused, bool Held, bool Free>
