@@ -218,9 +218,13 @@ ElastoPlasticFrictionT<Real>::plasticRate(const SolveInput& in, double v, double
         const double t = 2.0 * (az - 0.5 * (ass + in.zba)) * invW;
         const double sn = Libm ? std::sin(0.5 * kPi * t) : frictionSinHalfPi(t);
         a = 0.5 * sn + 0.5;
-        // da/dt = (pi / 4) cos(pi t / 2), cos = sqrt(1 - sin^2) >= 0 on [-1, 1] (only the
-        // Newton step uses derivatives: their rounding does not change the converged solution)
-        const double dadt = 0.25 * kPi * std::sqrt(std::max(0.0, 1.0 - sn * sn));
+        // da/dt = (pi / 4) cos(pi t / 2) >= 0 on [-1, 1]. The cosine is its own polynomial,
+        // evaluated beside the sine: taken as sqrt(1 - sin^2) it waited for the sine and a square
+        // root, on the chain of dependent operations that sets a sample's time (only the Newton
+        // step uses derivatives: their rounding moves the solution by far less than the stop's
+        // tolerance)
+        const double cs = Libm ? std::cos(0.5 * kPi * t) : frictionCosHalfPi(t);
+        const double dadt = 0.25 * kPi * std::max(0.0, cs);
         daDz = dadt * 2.0 * invW;          // d a / d|z|
         daDass = -dadt * (1.0 + t) * invW; // d a / d|z_ss|
     }

@@ -126,19 +126,23 @@ TEST(ElastoPlasticFriction, StickSlipUnderASteadyDragMakesAPeriodicCreak) {
     EXPECT_LT(slips, 2000);
 }
 
-// issue #18: the fixed point's Stribeck exp and raised sine are polynomials with stated error
-// bounds instead of libm calls.
+// issue #18: the fixed point's Stribeck exp and raised sine (and the Newton step's cosine, its
+// derivative) are polynomials with stated error bounds instead of libm calls.
 TEST(FrictionFunctions, ErrorsStayWithinTheirStatedBounds) {
-    double worstExp = 0.0, worstSin = 0.0;
+    double worstExp = 0.0, worstSin = 0.0, worstCos = 0.0;
     for (int i = 0; i <= 2000000; ++i) {
         const double y = -60.0 * i / 2000000.0; // the Stribeck argument -(v / v_s)^2
         const double ref = std::exp(y);
         worstExp = std::max(worstExp, std::fabs(frictionExpNeg(y) - ref) / ref);
         const double t = -1.0 + 2.0 * i / 2000000.0;
         worstSin = std::max(worstSin, std::fabs(frictionSinHalfPi(t) - std::sin(0.5 * kPi * t)));
+        worstCos = std::max(worstCos, std::fabs(frictionCosHalfPi(t) - std::cos(0.5 * kPi * t)));
     }
     EXPECT_LT(worstExp, 1e-15);
     EXPECT_LT(worstSin, 1e-15);
+    EXPECT_LT(worstCos, 1e-15);
+    EXPECT_EQ(frictionCosHalfPi(0.0), 1.0);
+    EXPECT_NEAR(frictionCosHalfPi(1.0), 0.0, 1e-15);
     EXPECT_EQ(frictionExpNeg(0.0), 1.0);
     EXPECT_EQ(frictionExpNeg(-800.0), 0.0);
     EXPECT_EQ(frictionSinHalfPi(0.0), 0.0);
