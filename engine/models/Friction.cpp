@@ -296,28 +296,33 @@ ElastoPlasticFrictionT<Real>::solveNewton(const SolveInput& in, double vRelPred,
         double next = pk - g / gp;
         if (next < 0.0) next = 0.0; // (p >= 0; a NaN step fails the bracket test below)
         if (!(next > lo && next < hi)) next = hi < HUGE_VAL ? 0.5 * (std::max(lo, 0.0) + hi) : P.p;
-        const double step = std::fabs(next - pk);
-        // Contraction of this step against the last one: the error left after a step of a
-        // sequence contracting by theta < 1 is at most theta / (1 - theta) times the step
-        // (for Newton far less: about theta^2 times it). With no earlier step, factor 1: the
-        // fixed-point criterion itself (a pass that moves by at most tol).
-        const double theta = step / lastStep; // (0 / 0 or x / 0 before a step: factor 1)
-        const double factor = theta < 0.5 ? theta / (1.0 - theta) : 1.0;
+        const double step = std::fabs(next - pk), lastStepBefore = lastStep;
         lastStep = step;
         pk = next;
         const double vb = x.v, zb = x.z;
         x = passAt(in, pk);
-        // Converged when the error left in v and z (estimated from the step as above) is at
-        // most tol relative to max(|v|, v_s) and max(|z|, T v_s): the plain passes' criterion
-        // (a pass that moves by at most tol leaves an error of about theta / (1 - theta) tol,
-        // theta up to ~0.5 there).
-        // Or, with newtonStepTolerance, when the step itself was at most stepTol: Newton's error
-        // after it is of the order of its square (see FrictionParams).
+        // Converged when the step was at most newtonStepTolerance (Newton's error after it is of
+        // the order of its square, see FrictionParams), or when the error left in v and z,
+        // estimated from the step as below, is at most tol, relative to max(|v|, v_s) and
+        // max(|z|, T v_s): the plain passes' criterion. The step's test comes first: it decides
+        // almost every sample (1.08 evaluations a sample on the creak), and the estimate's two
+        // divisions and its branch are then left out of the sample's chain of operations (the
+        // same decision either way: an "or" of the two tests).
         const double moveV = std::fabs(x.v - vb), moveZ = std::fabs(x.z - zb);
         const double scaleV = std::max(std::fabs(x.v), vScale),
                      scaleZ = std::max(std::fabs(x.z), zScale);
-        if ((factor * moveV <= tol * scaleV && factor * moveZ <= tol * scaleZ) ||
-            (moveV <= stepTol * scaleV && moveZ <= stepTol * scaleZ)) {
+        if (moveV <= stepTol * scaleV && moveZ <= stepTol * scaleZ) {
+            converged = true;
+            break;
+        }
+        // Contraction of this step against the last one: the error left after a step of a
+        // sequence contracting by theta < 1 is at most theta / (1 - theta) times the step (for
+        // Newton far less: about theta^2 times it; a pass that moves by at most tol leaves an
+        // error of about theta / (1 - theta) tol, theta up to ~0.5 there). With no earlier step,
+        // factor 1: the fixed-point criterion itself (a pass that moves by at most tol).
+        const double theta = step / lastStepBefore; // (0 / 0 or x / 0 before a step: factor 1)
+        const double factor = theta < 0.5 ? theta / (1.0 - theta) : 1.0;
+        if (factor * moveV <= tol * scaleV && factor * moveZ <= tol * scaleZ) {
             converged = true;
             break;
         }
