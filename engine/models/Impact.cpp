@@ -315,25 +315,35 @@ inline void HuntCrossleyImpactT<Real>::evaluateTrial(Trial& t, double fextNow,
     t.work = 0.5 * (fextNow + fextNext) * (t.x - exciterX_);
 }
 
-// The contact statistics of a committed step: `force` its contact force, `wasInContact` whether
-// the step before touched, `approach` the relative velocity before the step, `time` and
-// `exciterV` the time and the sole's velocity after it (the resonator committed).
+// The commit of step() and of the sub-step loop: the same operations in the same order on
+// either's state. The contact statistics: `approach` is the relative velocity before the step.
 template <typename Real>
-inline void HuntCrossleyImpactT<Real>::countContact(double force, bool wasInContact,
-                                                    double approach, double time,
-                                                    double exciterV) noexcept {
+[[gnu::always_inline]] inline void
+HuntCrossleyImpactT<Real>::commitStep(const Trial& t, double absorbed, double& x, double& v,
+                                      double& last, double& stored, double& time,
+                                      bool& inContact) noexcept {
+    const double force = t.force;
+    const double approach = v - resonator_.contactVelocity(); // at n, for the stats
+    x = t.x;
+    v = t.v;
+    resonator_.commit(0, force);
+    last = force;
+    // Energy stored in the contact; what is left when it opens is lost (dissipated).
+    stored = force > 0.0 ? std::max(0.0, stored + absorbed) : 0.0;
+    time += T_;
     if (force > 0.0) {
         ++stats_.solvedSamples;
-        if (!wasInContact) {
+        if (!inContact) {
             contactStart_ = time;
             stats_.peakForceN = 0;
             stats_.incomingVelocity = approach;
         }
         stats_.peakForceN = std::max(stats_.peakForceN, force);
-    } else if (wasInContact) {
+    } else if (inContact) {
         stats_.contactTimeSeconds = time - contactStart_;
-        stats_.outgoingVelocity = exciterV - resonator_.contactVelocity();
+        stats_.outgoingVelocity = v - resonator_.contactVelocity();
     }
+    inContact = force > 0.0;
 }
 
 template <typename Real>
@@ -388,7 +398,7 @@ HuntCrossleyImpactT<Real>::correctPassivity(double fextNow, double fextNext, dou
 template <typename Real>
 bool HuntCrossleyImpactT<Real>::step(double fextNow, double fextNext, bool abortOnContact,
                                      double& y) noexcept {
-    const double M = params_.exciterMassKg, T = T_;
+    const double M = params_.exciterMassKg;
     // Both bodies are integrated exactly for the linear force ramp, so their energy change is
     // exactly the ramp's work: the check below is then exactly "the contact returns no more
     // energy than it stored".
@@ -423,18 +433,7 @@ bool HuntCrossleyImpactT<Real>::step(double fextNow, double fextNext, bool abort
     }
 
     // Commit the sample with the contact force at n+1.
-    const double force = t.force;
-    const double approach = exciterV_ - resonator_.contactVelocity(); // at n, for the stats
-    exciterX_ = t.x;
-    exciterV_ = t.v;
-    resonator_.commit(0, force);
-    lastForce_ = force;
-    // Energy stored in the contact; what is left when it opens is lost (dissipated).
-    contactEnergy_ = force > 0.0 ? std::max(0.0, contactEnergy_ + absorbed) : 0.0;
-    time_ += T;
-
-    countContact(force, inContact_, approach, time_, exciterV_);
-    inContact_ = force > 0.0;
+    commitStep(t, absorbed, exciterX_, exciterV_, lastForce_, contactEnergy_, time_, inContact_);
     y = resonator_.velocity(listen_);
     return true;
 }
@@ -613,17 +612,7 @@ template <bool Wide>
             }
             absorbed = bodiesBefore + t.work - t.energy;
         }
-        // step()'s commit
-        const double force = t.force;
-        const double approach = v - resonator_.contactVelocity();
-        x = t.x;
-        v = t.v;
-        resonator_.commit(0, force);
-        last = force;
-        stored = force > 0.0 ? std::max(0.0, stored + absorbed) : 0.0;
-        time += T;
-        countContact(force, inContact, approach, time, v);
-        inContact = force > 0.0;
+        commitStep(t, absorbed, x, v, last, stored, time, inContact); // (step()'s commit)
         s2 = s1;
         s1 = f;
     }

@@ -137,8 +137,11 @@ class HuntCrossleyImpactT {
     };
     Trial trialAt(double fextNow, double fextNext, double held, double scale) noexcept;
     void evaluateTrial(Trial& t, double fextNow, double fextNext) const noexcept;
-    void countContact(double force, bool wasInContact, double approach, double time,
-                      double exciterV) noexcept; // stats() after a committed step
+    // Commits a step's trial t (`absorbed`: the energy the contact took in it) to the sole's
+    // state (x, v), the last force, the contact's stored energy, the time and the contact flag,
+    // and counts it in stats(): step() passes its members, the sub-step loop its registers.
+    void commitStep(const Trial& t, double absorbed, double& x, double& v, double& last,
+                    double& stored, double& time, bool& inContact) noexcept;
     // The passivity guard's correction of a step whose trial (1, 1) would return more energy than
     // the contact stored (rare: see step()); returns the passive trial, the resonator predicted
     // for it.
