@@ -124,88 +124,104 @@ void LiveEngine::open(const AudioSettings& settings) {
     dev->audio->showWarnings(false);
     auto& audio = *dev->audio;
     const std::string apiName = RtAudio::getApiName(audio.getCurrentApi());
-    const unsigned count = audio.getDeviceCount();
-    std::vector<RtAudio::DeviceInfo> infos(count);
-    for (unsigned i = 0; i < count; ++i) {
-        try {
-            infos[i] = audio.getDeviceInfo(i);
-        } catch (const RtAudioError&) {
-            infos[i].probed = false;
+    // What the open settled on, for the checks and the names after it.
+    std::string outName;
+    unsigned int frames = 0;
+    for (int attempt = 0;; ++attempt) {
+        const unsigned count = audio.getDeviceCount();
+        std::vector<RtAudio::DeviceInfo> infos(count);
+        for (unsigned i = 0; i < count; ++i) {
+            try {
+                infos[i] = audio.getDeviceInfo(i);
+            } catch (const RtAudioError&) {
+                infos[i].probed = false;
+            }
         }
-    }
-    auto describe = [&] {
-        std::string list;
-        for (const auto& info : infos)
-            if (info.probed)
-                list += fmt::format("{}\"{}\" ({} in, {} out)", list.empty() ? "" : ", ", info.name,
-                                    info.inputChannels, info.outputChannels);
-        return list.empty() ? std::string("none") : list;
-    };
-    auto find = [&](const std::string& name, bool output) -> unsigned {
-        if (name.empty()) {
-            const unsigned d =
-                output ? audio.getDefaultOutputDevice() : audio.getDefaultInputDevice();
-            if (d < count && infos[d].probed) return d;
-            throw AudioSettingsError(fmt::format("audio API \"{}\" has no default {} device; "
-                                                 "devices: {}",
-                                                 apiName, output ? "output" : "input", describe()));
-        }
-        for (unsigned i = 0; i < count; ++i)
-            if (infos[i].probed && infos[i].name == name) return i;
-        throw AudioSettingsError(fmt::format(
-            "audio device \"{}\" not found on API \"{}\"; expected one of: {} (see `underfoot "
-            "devices`)",
-            name, apiName, describe()));
-    };
-    const unsigned outId = find(settings_.device, true);
-    const unsigned inId =
-        numInputs_ > 0
-            ? find(settings_.inputDevice.empty() ? infos[outId].name : settings_.inputDevice, false)
-            : outId;
-    if (static_cast<int>(infos[outId].outputChannels) < numOutputs_)
-        throw AudioSettingsError(fmt::format(
-            "audio device \"{}\" has {} output channels; the channel map uses {} (headphones "
-            "{}/{}{})",
-            infos[outId].name, infos[outId].outputChannels, numOutputs_,
-            settings_.channels.headphonesLeft + 1, settings_.channels.headphonesRight + 1,
-            settings_.channels.hasHaptics() ? " and haptic actuators" : ""));
-    if (numInputs_ > 0 && static_cast<int>(infos[inId].inputChannels) < numInputs_)
-        throw AudioSettingsError(
-            fmt::format("audio device \"{}\" has {} input channels; the microphones need {}",
-                        infos[inId].name, infos[inId].inputChannels, numInputs_));
+        auto describe = [&] {
+            std::string list;
+            for (const auto& info : infos)
+                if (info.probed)
+                    list += fmt::format("{}\"{}\" ({} in, {} out)", list.empty() ? "" : ", ",
+                                        info.name, info.inputChannels, info.outputChannels);
+            return list.empty() ? std::string("none") : list;
+        };
+        auto find = [&](const std::string& name, bool output) -> unsigned {
+            if (name.empty()) {
+                const unsigned d =
+                    output ? audio.getDefaultOutputDevice() : audio.getDefaultInputDevice();
+                if (d < count && infos[d].probed) return d;
+                throw AudioSettingsError(fmt::format("audio API \"{}\" has no default {} device; "
+                                                     "devices: {}",
+                                                     apiName, output ? "output" : "input",
+                                                     describe()));
+            }
+            for (unsigned i = 0; i < count; ++i)
+                if (infos[i].probed && infos[i].name == name) return i;
+            throw AudioSettingsError(fmt::format(
+                "audio device \"{}\" not found on API \"{}\"; expected one of: {} (see `underfoot "
+                "devices`)",
+                name, apiName, describe()));
+        };
+        const unsigned outId = find(settings_.device, true);
+        const unsigned inId =
+            numInputs_ > 0
+                ? find(settings_.inputDevice.empty() ? infos[outId].name : settings_.inputDevice,
+                       false)
+                : outId;
+        if (static_cast<int>(infos[outId].outputChannels) < numOutputs_)
+            throw AudioSettingsError(fmt::format(
+                "audio device \"{}\" has {} output channels; the channel map uses {} (headphones "
+                "{}/{}{})",
+                infos[outId].name, infos[outId].outputChannels, numOutputs_,
+                settings_.channels.headphonesLeft + 1, settings_.channels.headphonesRight + 1,
+                settings_.channels.hasHaptics() ? " and haptic actuators" : ""));
+        if (numInputs_ > 0 && static_cast<int>(infos[inId].inputChannels) < numInputs_)
+            throw AudioSettingsError(
+                fmt::format("audio device \"{}\" has {} input channels; the microphones need {}",
+                            infos[inId].name, infos[inId].inputChannels, numInputs_));
 
-    RtAudio::StreamParameters outParams, inParams;
-    outParams.deviceId = outId;
-    outParams.nChannels = static_cast<unsigned>(numOutputs_);
-    inParams.deviceId = inId;
-    inParams.nChannels = static_cast<unsigned>(numInputs_);
-    RtAudio::StreamOptions options;
-    options.flags = RTAUDIO_NONINTERLEAVED | RTAUDIO_MINIMIZE_LATENCY;
-    if (settings_.portConnection == AudioSettings::PortConnection::Manual)
-        options.flags |= RTAUDIO_JACK_DONT_CONNECT;
-    options.streamName = settings_.clientName;
-    unsigned int frames = static_cast<unsigned>(settings_.blockSize);
-    try {
-        audio.openStream(&outParams, numInputs_ > 0 ? &inParams : nullptr, RTAUDIO_FLOAT32,
-                         static_cast<unsigned>(settings_.sampleRateHz), &frames,
-                         &DeviceCallback::run, this, &options);
-    } catch (const RtAudioError& e) {
-        throw AudioSettingsError(fmt::format("audio device \"{}\" ({}) refused a {}-in/{}-out "
-                                             "stream at {} Hz, {} frames: {}",
-                                             infos[outId].name, apiName, numInputs_, numOutputs_,
-                                             settings_.sampleRateHz, settings_.blockSize,
-                                             e.getMessage()));
+        RtAudio::StreamParameters outParams, inParams;
+        outParams.deviceId = outId;
+        outParams.nChannels = static_cast<unsigned>(numOutputs_);
+        inParams.deviceId = inId;
+        inParams.nChannels = static_cast<unsigned>(numInputs_);
+        RtAudio::StreamOptions options;
+        options.flags = RTAUDIO_NONINTERLEAVED | RTAUDIO_MINIMIZE_LATENCY;
+        if (settings_.portConnection == AudioSettings::PortConnection::Manual)
+            options.flags |= RTAUDIO_JACK_DONT_CONNECT;
+        options.streamName = settings_.clientName;
+        frames = static_cast<unsigned>(settings_.blockSize);
+        try {
+            audio.openStream(&outParams, numInputs_ > 0 ? &inParams : nullptr, RTAUDIO_FLOAT32,
+                             static_cast<unsigned>(settings_.sampleRateHz), &frames,
+                             &DeviceCallback::run, this, &options);
+        } catch (const RtAudioError& e) {
+            // openStream lists the devices again and refuses an id that is no longer in the list:
+            // the list changed between the lookup above and the open (a device went away, or the
+            // JACK server did not answer openStream's own probe on a loaded machine). The names
+            // are looked up again, once; a device that is really gone is then "not found".
+            const std::string why = e.getMessage();
+            if (attempt == 0 && why.find("device parameter value is invalid") != std::string::npos)
+                continue;
+            throw AudioSettingsError(fmt::format("audio device \"{}\" ({}) refused a {}-in/{}-out "
+                                                 "stream at {} Hz, {} frames: {}",
+                                                 infos[outId].name, apiName, numInputs_,
+                                                 numOutputs_, settings_.sampleRateHz,
+                                                 settings_.blockSize, why));
+        }
+        outName = infos[outId].name;
+        break;
     }
     const unsigned rate = audio.getStreamSampleRate();
     if (rate != 0 && static_cast<int>(rate) != settings_.sampleRateHz) {
         audio.closeStream();
         throw AudioSettingsError(fmt::format(
             "audio device \"{}\" runs at {} Hz, the settings ask for {} Hz (change one of them)",
-            infos[outId].name, rate, settings_.sampleRateHz));
+            outName, rate, settings_.sampleRateHz));
     }
     settings_.blockSize = static_cast<int>(frames);
     openedApi_ = apiName;
-    openedDevice_ = infos[outId].name;
+    openedDevice_ = outName;
     crossfadeFrames_ =
         static_cast<int>(std::lround(settings_.crossfadeMs * 0.001 * settings_.sampleRateHz));
     silence_.assign(static_cast<std::size_t>(settings_.blockSize), 0.0f);
