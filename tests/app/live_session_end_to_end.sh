@@ -21,10 +21,19 @@ export JACK_DEFAULT_SERVER="underfoot_cli_$$"
 pids=()
 cleanup() { for p in "${pids[@]}"; do kill "$p" 2> /dev/null || true; done; wait 2> /dev/null || true; }
 trap cleanup EXIT
+# A failing step says which one it was and shows the outputs so far (set -e alone exits silently).
+trap 'echo "failed at line $LINENO: $BASH_COMMAND"; for f in *.txt jackd.log; do [ -e "$f" ] && { echo "--- $f"; tail -n 15 "$f"; }; done' ERR
 jackd --no-realtime -n "$JACK_DEFAULT_SERVER" -d dummy -r 48000 -p 64 -C 4 -P 6 > jackd.log 2>&1 &
 pids+=($!)
 for _ in $(seq 50); do jack_lsp > /dev/null 2>&1 && break; sleep 0.1; done
 jack_lsp > /dev/null 2>&1 || { echo "jackd did not start"; cat jackd.log; exit 1; }
+# The ports exist, but on a loaded machine RtAudio's probe of a new server can still fail for a
+# moment (its client cannot open and the device list comes back empty). Ready means that our own
+# device list shows "system", within 10 s.
+for _ in $(seq 100); do
+  "$underfoot" devices --api jack 2> /dev/null | grep -q '"system"' && break
+  sleep 0.1
+done
 
 "$underfoot" devices --api jack --save audio.toml > /dev/null
 

@@ -254,7 +254,7 @@ void LiveProtocols::run(const std::string& id, Compare compare) {
     settings.portConnection = eng::AudioSettings::PortConnection::Manual;
     if (mics) settings.channels.microphones = {0, 1};
     eng::LiveEngine engine;
-    engine.open(settings);
+    underfoot::test::openJackDevice(engine, settings);
     engine.start();
     JackTap ears(client + "_ears", JackTap::Kind::Ears, static_cast<std::size_t>(kRate * 12));
     ASSERT_TRUE(ears.ok());

@@ -5,6 +5,7 @@
 /// RtAudio's JACK API then sees the device "system" with 4 inputs and 6 outputs. The server is a
 /// child that dies with the test program (PR_SET_PDEATHSIG), even when a test crashes.
 #include "engine/io/AudioDevice.h"
+#include "engine/scene/LiveEngine.h"
 
 #include <chrono>
 #include <csignal>
@@ -140,5 +141,27 @@ class JackDummyServer {
     pid_t pid_ = -1;
     bool ready_ = false;
 };
+
+/// engine.open(settings) on the dummy server. On a loaded machine RtAudio's probe of the server
+/// can fail for a moment even after the server showed its ports and the device: the probe's
+/// own client cannot open and the device list comes back empty. open() then says `audio device
+/// "system" not found`, or, when it is openStream's own second probe that fails twice, that the
+/// device "refused" the stream because its "device parameter value is invalid". The server is
+/// up, so either is retried for up to 5 s; any other error is thrown at once.
+inline void openJackDevice(engine::LiveEngine& engine, const engine::AudioSettings& settings) {
+    for (int i = 0;; ++i) {
+        try {
+            engine.open(settings);
+            return;
+        } catch (const std::exception& e) {
+            const std::string what = e.what();
+            const bool transient =
+                what.find("\"" + settings.device + "\" not found") != std::string::npos ||
+                what.find("device parameter value is invalid") != std::string::npos;
+            if (!transient || i == 49) throw;
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    }
+}
 
 } // namespace underfoot::test

@@ -73,22 +73,8 @@ class JackServer : public ::testing::Test {
         return s;
     }
 
-    // engine.open(settings(client)). On a loaded machine RtAudio's probe of the server can
-    // fail for a moment even after the server showed its ports and the device (the probe's own
-    // client cannot open: the device list comes back empty, and open() says `audio device
-    // "system" not found`); the server is up, so such an open is retried for up to 5 s.
     static void openSystem(eng::LiveEngine& engine, const std::string& client) {
-        for (int i = 0;; ++i) {
-            try {
-                engine.open(settings(client));
-                return;
-            } catch (const std::exception& e) {
-                const bool transient =
-                    std::string(e.what()).find("\"system\" not found") != std::string::npos;
-                if (!transient || i == 49) throw;
-            }
-            std::this_thread::sleep_for(100ms);
-        }
+        underfoot::test::openJackDevice(engine, settings(client));
     }
 
     static underfoot::test::JackDummyServer* server_;

@@ -144,7 +144,7 @@ Trial runTrial(const eng::AudioSettings& s, bool armed, const std::string& gaitC
                bool thenSilence = false) {
     Trial t;
     eng::LiveEngine engine;
-    engine.open(s);
+    underfoot::test::openJackDevice(engine, s);
     engine.setCallbackHooks({&onEnter, &onLeave});
     eng::OscGyroConfig config;
     config.port = 0;
