@@ -76,8 +76,13 @@ class JackTap {
     enum class Kind { Ears, Mics };
     JackTap(const std::string& name, Kind kind, std::size_t capacityFrames = 0)
         : kind_(kind), noise_(42) {
-        jack_status_t status{};
-        client_ = jack_client_open(name.c_str(), JackNoStartServer, &status);
+        // On a loaded machine a client can fail to open for a moment on a running server (the
+        // same transient as RtAudio's probe, see openJackDevice): retried for up to 5 s.
+        for (int i = 0; i < 50 && !client_; ++i) {
+            if (i > 0) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+            jack_status_t status{};
+            client_ = jack_client_open(name.c_str(), JackNoStartServer, &status);
+        }
         if (!client_) return;
         for (int c = 0; c < 2; ++c) {
             const std::string port = (kind == Kind::Ears ? "in_" : "out_") + std::to_string(c);
