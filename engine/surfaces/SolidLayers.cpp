@@ -17,6 +17,7 @@
 #include "engine/dsp/SleepGrid.h"
 #include "engine/models/Friction.h"
 #include "engine/models/Impact.h"
+#include "engine/surfaces/FrictionDrive.h"
 
 #include <algorithm>
 #include <cmath>
@@ -253,57 +254,25 @@ class ImpactLayer final : public SurfaceLayer {
     std::vector<float> press_, buffer_;
 };
 
-/// Creaking boards: while the load changes, the boards shear against each other (and their nails):
-/// an anchor moves with a speed proportional to the GRF's rate of change and drags a rubbing mass
-/// through a stiff spring; stick-slip against the boards' modes makes the creak.
+/// Creaking boards (engine/surfaces/FrictionDrive.h): while the load changes, the boards shear
+/// against each other (and their nails): an anchor moves with a speed proportional to the GRF's
+/// rate of change and drags a rubbing mass through a stiff spring; stick-slip against the
+/// boards' modes makes the creak.
 class FrictionLayer final : public SurfaceLayer {
   public:
     FrictionLayer(PresetReader& r, const AccuracyOptions& options) {
-        std::vector<Mode> modes;
-        std::vector<double> gains;
-        readModes(r, options, modes, gains);
-        FrictionParams p;
-        p.sigma0 = r.number("sigma0", 1e5, 1e2, 1e8, "N/m", "bristle stiffness", true);
-        p.sigma1 = r.number("sigma1", 300.0, 0.0, 1e5, "N s/m", "bristle damping");
-        p.sigma2 = r.number("sigma2", 0.5, 0.0, 100.0, "N s/m", "viscous friction");
-        p.sigma3 = r.number("sigma3", 0.0, 0.0, 100.0, "N", "roughness noise");
-        p.staticCoefficient =
-            r.number("static_coefficient", 0.6, 0.0, 2.0, "", "static friction per newton of load");
-        p.dynamicCoefficient = r.number("dynamic_coefficient", 0.3, 0.0, 2.0, "",
-                                        "Coulomb friction per newton of load");
-        if (p.dynamicCoefficient > p.staticCoefficient)
-            r.fail("dynamic_coefficient", "expected dynamic_coefficient <= static_coefficient");
-        p.stribeckVelocity =
-            r.number("stribeck_velocity", 0.05, 1e-4, 1.0, "m/s", "Stribeck velocity", true);
-        p.breakAway = r.number("break_away", 0.7, 0.05, 0.95, "",
-                               "break-away deflection / static deflection");
-        p.exciterMassKg = r.number("rubbing_mass_kg", 0.05, 1e-3, 5.0, "kg",
-                                   "mass of the rubbing board edge", true);
-        normalFraction_ = r.number("normal_fraction", 0.2, 0.0, 1.0, "",
-                                   "share of the GRF pressing the rubbing surfaces");
-        driveStiffness_ = r.number("drive_stiffness", 1e6, 1e2, 1e7, "N/m",
-                                   "stiffness dragging the rubbing mass", true);
-        driveDamping_ = r.number("drive_damping", 5.0, 0.0, 1e3, "N s/m", "damping of the drag");
-        slipPerRate_ = r.number("slip_m_per_s_per_kn_per_s", 0.002, 0.0, 0.1, "(m/s)/(kN/s)",
-                                "shear speed of the boards per kN/s of load change");
-        threshold_ = r.number("slip_threshold_n_per_s", 500.0, 0.0, 1e5, "N/s",
-                              "load change below which the boards do not shear");
-        gain_ = dbToGain(
-            r.number("gain_db", 20.0, -40.0, 80.0, "dB", "output gain (0 dB: 1 m/s = full scale)"));
-        sleepVelocity_ = 1e-6 / gain_; // asleep below -120 dBFS at the output
-        p.driveStiffness = driveStiffness_;
-        p.driveDamping = driveDamping_;
-        friction_.configure(p, std::move(modes), {gains});
+        FrictionLayerSettings s = readFrictionLayer(r, options);
+        gain_ = s.gain;
+        drive_.configure(s.drive);
+        friction_.configure(s.model, std::move(s.modes), {std::move(s.gains)});
     }
     void prepare(const ProcessSpec& spec) override {
-        fs_ = spec.sampleRateHz;
-        friction_.prepare(fs_);
-        smooth_ = onePoleCoefficientTau(0.005, fs_);
+        friction_.prepare(spec.sampleRateHz);
+        drive_.prepare(spec.sampleRateHz);
     }
     void reset(std::uint64_t seed) noexcept override {
         friction_.reset(seed);
-        last_ = rate_ = anchor_ = 0;
-        quiet_ = 1 << 30;
+        drive_.reset();
         sleepGrid_.reset();
     }
     void process(const float* grf, float* out, int n) noexcept override {
@@ -314,46 +283,63 @@ class FrictionLayer final : public SurfaceLayer {
             if (atGridPoint) friction_.resonator().flushTinyState();
         });
     }
-    bool isSleeping() const noexcept override {
-        return quiet_ > static_cast<long>(0.05 * fs_) && std::fabs(rate_) <= threshold_;
-    }
+    bool isSleeping() const noexcept override { return drive_.isSleeping(); }
     const char* kind() const noexcept override { return "friction"; }
 
   private:
     void processSpan(const float* grf, float* out, int n) noexcept {
         const float g = static_cast<float>(gain_);
+        FrictionDrive::Input in;
         for (int i = 0; i < n; ++i) {
-            const double load = std::max(0.0f, grf[i]);
-            const double d = (load - last_) * fs_;
-            last_ = load;
-            rate_ = d + smooth_ * (rate_ - d);
-            const double shear = std::max(0.0, std::fabs(rate_) - threshold_) * 1e-3 * slipPerRate_;
-            // Asleep while nothing shears and the boards have rung out (standing still or in the
-            // air): the friction state is held, nothing is computed.
-            if (shear <= 0.0 && quiet_ > static_cast<long>(0.05 * fs_)) {
-                anchor_ = friction_.exciterPosition();
-                continue;
-            }
-            anchor_ += shear / fs_;
-            const double xe = friction_.exciterPosition();
-            if (load <= 0.0) { // unloaded: the drag and the bristles relax
-                friction_.relax();
-                anchor_ = xe;
-            }
-            const double y = friction_.processSample(normalFraction_ * load, 0.0, anchor_, shear);
+            if (!drive_.next(grf[i], friction_, in)) continue; // asleep: nothing computed
+            const double y = friction_.processSample(in.normal, 0.0, in.anchor, in.anchorVelocity);
             out[i] += g * static_cast<float>(y);
-            const bool still = load <= 0.0 || std::fabs(friction_.relativeVelocity()) < 1e-6;
-            quiet_ = (std::fabs(y) < sleepVelocity_ && still) ? quiet_ + 1 : 0;
+            drive_.settle(y, friction_);
         }
     }
     ElastoPlasticFriction friction_;
+    FrictionDrive drive_;
     SleepGrid sleepGrid_;
-    double normalFraction_, driveStiffness_, driveDamping_, slipPerRate_, threshold_, gain_;
-    double fs_ = 48000, smooth_ = 0, last_ = 0, rate_ = 0, anchor_ = 0, sleepVelocity_ = 1e-7;
-    long quiet_ = 1 << 30;
+    double gain_ = 1.0;
 };
 
 } // namespace
+
+FrictionLayerSettings readFrictionLayer(PresetReader& r, const AccuracyOptions& options) {
+    FrictionLayerSettings s;
+    readModes(r, options, s.modes, s.gains);
+    FrictionParams& p = s.model;
+    p.sigma0 = r.number("sigma0", 1e5, 1e2, 1e8, "N/m", "bristle stiffness", true);
+    p.sigma1 = r.number("sigma1", 300.0, 0.0, 1e5, "N s/m", "bristle damping");
+    p.sigma2 = r.number("sigma2", 0.5, 0.0, 100.0, "N s/m", "viscous friction");
+    p.sigma3 = r.number("sigma3", 0.0, 0.0, 100.0, "N", "roughness noise");
+    p.staticCoefficient =
+        r.number("static_coefficient", 0.6, 0.0, 2.0, "", "static friction per newton of load");
+    p.dynamicCoefficient =
+        r.number("dynamic_coefficient", 0.3, 0.0, 2.0, "", "Coulomb friction per newton of load");
+    if (p.dynamicCoefficient > p.staticCoefficient)
+        r.fail("dynamic_coefficient", "expected dynamic_coefficient <= static_coefficient");
+    p.stribeckVelocity =
+        r.number("stribeck_velocity", 0.05, 1e-4, 1.0, "m/s", "Stribeck velocity", true);
+    p.breakAway =
+        r.number("break_away", 0.7, 0.05, 0.95, "", "break-away deflection / static deflection");
+    p.exciterMassKg =
+        r.number("rubbing_mass_kg", 0.05, 1e-3, 5.0, "kg", "mass of the rubbing board edge", true);
+    FrictionDriveParams& d = s.drive;
+    d.normalFraction = r.number("normal_fraction", 0.2, 0.0, 1.0, "",
+                                "share of the GRF pressing the rubbing surfaces");
+    p.driveStiffness = r.number("drive_stiffness", 1e6, 1e2, 1e7, "N/m",
+                                "stiffness dragging the rubbing mass", true);
+    p.driveDamping = r.number("drive_damping", 5.0, 0.0, 1e3, "N s/m", "damping of the drag");
+    d.slipPerRate = r.number("slip_m_per_s_per_kn_per_s", 0.002, 0.0, 0.1, "(m/s)/(kN/s)",
+                             "shear speed of the boards per kN/s of load change");
+    d.threshold = r.number("slip_threshold_n_per_s", 500.0, 0.0, 1e5, "N/s",
+                           "load change below which the boards do not shear");
+    s.gain = dbToGain(
+        r.number("gain_db", 20.0, -40.0, 80.0, "dB", "output gain (0 dB: 1 m/s = full scale)"));
+    d.sleepVelocity = 1e-6 / s.gain; // asleep below -120 dBFS at the output
+    return s;
+}
 
 std::unique_ptr<SurfaceLayer> makeImpactLayer(PresetReader& reader,
                                               const AccuracyOptions& options) {

@@ -7,20 +7,21 @@
 // most samples are in the raised sine between stick and slip (the longer chain).
 //
 // The inputs are recorded once: the virtual walker's left foot (seed 7, 12 s) through the
-// friction layer's drive (engine/surfaces/SolidLayers.cpp, FrictionLayer::processSpan: the
-// load's smoothed rate of change above the slip threshold drags the anchor) with the parameters
-// of engine/data/surfaces/creaking_wood.toml as shipped on 29 Nov 2026, keeping the samples the
-// layer solves (the others sleep). The benchmark then replays them into a fresh friction model.
+// shipped creaking_wood preset's friction layer, read from engine/data/surfaces/creaking_wood.toml
+// by the layer's own reader and driven by its own FrictionDrive (engine/surfaces/FrictionDrive.h),
+// keeping the samples the layer solves (the others sleep). The benchmark then replays them into a
+// fresh friction model.
 // Run: build/tests/bench/bench_friction (counter "per sample": time per solved sample).
 #include "engine/control/VirtualWalker.h"
 #include "engine/dsp/Denormals.h"
-#include "engine/dsp/Envelope.h"
 #include "engine/models/Friction.h"
+#include "engine/surfaces/FrictionDrive.h"
+#include "engine/surfaces/Surface.h"
 
 #include <benchmark/benchmark.h>
 
-#include <algorithm>
-#include <cmath>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 using namespace underfoot::engine;
@@ -28,42 +29,33 @@ using namespace underfoot::engine;
 namespace {
 constexpr double kFs = 48000.0;
 
-struct Drive {
-    double normal, anchor, anchorVelocity;
-};
-
 // creaking_wood.toml's friction layer as shipped (not configureCreakScenario of
 // engine/render/AccuracyCost.h: that one keeps the values of the time, sigma3 0.05 and a
 // 2.65 kHz top mode, so that its figures stay comparable with the Sound Design Toolkit's)
-constexpr double kNormalFraction = 0.15, kSlipPerRate = 0.006, kThreshold = 1200.0;
-constexpr double kGainDb = -15.4;
+const FrictionLayerSettings& creak() {
+    static const FrictionLayerSettings settings = [] {
+        const std::string file = surfacesDirectory() + "/creaking_wood.toml";
+        const toml::table root = toml::parse_file(file);
+        const toml::array* layers = root["layer"].as_array();
+        for (std::size_t i = 0; layers && i < layers->size(); ++i) {
+            const toml::table* t = layers->get(i)->as_table();
+            if (!t || (*t)["type"].value_or(std::string()) != "friction") continue;
+            PresetReader reader(file, *t, "layer[" + std::to_string(i) + "]", nullptr);
+            return readFrictionLayer(reader, AccuracyOptions{});
+        }
+        throw std::runtime_error(file + ": expected a [[layer]] with type = \"friction\"");
+    }();
+    return settings;
+}
 
 void configureCreak(ElastoPlasticFriction& f) {
-    FrictionParams p;
-    p.sigma0 = 2e5;
-    p.sigma1 = 150.0;
-    p.sigma2 = 0.2;
-    p.sigma3 = 0.5;
-    p.staticCoefficient = 0.55;
-    p.dynamicCoefficient = 0.25;
-    p.stribeckVelocity = 0.02;
-    p.breakAway = 0.6;
-    p.exciterMassKg = 0.02;
-    p.driveStiffness = 5e5;
-    p.driveDamping = 2.0;
-    f.configure(p,
-                {{310, 0.06, 0.05},
-                 {690, 0.05, 0.04},
-                 {1130, 0.04, 0.04},
-                 {1870, 0.03, 0.05},
-                 {4500, 0.01, 0.03}},
-                {{1.0, 0.8, 0.25, 0.1, 0.6}});
+    f.configure(creak().model, creak().modes, {creak().gains});
     f.prepare(kFs);
     f.reset(7);
 }
 
-const std::vector<Drive>& walkDrive() {
-    static const std::vector<Drive> drive = [] {
+const std::vector<FrictionDrive::Input>& walkDrive() {
+    static const std::vector<FrictionDrive::Input> drive = [] {
         VirtualWalker walker;
         walker.prepare({kFs, 256});
         walker.reset(7);
@@ -71,31 +63,16 @@ const std::vector<Drive>& walkDrive() {
         walker.process(left.data(), right.data(), static_cast<int>(left.size()));
         ElastoPlasticFriction f;
         configureCreak(f);
-        const double smooth = onePoleCoefficientTau(0.005, kFs);
-        const double sleepVelocity = 1e-6 / std::pow(10.0, kGainDb / 20.0);
-        double last = 0, rate = 0, anchor = 0;
-        long quiet = 1 << 30;
-        std::vector<Drive> d;
+        FrictionDrive layer;
+        layer.configure(creak().drive);
+        layer.prepare(kFs);
+        layer.reset();
+        std::vector<FrictionDrive::Input> d;
+        FrictionDrive::Input in;
         for (float g : left) { // (as FrictionLayer::processSpan)
-            const double load = std::max(0.0f, g);
-            const double change = (load - last) * kFs;
-            last = load;
-            rate = change + smooth * (rate - change);
-            const double shear = std::max(0.0, std::fabs(rate) - kThreshold) * 1e-3 * kSlipPerRate;
-            if (shear <= 0.0 && quiet > static_cast<long>(0.05 * kFs)) {
-                anchor = f.exciterPosition();
-                continue;
-            }
-            anchor += shear / kFs;
-            if (load <= 0.0) {
-                const double x = f.exciterPosition();
-                f.relax();
-                anchor = x;
-            }
-            d.push_back({kNormalFraction * load, anchor, shear});
-            const double y = f.processSample(d.back().normal, 0.0, anchor, shear);
-            const bool still = load <= 0.0 || std::fabs(f.relativeVelocity()) < 1e-6;
-            quiet = (std::fabs(y) < sleepVelocity && still) ? quiet + 1 : 0;
+            if (!layer.next(g, f, in)) continue;
+            d.push_back(in);
+            layer.settle(f.processSample(in.normal, 0.0, in.anchor, in.anchorVelocity), f);
         }
         return d;
     }();
@@ -112,8 +89,8 @@ void frictionAlongAWalk(benchmark::State& state, bool avx) {
     double sum = 0;
     for (auto _ : state) {
         f.reset(7);
-        for (const Drive& d : drive) {
-            if (d.normal <= 0.0) f.relax();
+        for (const FrictionDrive::Input& d : drive) {
+            if (d.unloaded) f.relax();
             sum += f.processSample(d.normal, 0.0, d.anchor, d.anchorVelocity);
         }
         samples += static_cast<std::int64_t>(drive.size());
