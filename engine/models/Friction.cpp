@@ -422,7 +422,7 @@ template <typename Real>
 template <bool Libm, bool Wide>
 [[gnu::always_inline]] inline double
 ElastoPlasticFrictionT<Real>::processBody(double normal, double drive, double anchorX,
-                                          double anchorV) noexcept {
+                                          double anchorV, double roughness) noexcept {
     const double T = T_;
     const double N = std::max(0.0, normal);
     // Predictions without a new friction force (old net force held, the external force at n+1:
@@ -440,8 +440,9 @@ ElastoPlasticFrictionT<Real>::processBody(double normal, double drive, double an
     if (trackResidual_) in_.zssC = in_.zssD = 0.0;
     double force = 0.0, z1 = 0.0;
     if (N > 0.0) {
-        // Roughness noise acts only while the surfaces are pressed together.
-        const double noise = params_.sigma3 * rng_.bipolar();
+        // Roughness noise acts only while the surfaces are pressed together (and, at the
+        // caller's say, rubbed: roughness 0 draws nothing).
+        const double noise = roughness != 0.0 ? roughness * (params_.sigma3 * rng_.bipolar()) : 0.0;
         const double z0 = z_;
         int passes = 0;
         bool converged = false;
@@ -496,9 +497,9 @@ ElastoPlasticFrictionT<Real>::processBody(double normal, double drive, double an
 template <typename Real>
 template <bool Libm>
 double ElastoPlasticFrictionT<Real>::kernelGeneric(ElastoPlasticFrictionT& f, double normal,
-                                                   double drive, double anchorX,
-                                                   double anchorV) noexcept {
-    return f.processBody<Libm, false>(normal, drive, anchorX, anchorV);
+                                                   double drive, double anchorX, double anchorV,
+                                                   double roughness) noexcept {
+    return f.processBody<Libm, false>(normal, drive, anchorX, anchorV, roughness);
 }
 
 // The same code compiled with VEX encoding (three-operand scalar instructions: fewer register
@@ -507,8 +508,8 @@ template <typename Real>
 template <bool Libm>
 [[gnu::target("avx")]] double
 ElastoPlasticFrictionT<Real>::kernelAvx(ElastoPlasticFrictionT& f, double normal, double drive,
-                                        double anchorX, double anchorV) noexcept {
-    return f.processBody<Libm, true>(normal, drive, anchorX, anchorV);
+                                        double anchorX, double anchorV, double roughness) noexcept {
+    return f.processBody<Libm, true>(normal, drive, anchorX, anchorV, roughness);
 }
 
 template <typename Real>

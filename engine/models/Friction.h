@@ -166,10 +166,14 @@ class ElastoPlasticFrictionT {
     /// One sample: `normalForceN` presses the bodies together, `driveForceN` pushes the exciter
     /// tangentially and the drive spring/damper pulls it towards an anchor at `anchorPosition`
     /// moving at `anchorVelocity` (integrated implicitly: an explicit stiff drag would delay its
-    /// force by a sample and pump energy in). Returns the resonator's velocity at pickup 0 (m/s).
+    /// force by a sample and pump energy in). `roughness` scales the roughness noise sigma3 w at
+    /// this sample (1: as configured; 0: the surfaces are not being rubbed, no noise and no draw
+    /// from the generator; a caller that knows when the surfaces are rubbed, as the friction
+    /// layer does, lets a contact at rest ring out instead of hissing for ever). Returns the
+    /// resonator's velocity at pickup 0 (m/s).
     double processSample(double normalForceN, double driveForceN, double anchorPosition = 0.0,
-                         double anchorVelocity = 0.0) noexcept {
-        return kernel_(*this, normalForceN, driveForceN, anchorPosition, anchorVelocity);
+                         double anchorVelocity = 0.0, double roughness = 1.0) noexcept {
+        return kernel_(*this, normalForceN, driveForceN, anchorPosition, anchorVelocity, roughness);
     }
     /// allowAvx(false) selects the SSE2 build of the per-sample kernel (and of the resonator's);
     /// with AVX (VEX-encoded scalar code, no FMA) the samples are the same bit for bit.
@@ -200,16 +204,18 @@ class ElastoPlasticFrictionT {
     ModalResonatorT<Real>& resonator() noexcept { return resonator_; }
 
   private:
-    using Kernel = double (*)(ElastoPlasticFrictionT&, double, double, double, double) noexcept;
+    using Kernel = double (*)(ElastoPlasticFrictionT&, double, double, double, double,
+                              double) noexcept;
     // (Wide: the resonator's pass inline with its AVX kernel, for kernelAvx)
     template <bool Libm, bool Wide>
-    double processBody(double normal, double drive, double anchorX, double anchorV) noexcept;
+    double processBody(double normal, double drive, double anchorX, double anchorV,
+                       double roughness) noexcept;
     template <bool Libm>
     static double kernelGeneric(ElastoPlasticFrictionT& f, double normal, double drive,
-                                double anchorX, double anchorV) noexcept;
+                                double anchorX, double anchorV, double roughness) noexcept;
     template <bool Libm>
     static double kernelAvx(ElastoPlasticFrictionT& f, double normal, double drive, double anchorX,
-                            double anchorV) noexcept;
+                            double anchorV, double roughness) noexcept;
     void chooseKernel() noexcept;
     /// The fixed-point passes (newton = false): the reference solve.
     struct PassesResult {
