@@ -42,6 +42,7 @@ void GrainsLayer::prepare(const ProcessSpec& spec) {
     loads_.assign(block, SampleLoad{});
     buffer_.assign(block, 0.0f);
     tailLength_ = static_cast<int>(kTailSeconds * sampleRateHz_);
+    settling_.prepare(control_.settling, sampleRateHz_);
     heelEnd_ = static_cast<std::int64_t>(
         std::ceil((control_.heelMs + 10.0 * control_.heelDecayMs) * 1e-3 * sampleRateHz_));
     reset(0);
@@ -60,6 +61,7 @@ void GrainsLayer::reset(std::uint64_t seed) noexcept {
     sleepGrid_.reset();
     contactSinceGridPoint_ = false;
     heelAge_ = -1;
+    settling_.reset();
 }
 
 double GrainsLayer::heelEnvelope() noexcept {
@@ -129,9 +131,12 @@ void GrainsLayer::processChunk(const float* grf, float* out, int n) noexcept {
             const double rise = f >= control_.felicityRatio * contactPeakN_ ? loadRise : 0.0;
             contactPeakN_ = std::max(contactPeakN_, f);
             const double fall = std::max(-derivative_, 0.0);
-            rate_[u] = static_cast<float>(control_.eventsPerSecondPerKn * kn +
-                                          control_.eventsPerKnRise * rise +
-                                          control_.eventsPerKnFall * fall);
+            // A load held still: the bed settles (LoadSettling; exactly 1 while walking).
+            const double settle = settling_.inContact(derivative_);
+            rate_[u] = static_cast<float>((control_.eventsPerSecondPerKn * kn +
+                                           control_.eventsPerKnRise * rise +
+                                           control_.eventsPerKnFall * fall) *
+                                          settle);
             SampleLoad& sl = loads_[u];
             sl.contact = true;
             sl.kn = kn;
@@ -159,6 +164,7 @@ void GrainsLayer::processChunk(const float* grf, float* out, int n) noexcept {
             loads_[u].contact = false;
             onsetArmed_ = true;
             contactPeakN_ = 0.0;
+            settling_.reset();
         }
     }
     runModel(modelDone, n, buffer);
@@ -304,6 +310,7 @@ std::unique_ptr<SurfaceLayer> makeGrainsLayer(PresetReader& r, const AccuracyOpt
     c.heelEnergy =
         r.number("heel_energy", 1.0, 0.0, 100.0, "x energy scale at 1 kN",
                  "heel burst: energy scale of its events at the peak (follows the same envelope)");
+    c.settling = LoadSettling::read(r);
     if (c.lowpassHz > 0 && c.lowpassHz < 20) c.lowpassHz = 20; // a 0+ cutoff would mute everything
     return std::make_unique<GrainsLayer>(m, c, options);
 }

@@ -48,6 +48,7 @@
 #include "engine/dsp/SleepGrid.h"
 #include "engine/models/Aggregate.h"
 #include "engine/surfaces/Layer.h"
+#include "engine/surfaces/LoadInput.h"
 
 namespace underfoot::engine {
 
@@ -71,6 +72,7 @@ struct GrainsControl {
     double heelDecayMs = 30.0;  ///< heel burst: decay time constant after the peak
     double heelEnergy = 1.0;    ///< heel burst: energy scale of its events at the peak
     double felicityRatio = 0.0; ///< rise terms only while F >= ratio x the contact's peak; 0: off
+    LoadSettling::Params settling; ///< a load held still: the bed settles (LoadInput.h)
 };
 
 class GrainsLayer final : public SurfaceLayer {
@@ -118,6 +120,7 @@ class GrainsLayer final : public SurfaceLayer {
     bool onsetArmed_ = true;
     bool sleeping_ = true;
     int tailSamples_ = 0, tailLength_ = 0;
+    LoadSettling settling_;
     std::int64_t heelAge_ = -1; ///< samples since the heel burst started; -1: none running
     std::int64_t heelEnd_ = 0;  ///< its length (heel_ms + 10 heel_decay_ms) in samples
     SleepGrid sleepGrid_;

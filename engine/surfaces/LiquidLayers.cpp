@@ -39,6 +39,7 @@ void BubblesLayer::prepare(const ProcessSpec& spec) {
                        : 0.0;
     wakeG_ = onePoleCoefficientTau(control_.wakeMs * 1e-3, sampleRateHz_);
     motionG_ = onePoleCoefficientTau(0.03, sampleRateHz_); // 30 ms: the water follows the foot
+    settling_.prepare(control_.settling, sampleRateHz_);
     const double guard = 0.45 * sampleRateHz_;
     splashFilter_.setCoefficients(
         BiquadCoefficients::bandpass(sampleRateHz_, std::min(control_.splashHz, guard), 0.8));
@@ -60,6 +61,7 @@ void BubblesLayer::reset(std::uint64_t seed) noexcept {
     sloshFilter_.reset();
     previousF_ = derivative_ = 0.0;
     inContact_ = false;
+    settling_.reset();
     contactSamples_ = 0;
     releasePeak_ = 0.0;
     splashEnv_ = wakeEnv_ = motionEnv_ = 0.0;
@@ -112,6 +114,7 @@ void BubblesLayer::processChunk(const float* grf, float* out, int n) noexcept {
             releasePeak_ = 0.0;
         } else if (!contact && inContact_) {
             inContact_ = false;
+            settling_.reset();
             if (control_.wakeMs > 0)
                 wakeEnv_ =
                     std::max(wakeEnv_, std::clamp(releasePeak_ / kDerivativeRefKnPerS, 0.25, 2.0));
@@ -125,12 +128,15 @@ void BubblesLayer::processChunk(const float* grf, float* out, int n) noexcept {
             contactSeen = true;
             ++contactSamples_;
             releasePeak_ = std::max(releasePeak_, -derivative_);
-            rate += control_.bubblesPerKn * speed;
+            // A leg held still: the water around it calms (LoadSettling; exactly 1 while
+            // wading), so the motion's bubbles and slosh fade out.
+            const double settle = settling_.inContact(derivative_);
+            rate += control_.bubblesPerKn * speed * settle;
             if (contactSamples_ <= splashSamples_) {
                 rate += control_.splashBubblesPerKn * rise;
                 splashDrive = rise / kDerivativeRefKnPerS;
             }
-            motionDrive = speed / kDerivativeRefKnPerS;
+            motionDrive = speed / kDerivativeRefKnPerS * settle;
         }
         rate_[static_cast<std::size_t>(i)] = static_cast<float>(rate);
         wakeEnv_ *= wakeG_;
@@ -227,6 +233,7 @@ std::unique_ptr<SurfaceLayer> makeBubblesLayer(PresetReader& r, const AccuracyOp
         r.number("derivative_ms", 5.0, 0.5, 50.0, "ms", "smoothing time constant of dF/dt", true);
     c.contactThresholdN = r.number("contact_threshold_n", 5.0, 0.5, 100.0, "N",
                                    "load below which the foot is out of the water", true);
+    c.settling = LoadSettling::read(r);
     return std::make_unique<BubblesLayer>(s, c, options);
 }
 

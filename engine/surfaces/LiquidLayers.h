@@ -26,6 +26,7 @@
 #include "engine/dsp/SleepGrid.h"
 #include "engine/models/Bubbles.h"
 #include "engine/surfaces/Layer.h"
+#include "engine/surfaces/LoadInput.h"
 
 namespace underfoot::engine {
 
@@ -44,6 +45,7 @@ struct BubblesControl {
     double derivativeMs = 5.0;
     double contactThresholdN = 5.0;
     double gainDb = 0.0;
+    LoadSettling::Params settling; ///< a leg held still: the water calms (LoadInput.h)
 };
 
 class BubblesLayer final : public SurfaceLayer {
@@ -72,6 +74,7 @@ class BubblesLayer final : public SurfaceLayer {
     std::vector<float> rate_, scale_, buffer_;
     double previousF_ = 0, derivative_ = 0;
     bool inContact_ = false;
+    LoadSettling settling_;
     int contactSamples_ = 0, splashSamples_ = 0;
     double releasePeak_ = 0;
     double splashEnv_ = 0, wakeEnv_ = 0, motionEnv_ = 0;

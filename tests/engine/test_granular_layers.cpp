@@ -66,12 +66,35 @@ std::uint64_t events(const Surface& s) {
 } // namespace
 
 TEST(GrainsLayer, StaticLoadRateFollowsTheGrf) {
-    auto s = surfaceWithLayer("events_per_s_per_kn = 500.0\nmax_rate_hz = 20000.0");
+    // (settle_after_s: the bed does not settle within the 20 s)
+    auto s = surfaceWithLayer(
+        "events_per_s_per_kn = 500.0\nmax_rate_hz = 20000.0\nsettle_after_s = 3600.0");
     // 800 N held for 20 s: 400 events/s -> 8000 events (the initial step adds rise events: none
     // with events_per_kn_rise = 0).
     std::vector<float> grf(static_cast<std::size_t>(20 * kFs), 800.0f);
     render(*s, grf);
     EXPECT_NEAR(static_cast<double>(events(*s)), 8000.0, 4.0 * std::sqrt(8000.0));
+}
+
+TEST(GrainsLayer, AHeldLoadSettlesAndAShiftOfTheWeightWakesTheBed) {
+    // Default settling: 2 s at the full 400 events/s, then a fade of 0.5 s time constant, so
+    // 400 x (2 + 0.5) = 1000 events in all, none after ~7 s.
+    auto s = surfaceWithLayer("events_per_s_per_kn = 500.0\nmax_rate_hz = 20000.0");
+    std::vector<float> grf(static_cast<std::size_t>(10 * kFs), 800.0f);
+    render(*s, grf);
+    const auto settled = events(*s);
+    EXPECT_NEAR(static_cast<double>(settled), 1000.0, 4.0 * std::sqrt(1000.0));
+    auto out = render(*s, grf); // 10 s more standing: not one event, silence
+    EXPECT_EQ(events(*s), settled);
+    for (float v : out) ASSERT_EQ(v, 0.0f);
+    // The weight shifts (800 -> 400 N in 0.2 s, 2 kN/s) and stays: the events are back at once,
+    // 300 /s over the shift (600 N on average) and then at the lower load's rate for 2 s and the
+    // fade: 60 + 200 x 2.5 = 560 more.
+    std::vector<float> shift(static_cast<std::size_t>(10 * kFs), 400.0f);
+    for (std::size_t i = 0; i < static_cast<std::size_t>(0.2 * kFs); ++i)
+        shift[i] = static_cast<float>(800.0 - 400.0 * static_cast<double>(i) / (0.2 * kFs));
+    render(*s, shift);
+    EXPECT_NEAR(static_cast<double>(events(*s) - settled), 560.0, 4.0 * std::sqrt(560.0));
 }
 
 TEST(GrainsLayer, LoadChangesGiveEventsPerKilonewton) {
@@ -254,6 +277,31 @@ TEST(BubblesLayer, SilentAtZeroAndSplashesOnLanding) {
     EXPECT_LT(layer.stream().bubbleCount(), 400u);
     out = render(*s, zero);
     EXPECT_TRUE(s->isSleeping());
+}
+
+TEST(BubblesLayer, ALegHeldStillCalmsTheWater) {
+    // Standing in the water with a quiet stance's sway (+-15 N at 0.4 Hz, at most 0.04 kN/s):
+    // the sway stirs bubbles and slosh for the 2 s of settle_after_s, then they fade (0.5 s time
+    // constant) and the water is silent; a quick shift of the weight stirs it again.
+    auto s = surfaceWithLayer("bubbles_per_kn = 400.0\nslosh_db = 0.0", "bubbles");
+    const auto& layer = dynamic_cast<const BubblesLayer&>(s->layer(0));
+    const double pi = 3.141592653589793;
+    std::vector<float> sway(static_cast<std::size_t>(10 * kFs));
+    for (std::size_t i = 0; i < sway.size(); ++i)
+        sway[i] = static_cast<float>(
+            600.0 + 15.0 * std::sin(2.0 * pi * 0.4 * static_cast<double>(i) / kFs));
+    auto out = render(*s, sway);
+    const auto stirred = layer.stream().bubbleCount();
+    EXPECT_GT(stirred, 0u); // (the first 2 s: 400 x 0.02-0.04 kN/s)
+    for (std::size_t i = static_cast<std::size_t>(8 * kFs); i < out.size(); ++i)
+        ASSERT_EQ(out[i], 0.0f) << "still sounding at " << static_cast<double>(i) / kFs << " s";
+    out = render(*s, sway); // 10 s more: not one bubble
+    EXPECT_EQ(layer.stream().bubbleCount(), stirred);
+    std::vector<float> shift(static_cast<std::size_t>(kFs), 300.0f);
+    for (std::size_t i = 0; i < static_cast<std::size_t>(0.15 * kFs); ++i)
+        shift[i] = static_cast<float>(600.0 - 300.0 * static_cast<double>(i) / (0.15 * kFs));
+    render(*s, shift); // 2 kN/s for 0.15 s: 400 x 0.3 kN = 120 bubbles
+    EXPECT_GT(layer.stream().bubbleCount(), stirred + 60u);
 }
 
 TEST(SurfaceLayers, NoAllocationWhileProcessing) {
