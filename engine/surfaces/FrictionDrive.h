@@ -13,6 +13,7 @@
 #include "engine/dsp/Envelope.h"
 #include "engine/models/Friction.h"
 #include "engine/surfaces/Layer.h"
+#include "engine/surfaces/LoadInput.h"
 
 #include <algorithm>
 #include <cmath>
@@ -27,6 +28,9 @@ struct FrictionDriveParams {
     /// m/s: the model's output below which the boards count as rung out (the layer: -120 dBFS
     /// after its gain)
     double sleepVelocity = 1e-7;
+    /// The boards' roughness (the model's noise) keeps rubbing for settling.afterS after the last
+    /// shear, then fades out: a load held still lets the boards ring out and sleep
+    LoadSettling::Params settling;
 };
 
 /// Everything a "friction" layer reads from its preset table.
@@ -54,18 +58,23 @@ class FrictionDrive {
         double normal;         ///< N pressing the rubbing surfaces
         double anchor;         ///< m: where the drag's spring is anchored
         double anchorVelocity; ///< m/s: the shear speed
-        bool unloaded;         ///< no load: next() relaxed the model (a replay must do the same)
+        /// scale of the model's roughness noise: 1 while the boards shear and for
+        /// settling.afterS after, then fading to 0 (a load held still lets them fall asleep)
+        double roughness;
+        bool unloaded; ///< no load: next() relaxed the model (a replay must do the same)
     };
 
     void configure(const FrictionDriveParams& params) noexcept { params_ = params; }
     void prepare(double sampleRateHz) noexcept {
         fs_ = sampleRateHz;
         smooth_ = onePoleCoefficientTau(0.005, fs_);
+        settling_.prepare(params_.settling, fs_);
         sleepAfter_ = static_cast<long>(0.05 * fs_);
     }
     void reset() noexcept {
         last_ = rate_ = anchor_ = 0.0;
         quiet_ = 1L << 30;
+        settling_.reset();
     }
 
     /// One GRF sample (N). false: the boards sleep, do not run the model for this sample.
@@ -85,10 +94,12 @@ class FrictionDrive {
         if (in.unloaded) { // unloaded: the drag and the bristles relax
             anchor_ = model.exciterPosition();
             model.relax();
+            settling_.reset();
         }
         in.normal = params_.normalFraction * load;
         in.anchor = anchor_;
         in.anchorVelocity = shear;
+        in.roughness = settling_.next(shear > 0.0);
         loaded_ = !in.unloaded;
         return true;
     }
@@ -104,6 +115,7 @@ class FrictionDrive {
 
   private:
     FrictionDriveParams params_;
+    LoadSettling settling_;
     double fs_ = 48000.0, smooth_ = 0.0, last_ = 0.0, rate_ = 0.0, anchor_ = 0.0;
     long quiet_ = 1L << 30, sleepAfter_ = 2400;
     bool loaded_ = false;

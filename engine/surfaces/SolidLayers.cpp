@@ -292,7 +292,8 @@ class FrictionLayer final : public SurfaceLayer {
         FrictionDrive::Input in;
         for (int i = 0; i < n; ++i) {
             if (!drive_.next(grf[i], friction_, in)) continue; // asleep: nothing computed
-            const double y = friction_.processSample(in.normal, 0.0, in.anchor, in.anchorVelocity);
+            const double y =
+                friction_.processSample(in.normal, 0.0, in.anchor, in.anchorVelocity, in.roughness);
             out[i] += g * static_cast<float>(y);
             drive_.settle(y, friction_);
         }
@@ -338,6 +339,8 @@ FrictionLayerSettings readFrictionLayer(PresetReader& r, const AccuracyOptions& 
     s.gain = dbToGain(
         r.number("gain_db", 20.0, -40.0, 80.0, "dB", "output gain (0 dB: 1 m/s = full scale)"));
     d.sleepVelocity = 1e-6 / s.gain; // asleep below -120 dBFS at the output
+    d.settling = LoadSettling::read(
+        r, "after the boards' last shear, a load held still (the roughness noise of the contact)");
     return s;
 }
 

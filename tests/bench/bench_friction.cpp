@@ -72,7 +72,8 @@ const std::vector<FrictionDrive::Input>& walkDrive() {
         for (float g : left) { // (as FrictionLayer::processSpan)
             if (!layer.next(g, f, in)) continue;
             d.push_back(in);
-            layer.settle(f.processSample(in.normal, 0.0, in.anchor, in.anchorVelocity), f);
+            layer.settle(
+                f.processSample(in.normal, 0.0, in.anchor, in.anchorVelocity, in.roughness), f);
         }
         return d;
     }();
@@ -91,7 +92,7 @@ void frictionAlongAWalk(benchmark::State& state, bool avx) {
         f.reset(7);
         for (const FrictionDrive::Input& d : drive) {
             if (d.unloaded) f.relax();
-            sum += f.processSample(d.normal, 0.0, d.anchor, d.anchorVelocity);
+            sum += f.processSample(d.normal, 0.0, d.anchor, d.anchorVelocity, d.roughness);
         }
         samples += static_cast<std::int64_t>(drive.size());
     }

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <numbers>
 #include <set>
 #include <sstream>
 
@@ -216,6 +217,50 @@ TEST(SurfacePresets, AfterTheLastStepEverySurfaceFallsSilentAndSleeps) {
             }
         }
         EXPECT_TRUE(slept) << s.id;
+    }
+}
+
+// Standing still: a load held with a quiet stance's sway (+-15 N at 0.4 Hz, 0.04 kN/s at most)
+// after a 0.3 s rise to 700 N. Granular beds settle (GrainsControl::settleAfterS: 2 s, then a
+// 0.5 s fade), creaking boards stop shearing and their roughness stops with the shear: every
+// surface is silent well before 10 s of standing (they sounded for ever: gravel at -44 dBFS RMS,
+// deep snow at -32, creaking wood at -90). A shift of the weight (700 -> 350 N in 0.25 s) wakes
+// the beds and the boards again.
+TEST(SurfacePresets, StandingStillFallsSilentAndAWeightShiftWakesTheBed) {
+    const double fs = 48000.0;
+    auto load = [&](std::size_t i) {
+        const double t = static_cast<double>(i) / fs;
+        if (t < 0.3) return 700.0 * t / 0.3;
+        if (t < 12.0) return 700.0 + 15.0 * std::sin(2.0 * std::numbers::pi * 0.4 * (t - 0.3));
+        const double base = 700.0 + 15.0 * std::sin(2.0 * std::numbers::pi * 0.4 * (12.0 - 0.3));
+        return t < 12.25 ? base - (base - 350.0) * (t - 12.0) / 0.25 : 350.0;
+    };
+    const std::size_t frames = static_cast<std::size_t>(13.0 * fs);
+    std::vector<float> grf(frames);
+    for (std::size_t i = 0; i < frames; ++i) grf[i] = static_cast<float>(load(i));
+    const std::set<std::string> wake = {"gravel", "dry_leaves", "deep_snow", "creaking_wood"};
+    for (const auto& s : listSurfaces()) {
+        FootstepScene scene;
+        scene.build(s.id, {});
+        scene.prepare({fs, 480});
+        scene.reset(5);
+        std::vector<float> l(480), r(480), silent(480, 0.0f);
+        double standingPeak = 0.0, shiftPeak = 0.0;
+        for (std::size_t i = 0; i + 480 <= frames; i += 480) {
+            const float* in[2] = {grf.data() + i, silent.data()};
+            scene.process(in, l.data(), r.data(), 480);
+            const double t = static_cast<double>(i) / fs;
+            for (std::size_t k = 0; k < 480; ++k) {
+                const double v = std::max(std::fabs(l[k]), std::fabs(r[k]));
+                if (t >= 10.0 && t < 12.0) standingPeak = std::max(standingPeak, v);
+                if (t >= 12.0) shiftPeak = std::max(shiftPeak, v);
+            }
+        }
+        EXPECT_LT(standingPeak, 1e-6) << s.id << " still sounds after 10 s of standing still: peak "
+                                      << 20 * std::log10(standingPeak) << " dBFS";
+        if (wake.count(s.id)) {
+            EXPECT_GT(shiftPeak, 1e-3) << s.id << ": the weight shift is silent";
+        }
     }
 }
 
