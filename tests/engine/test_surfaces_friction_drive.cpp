@@ -48,19 +48,27 @@ modes = [
 ]
 )";
 
-FrictionDrive makeDrive(const FrictionLayerSettings& s) {
+// The model and its drive, configured from kAllKeys.
+struct Rig {
+    FrictionLayerSettings s = readTable(kAllKeys);
+    ElastoPlasticFriction f;
     FrictionDrive d;
-    d.configure(s.drive);
-    d.prepare(kFs);
-    d.reset();
-    return d;
-}
-
-void makeModel(const FrictionLayerSettings& s, ElastoPlasticFriction& f) {
-    f.configure(s.model, s.modes, {s.gains});
-    f.prepare(kFs);
-    f.reset(3);
-}
+    FrictionDrive::Input in{};
+    Rig() {
+        f.configure(s.model, s.modes, {s.gains});
+        f.prepare(kFs);
+        f.reset(3);
+        d.configure(s.drive);
+        d.prepare(kFs);
+        d.reset();
+    }
+    /// One GRF sample through the drive and, when it runs, the model.
+    bool step(double load) {
+        if (!d.next(static_cast<float>(load), f, in)) return false;
+        d.settle(f.processSample(in.normal, 0.0, in.anchor, in.anchorVelocity, in.roughness), f);
+        return true;
+    }
+};
 } // namespace
 
 TEST(FrictionDrive, ReaderPutsEveryKeyInItsField) {
@@ -100,14 +108,10 @@ TEST(FrictionDrive, ReaderRejectsFrictionLawsThatCannotHold) {
 }
 
 TEST(FrictionDrive, ShearsOnlyWhileTheLoadChangesFasterThanTheThreshold) {
-    const auto s = readTable(kAllKeys);
-    ElastoPlasticFriction f;
-    makeModel(s, f);
-    FrictionDrive d = makeDrive(s);
-    FrictionDrive::Input in{};
+    Rig r;
     // Nobody on the boards: nothing changes, nothing is solved.
-    for (int i = 0; i < 4800; ++i) EXPECT_FALSE(d.next(0.0f, f, in)) << i;
-    EXPECT_TRUE(d.isSleeping());
+    for (int i = 0; i < 4800; ++i) EXPECT_FALSE(r.step(0.0)) << i;
+    EXPECT_TRUE(r.d.isSleeping());
 
     // Loading at 3 kN/s for 0.2 s: once the 5 ms smoothing has settled, the anchor moves at
     // (3000 - 900) N/s * 0.007 (m/s)/(kN/s) = 14.7 mm/s and the normal force is 12 % of the load.
@@ -116,24 +120,21 @@ TEST(FrictionDrive, ShearsOnlyWhileTheLoadChangesFasterThanTheThreshold) {
     int solved = 0;
     for (int i = 0; i < 9600; ++i) {
         load += rate / kFs;
-        anchorBefore = in.anchor;
-        if (!d.next(static_cast<float>(load), f, in)) continue;
-        ++solved;
-        d.settle(f.processSample(in.normal, 0.0, in.anchor, in.anchorVelocity, in.roughness), f);
+        anchorBefore = r.in.anchor;
+        solved += r.step(load) ? 1 : 0;
     }
     // The smoothed rate rises from 0 towards 3 kN/s: it passes 900 N/s after 1.8 ms (86 samples),
     // and from then on every sample is solved.
     EXPECT_GT(solved, 9600 - 96);
     EXPECT_LT(solved, 9600 - 80);
-    EXPECT_FALSE(in.unloaded);
+    EXPECT_FALSE(r.in.unloaded);
     // (within 0.1 %: the GRF is a float signal, whose rounding jitters the load's rate)
-    EXPECT_NEAR(in.anchorVelocity, (rate - 900.0) * 1e-3 * 0.007, 1e-3 * 0.0147);
-    EXPECT_NEAR(in.anchor - anchorBefore, in.anchorVelocity / kFs, 1e-12);
+    EXPECT_NEAR(r.in.anchorVelocity, (rate - 900.0) * 1e-3 * 0.007, 1e-3 * 0.0147);
+    EXPECT_NEAR(r.in.anchor - anchorBefore, r.in.anchorVelocity / kFs, 1e-12);
     // (the float GRF sample: the load is rounded to float before the drive reads it)
-    EXPECT_NEAR(in.normal, 0.12 * load, 0.12 * load * 1e-6);
-    EXPECT_FALSE(d.isSleeping());
-
-    EXPECT_EQ(in.roughness, 1.0);
+    EXPECT_NEAR(r.in.normal, 0.12 * load, 0.12 * load * 1e-6);
+    EXPECT_FALSE(r.d.isSleeping());
+    EXPECT_EQ(r.in.roughness, 1.0);
 
     // Holding the load: no more shear. The boards' roughness keeps rubbing for settle_after_s
     // (1.5 s), then fades with settle_tau_s (0.25 s); the boards ring out and fall asleep (50 ms
@@ -142,12 +143,11 @@ TEST(FrictionDrive, ShearsOnlyWhileTheLoadChangesFasterThanTheThreshold) {
     int lastSolved = -1;
     double roughnessAt1s = -1.0, roughnessAt2s = -1.0;
     for (int i = 0; i < 10 * 48000; ++i) {
-        if (!d.next(static_cast<float>(load), f, in)) continue;
+        if (!r.step(load)) continue;
         lastSolved = i;
-        EXPECT_LE(in.anchorVelocity, 0.0148);
-        if (i == 48000) roughnessAt1s = in.roughness;
-        if (i == 96000) roughnessAt2s = in.roughness;
-        d.settle(f.processSample(in.normal, 0.0, in.anchor, in.anchorVelocity, in.roughness), f);
+        EXPECT_LE(r.in.anchorVelocity, 0.0148);
+        if (i == 48000) roughnessAt1s = r.in.roughness;
+        if (i == 96000) roughnessAt2s = r.in.roughness;
     }
     EXPECT_EQ(roughnessAt1s, 1.0);
     // 2 s: 0.5 s less the ~6 ms the smoothed rate took to fall below the threshold into the fade
@@ -156,32 +156,26 @@ TEST(FrictionDrive, ShearsOnlyWhileTheLoadChangesFasterThanTheThreshold) {
     // (it drives the boards at about -90 dBFS); asleep well before the roughness is cut.
     EXPECT_GT(lastSolved, 2 * 48000);
     EXPECT_LT(lastSolved, 5 * 48000);
-    EXPECT_TRUE(d.isSleeping());
+    EXPECT_TRUE(r.d.isSleeping());
 }
 
 TEST(FrictionDrive, LiftingTheFootRelaxesTheContact) {
-    const auto s = readTable(kAllKeys);
-    ElastoPlasticFriction f;
-    makeModel(s, f);
-    FrictionDrive d = makeDrive(s);
-    FrictionDrive::Input in{};
+    Rig r;
     double load = 0.0;
     for (int i = 0; i < 4800; ++i) { // loading at 10 kN/s: the boards shear and stick-slip
         load += 10000.0 / kFs;
-        if (d.next(static_cast<float>(load), f, in))
-            d.settle(f.processSample(in.normal, 0.0, in.anchor, in.anchorVelocity, in.roughness),
-                     f);
+        r.step(load);
     }
-    ASSERT_NE(f.bristle(), 0.0);
-    ASSERT_NE(f.frictionForce(), 0.0);
-    const double exciter = f.exciterPosition();
+    ASSERT_NE(r.f.bristle(), 0.0);
+    ASSERT_NE(r.f.frictionForce(), 0.0);
+    const double exciter = r.f.exciterPosition();
     // The foot leaves at once: the load's rate is far past the threshold, so the sample is
     // solved, unloaded: the model was relaxed and the drag re-anchored at the rubbing mass.
-    ASSERT_TRUE(d.next(0.0f, f, in));
-    EXPECT_TRUE(in.unloaded);
-    EXPECT_EQ(in.normal, 0.0);
-    EXPECT_EQ(f.bristle(), 0.0);
-    EXPECT_EQ(f.frictionForce(), 0.0);
-    EXPECT_EQ(f.exciterVelocity(), 0.0);
-    EXPECT_EQ(in.anchor, exciter);
+    ASSERT_TRUE(r.d.next(0.0f, r.f, r.in));
+    EXPECT_TRUE(r.in.unloaded);
+    EXPECT_EQ(r.in.normal, 0.0);
+    EXPECT_EQ(r.f.bristle(), 0.0);
+    EXPECT_EQ(r.f.frictionForce(), 0.0);
+    EXPECT_EQ(r.f.exciterVelocity(), 0.0);
+    EXPECT_EQ(r.in.anchor, exciter);
 }
