@@ -90,6 +90,18 @@ GrfSignal resampleGrf(GrfSignal in, double targetRateHz) {
     return out;
 }
 
+// (GrfTare) the unloaded plate's samples: below this fraction of the channel's peak
+constexpr double kNearZeroFraction = 0.05;
+constexpr double kTareSigmas = 4.0;
+
+// Measured before the negative samples are set to 0 (they carry half of the noise).
+std::vector<GrfTare> measureTares(const GrfSignal& grf, const GrfLoadOptions& o) {
+    std::vector<GrfTare> tares;
+    if (o.tare)
+        for (const auto& x : grf.channels) tares.push_back(measureGrfTare(x));
+    return tares;
+}
+
 // Negative forces beyond noise are an error; small negative offsets are set to 0.
 template <typename Where>
 void checkNegative(const std::string& path, GrfSignal& grf, Where&& where) {
@@ -139,11 +151,15 @@ GrfSignal loadAudioGrf(const std::string& path, const GrfLoadOptions& o) {
             grf.channels[c][i] = static_cast<float>(v * o.fullScaleNewtons);
         }
     }
+    const auto tares = measureTares(grf, o);
     checkNegative(path, grf, [&](std::size_t c, std::size_t i) {
         return fmt::format("channel {}, frame {} (t = {:.6f} s)", c + 1, i,
                            static_cast<double>(i) / audio.sampleRateHz);
     });
-    return resampleGrf(std::move(grf), o.targetRateHz);
+    for (std::size_t c = 0; c < tares.size(); ++c) applyGrfTare(grf.channels[c], tares[c]);
+    GrfSignal out = resampleGrf(std::move(grf), o.targetRateHz);
+    out.tare = tares;
+    return out;
 }
 
 GrfSignal loadCsvGrf(const std::string& path, const GrfLoadOptions& o) {
@@ -298,12 +314,60 @@ GrfSignal loadCsvGrf(const std::string& path, const GrfLoadOptions& o) {
                     "tolerated)",
                     path, rowLines[i], grf.names[c], values[c][i], tolerance));
     }
+    const auto tares = measureTares(grf, o);
     for (auto& x : grf.channels)
         for (float& v : x) v = std::max(0.0f, v);
-    return resampleGrf(std::move(grf), o.targetRateHz);
+    for (std::size_t c = 0; c < tares.size(); ++c) applyGrfTare(grf.channels[c], tares[c]);
+    GrfSignal out = resampleGrf(std::move(grf), o.targetRateHz);
+    out.tare = tares;
+    return out;
 }
 
 } // namespace
+
+GrfTare measureGrfTare(const std::vector<float>& x) {
+    GrfTare t;
+    if (x.empty()) return t;
+    const double peak = *std::max_element(x.begin(), x.end());
+    if (!(peak > 0.0)) return t;
+    const double limit = kNearZeroFraction * peak;
+    std::vector<float> near; // (float as the channel: at most the channel's own size again)
+    for (float v : x)
+        if (std::fabs(v) < limit) near.push_back(v);
+    t.samplesNearZero = near.size();
+    if (near.size() < 50 || near.size() * 100 < x.size()) return t; // no swing phase to learn from
+    auto median = [](std::vector<float>& v) {
+        const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+        std::nth_element(v.begin(), mid, v.end());
+        return static_cast<double>(*mid);
+    };
+    t.levelN = median(near);
+    for (float& v : near) v = static_cast<float>(std::fabs(static_cast<double>(v) - t.levelN));
+    t.noiseN = 1.4826 * median(near);
+    const double zero = t.levelN + kTareSigmas * t.noiseN;
+    // (a clean channel: 0; a level that is load, not the plate's zero: left as it is)
+    if (zero > 0.0 && zero < limit) t.subtractedN = zero;
+    return t;
+}
+
+void applyGrfTare(std::vector<float>& x, const GrfTare& t) {
+    const auto z = static_cast<float>(t.subtractedN);
+    for (float& v : x) v = std::max(0.0f, v - z);
+}
+
+std::string describeGrfTare(const GrfSignal& grf, const std::string& file) {
+    std::string text;
+    for (std::size_t c = 0; c < grf.tare.size() && c < grf.names.size(); ++c) {
+        const GrfTare& t = grf.tare[c];
+        if (t.subtractedN > 0.0)
+            text += fmt::format(
+                "{}: channel \"{}\": force-plate zero {:+.1f} N, noise {:.1f} N rms (from {} "
+                "samples near 0 N): {:.1f} N taken off every sample, so that the unloaded plate's "
+                "noise starts no contact in the air\n",
+                file, grf.names[c], t.levelN, t.noiseN, t.samplesNearZero, t.subtractedN);
+    }
+    return text;
+}
 
 double GrfSignal::durationSeconds() const {
     return sampleRateHz > 0 ? static_cast<double>(frames()) / sampleRateHz : 0.0;

@@ -25,6 +25,10 @@
 /// are further bounded by readAudioFile's limits and the file's real size.
 /// The signal is resampled to `targetRateHz` (libsamplerate, best sinc); the resampler's ringing
 /// below 0 N is clamped, since a ground reaction force never pulls.
+/// With `GrfLoadOptions::tare` (off by default: replays read their recordings exactly as they
+/// were written), each channel's force-plate zero is measured and taken off before resampling
+/// (see GrfTare): the noise of an unloaded plate would otherwise cross the layers' contact
+/// thresholds (5 N) in the air and start landings, grain bursts and splashes there.
 #include "engine/io/AudioFile.h"
 
 #include <string>
@@ -39,11 +43,28 @@ inline constexpr double kMaxGrfRateHz = 192000.0;
 /// Longest GRF file read, seconds (a trial or a recorded walk; a render from it is as long).
 inline constexpr double kMaxGrfSeconds = 900.0;
 
+/// A channel's force-plate zero, measured on the file's own samples near 0 N (those below 5 % of
+/// the channel's peak: the foot in the air, the plate unloaded): its level (median) and its noise
+/// (1.4826 x the median absolute deviation: the standard deviation of Gaussian noise). The zero
+/// taken off is level + 4 x noise, and forces below it read as 0 N: 4 standard deviations leave
+/// about one sample in 30,000 of the unloaded plate above it, and a step's load, hundreds of
+/// newtons, loses a few (a contact threshold is then crossed a fraction of a millisecond
+/// later). Nothing is taken off a clean channel (exact zeros in the air: level and noise 0), a
+/// channel with too few samples near 0 to tell (under 1 % of them, or under 50: no swing phase),
+/// or one whose zero would exceed 5 % of its peak (the "noise" is then load).
+struct GrfTare {
+    double levelN = 0.0;             ///< the unloaded plate's median reading
+    double noiseN = 0.0;             ///< its noise, standard deviation
+    double subtractedN = 0.0;        ///< taken off every sample (0: nothing done)
+    std::size_t samplesNearZero = 0; ///< how many samples the estimate rests on
+};
+
 /// A multichannel vertical GRF in newtons at one sample rate.
 struct GrfSignal {
     double sampleRateHz = 0;
     std::vector<std::string> names;           ///< one per channel
     std::vector<std::vector<float>> channels; ///< newtons, all the same length
+    std::vector<GrfTare> tare; ///< per channel when loaded with GrfLoadOptions::tare, else empty
     /// Length in seconds (0 when there is no channel).
     double durationSeconds() const;
     /// Samples per channel.
@@ -56,7 +77,19 @@ struct GrfLoadOptions {
     double fullScaleNewtons = 1000.0; ///< audio files: force of a sample of 1.0
     double bodyMassKg = 70.0;         ///< CSV columns in body weights (`*_bw`)
     bool allowClipped = false;        ///< accept flat tops at full scale in audio files
+    /// measure and take off each channel's force-plate zero (GrfTare): for recorded force files;
+    /// off for replays, which must read what was recorded
+    bool tare = false;
 };
+
+/// Measures a channel's force-plate zero (GrfTare) from its samples in newtons (negative noise
+/// included: measure before clamping at 0).
+GrfTare measureGrfTare(const std::vector<float>& newtons);
+/// Takes the zero off: x = max(0, x - tare.subtractedN).
+void applyGrfTare(std::vector<float>& newtons, const GrfTare& tare);
+/// One line per channel whose zero was taken off, for the user ("" when none was):
+/// `file: channel "left": force-plate zero +0.1 N, noise 3.0 N rms: 12.2 N taken off ...`.
+std::string describeGrfTare(const GrfSignal& grf, const std::string& file);
 
 /// Loads a GRF from a .csv file or an audio file (WAV/FLAC/OGG). Throws FileError.
 GrfSignal loadGrfFile(const std::string& path, const GrfLoadOptions& options = {});

@@ -202,6 +202,96 @@ TEST(GrfFile, CsvInNewtonsAndBodyWeights) {
                 0.01);
 }
 
+// A force-plate walk: steps of 0.6 s (half-sines peaking at 700 N) every 1.0 s, 0.4 s of swing
+// between them, at 1 kHz, plus Gaussian noise of `sigma` N around `level` N (0, 0: clean).
+std::vector<float> plateWalk(double level, double sigma, std::uint64_t seed = 3) {
+    Random random(seed);
+    std::vector<float> x;
+    for (int i = 0; i < 6000; ++i) {
+        const double t = std::fmod(i / 1000.0, 1.0);
+        // Box-Muller from two uniforms (the engine's seeded generator)
+        const double u1 = std::max(random.uniform(), 1e-300), u2 = random.uniform();
+        const double g = std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
+        x.push_back(static_cast<float>((t < 0.6 ? 700.0 * std::sin(M_PI * t / 0.6) : 0.0) +
+                                       (sigma > 0 ? level + sigma * g : level)));
+    }
+    return x;
+}
+
+TEST(GrfFile, TareMeasuresThePlatesZeroAndLeavesCleanChannelsAlone) {
+    // Clean: exact zeros in the air, nothing measured, nothing taken off.
+    const GrfTare clean = measureGrfTare(plateWalk(0, 0));
+    EXPECT_EQ(clean.subtractedN, 0.0);
+    EXPECT_EQ(clean.levelN, 0.0);
+    EXPECT_EQ(clean.noiseN, 0.0);
+    // Noise of 3 N around +2 N: the level and the noise come back within ~10 % (2400 swing
+    // samples), and the zero taken off is level + 4 sigma.
+    const GrfTare noisy = measureGrfTare(plateWalk(2.0, 3.0));
+    EXPECT_NEAR(noisy.levelN, 2.0, 0.3);
+    EXPECT_NEAR(noisy.noiseN, 3.0, 0.3);
+    EXPECT_NEAR(noisy.subtractedN, noisy.levelN + 4.0 * noisy.noiseN, 1e-9);
+    EXPECT_GT(noisy.samplesNearZero, 2000u);
+    std::vector<float> x = plateWalk(2.0, 3.0);
+    applyGrfTare(x, noisy);
+    std::size_t airborne = 0; // swing samples still above the layers' 5 N contact threshold
+    for (std::size_t i = 0; i < x.size(); ++i)
+        if (std::fmod(static_cast<double>(i) / 1000.0, 1.0) >= 0.6 && x[i] > 5.0f) ++airborne;
+    EXPECT_EQ(airborne, 0u);
+    for (float v : x) ASSERT_GE(v, 0.0f);
+    // Standing only (no sample near 0 N): nothing to learn the zero from, nothing taken off.
+    std::vector<float> standing(6000);
+    for (std::size_t i = 0; i < standing.size(); ++i)
+        standing[i] = static_cast<float>(700.0 + 15.0 * std::sin(static_cast<double>(i) / 400.0));
+    EXPECT_EQ(measureGrfTare(standing).subtractedN, 0.0);
+    // A "zero" that would be 5 % of the peak or more is load, not noise: left alone.
+    EXPECT_EQ(measureGrfTare(plateWalk(0.0, 12.0)).subtractedN, 0.0);
+}
+
+TEST(GrfFile, TareIsAnOptionOfTheLoaderAndReplaysReadTheFileAsItIs) {
+    const auto x = plateWalk(1.0, 3.0);
+    std::string text = "time_s,left\n";
+    for (std::size_t i = 0; i < x.size(); ++i)
+        text += std::to_string(static_cast<double>(i) * 0.001) + "," + std::to_string(x[i]) + "\n";
+    const auto path = writeText("noisy_plate.csv", text);
+    // Default (as replays load their recordings): the noise is kept, no tare reported.
+    const GrfSignal raw = loadGrfFile(path);
+    EXPECT_TRUE(raw.tare.empty());
+    EXPECT_EQ(describeGrfTare(raw, path), "");
+    auto swingMax = [](const GrfSignal& g) {
+        float m = 0.0f; // mid-swing, 0.7-0.9 s of each second, away from the resampler's edges
+        for (std::size_t i = 0; i < g.frames(); ++i) {
+            const double t = std::fmod(static_cast<double>(i) / g.sampleRateHz, 1.0);
+            if (t > 0.7 && t < 0.9) m = std::max(m, g.channels[0][i]);
+        }
+        return m;
+    };
+    EXPECT_GT(swingMax(raw), 5.0f); // the plate's noise crosses the layers' contact threshold
+    GrfLoadOptions o;
+    o.tare = true;
+    const GrfSignal tared = loadGrfFile(path, o);
+    ASSERT_EQ(tared.tare.size(), 1u);
+    EXPECT_GT(tared.tare[0].subtractedN, 10.0);
+    EXPECT_LT(swingMax(tared), 0.5f);
+    const std::string note = describeGrfTare(tared, path);
+    EXPECT_NE(note.find("noisy_plate.csv: channel \"left\": force-plate zero +"), std::string::npos)
+        << note;
+    EXPECT_NE(note.find("N taken off every sample"), std::string::npos) << note;
+    // The same file in WAV (float, 1000 N full scale) gives the same zero.
+    std::vector<float> scaled(x.size());
+    for (std::size_t i = 0; i < x.size(); ++i) scaled[i] = x[i] / 1000.0f;
+    const GrfSignal wav =
+        loadGrfFile(writeWav("noisy_plate.wav", scaled, 1000, SF_FORMAT_FLOAT), o);
+    ASSERT_EQ(wav.tare.size(), 1u);
+    EXPECT_NEAR(wav.tare[0].subtractedN, tared.tare[0].subtractedN, 0.01);
+    // A clean file loads the same samples with and without the tare.
+    const auto c = plateWalk(0, 0);
+    std::string clean = "time_s,left\n";
+    for (std::size_t i = 0; i < c.size(); ++i)
+        clean += std::to_string(static_cast<double>(i) * 0.001) + "," + std::to_string(c[i]) + "\n";
+    const auto cleanPath = writeText("clean_plate.csv", clean);
+    EXPECT_EQ(loadGrfFile(cleanPath, o).channels, loadGrfFile(cleanPath).channels);
+}
+
 TEST(GrfFile, CsvErrorsNameFileLineColumnAndExpectation) {
     const std::string head = "time_s,left,right\n";
     struct Case {

@@ -6,6 +6,10 @@
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     using namespace underfoot;
     const std::string path = fuzz::writeInput("grf.csv", data, size);
-    fuzz::expectReadOrRefusal<engine::FileError>(path, [&] { (void)engine::loadGrfFile(path); });
+    // Odd sizes also measure and take off the force-plate zero (render and live --grf do).
+    engine::GrfLoadOptions options;
+    options.tare = size % 2 == 1;
+    fuzz::expectReadOrRefusal<engine::FileError>(path,
+                                                 [&] { (void)engine::loadGrfFile(path, options); });
     return 0;
 }
