@@ -25,6 +25,7 @@ struct LiveArgs {
     std::string surface, walker = "cadence=100", grf, reverb, soundscape, haptics = "audio",
                          pairs = "both", settings, api, device, record, recordOutput;
     bool mics = false, quiet = false;
+    bool grfTare = true;
     double seconds = 10.0;
     std::uint64_t seed = 1;
 };
@@ -85,7 +86,9 @@ int runLive(const LiveArgs& a) {
         if (d.control == eng::ControlKind::GrfReplay) {
             eng::GrfLoadOptions o;
             o.targetRateHz = spec.sampleRateHz;
+            o.tare = a.grfTare; // (--record stores the GRF as tared: replays read it as it is)
             d.grf = eng::loadGrfFile(a.grf, o);
+            fmt::print(stderr, "{}", eng::describeGrfTare(d.grf, a.grf));
         }
         if (!a.soundscape.empty()) d.ambience = wiring::makeSoundscapeAmbience(a.soundscape);
         const int grfChannels = d.control == eng::ControlKind::Walker ? 2
@@ -170,6 +173,9 @@ CommandRegistrar reg("live", [](CLI::App& app, int& exitCode) {
     auto* mics = cmd->add_flag("--mics", a->mics,
                                "drive with the microphones (Cook envelope, loudest input)");
     auto* grf = cmd->add_option("--grf", a->grf, "drive with a GRF recording (.wav/.csv)");
+    cmd->add_flag("--grf-tare,!--no-grf-tare", a->grfTare,
+                  "with --grf: take each channel's force-plate zero off first (as `render "
+                  "--grf-tare`; default on)");
     mics->excludes(grf);
     walker->excludes(mics);
     walker->excludes(grf);

@@ -32,6 +32,7 @@ struct RenderArgs {
     std::string output;
     std::string format = "pcm24";
     double grfFullScale = 1000.0;
+    bool grfTare = true;
     bool quiet = false;
 };
 
@@ -61,8 +62,10 @@ int runRender(const RenderArgs& a) {
             eng::GrfLoadOptions lo;
             lo.targetRateHz = a.rate;
             lo.fullScaleNewtons = a.grfFullScale;
+            lo.tare = a.grfTare;
             grf = eng::loadGrfFile(a.grfFile, lo);
             source = a.grfFile;
+            if (!a.quiet) fmt::print(stderr, "{}", eng::describeGrfTare(grf, a.grfFile));
         } else {
             const auto params = eng::WalkerParameters::parse(a.walker);
             grf = eng::walkerGrf(params, a.seconds, a.rate, a.seed);
@@ -134,6 +137,10 @@ CommandRegistrar reg("render", [](CLI::App& app, int& exitCode) {
     cmd->add_option("--grf-full-scale", args->grfFullScale,
                     "newtons of a full-scale sample in a WAV GRF")
         ->capture_default_str();
+    cmd->add_flag("--grf-tare,!--no-grf-tare", args->grfTare,
+                  "take each GRF channel's force-plate zero (level + 4 x its noise, measured on "
+                  "the samples near 0 N) off before rendering, so that plate noise starts no "
+                  "contact in the air (default on; a clean file is left as it is)");
     cmd->add_option("--seconds", args->seconds, "length of the walk (virtual walker)")
         ->capture_default_str()
         ->check(CLI::Range(0.01, 86400.0));
