@@ -127,6 +127,9 @@ int infoCommand(const Options& o) {
         lo.fullScaleNewtons = o.fullScaleN;
         lo.bodyMassKg = o.massKg;
         const GrfSignal g = loadGrfFile(o.input, lo);
+        // What `render --grf` and `live --grf` will take off (GrfTare), from a second load
+        lo.tare = true;
+        const std::vector<GrfTare> tare = loadGrfFile(o.input, lo).tare;
         fmt::print("{}: {} channel(s) at {:.0f} Hz, {:.3f} s\n", o.input, g.channels.size(),
                    g.sampleRateHz, g.durationSeconds());
         for (std::size_t c = 0; c < g.channels.size(); ++c) {
@@ -147,6 +150,21 @@ int infoCommand(const Options& o) {
                        "{} contact(s)\n",
                        g.names[c], peak, peak / (o.massKg * kGravity), o.massKg,
                        x.empty() ? 0.0 : sum / static_cast<double>(x.size()), contacts);
+            if (c < tare.size()) {
+                const GrfTare& t = tare[c];
+                if (t.subtractedN > 0.0)
+                    fmt::print("           force-plate zero {:+.1f} N, noise {:.1f} N rms: render "
+                               "and live --grf take {:.1f} N off (--no-grf-tare: nothing)\n",
+                               t.levelN, t.noiseN, t.subtractedN);
+                else if (t.noiseN == 0.0 && t.levelN == 0.0 && t.samplesNearZero >= 50)
+                    fmt::print("           clean zero (exact 0 N in the air): nothing to take "
+                               "off\n");
+                else
+                    fmt::print("           no force-plate zero taken off (level {:+.1f} N, noise "
+                               "{:.1f} N rms from {} samples near 0 N: too few, or too large "
+                               "to be the plate's)\n",
+                               t.levelN, t.noiseN, t.samplesNearZero);
+            }
         }
     });
     return 0;

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # `underfoot render --grf` on a noisy force-plate file: the plate's zero is measured and taken
 # off by default (a note names the file, the channel and what was taken off), and not with
-# --no-grf-tare; a clean file gets no note. The signal side is tested in
-# tests/engine/test_control_grf.cpp (GrfFile.Tare*). Usage: render_grf_tare.sh <underfoot> <work>
+# --no-grf-tare; a clean file gets no note; `grf info` shows what will be taken off. The signal
+# side is tested in tests/engine/test_control_grf.cpp (GrfFile.Tare*).
+# Usage: render_grf_tare.sh <underfoot> <work>
 set -euo pipefail
 underfoot="$1"
 work="$2"
@@ -30,4 +31,11 @@ grep -q 'N taken off every sample' noisy.out || { echo "FAIL: tare note incomple
 if grep -q 'taken off' raw.out; then echo "FAIL: --no-grf-tare still tared"; cat raw.out; exit 1; fi
 "$underfoot" render -s gravel --grf clean.csv --tail 0 -o clean.wav > clean.out 2>&1
 if grep -q 'taken off' clean.out; then echo "FAIL: a clean file was tared"; cat clean.out; exit 1; fi
-echo "ok: noisy file tared ($(grep -o '[0-9.]* N taken off' noisy.out)), --no-grf-tare and a clean file left alone"
+"$underfoot" grf info noisy.csv > info_noisy.out
+grep -q 'force-plate zero +.* N off (--no-grf-tare: nothing)' info_noisy.out ||
+    { echo "FAIL: grf info does not show the zero"; cat info_noisy.out; exit 1; }
+"$underfoot" grf info clean.csv > info_clean.out
+grep -q 'clean zero (exact 0 N in the air): nothing to take off' info_clean.out ||
+    { echo "FAIL: grf info on a clean file"; cat info_clean.out; exit 1; }
+echo "ok: noisy file tared ($(grep -o '[0-9.]* N taken off' noisy.out)), --no-grf-tare and a" \
+    "clean file left alone, grf info shows both"
