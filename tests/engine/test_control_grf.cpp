@@ -3,6 +3,7 @@
 #include "engine/control/GrfFile.h"
 #include "engine/control/VirtualWalker.h"
 #include "engine/dsp/Random.h"
+#include "engine/surfaces/Surface.h"
 
 #include <gtest/gtest.h>
 #include <sndfile.h>
@@ -290,6 +291,35 @@ TEST(GrfFile, TareIsAnOptionOfTheLoaderAndReplaysReadTheFileAsItIs) {
         clean += std::to_string(static_cast<double>(i) * 0.001) + "," + std::to_string(c[i]) + "\n";
     const auto cleanPath = writeText("clean_plate.csv", clean);
     EXPECT_EQ(loadGrfFile(cleanPath, o).channels, loadGrfFile(cleanPath).channels);
+}
+
+TEST(GrfFile, AFileThatStartsAndEndsUnderLoadIsNoLandingAndNoRinging) {
+    // A recording cut from a longer trial: 600 N from the first sample to the last, at 1 kHz (CSV)
+    // and at 44.1 kHz (WAV). The resampler used to start from silence: the load rose from 0 N over
+    // a few milliseconds with the sinc's ringing (682 N peak) and ended the same way, and a wood
+    // floor heard a landing at the first sample (-20.5 dBFS) and a strike at the last.
+    std::string text = "time_s,left\n";
+    for (int i = 0; i < 1000; ++i) text += std::to_string(i * 0.001) + ",600\n";
+    const GrfSignal csv = loadGrfFile(writeText("held.csv", text));
+    const GrfSignal wav =
+        loadGrfFile(writeWav("held.wav", std::vector<float>(44100, 0.6f), 44100, SF_FORMAT_FLOAT));
+    for (const GrfSignal* g : {&csv, &wav}) {
+        ASSERT_EQ(g->frames(), 48000u);
+        const auto [lo, hi] = std::minmax_element(g->channels[0].begin(), g->channels[0].end());
+        EXPECT_NEAR(*lo, 600.0f, 0.5f);
+        EXPECT_NEAR(*hi, 600.0f, 0.5f);
+    }
+    auto wood = Surface::loadById("wood");
+    wood->prepare({48000.0, 480});
+    wood->reset(1);
+    std::vector<float> out(480);
+    float peak = 0.0f;
+    for (std::size_t i = 0; i + 480 <= csv.frames(); i += 480) {
+        std::fill(out.begin(), out.end(), 0.0f);
+        wood->process(csv.channels[0].data() + i, out.data(), 480);
+        for (float v : out) peak = std::max(peak, std::fabs(v));
+    }
+    EXPECT_EQ(peak, 0.0f) << "a landing or a strike was heard in a load held from start to end";
 }
 
 TEST(GrfFile, CsvErrorsNameFileLineColumnAndExpectation) {
