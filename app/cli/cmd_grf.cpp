@@ -126,10 +126,9 @@ int infoCommand(const Options& o) {
         lo.targetRateHz = o.rateHz;
         lo.fullScaleNewtons = o.fullScaleN;
         lo.bodyMassKg = o.massKg;
+        lo.tare = GrfTareMode::Measure; // what `render --grf` and `live --grf` will take off
         const GrfSignal g = loadGrfFile(o.input, lo);
-        // What `render --grf` and `live --grf` will take off (GrfTare), from a second load
-        lo.tare = true;
-        const std::vector<GrfTare> tare = loadGrfFile(o.input, lo).tare;
+        const std::vector<GrfTare>& tare = g.tare;
         fmt::print("{}: {} channel(s) at {:.0f} Hz, {:.3f} s\n", o.input, g.channels.size(),
                    g.sampleRateHz, g.durationSeconds());
         for (std::size_t c = 0; c < g.channels.size(); ++c) {

@@ -86,7 +86,9 @@ int runLive(const LiveArgs& a) {
         if (d.control == eng::ControlKind::GrfReplay) {
             eng::GrfLoadOptions o;
             o.targetRateHz = spec.sampleRateHz;
-            o.tare = a.grfTare; // (--record stores the GRF as tared: replays read it as it is)
+            o.tare = a.grfTare ? eng::GrfTareMode::Apply
+                               : eng::GrfTareMode::Off; // (--record stores the GRF as tared:
+                                                        // replays read it as it is)
             d.grf = eng::loadGrfFile(a.grf, o);
             fmt::print(stderr, "{}", eng::describeGrfTare(d.grf, a.grf));
         }

@@ -62,7 +62,7 @@ int runRender(const RenderArgs& a) {
             eng::GrfLoadOptions lo;
             lo.targetRateHz = a.rate;
             lo.fullScaleNewtons = a.grfFullScale;
-            lo.tare = a.grfTare;
+            lo.tare = a.grfTare ? eng::GrfTareMode::Apply : eng::GrfTareMode::Off;
             grf = eng::loadGrfFile(a.grfFile, lo);
             source = a.grfFile;
             if (!a.quiet) fmt::print(stderr, "{}", eng::describeGrfTare(grf, a.grfFile));

@@ -115,9 +115,22 @@ constexpr double kTareSigmas = 4.0;
 // Measured before the negative samples are set to 0 (they carry half of the noise).
 std::vector<GrfTare> measureTares(const GrfSignal& grf, const GrfLoadOptions& o) {
     std::vector<GrfTare> tares;
-    if (o.tare)
+    if (o.tare != GrfTareMode::Off)
         for (const auto& x : grf.channels) tares.push_back(measureGrfTare(x));
     return tares;
+}
+
+// The loaders' common end, once the negative samples are 0: the zeros taken off (Apply), the
+// resampling, the tares reported.
+GrfSignal finishGrf(GrfSignal grf, std::vector<GrfTare> tares, const GrfLoadOptions& o) {
+    if (o.tare == GrfTareMode::Apply)
+        for (std::size_t c = 0; c < tares.size(); ++c) {
+            applyGrfTare(grf.channels[c], tares[c]);
+            tares[c].applied = tares[c].subtractedN > 0.0;
+        }
+    GrfSignal out = resampleGrf(std::move(grf), o.targetRateHz);
+    out.tare = std::move(tares);
+    return out;
 }
 
 // Negative forces beyond noise are an error; small negative offsets are set to 0.
@@ -174,10 +187,7 @@ GrfSignal loadAudioGrf(const std::string& path, const GrfLoadOptions& o) {
         return fmt::format("channel {}, frame {} (t = {:.6f} s)", c + 1, i,
                            static_cast<double>(i) / audio.sampleRateHz);
     });
-    for (std::size_t c = 0; c < tares.size(); ++c) applyGrfTare(grf.channels[c], tares[c]);
-    GrfSignal out = resampleGrf(std::move(grf), o.targetRateHz);
-    out.tare = tares;
-    return out;
+    return finishGrf(std::move(grf), tares, o);
 }
 
 GrfSignal loadCsvGrf(const std::string& path, const GrfLoadOptions& o) {
@@ -335,10 +345,7 @@ GrfSignal loadCsvGrf(const std::string& path, const GrfLoadOptions& o) {
     const auto tares = measureTares(grf, o);
     for (auto& x : grf.channels)
         for (float& v : x) v = std::max(0.0f, v);
-    for (std::size_t c = 0; c < tares.size(); ++c) applyGrfTare(grf.channels[c], tares[c]);
-    GrfSignal out = resampleGrf(std::move(grf), o.targetRateHz);
-    out.tare = tares;
-    return out;
+    return finishGrf(std::move(grf), tares, o);
 }
 
 } // namespace
@@ -377,7 +384,7 @@ std::string describeGrfTare(const GrfSignal& grf, const std::string& file) {
     std::string text;
     for (std::size_t c = 0; c < grf.tare.size() && c < grf.names.size(); ++c) {
         const GrfTare& t = grf.tare[c];
-        if (t.subtractedN > 0.0)
+        if (t.applied)
             text += fmt::format(
                 "{}: channel \"{}\": force-plate zero {:+.1f} N, noise {:.1f} N rms (from {} "
                 "samples near 0 N): {:.1f} N taken off every sample, so that the unloaded plate's "

@@ -25,8 +25,8 @@
 /// are further bounded by readAudioFile's limits and the file's real size.
 /// The signal is resampled to `targetRateHz` (libsamplerate, best sinc); the resampler's ringing
 /// below 0 N is clamped, since a ground reaction force never pulls.
-/// With `GrfLoadOptions::tare` (off by default: replays read their recordings exactly as they
-/// were written), each channel's force-plate zero is measured and taken off before resampling
+/// With `GrfLoadOptions::tare` = Apply (Off by default: replays read their recordings exactly as
+/// they were written), each channel's force-plate zero is measured and taken off before resampling
 /// (see GrfTare): the noise of an unloaded plate would otherwise cross the layers' contact
 /// thresholds (5 N) in the air and start landings, grain bursts and splashes there.
 #include "engine/io/AudioFile.h"
@@ -55,8 +55,9 @@ inline constexpr double kMaxGrfSeconds = 900.0;
 struct GrfTare {
     double levelN = 0.0;             ///< the unloaded plate's median reading
     double noiseN = 0.0;             ///< its noise, standard deviation
-    double subtractedN = 0.0;        ///< taken off every sample (0: nothing done)
+    double subtractedN = 0.0;        ///< the zero to take off every sample (0: none)
     std::size_t samplesNearZero = 0; ///< how many samples the estimate rests on
+    bool applied = false;            ///< subtractedN was taken off (GrfTareMode::Apply)
 };
 
 /// A multichannel vertical GRF in newtons at one sample rate.
@@ -64,22 +65,27 @@ struct GrfSignal {
     double sampleRateHz = 0;
     std::vector<std::string> names;           ///< one per channel
     std::vector<std::vector<float>> channels; ///< newtons, all the same length
-    std::vector<GrfTare> tare; ///< per channel when loaded with GrfLoadOptions::tare, else empty
+    std::vector<GrfTare> tare;                ///< per channel unless loaded with GrfTareMode::Off
     /// Length in seconds (0 when there is no channel).
     double durationSeconds() const;
     /// Samples per channel.
     std::size_t frames() const { return channels.empty() ? 0 : channels.front().size(); }
 };
 
+/// What the loader does with each channel's force-plate zero (GrfTare).
+enum class GrfTareMode {
+    Off,     ///< nothing (replays: they must read what was recorded)
+    Measure, ///< measure it into GrfSignal::tare, leave the samples as they are (`grf info`)
+    Apply,   ///< measure it and take it off (recorded force files: `render`, `live --grf`)
+};
+
 /// How a GRF file is read.
 struct GrfLoadOptions {
-    double targetRateHz = 48000.0;    ///< output rate (the engine's audio rate)
-    double fullScaleNewtons = 1000.0; ///< audio files: force of a sample of 1.0
-    double bodyMassKg = 70.0;         ///< CSV columns in body weights (`*_bw`)
-    bool allowClipped = false;        ///< accept flat tops at full scale in audio files
-    /// measure and take off each channel's force-plate zero (GrfTare): for recorded force files;
-    /// off for replays, which must read what was recorded
-    bool tare = false;
+    double targetRateHz = 48000.0;       ///< output rate (the engine's audio rate)
+    double fullScaleNewtons = 1000.0;    ///< audio files: force of a sample of 1.0
+    double bodyMassKg = 70.0;            ///< CSV columns in body weights (`*_bw`)
+    bool allowClipped = false;           ///< accept flat tops at full scale in audio files
+    GrfTareMode tare = GrfTareMode::Off; ///< each channel's force-plate zero (GrfTare)
 };
 
 /// Measures a channel's force-plate zero (GrfTare) from its samples in newtons (negative noise

@@ -210,9 +210,7 @@ std::vector<float> plateWalk(double level, double sigma, std::uint64_t seed = 3)
     std::vector<float> x;
     for (int i = 0; i < 6000; ++i) {
         const double t = std::fmod(i / 1000.0, 1.0);
-        // Box-Muller from two uniforms (the engine's seeded generator)
-        const double u1 = std::max(random.uniform(), 1e-300), u2 = random.uniform();
-        const double g = std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
+        const double g = random.gaussian();
         x.push_back(static_cast<float>((t < 0.6 ? 700.0 * std::sin(M_PI * t / 0.6) : 0.0) +
                                        (sigma > 0 ? level + sigma * g : level)));
     }
@@ -268,11 +266,21 @@ TEST(GrfFile, TareIsAnOptionOfTheLoaderAndReplaysReadTheFileAsItIs) {
     };
     EXPECT_GT(swingMax(raw), 5.0f); // the plate's noise crosses the layers' contact threshold
     GrfLoadOptions o;
-    o.tare = true;
+    o.tare = GrfTareMode::Apply;
     const GrfSignal tared = loadGrfFile(path, o);
     ASSERT_EQ(tared.tare.size(), 1u);
     EXPECT_GT(tared.tare[0].subtractedN, 10.0);
     EXPECT_LT(swingMax(tared), 0.5f);
+    // Measure (what `grf info` shows): the same zero, the samples as they are, nothing reported.
+    o.tare = GrfTareMode::Measure;
+    const GrfSignal measured = loadGrfFile(path, o);
+    ASSERT_EQ(measured.tare.size(), 1u);
+    EXPECT_EQ(measured.tare[0].subtractedN, tared.tare[0].subtractedN);
+    EXPECT_FALSE(measured.tare[0].applied);
+    EXPECT_TRUE(tared.tare[0].applied);
+    EXPECT_EQ(measured.channels, raw.channels);
+    EXPECT_EQ(describeGrfTare(measured, path), "");
+    o.tare = GrfTareMode::Apply;
     const std::string note = describeGrfTare(tared, path);
     EXPECT_NE(note.find("noisy_plate.csv: channel \"left\": force-plate zero +"), std::string::npos)
         << note;
