@@ -100,12 +100,12 @@ class FrictionDrive {
         in.anchor = anchor_;
         in.anchorVelocity = shear;
         in.roughness = settling_.next(shear > 0.0);
-        loaded_ = !in.unloaded;
         return true;
     }
-    /// The model's output for the sample next() let through.
-    [[gnu::always_inline]] void settle(double y, const ElastoPlasticFriction& model) noexcept {
-        const bool still = !loaded_ || std::fabs(model.relativeVelocity()) < 1e-6;
+    /// The model's output for the sample next() let through (with next()'s input).
+    [[gnu::always_inline]] void settle(double y, const Input& in,
+                                       const ElastoPlasticFriction& model) noexcept {
+        const bool still = in.unloaded || std::fabs(model.relativeVelocity()) < 1e-6;
         quiet_ = (std::fabs(y) < params_.sleepVelocity && still) ? quiet_ + 1 : 0;
     }
     /// Asleep now, and the load is not changing fast enough to wake the boards.
@@ -118,7 +118,6 @@ class FrictionDrive {
     LoadSettling settling_;
     double fs_ = 48000.0, smooth_ = 0.0, last_ = 0.0, rate_ = 0.0, anchor_ = 0.0;
     long quiet_ = 1L << 30, sleepAfter_ = 2400;
-    bool loaded_ = false;
 };
 
 } // namespace underfoot::engine

@@ -295,7 +295,7 @@ class FrictionLayer final : public SurfaceLayer {
             const double y =
                 friction_.processSample(in.normal, 0.0, in.anchor, in.anchorVelocity, in.roughness);
             out[i] += g * static_cast<float>(y);
-            drive_.settle(y, friction_);
+            drive_.settle(y, in, friction_);
         }
     }
     ElastoPlasticFriction friction_;

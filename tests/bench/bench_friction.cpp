@@ -73,7 +73,7 @@ const std::vector<FrictionDrive::Input>& walkDrive() {
             if (!layer.next(g, f, in)) continue;
             d.push_back(in);
             layer.settle(
-                f.processSample(in.normal, 0.0, in.anchor, in.anchorVelocity, in.roughness), f);
+                f.processSample(in.normal, 0.0, in.anchor, in.anchorVelocity, in.roughness), in, f);
         }
         return d;
     }();

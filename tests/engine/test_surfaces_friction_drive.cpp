@@ -65,7 +65,8 @@ struct Rig {
     /// One GRF sample through the drive and, when it runs, the model.
     bool step(double load) {
         if (!d.next(static_cast<float>(load), f, in)) return false;
-        d.settle(f.processSample(in.normal, 0.0, in.anchor, in.anchorVelocity, in.roughness), f);
+        d.settle(f.processSample(in.normal, 0.0, in.anchor, in.anchorVelocity, in.roughness), in,
+                 f);
         return true;
     }
 };
