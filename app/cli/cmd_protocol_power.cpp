@@ -4,6 +4,7 @@
 #include "analysis/model/Catalog.h"
 #include "analysis/power/Power.h"
 #include "app/cli/CommandRegistry.h"
+#include "app/cli/PowerSimulators.h"
 #include "experiment/Catalogue.h"
 #include "experiment/Plan.h"
 #include "experiment/Protocol.h"
@@ -18,14 +19,17 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <map>
 #include <memory>
+#include <numbers>
 #include <thread>
 
 namespace underfoot::cli::protocol_power_command {
 namespace {
 
 using namespace underfoot::experiment;
+using namespace underfoot::cli::power;
 
 struct PowerArgs {
     std::string file;
@@ -40,11 +44,17 @@ struct PowerArgs {
     std::vector<std::string> groups;
     bool noMixed = false;
     int nAGQ = 1;
-    std::string publishedDir = std::string(UNDERFOOT_SOURCE_DIR) + "/tests/analysis/data/published";
+    /// Folder of the [simulation] matrices; empty = where the protocol names them (beside the
+    /// protocol file, then the shipped protocols folder).
+    std::string publishedDir;
     std::string ratingModel; ///< rating protocols: the model (default: the protocol's [simulation])
     std::string scale;
     std::string factor;
     std::vector<std::string> levels;
+    double oddsRatio = 0;       ///< > 0: the effect of --factor's second level as an odds ratio
+    double baselineCorrect = 0; ///< identification at the first level (0 = from the matrices)
+    double difference = std::numeric_limits<double>::quiet_NaN(); ///< ratings: effect in points
+    bool noOrdinal = false;
 };
 
 /// "10..60" (step 10), "10..60:5" or "10,15,20".
@@ -88,85 +98,38 @@ std::vector<int> parseSizes(const std::string& text) {
     return out;
 }
 
-/// The published confusion matrices of the reference studies, by protocol and group.
-std::map<std::string, std::string> publishedFiles(const std::string& protocolId) {
-    if (protocolId == "tvcg2011_exp2")
-        return {{"none", "tvcg2011_exp2_cond1_no_soundscape_confusion.csv"},
-                {"coherent", "tvcg2011_exp2_cond2_coherent_confusion.csv"},
-                {"incoherent", "tvcg2011_exp2_cond3_incoherent_confusion.csv"}};
-    if (protocolId == "eurohaptics2010")
-        return {{"audio", "eurohaptics2010_audio_confusion.csv"},
-                {"haptic", "eurohaptics2010_haptic_confusion.csv"},
-                {"audiohaptic", "eurohaptics2010_audiohaptic_confusion.csv"}};
-    return {};
-}
-
-/// A participant's own matrix: the row's share of correct answers shifted by `ability` on the
-/// logit scale (a row with every answer correct or none counts as half an answer off, so that it
-/// can move), the wrong answers keeping their proportions: participants differ as real ones do.
-ConfusionMatrix withAbility(const ConfusionMatrix& m, double ability) {
-    if (ability == 0.0) return m;
-    ConfusionMatrix out = m;
-    for (auto& row : out.rows) {
-        double correct = 0, total = 0;
-        std::size_t rightColumn = row.counts.size(), wrongColumn = row.counts.size();
-        for (std::size_t c = 0; c < row.counts.size(); ++c) {
-            total += row.counts[c];
-            const bool right = answerIsCorrect(m.answers[c], row.surface);
-            if (right) correct += row.counts[c];
-            if (right && rightColumn == row.counts.size()) rightColumn = c;
-            if (!right && m.answers[c] == kDontKnow) wrongColumn = c;
-        }
-        if (total <= 0 || rightColumn == row.counts.size()) continue;
-        const double p = std::clamp(correct / total, 0.5 / total, 1.0 - 0.5 / total);
-        const double shifted = 1.0 / (1.0 + std::exp(-(std::log(p / (1 - p)) + ability)));
-        const double wrong = total - correct;
-        for (std::size_t c = 0; c < row.counts.size(); ++c) {
-            const bool right = answerIsCorrect(m.answers[c], row.surface);
-            if (right)
-                row.counts[c] = correct > 0 ? row.counts[c] * shifted * total / correct : 0.0;
-            else
-                row.counts[c] = wrong > 0 ? row.counts[c] * (1 - shifted) * total / wrong : 0.0;
-        }
-        if (correct <= 0) row.counts[rightColumn] = shifted * total;
-        if (wrong <= 0 && wrongColumn < row.counts.size())
-            row.counts[wrongColumn] = (1 - shifted) * total;
-    }
-    return out;
-}
-
 /// --effect: "published" (the reference study's matrices, else the protocol's [simulation]
 /// confusion matrices), or [GROUP=]FILE confusion matrices (published CSV format).
 std::map<std::string, ConfusionMatrix> loadEffects(const PowerArgs& a, const Protocol& p) {
     std::map<std::string, ConfusionMatrix> matrices;
     for (const auto& spec : a.effect) {
         if (spec == "published") {
-            const auto files = publishedFiles(p.id);
-            if (files.empty()) {
-                MatrixByGroup defaults;
-                try {
+            MatrixByGroup defaults;
+            try {
+                if (a.publishedDir.empty()) {
                     defaults = defaultMatrices(p, a.file);
-                } catch (const std::runtime_error& e) {
-                    throw underfoot::cli::UserError(
-                        fmt::format("--effect published: {}", e.what()));
+                } else {
+                    for (const auto& [group, relative] : p.simulation.confusion) {
+                        const auto slash = relative.find_last_of('/');
+                        defaults[group] = loadConfusionMatrix(
+                            a.publishedDir + "/" +
+                            (slash == std::string::npos ? relative : relative.substr(slash + 1)));
+                    }
                 }
-                if (defaults.empty())
-                    throw underfoot::cli::UserError(fmt::format(
-                        "--effect published: no published confusion matrices for protocol {} "
-                        "(known: tvcg2011_exp2, eurohaptics2010, or a protocol naming them in "
-                        "[simulation]); give --effect GROUP=FILE per group",
-                        p.id));
-                for (auto& [group, m] : defaults) matrices[group] = std::move(m);
-                continue;
+            } catch (const std::runtime_error& e) {
+                throw underfoot::cli::UserError(
+                    fmt::format("--effect published: {}{}", e.what(),
+                                a.publishedDir.empty() ? "" : " (see --published-dir)"));
             }
-            for (const auto& [group, name] : files) {
-                try {
-                    matrices[group] = loadConfusionMatrix(a.publishedDir + "/" + name);
-                } catch (const std::runtime_error& e) {
-                    throw underfoot::cli::UserError(
-                        fmt::format("--effect published: {} (see --published-dir)", e.what()));
-                }
-            }
+            if (defaults.empty())
+                throw underfoot::cli::UserError(fmt::format(
+                    "--effect published: protocol {} names no published confusion matrices in "
+                    "[simulation]; give --effect GROUP=FILE per group, or the effect of a factor "
+                    "on identification as an odds ratio: --factor FACTOR --levels A,B "
+                    "--odds-ratio OR [--baseline-correct P] (FACTOR a stimulus factor, or "
+                    "'group' for between-participant groups)",
+                    p.id));
+            for (auto& [group, m] : defaults) matrices[group] = std::move(m);
             continue;
         }
         const auto eq = spec.find('=');
@@ -207,6 +170,7 @@ underfoot::analysis::PowerOptions powerOptions(const PowerArgs& a) {
     o.alpha = a.alpha;
     o.target = a.target;
     o.mixedModel = !a.noMixed;
+    o.ordinalModel = !a.noOrdinal;
     o.nAGQ = a.nAGQ;
     o.progress = [last = -1](std::size_t done, std::size_t total) mutable {
         const int percent = static_cast<int>(100 * done / total);
@@ -225,23 +189,31 @@ underfoot::analysis::PowerOptions powerOptions(const PowerArgs& a) {
 void printCurve(const PowerArgs& a, const underfoot::analysis::PowerCurve& curve,
                 const underfoot::analysis::PowerOptions& o, const std::string& sizeLabel,
                 double seconds) {
-    fmt::print("classic: {}\nmixed:   {}\n\n", curve.classicMethod,
+    fmt::print("classic: {}\nmixed:   {}\n", curve.classicMethod,
                o.mixedModel ? curve.mixedMethod : std::string("(not fitted: --no-mixed)"));
-    fmt::print("{:>12}  {:>7} {:>17} {:>17}", sizeLabel, "classic", "Wilson 95%",
+    if (curve.ordinal) fmt::print("ordinal: {}\n", curve.ordinalMethod);
+    fmt::print("\n{:>12}  {:>7} {:>17} {:>17}", sizeLabel, "classic", "Wilson 95%",
                "Clopper-Pearson");
     if (o.mixedModel)
         fmt::print("  {:>7} {:>17} {:>17} {:>8}", "mixed", "Wilson 95%", "Clopper-Pearson",
                    "singular");
+    if (curve.ordinal)
+        fmt::print("  {:>7} {:>17} {:>17}", "ordinal", "Wilson 95%", "Clopper-Pearson");
     fmt::print("\n");
     auto interval = [](const underfoot::analysis::Interval& i) {
         return fmt::format("[{:.3f}, {:.3f}]", i.lower, i.upper);
     };
+    int ordinalFailures = 0;
     for (const auto& pt : curve.points) {
         fmt::print("{:>12}  {:>7.3f} {:>17} {:>17}", pt.participantsPerGroup, pt.classic.power,
                    interval(pt.classic.wilson), interval(pt.classic.clopperPearson));
         if (o.mixedModel)
             fmt::print("  {:>7.3f} {:>17} {:>17} {:>8}", pt.mixed.power, interval(pt.mixed.wilson),
                        interval(pt.mixed.clopperPearson), pt.mixedSingular);
+        if (curve.ordinal)
+            fmt::print("  {:>7.3f} {:>17} {:>17}", pt.ordinal.power, interval(pt.ordinal.wilson),
+                       interval(pt.ordinal.clopperPearson));
+        ordinalFailures += pt.ordinalFailures;
         fmt::print("\n");
     }
     auto smallest = [&](int n) {
@@ -254,41 +226,12 @@ void printCurve(const PowerArgs& a, const underfoot::analysis::PowerCurve& curve
                sizeLabel == "per group" ? "group size" : "number of participants", 100 * a.target,
                smallest(curve.smallestClassic));
     if (o.mixedModel) fmt::print("; mixed model {}", smallest(curve.smallestMixed));
-    fmt::print("\n({:.1f} s on {} thread(s))\n", seconds,
+    if (curve.ordinal) fmt::print("; ordinal model {}", smallest(curve.smallestOrdinal));
+    fmt::print("\n");
+    if (ordinalFailures > 0)
+        fmt::print("({} clmm fits stopped and count as not significant)\n", ordinalFailures);
+    fmt::print("({:.1f} s on {} thread(s))\n", seconds,
                a.threads ? a.threads : std::max(1u, std::thread::hardware_concurrency()));
-}
-
-/// Answers of participant `index` of a simulated study (plan from the study seed `seed`, the
-/// participant's own draws from `ps`) by the experiment layer's synthetic answerer.
-template <typename Emit>
-void answerPlan(const Protocol& p, const Group& group, const ConfusionMatrix& matrix,
-                double abilitySd, std::uint64_t seed, std::uint64_t ps, int index,
-                const std::shared_ptr<const RatingModel>& ratingModel, Emit&& emit) {
-    Rng abilityRng(deriveSeed(ps, {0xAB1E}));
-    const ConfusionMatrix own =
-        abilitySd > 0 ? withAbility(matrix, abilitySd * abilityRng.gaussian()) : matrix;
-    SimulationSettings settings;
-    settings.ratingModel = ratingModel;
-    SimulatedParticipant answerer(own, p, group.id, deriveSeed(ps, {0xA5}), settings);
-    if (ratingModel) { // participant fields uniformly among their options, as simulateStudy
-        std::map<std::string, std::string> fields;
-        Rng fieldRng(deriveSeed(ps, {0xF1E1D}));
-        for (const auto& f : p.participantFields)
-            fields[f.id] =
-                f.options.empty()
-                    ? std::string("simulated")
-                    : f.options[static_cast<std::size_t>(fieldRng.below(f.options.size()))];
-        answerer.setParticipant(deriveSeed(ps, {0xB1A5}), std::move(fields));
-    }
-    for (const auto& planned : generatePlan(p, group.id, seed, index)) {
-        if (planned.practice) continue;
-        TrialRecord trial;
-        trial.index = planned.index;
-        trial.block = planned.block;
-        trial.stimulus = planned.stimulus;
-        trial.repetition = planned.repetition;
-        emit(planned, answerer.answer(trial));
-    }
 }
 
 /// Rating protocols (no surface question): a within-subject comparison of two levels of a
@@ -387,6 +330,24 @@ int runRatingPower(const PowerArgs& a, const Protocol& p) {
                 fmt::format("--levels: '{}' is not a level of {} (levels: {})", l, factor,
                             fmt::join(levels, ", ")));
 
+    // the effect, when given: the second level rated `shift` points above the first (the rest
+    // of the model as it is); an odds ratio of a higher rating becomes points through the
+    // model's trial noise taken as a logistic variable (SD noise: scale noise * sqrt(3) / pi)
+    std::string effectText = "the rating model's effects";
+    if (!std::isnan(a.difference) || a.oddsRatio > 0) {
+        auto& sm = model->scales.at(scale->id);
+        double shift = a.difference;
+        if (std::isnan(shift)) {
+            shift = std::log(a.oddsRatio) * sm.noiseSd * std::sqrt(3.0) / std::numbers::pi;
+            effectText = fmt::format("odds ratio {:g} of a higher rating = {:.3g} points (noise "
+                                     "SD {:g})",
+                                     a.oddsRatio, shift, sm.noiseSd);
+        } else {
+            effectText = fmt::format("{:g} points (--difference)", shift);
+        }
+        auto& effect = sm.effects[factor];
+        effect[compared[1]] = effect[compared[0]] + shift;
+    }
     const ConfusionMatrix none;
     const std::string scaleId = scale->id;
     const underfoot::analysis::RatingStudySimulator simulate = [&](int participants,
@@ -419,9 +380,193 @@ int runRatingPower(const PowerArgs& a, const Protocol& p) {
                "size, seed {}, alpha {:g})\n",
                p.id, scaleId, factor, compared[0], compared[1], a.simulations, a.seed, a.alpha);
     fmt::print("ratings from the rating model {} (rounded and clamped to {}..{}, as a session "
-               "stores them)\n",
-               modelFile, scale->min, scale->max);
+               "stores them); effect: {}\n",
+               modelFile, scale->min, scale->max, effectText);
     printCurve(a, curve, o, "participants", seconds);
+    return 0;
+}
+
+/// The share of correct answers to `stimulus` in `m` (its row), NaN without a row.
+double correctShare(const ConfusionMatrix& m, const Stimulus& stimulus) {
+    const auto* row = m.find(stimulus);
+    if (!row) return std::numeric_limits<double>::quiet_NaN();
+    double correct = 0, total = 0;
+    for (std::size_t c = 0; c < row->counts.size(); ++c) {
+        total += row->counts[c];
+        if (answerIsCorrect(m.answers[c], row->surface)) correct += row->counts[c];
+    }
+    return total > 0 ? correct / total : std::numeric_limits<double>::quiet_NaN();
+}
+
+/// Identification protocols, --odds-ratio: the effect of a factor (a stimulus factor within
+/// participants, or "group" between them) on the odds of a correct answer. Every participant
+/// answers each of its stimuli `repetitions` times; a trial is correct with probability
+/// logistic(logit(p0) + ability + ln(OR) [second level]), p0 the stimulus's share of correct
+/// answers in the protocol's [simulation] matrix (or --baseline-correct), ability ~ N(0, SD).
+int runOddsRatioPower(const PowerArgs& a, const Protocol& p) {
+    if (a.factor.empty())
+        throw underfoot::cli::UserError(
+            "--odds-ratio: name the factor whose effect it is, --factor FACTOR (a stimulus factor "
+            "of the protocol, or 'group' for its between-participant groups)");
+    const bool between = a.factor == "group";
+    // levels: the groups, or the factor's levels in the order the stimuli declare them
+    std::vector<std::string> levels;
+    if (between) {
+        for (const auto& g : p.groups) levels.push_back(g.id);
+    } else {
+        for (const auto& g : p.groups)
+            for (const auto& st : groupStimuli(p, g))
+                if (auto it = st.factors.find(a.factor);
+                    it != st.factors.end() &&
+                    std::find(levels.begin(), levels.end(), it->second) == levels.end())
+                    levels.push_back(it->second);
+        if (levels.empty())
+            throw underfoot::cli::UserError(fmt::format(
+                "--factor {}: no stimulus of protocol {} has this factor (give the stimuli "
+                "factors = {{ {} = \"...\" }}, or --factor group for its groups)",
+                a.factor, p.id, a.factor));
+    }
+    std::vector<std::string> compared = a.levels;
+    if (compared.empty() && levels.size() >= 2) compared = {levels[0], levels[1]};
+    if (compared.size() != 2 || compared[0] == compared[1])
+        throw underfoot::cli::UserError(
+            fmt::format("--levels: two different levels of {} to compare expected (levels: {})",
+                        a.factor, fmt::join(levels, ", ")));
+    for (const auto& l : compared)
+        if (std::find(levels.begin(), levels.end(), l) == levels.end())
+            throw underfoot::cli::UserError(
+                fmt::format("--levels: '{}' is not a level of {} (levels: {})", l, a.factor,
+                            fmt::join(levels, ", ")));
+    if (between && p.design == DesignKind::Within)
+        throw underfoot::cli::UserError(fmt::format(
+            "--factor group: protocol {} is within-subject (one group); name a stimulus factor",
+            p.id));
+    // the baseline: the protocol's matrices (per stimulus) unless --baseline-correct is given
+    MatrixByGroup matrices;
+    if (a.baselineCorrect <= 0) {
+        try {
+            matrices = defaultMatrices(p, a.file);
+        } catch (const std::runtime_error& e) {
+            throw underfoot::cli::UserError(e.what());
+        }
+    }
+    const double logOr = std::log(a.oddsRatio);
+    struct Trial {
+        int level = 0, surface = 0;
+        double logit0 = 0;
+    };
+    std::map<std::string, int> surfaceIndex;
+    std::vector<std::vector<Trial>> trialsOf; // per group of the protocol
+    std::vector<int> usedGroups;              // groups whose participants are simulated
+    std::string baseline =
+        a.baselineCorrect > 0
+            ? fmt::format("{:g} correct at every stimulus (--baseline-correct)", a.baselineCorrect)
+            : std::string();
+    for (std::size_t gi = 0; gi < p.groups.size(); ++gi) {
+        const Group& g = p.groups[gi];
+        std::vector<Trial> trials;
+        int groupLevel = -1;
+        if (between) {
+            if (g.id == compared[0]) groupLevel = 0;
+            if (g.id == compared[1]) groupLevel = 1;
+            if (groupLevel < 0) {
+                trialsOf.emplace_back();
+                continue;
+            }
+        }
+        const ConfusionMatrix* m = nullptr;
+        if (!matrices.empty()) {
+            // the first level's matrix is the baseline of both (the odds ratio is the effect)
+            const std::string& source = between ? compared[0] : g.id;
+            auto it = matrices.count(source) ? matrices.find(source) : matrices.find("");
+            if (it == matrices.end()) it = matrices.begin();
+            m = &it->second;
+            baseline = fmt::format("each stimulus's share of correct answers in {}", m->source);
+        }
+        for (const auto& st : groupStimuli(p, g)) {
+            if (st.practiceOnly) continue;
+            int level = groupLevel;
+            if (!between) {
+                const auto it = st.factors.find(a.factor);
+                if (it == st.factors.end()) continue;
+                level = it->second == compared[0] ? 0 : it->second == compared[1] ? 1 : -1;
+                if (level < 0) continue;
+            }
+            double p0 = a.baselineCorrect > 0 ? a.baselineCorrect : 0.5;
+            if (m) {
+                Stimulus reference = st;
+                if (between) { // the same surface in the first level's matrix
+                    reference.soundscape.reset();
+                    for (const auto& row : m->rows)
+                        if (row.surface == st.surface) {
+                            if (!row.soundscape.empty()) reference.soundscape = row.soundscape;
+                            break;
+                        }
+                }
+                const double share = correctShare(*m, reference);
+                if (std::isnan(share))
+                    throw underfoot::cli::UserError(
+                        fmt::format("{}: no row for stimulus {} ({}); give --baseline-correct P",
+                                    m->source, st.id, st.surface));
+                p0 = share;
+            }
+            const double total = 20; // a share of 0 or 1 moves by half an answer in 20
+            p0 = std::clamp(p0, 0.5 / total, 1.0 - 0.5 / total);
+            const int surface =
+                surfaceIndex.try_emplace(st.surface, static_cast<int>(surfaceIndex.size()))
+                    .first->second;
+            for (int r = 0; r < std::max(1, p.ordering.repetitions); ++r)
+                trials.push_back({level, surface, std::log(p0 / (1 - p0))});
+        }
+        if (!trials.empty()) usedGroups.push_back(static_cast<int>(gi));
+        trialsOf.push_back(std::move(trials));
+    }
+    if (usedGroups.empty())
+        throw underfoot::cli::UserError(
+            fmt::format("protocol {}: no stimulus has level {} or {} of {}", p.id, compared[0],
+                        compared[1], a.factor));
+    const double sd = a.participantSd;
+    auto o = powerOptions(a);
+    const std::string sizeLabel = between ? "per group" : "participants";
+    const underfoot::analysis::StudySimulator simulate = [&](int size, std::uint64_t seed) {
+        std::vector<underfoot::analysis::SimulatedAnswer> answers;
+        int participant = 0;
+        // between: `size` participants in each compared group; within: `size` in all, spread
+        // over the protocol's groups (orders) as sessions assign them
+        const int total = between ? size * static_cast<int>(usedGroups.size()) : size;
+        for (int i = 0; i < total; ++i, ++participant) {
+            const int gi = between ? usedGroups[static_cast<std::size_t>(i / size)]
+                                   : usedGroups[static_cast<std::size_t>(i) % usedGroups.size()];
+            Rng rng(deriveSeed(seed, {static_cast<std::uint64_t>(i), 0x0DD5}));
+            const double ability = sd > 0 ? sd * rng.gaussian() : 0.0;
+            for (const Trial& t : trialsOf[static_cast<std::size_t>(gi)]) {
+                const double eta = t.logit0 + ability + (t.level == 1 ? logOr : 0.0);
+                underfoot::analysis::SimulatedAnswer out;
+                out.participant = participant;
+                out.group = t.level;
+                out.surface = t.surface;
+                out.correct = rng.uniform() < 1.0 / (1.0 + std::exp(-eta));
+                answers.push_back(out);
+            }
+        }
+        return answers;
+    };
+    const auto started = std::chrono::steady_clock::now();
+    auto curve = underfoot::analysis::simulatePower(simulate, 2, o);
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    if (!between) // the compared "groups" are the factor's levels
+        for (std::string* text : {&curve.classicMethod, &curve.mixedMethod})
+            for (const std::string from : {"~ group", "groups x", "test of group"})
+                if (const auto at = text->find(from); at != std::string::npos)
+                    text->replace(at + from.size() - 5, 5, a.factor);
+    fmt::print("power of {} — identification, {} {} vs {} {} participants: odds ratio {:g} ({} "
+               "simulated studies per size, seed {}, alpha {:g})\n",
+               p.id, a.factor, compared[0], compared[1], between ? "between" : "within",
+               a.oddsRatio, a.simulations, a.seed, a.alpha);
+    fmt::print("baseline at {}: {}; participants differ: SD {:g} of ability on the logit scale\n",
+               compared[0], baseline, sd);
+    printCurve(a, curve, o, sizeLabel, seconds);
     return 0;
 }
 
@@ -433,6 +578,17 @@ int runPower(const PowerArgs& a) {
         throw underfoot::cli::UserError(e.what());
     }
     if (!p.questions.asksSurface()) return runRatingPower(a, p);
+    if (!std::isnan(a.difference))
+        throw underfoot::cli::UserError(fmt::format(
+            "--difference: protocol {} asks which surface; give the effect on identification as "
+            "--odds-ratio OR",
+            p.id));
+    if (a.oddsRatio > 0) return runOddsRatioPower(a, p);
+    if (!a.factor.empty() || !a.levels.empty())
+        throw underfoot::cli::UserError(fmt::format(
+            "--factor/--levels: protocol {} asks which surface; compare the levels of a factor "
+            "with --odds-ratio OR (the effect of the second level on the odds of a correct answer)",
+            p.id));
     const auto matrices = loadEffects(a, p);
     const double sd = a.participantSd;
     auto o = powerOptions(a);
@@ -441,7 +597,6 @@ int runPower(const PowerArgs& a) {
     std::string sizeLabel = "per group";
     std::vector<const Group*> groups;
     std::vector<const ConfusionMatrix*> byGroup;
-    std::map<std::string, int> surfaceIndex;
     std::map<std::string, int> categoryIndex; // within: surface id -> compared category
     if (p.design == DesignKind::Within) {
         // one group of participants: the surface categories (solid, aggregate, ...) are
@@ -509,30 +664,7 @@ int runPower(const PowerArgs& a) {
             byGroup.push_back(&matrixFor(matrices, p, *g));
             names.push_back(g->id);
         }
-        // surfaces as indices for the mixed model's surface factor
-        for (const Group* g : groups)
-            for (const auto& st : groupStimuli(p, *g))
-                surfaceIndex.try_emplace(st.surface, static_cast<int>(surfaceIndex.size()));
-        simulate = [&](int perGroup, std::uint64_t seed) {
-            std::vector<underfoot::analysis::SimulatedAnswer> answers;
-            int participant = 0;
-            for (std::size_t gi = 0; gi < groups.size(); ++gi) {
-                for (int i = 0; i < perGroup; ++i, ++participant) {
-                    answerPlan(p, *groups[gi], *byGroup[gi], sd, seed,
-                               deriveSeed(seed, {gi, static_cast<std::uint64_t>(i)}), i, nullptr,
-                               [&](const PlannedTrial& planned, const TrialAnswer& answer) {
-                                   underfoot::analysis::SimulatedAnswer out;
-                                   out.participant = participant;
-                                   out.group = static_cast<int>(gi);
-                                   out.surface = surfaceIndex.at(planned.stimulus.surface);
-                                   out.correct =
-                                       answerIsCorrect(answer.answer, planned.stimulus.surface);
-                                   answers.push_back(out);
-                               });
-                }
-            }
-            return answers;
-        };
+        simulate = betweenGroupsSimulator(p, groups, byGroup, sd);
     }
     const auto started = std::chrono::steady_clock::now();
     const auto curve =
@@ -589,21 +721,39 @@ const underfoot::cli::CommandRegistrar registrar{
         power->add_option("--nagq", pa.nAGQ, "quadrature points of the mixed model (1 = Laplace)")
             ->check(CLI::Range(1, 25))
             ->capture_default_str();
+        power->add_option("--published-dir", pa.publishedDir,
+                          "folder to read the [simulation] confusion matrices from (default: "
+                          "where the protocol names them: beside it, then the shipped "
+                          "protocols' data folder)");
         power
-            ->add_option("--published-dir", pa.publishedDir,
-                         "folder of the published confusion matrices")
-            ->capture_default_str();
+            ->add_option("--odds-ratio", pa.oddsRatio,
+                         "the effect of --factor's second level against its first as an odds "
+                         "ratio: of a correct answer (identification protocols; --factor group "
+                         "compares groups) or of a higher rating (rating protocols)")
+            ->check(CLI::Range(1e-6, 1e6));
+        power
+            ->add_option("--baseline-correct", pa.baselineCorrect,
+                         "with --odds-ratio: share of correct answers at the first level "
+                         "(default: each stimulus's share in the protocol's [simulation] "
+                         "matrices, else 0.5)")
+            ->check(CLI::Range(0.001, 0.999));
+        power->add_option("--difference", pa.difference,
+                          "rating protocols: the second level rated this many scale points above "
+                          "the first (overrides the rating model's effect of --factor)");
+        power->add_flag("--no-ordinal", pa.noOrdinal,
+                        "rating protocols: no cumulative link mixed model (faster)");
         power->add_option("--rating-model", pa.ratingModel,
                           "rating protocols: rating model TOML (default: the protocol's "
                           "[simulation] rating_model)");
         power->add_option("--scale", pa.scale,
                           "rating protocols: the scale compared (default: the first modelled one)");
         power->add_option("--factor", pa.factor,
-                          "rating protocols: the stimulus factor compared (default: the first the "
-                          "model gives the scale an effect of)");
+                          "the stimulus factor compared (rating protocols default: the first the "
+                          "model gives the scale an effect of; with --odds-ratio, 'group' for "
+                          "the groups)");
         power
             ->add_option("--levels", pa.levels,
-                         "rating protocols: the two levels compared, A,B (default: the first two)")
+                         "the two levels compared, A,B (default: the first two)")
             ->delimiter(',');
         power->callback([&exitCode] {
             try {
