@@ -22,7 +22,7 @@
 namespace underfoot::analysis {
 
 /// Quartiles of R's quantile(type = 7) (the default of R and of boxplot.stats' fivenum differs:
-/// see analysis/README.md; SPSS's "weighted average" is type 6).
+/// see docs/reference/statistics.md; SPSS's "weighted average" is type 6).
 double quantileType7(std::vector<double> values, double probability);
 
 /// Tukey box-plot statistics of one cell, with the paper's outlier classes: outliers beyond
