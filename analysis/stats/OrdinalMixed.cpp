@@ -600,6 +600,12 @@ OrdinalMixedResult fitOrdinalMixedModel(const MixedModelData& data, const Ordina
     separationWarnings(d, X, category, J, r.warnings);
     const auto fit =
         optimise(d, X, category, J, link, options.nAGQ, startValues(category, J, X.cols(), link));
+    if (!std::isfinite(fit.value)) {
+        r.error = "the log-likelihood is not finite at the optimum: the ratings of a level are "
+                  "separated from the others beyond what the link can represent (a probability "
+                  "underflows to 0); no clmm can be fitted to these ratings";
+        return r;
+    }
     if (!fit.converged) r.warnings.push_back("convergence failure: " + fit.message);
     const int T = J - 1;
     const auto p = X.cols();

@@ -238,6 +238,16 @@ TEST(OrdinalMixedJson, RejectsBadRequestsWithClearMessages) {
     EXPECT_NE(error(R"({"y":[3,3,3,3],)" + base + "}").find("one category"), std::string::npos);
     EXPECT_NE(error(R"({"y":[1,2,3,4],)" + base + R"(,"nAGQ":26})").find("nAGQ"),
               std::string::npos);
+    // cloglog, every category once and the levels apart: a probability underflows to 0
+    const auto r = runMixedModelRequest(
+        "clmm", R"({"y":[1,2,3,4,5,6,7,8],"condition":["a","a","a","a","b","b","b","b"],)"
+                R"("participant":[1,2,3,4,1,2,3,4],"nAGQ":25,"link":"cloglog"})");
+    if (!r.ok) {
+        EXPECT_NE(json::parse(r.json).at("error").get<std::string>().find("not finite"),
+                  std::string::npos);
+    } else {
+        EXPECT_TRUE(json::parse(r.json).at("loglik").is_number()) << r.json;
+    }
 }
 
 } // namespace
