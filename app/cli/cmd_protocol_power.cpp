@@ -330,9 +330,10 @@ int runRatingPower(const PowerArgs& a, const Protocol& p) {
                 fmt::format("--levels: '{}' is not a level of {} (levels: {})", l, factor,
                             fmt::join(levels, ", ")));
 
-    // the effect, when given: the second level rated `shift` points above the first (the rest
-    // of the model as it is); an odds ratio of a higher rating becomes points through the
-    // model's trial noise taken as a logistic variable (SD noise: scale noise * sqrt(3) / pi)
+    // the effect, when given: the second level rated `shift` points above the first (the
+    // compared stimuli's own effects dropped, the rest of the model as it is); an odds ratio of a
+    // higher rating becomes points through the model's trial noise taken as a logistic variable (SD
+    // noise: scale noise * sqrt(3) / pi)
     std::string effectText = "the rating model's effects";
     if (!std::isnan(a.difference) || a.oddsRatio > 0) {
         auto& sm = model->scales.at(scale->id);
@@ -347,6 +348,11 @@ int runRatingPower(const PowerArgs& a, const Protocol& p) {
         }
         auto& effect = sm.effects[factor];
         effect[compared[1]] = effect[compared[0]] + shift;
+        // the compared stimuli lose their own effects: the levels then differ by `shift`
+        for (const auto& st : stimuli)
+            if (auto it = st.factors.find(factor);
+                it != st.factors.end() && (it->second == compared[0] || it->second == compared[1]))
+                sm.stimulusEffects.erase(st.id);
     }
     const ConfusionMatrix none;
     const std::string scaleId = scale->id;

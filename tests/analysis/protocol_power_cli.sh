@@ -38,6 +38,13 @@ if ! echo "$out" | grep -q '^ordinal: clmm' || ! echo "$out" | grep -q '; ordina
 else
     echo "ok rating power with the clmm"
 fi
+out=$(timeout 300 "$underfoot" protocol power "$src/protocols/wading_realism.toml" --participants 6 \
+      --simulations 4 --seed 3 --threads 1 --odds-ratio 3 2>/dev/null)
+if ! echo "$out" | grep -q 'effect: odds ratio 3 of a higher rating = 0.787 points'; then
+    echo "FAIL: wading_realism --odds-ratio: no effect line"; echo "$out"; fail=1
+else
+    echo "ok rating power with an odds ratio"
+fi
 # the effect of a within-participant factor on identification, as an odds ratio
 coherence="$src/tests/analysis/data/coherence_within.toml"
 out=$(timeout 300 "$underfoot" protocol power "$coherence" --factor coherence --odds-ratio 0.5 \
