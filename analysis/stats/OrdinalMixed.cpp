@@ -123,8 +123,7 @@ class Likelihood {
                 auto& cells = cells_[g];
                 const int k = category[static_cast<std::size_t>(i)];
                 std::size_t c = 0;
-                while (c < cells.size() && (cells[c].k != k || X_.row(cells[c].row) != X_.row(i)))
-                    ++c;
+                while (c < cells.size() && (cells[c].k != k || !sameRow(cells[c].row, i))) ++c;
                 if (c == cells.size()) cells.push_back({i, k, 0.0});
                 cells[c].n += 1;
             }
@@ -168,10 +167,12 @@ class Likelihood {
                 if (!terms(c, offset_(c.row) + s * u, 2, t)) return kInf;
                 value -= c.n * t.l;
                 S1 -= c.n * t.ls, W -= c.n * t.lss, Tt -= c.n * t.lsss;
-                const auto x = X_.row(c.row);
-                bs_.noalias() -= c.n * t.ls * x.transpose();
-                bw_.noalias() -= c.n * t.lss * x.transpose();
-                bt_.noalias() -= c.n * t.lsss * x.transpose();
+                if (p > 0) { // (no block of a matrix without columns)
+                    const auto x = X_.row(c.row);
+                    bs_.noalias() -= c.n * t.ls * x.transpose();
+                    bw_.noalias() -= c.n * t.lss * x.transpose();
+                    bt_.noalias() -= c.n * t.lsss * x.transpose();
+                }
                 if (c.k < J_ - 1) {
                     const auto a = static_cast<std::size_t>(c.k);
                     gt_[a] -= c.n * t.la, ut_[a] -= c.n * t.lsa, dt_[a] -= c.n * t.lssa;
@@ -196,6 +197,13 @@ class Likelihood {
     }
 
   private:
+    /// Whether observations a and b have the same fixed-effects row.
+    [[nodiscard]] bool sameRow(Eigen::Index a, Eigen::Index b) const {
+        for (Eigen::Index j = 0; j < X_.cols(); ++j)
+            if (X_(a, j) != X_(b, j)) return false;
+        return true;
+    }
+
     /// Sets thresholds, offsets and sigma; false when the thresholds are not increasing.
     bool unpack(const std::vector<double>& psi) {
         const auto T = static_cast<std::size_t>(J_ - 1);
@@ -205,7 +213,10 @@ class Likelihood {
         beta_.resize(X_.cols());
         for (Eigen::Index j = 0; j < X_.cols(); ++j)
             beta_(j) = psi[T + static_cast<std::size_t>(j)];
-        offset_.noalias() = X_ * beta_;
+        if (X_.cols() > 0)
+            offset_.noalias() = X_ * beta_;
+        else
+            offset_.setZero(X_.rows());
         sigma_ = psi.back();
         for (double v : psi)
             if (!std::isfinite(v)) return false;
