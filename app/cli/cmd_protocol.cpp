@@ -2,6 +2,7 @@
 // `underfoot protocol check FILE`: validates a protocol and prints its plan summary.
 // `underfoot protocol power FILE --effect ...`: how many participants (issue #15).
 #include "analysis/model/Catalog.h"
+#include "base/DataDir.h"
 #include "analysis/power/Power.h"
 #include "app/cli/CommandRegistry.h"
 #include "experiment/Catalogue.h"
@@ -115,7 +116,7 @@ struct PowerArgs {
     std::vector<std::string> groups;
     bool noMixed = false;
     int nAGQ = 1;
-    std::string publishedDir = std::string(UNDERFOOT_SOURCE_DIR) + "/tests/analysis/data/published";
+    std::string publishedDir; ///< empty: the shipped protocols/data (base::dataDirectory)
     std::string ratingModel; ///< rating protocols: the model (default: the protocol's [simulation])
     std::string scale;
     std::string factor;
@@ -236,7 +237,11 @@ std::map<std::string, ConfusionMatrix> loadEffects(const PowerArgs& a, const Pro
             }
             for (const auto& [group, name] : files) {
                 try {
-                    matrices[group] = loadConfusionMatrix(a.publishedDir + "/" + name);
+                    const std::string dir =
+                        a.publishedDir.empty()
+                            ? base::dataDirectory(base::DataKind::Protocols) + "/data"
+                            : a.publishedDir;
+                    matrices[group] = loadConfusionMatrix(dir + "/" + name);
                 } catch (const std::runtime_error& e) {
                     throw underfoot::cli::UserError(
                         fmt::format("--effect published: {} (see --published-dir)", e.what()));
@@ -679,8 +684,8 @@ const underfoot::cli::CommandRegistrar registrar{
             ->capture_default_str();
         power
             ->add_option("--published-dir", pa.publishedDir,
-                         "folder of the published confusion matrices")
-            ->capture_default_str();
+                         "folder of the published confusion matrices (default: the shipped "
+                         "protocols/data)");
         power->add_option("--rating-model", pa.ratingModel,
                           "rating protocols: rating model TOML (default: the protocol's "
                           "[simulation] rating_model)");
