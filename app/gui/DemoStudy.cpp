@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "app/gui/DemoStudy.h"
 
+#include "base/DataDir.h"
 #include "experiment/Simulation.h"
 #include "experiment/Store.h"
 
@@ -13,7 +14,7 @@ namespace underfoot::gui {
 namespace exp = underfoot::experiment;
 
 QString bundledDataDir() {
-    return QStringLiteral(UNDERFOOT_GUI_DATA_DIR);
+    return QString::fromStdString(base::dataDirectory(base::DataKind::GuiDemo));
 }
 
 QString userDataDir(const QString& overrideDir) {
