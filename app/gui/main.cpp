@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // underfoot-gui: the experimenter's console.
 #include "app/gui/MainWindow.h"
+#include "base/Version.h"
 #include "engine/dsp/Simd.h"
 
 #include <QApplication>
@@ -17,7 +18,7 @@ int main(int argc, char** argv) {
     QApplication app(argc, argv);
     QApplication::setApplicationName("underfoot");
     QApplication::setOrganizationName("underfoot");
-    QApplication::setApplicationVersion(UNDERFOOT_VERSION);
+    QApplication::setApplicationVersion(underfoot::base::versionLine());
     QCommandLineParser parser;
     parser.setApplicationDescription("Underfoot — the experimenter's console");
     parser.addHelpOption();
