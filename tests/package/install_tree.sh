@@ -51,9 +51,12 @@ gui="$prefix/bin/underfoot-gui"
 if [ -x "$gui" ]; then
     [ -f "$prefix/share/applications/underfoot-gui.desktop" ] || fail "no desktop entry"
     [ -f "$prefix/share/icons/hicolor/scalable/apps/underfoot.svg" ] || fail "no icon"
-    env -u DISPLAY -u WAYLAND_DISPLAY -u QT_QPA_PLATFORM "$gui" --help | grep -q -- --study ||
+    env -u DISPLAY -u WAYLAND_DISPLAY -u QT_QPA_PLATFORM XDG_RUNTIME_DIR="$work" "$gui" --help |
+        grep -q -- --study ||
         fail "underfoot-gui --help without a display"
-    QT_QPA_PLATFORM=offscreen XDG_RUNTIME_DIR="$work" "$gui" --data-dir "$work/gui" \
+    # Its own HOME: the console reopens the last study named in ~/.config, not the demo.
+    HOME="$work" XDG_CONFIG_HOME="$work/config" QT_QPA_PLATFORM=offscreen XDG_RUNTIME_DIR="$work" \
+        "$gui" --data-dir "$work/gui" \
         --screenshot "$work/shots" > gui.log 2>&1 || fail "underfoot-gui --screenshot: $(tail -5 gui.log)"
     [ -f "$work/gui/demo_study.db" ] || fail "the console made no demo study from share/underfoot/gui"
 fi
