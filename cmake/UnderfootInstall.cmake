@@ -73,6 +73,16 @@ if(TARGET underfoot-gui)
           DESTINATION ${CMAKE_INSTALL_DATADIR}/doc/underfoot-gui COMPONENT gui)
 endif()
 
+# What scripts/setup.sh builds: the programs and their man pages, not the tests.
+add_custom_target(underfoot_programs)
+add_dependencies(underfoot_programs underfoot)
+if(TARGET underfoot-gui)
+  add_dependencies(underfoot_programs underfoot-gui)
+endif()
+if(TARGET underfoot_man)
+  add_dependencies(underfoot_programs underfoot_man)
+endif()
+
 # ---------------------------------------------------------------------------- Debian packages
 set(CPACK_GENERATOR DEB)
 set(CPACK_PACKAGE_NAME underfoot)

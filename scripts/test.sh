@@ -1,22 +1,43 @@
 #!/usr/bin/env bash
-# Underfoot tests: the release build's suites, then the same suites built with
-# AddressSanitizer + UndefinedBehaviorSanitizer.
+# SPDX-License-Identifier: GPL-3.0-or-later
+# Underfoot tests: installs the test tools (Debian packages and the browser test's npm driver),
+# builds and runs the release build's suites, then the same suites built with
+# AddressSanitizer + UndefinedBehaviorSanitizer, then a short fuzz pass.
 #   bash scripts/test.sh                  # everything but long soaks
 #   bash scripts/test.sh -L engine        # extra ctest arguments (here: one part) apply to both runs
+#   UNDERFOOT_SKIP_APT=1 bash scripts/test.sh        # without apt-get (packages already there)
 #   UNDERFOOT_SKIP_SANITIZE=1 bash scripts/test.sh   # the release run only
-#   UNDERFOOT_SKIP_FUZZ=1 bash scripts/test.sh       # without the short fuzz pass
+#   UNDERFOOT_SKIP_FUZZ=1 bash scripts/test.sh       # without the fuzz pass
+#   UNDERFOOT_FUZZ_SECONDS=60 bash scripts/test.sh   # a longer fuzz pass (default 5 s per target)
 # The fuzz pass (a third, small build with clang: only the reader libraries and the libFuzzer
-# targets of tests/fuzz) replays every regression input and fuzzes each target for
-# UNDERFOOT_FUZZ_SECONDS (20 s); it runs when no extra ctest arguments are given.
-# Long soaks carry the ctest label `soak` and run with: ctest --test-dir build -L soak
-# Every build uses -g1 (line tables: file:line in sanitizer reports) and unity batches
-# (UNDERFOOT_UNITY), which keep the three builds within CI's time.
+# targets of tests/fuzz) replays every regression input and the seed corpus, then fuzzes each
+# target for UNDERFOOT_FUZZ_SECONDS; it runs when no extra ctest arguments are given. Long soaks
+# and fuzz campaigns carry the ctest label `soak`: ctest --test-dir build-fuzz -L soak.
+# Every build uses -g1 (line tables), unity batches (UNDERFOOT_UNITY) and ccache when present.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+source scripts/packages.sh
 jobs="$(nproc)"
+launcher="$(underfoot_cmake_launcher)"
+
+underfoot_install_packages test "${UNDERFOOT_BUILD_PACKAGES[@]}" "${UNDERFOOT_TEST_PACKAGES[@]}"
+# Node.js and npm drive the browser test (puppeteer-core). Many machines already carry a newer
+# Node.js than Debian's (whose npm package would conflict with it): Debian's only when there is
+# none.
+if ! command -v npm > /dev/null; then
+  underfoot_install_packages test nodejs npm
+fi
+# The browser test's driver (puppeteer-core, pinned by package-lock.json; Debian's chromium is
+# used, no browser download).
+if [ -f tests/web/browser/package-lock.json ] && command -v npm > /dev/null &&
+  [ ! -L tests/web/browser/node_modules ]; then
+  (cd tests/web/browser && PUPPETEER_SKIP_DOWNLOAD=1 npm ci --no-audit --no-fund --silent)
+fi
 
 if [ ! -f build/CMakeCache.txt ]; then
-  cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g1 -DNDEBUG"
+  # shellcheck disable=SC2086
+  cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+    -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g1 -DNDEBUG" $launcher
 fi
 cmake --build build --parallel "$jobs"
 echo "== tests (release build)"
@@ -24,8 +45,9 @@ ctest --test-dir build --output-on-failure -j "$jobs" -LE soak "$@"
 
 if [ "${UNDERFOOT_SKIP_SANITIZE:-0}" != "1" ]; then
   if [ ! -f build-asan/CMakeCache.txt ]; then
+    # shellcheck disable=SC2086
     cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g1" \
-      -DUNDERFOOT_SANITIZE=ON -DUNDERFOOT_BUILD_BENCHMARKS=OFF -DUNDERFOOT_BUILD_GUI=OFF
+      -DUNDERFOOT_SANITIZE=ON -DUNDERFOOT_BUILD_BENCHMARKS=OFF -DUNDERFOOT_BUILD_GUI=OFF $launcher
   fi
   cmake --build build-asan --parallel "$jobs"
   echo "== tests (address + undefined sanitizers)"
@@ -35,16 +57,17 @@ fi
 
 if [ "${UNDERFOOT_SKIP_FUZZ:-0}" != "1" ] && [ $# -eq 0 ]; then
   if ! command -v clang++-14 > /dev/null; then
-    echo "== fuzz pass skipped: clang++-14 is not installed (bash scripts/setup.sh installs it)"
+    echo "== fuzz pass skipped: clang++-14 is not installed (bash scripts/test.sh installs it)"
   else
     if [ ! -f build-fuzz/CMakeCache.txt ]; then
+      # shellcheck disable=SC2086
       cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g1" \
         -DCMAKE_C_COMPILER=clang-14 -DCMAKE_CXX_COMPILER=clang++-14 -DUNDERFOOT_FUZZ=ON \
-        -DUNDERFOOT_BUILD_BENCHMARKS=OFF -DUNDERFOOT_BUILD_GUI=OFF
+        -DUNDERFOOT_BUILD_BENCHMARKS=OFF -DUNDERFOOT_BUILD_GUI=OFF $launcher
     fi
-    cmake -S . -B build-fuzz -DUNDERFOOT_FUZZ_SECONDS="${UNDERFOOT_FUZZ_SECONDS:-20}" > /dev/null
+    cmake -S . -B build-fuzz -DUNDERFOOT_FUZZ_SECONDS="${UNDERFOOT_FUZZ_SECONDS:-5}" > /dev/null
     cmake --build build-fuzz --parallel "$jobs" --target underfoot_fuzz
-    echo "== fuzz pass (libFuzzer + address + undefined sanitizers, regression inputs + ${UNDERFOOT_FUZZ_SECONDS:-20} s per target)"
+    echo "== fuzz pass (libFuzzer + address + undefined sanitizers, regression inputs + ${UNDERFOOT_FUZZ_SECONDS:-5} s per target)"
     ctest --test-dir build-fuzz --output-on-failure -j "$jobs" -L fuzz
   fi
 fi

@@ -25,7 +25,8 @@ work="$(readlink -f "$work")"
 root="$work/root"
 cleanup() {
     mountpoint -q "$root/proc" 2> /dev/null && umount "$root/proc"
-    rm -rf "$root"
+    # never into a /proc that is still mounted
+    mountpoint -q "$root/proc" 2> /dev/null || rm -rf --one-file-system "$root"
 }
 trap cleanup EXIT
 t0=$SECONDS
