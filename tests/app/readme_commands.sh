@@ -20,7 +20,7 @@ export UBSAN_OPTIONS="${UBSAN_OPTIONS:-print_stacktrace=1}:halt_on_error=1:abort
 skip_reason() {
     local c="$1"
     case "$c" in
-    *scripts/setup.sh* | *scripts/test.sh* | cmake* | ninja* | .ci/run* | *"git clone"*) echo "builds or tests the project (this test runs inside that)" ;;
+    *scripts/setup.sh* | *scripts/test.sh* | *scripts/package.sh* | cmake* | ninja* | .ci/run* | *"git clone"*) echo "builds or tests the project (this test runs inside that)" ;;
     *fetch-recordings.sh*) echo "downloads recorded footsteps from Debian's archive (setup.sh does; the realism tests use them)" ;;
     jackd* | *"export JACK_"*) echo "starts a JACK server (the live tests do this with their own server)" ;;
     socat*) echo "starts a pseudo-terminal pair that runs until stopped (tests/live do this with their own)" ;;
