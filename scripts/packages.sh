@@ -67,8 +67,12 @@ underfoot_install_packages() {
   fi
 }
 
-# The configure flags every build shares: line tables only (-g1: file:line in backtraces and
-# sanitizer reports, faster than full debug information) and ccache when it is there.
+# ccache when it is there; its base directory is the checkout, so that two checkouts (or a
+# moved one) share their objects: no object but base/DataDir.cpp's holds an absolute path of the
+# checkout (base/CMakeLists.txt).
+if command -v ccache > /dev/null; then
+  export CCACHE_BASEDIR="${CCACHE_BASEDIR:-$PWD}"
+fi
 underfoot_cmake_launcher() {
   if command -v ccache > /dev/null; then
     echo "-DCMAKE_C_COMPILER_LAUNCHER=ccache -DCMAKE_CXX_COMPILER_LAUNCHER=ccache"

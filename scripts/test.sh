@@ -9,10 +9,13 @@
 #   UNDERFOOT_SKIP_SANITIZE=1 bash scripts/test.sh   # the release run only
 #   UNDERFOOT_SKIP_FUZZ=1 bash scripts/test.sh       # without the fuzz pass
 #   UNDERFOOT_FUZZ_SECONDS=60 bash scripts/test.sh   # a longer fuzz pass (default 5 s per target)
+#   UNDERFOOT_PACKAGE_TEST=1 bash scripts/test.sh    # also the package test (label package: root,
+#                                                    # debootstrap and Debian's archive; 2-10 min)
 # The fuzz pass (a third, small build with clang: only the reader libraries and the libFuzzer
 # targets of tests/fuzz) replays every regression input and the seed corpus, then fuzzes each
 # target for UNDERFOOT_FUZZ_SECONDS; it runs when no extra ctest arguments are given. Long soaks
-# and fuzz campaigns carry the ctest label `soak`: ctest --test-dir build-fuzz -L soak.
+# and fuzz campaigns carry the ctest label `soak` (ctest --test-dir build-fuzz -L soak), the
+# package test the label `package` (ctest --test-dir build -L package): neither runs by default.
 # Every build uses -g1 (line tables), unity batches (UNDERFOOT_UNITY) and ccache when present.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -41,7 +44,11 @@ if [ ! -f build/CMakeCache.txt ]; then
 fi
 cmake --build build --parallel "$jobs"
 echo "== tests (release build)"
-ctest --test-dir build --output-on-failure -j "$jobs" -LE soak "$@"
+ctest --test-dir build --output-on-failure -j "$jobs" -LE "soak|package" "$@"
+if [ "${UNDERFOOT_PACKAGE_TEST:-0}" = "1" ]; then
+  echo "== package test (the .deb files installed with apt-get in a clean Debian root)"
+  ctest --test-dir build --output-on-failure -L package
+fi
 
 if [ "${UNDERFOOT_SKIP_SANITIZE:-0}" != "1" ]; then
   if [ ! -f build-asan/CMakeCache.txt ]; then
