@@ -98,8 +98,8 @@ std::string dataDirectory(DataKind kind) {
     if (runsFromBuildTree()) return (fs::path(UNDERFOOT_SOURCE_DIR) / k.source).string();
     // The program's own folder could not be read (no /proc in a chroot) or holds no data: the
     // configured prefix, then Debian's and a local install's.
-    for (const char* root : {UNDERFOOT_INSTALL_DATA_DIR, "/usr/share/underfoot",
-                             "/usr/local/share/underfoot"}) {
+    for (const char* root :
+         {UNDERFOOT_INSTALL_DATA_DIR, "/usr/share/underfoot", "/usr/local/share/underfoot"}) {
         const auto dir = fs::path(root) / k.installed;
         if (isDirectory(dir)) return dir.string();
     }

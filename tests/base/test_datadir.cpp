@@ -15,12 +15,12 @@
 
 namespace {
 namespace fs = std::filesystem;
-using underfoot::base::DataKind;
 using underfoot::base::dataDirectory;
+using underfoot::base::DataKind;
 
 /// Sets (or unsets, with nullopt) one environment variable for a test's lifetime.
 class ScopedEnv {
-public:
+  public:
     ScopedEnv(const char* name, std::optional<std::string> value) : name_(name) {
         if (const char* old = std::getenv(name)) old_ = old;
         if (value)
@@ -37,15 +37,14 @@ public:
     ScopedEnv(const ScopedEnv&) = delete;
     ScopedEnv& operator=(const ScopedEnv&) = delete;
 
-private:
+  private:
     const char* name_;
     std::optional<std::string> old_;
 };
 
-constexpr DataKind kAll[] = {DataKind::Surfaces,    DataKind::ImpulseResponses,
-                             DataKind::GrfBank,     DataKind::WadingPresets,
-                             DataKind::Soundscapes, DataKind::Protocols,
-                             DataKind::GuiDemo};
+constexpr DataKind kAll[] = {
+    DataKind::Surfaces,    DataKind::ImpulseResponses, DataKind::GrfBank, DataKind::WadingPresets,
+    DataKind::Soundscapes, DataKind::Protocols,        DataKind::GuiDemo};
 
 TEST(DataDir, BuildTreeProgramReadsTheSourceTree) {
     ScopedEnv root("UNDERFOOT_DATA_DIR", std::nullopt);
