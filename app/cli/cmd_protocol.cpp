@@ -2,9 +2,9 @@
 // `underfoot protocol check FILE`: validates a protocol and prints its plan summary.
 // `underfoot protocol power FILE --effect ...`: how many participants (issue #15).
 #include "analysis/model/Catalog.h"
-#include "base/DataDir.h"
 #include "analysis/power/Power.h"
 #include "app/cli/CommandRegistry.h"
+#include "base/DataDir.h"
 #include "experiment/Catalogue.h"
 #include "experiment/Plan.h"
 #include "experiment/Protocol.h"
@@ -682,10 +682,9 @@ const underfoot::cli::CommandRegistrar registrar{
         power->add_option("--nagq", pa.nAGQ, "quadrature points of the mixed model (1 = Laplace)")
             ->check(CLI::Range(1, 25))
             ->capture_default_str();
-        power
-            ->add_option("--published-dir", pa.publishedDir,
-                         "folder of the published confusion matrices (default: the shipped "
-                         "protocols/data)");
+        power->add_option("--published-dir", pa.publishedDir,
+                          "folder of the published confusion matrices (default: the shipped "
+                          "protocols/data)");
         power->add_option("--rating-model", pa.ratingModel,
                           "rating protocols: rating model TOML (default: the protocol's "
                           "[simulation] rating_model)");
