@@ -277,7 +277,7 @@ AudioSettings loadAudioSettings(const std::string& path) {
     const std::string text = ss.str();
     AudioSettings settings = parseAudioSettings(text, path);
     // An empty or truncated file is refused rather than silently read as the defaults
-    // (issue #16): the file `underfoot devices --save` writes always has an [audio] table.
+    //: the file `underfoot devices --save` writes always has an [audio] table.
     const toml::table root = toml::parse(text, path);
     const toml::table* audio = root["audio"].as_table();
     if (!audio || audio->empty())

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// `underfoot analyze` with the mixed models beside the between-group comparisons (issue #15):
+// `underfoot analyze` with the mixed models beside the between-group comparisons:
 // the rows are the models of MixedModels.h (checked against R in MixedModelsTest.cpp) fitted on
 // the trials the tables use, and every export format carries them with the advice sentence.
 #include "analysis/report/MixedModelReport.h"
