@@ -2,6 +2,7 @@
 // `underfoot study ...`: create a study file, register / drop participants, exclude trials,
 // inspect a study, its journal and what replay needs for a trial.
 #include "app/cli/CommandRegistry.h"
+#include "app/wiring/StimulusRender.h"
 #include "experiment/Export.h"
 #include "experiment/Invitations.h"
 #include "experiment/Protocol.h"
@@ -68,6 +69,15 @@ const underfoot::cli::CommandRegistrar registrar{
         create->callback([&exitCode, &o] {
             guarded([&] {
                 const Protocol p = loadProtocol(o.protocol);
+                // A study is created only from a protocol whose every stimulus renders.
+                if (const auto problems = wiring::checkStimuliRender(p); !problems.empty()) {
+                    std::string all;
+                    for (const auto& line : problems)
+                        all += (all.empty() ? "" : "\n") +
+                               (line.rfind("  ", 0) == 0 ? line : o.protocol + ": " + line);
+                    throw UserError(all + "\nstudy create: nothing was created");
+                }
+                for (const auto& w : p.warnings) fmt::print(stderr, "{}\n", w.toString());
                 StudyStore store =
                     StudyStore::create(o.study, p, {o.code, o.site, o.seed, UNDERFOOT_VERSION});
                 fmt::print("created {} (study {}, protocol {} sha256 {})\n", o.study, o.code, p.id,

@@ -9,10 +9,14 @@
 #include "soundscapes/Library.h"
 #include "soundscapes/Renderer.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <numbers>
+#include <set>
+#include <stdexcept>
 #include <vector>
 
 namespace underfoot::wiring {
@@ -139,6 +143,72 @@ eng::AudioBuffer renderStimulus(const StimulusRender& q) {
     mixSoundscape(q.stimulus, q.seed, audio);
     limit(audio);
     return audio;
+}
+
+std::vector<std::string> checkStimuliRender(const exp::Protocol& protocol, double seconds,
+                                            int* rendered) {
+    // One entry per distinct cause, in the order found: the first stimulus it stops, then the
+    // others (a walker of [input] that cannot walk is one cause, not one line per stimulus).
+    struct Cause {
+        std::string why;
+        std::vector<std::string> stimuli;
+    };
+    std::vector<Cause> causes;
+    std::set<std::string> done;
+    int count = 0;
+    for (const auto& stimulus : protocol.stimuli) {
+        if (stimulus.clip) continue; // a lab's file: `underfoot clips` checks it
+        // What renders, without the names: stimuli that differ only by id share one render.
+        exp::Stimulus key = stimulus;
+        key.id = "x";
+        key.label.clear();
+        key.factors.clear();
+        key.practiceOnly = false;
+        if (!done.insert(exp::stimulusToToml(key)).second) continue;
+        StimulusRender q;
+        q.stimulus = stimulus;
+        q.seed = 1;
+        q.walkSeconds = seconds;
+        q.clipSeconds =
+            protocol.clips.enabled ? std::optional<double>(seconds + 0.2) : std::nullopt;
+        std::string why;
+        try {
+            const auto audio = renderStimulus(q);
+            ++count;
+            for (const float v : audio.samples)
+                if (!std::isfinite(v)) {
+                    why = "the render holds a sample that is not finite";
+                    break;
+                }
+        } catch (const std::exception& e) {
+            why = e.what();
+        }
+        if (why.empty()) continue;
+        const std::string name =
+            fmt::format("'{}' ({}{}{}{})", stimulus.id, stimulus.surface,
+                        stimulus.soundscape ? " + " : "", stimulus.soundscape.value_or(""),
+                        stimulus.reverb ? ", reverb " + *stimulus.reverb : "");
+        auto it = std::find_if(causes.begin(), causes.end(),
+                               [&](const Cause& c) { return c.why == why; });
+        if (it == causes.end())
+            causes.push_back({why, {name}});
+        else
+            it->stimuli.push_back(name);
+    }
+    std::vector<std::string> problems;
+    for (const auto& c : causes) {
+        problems.push_back(fmt::format("stimulus {} cannot be rendered: {}", c.stimuli[0], c.why));
+        if (c.stimuli.size() > 1) {
+            std::string others;
+            for (std::size_t i = 1; i < c.stimuli.size(); ++i)
+                others += (i > 1 ? ", " : "") + c.stimuli[i];
+            problems.push_back(fmt::format("  the same cause stops {} more stimul{}: {}",
+                                           c.stimuli.size() - 1, c.stimuli.size() == 2 ? "us" : "i",
+                                           others));
+        }
+    }
+    if (rendered) *rendered = count;
+    return problems;
 }
 
 std::string samplesSha256(const eng::AudioBuffer& audio) {

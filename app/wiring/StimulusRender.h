@@ -18,6 +18,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace underfoot::wiring {
 
@@ -38,6 +39,15 @@ struct StimulusRender {
 /// Renders a stimulus (stereo). Throws std::invalid_argument (walker keys, wading options),
 /// PresetError / DefinitionError (surface, soundscape, impulse response) with the reason.
 engine::AudioBuffer renderStimulus(const StimulusRender& request);
+
+/// What `protocol check` and `study create` prove before a study starts: every distinct
+/// stimulus (surface, soundscape, reverb, walker or wading settings, modalities) renders a short
+/// piece (`seconds` of walking) through renderStimulus. Lab-supplied clips are not rendered.
+/// Returns one line per cause ("stimulus 'X' (gravel + forest) cannot be rendered: <why>"),
+/// followed, when the same cause stops other stimuli, by an indented line naming them;
+/// empty when every one renders; `rendered` (when given) receives the number of renders made.
+std::vector<std::string> checkStimuliRender(const experiment::Protocol& protocol,
+                                            double seconds = 0.3, int* rendered = nullptr);
 
 /// The length of a clip in frames: llround(seconds * rate).
 std::size_t clipFrames(double seconds, double sampleRateHz);

@@ -49,6 +49,7 @@ void renderClips(const Protocol& p, const std::string& dir, double seconds) {
                      seconds,
                      0,
                      0,
+                     {},
                      {}};
         if (job.source == ClipSource::Wading) {
             auto options =
