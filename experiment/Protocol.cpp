@@ -2,6 +2,7 @@
 #include "experiment/Protocol.h"
 #include "experiment/ProtocolReader.h"
 
+#include "base/DataDir.h"
 #include "experiment/Random.h"
 
 #include <fmt/format.h>
@@ -193,7 +194,7 @@ const char* toString(DesignKind design) {
 }
 
 std::string shippedProtocolDir() {
-    return std::string(UNDERFOOT_SOURCE_DIR) + "/protocols";
+    return base::dataDirectory(base::DataKind::Protocols);
 }
 
 // ----------------------------------------------------------------------------------------------

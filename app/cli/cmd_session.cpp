@@ -9,6 +9,7 @@
 #include "app/wiring/ClipPlayer.h"
 #include "app/wiring/Players.h"
 #include "app/wiring/SessionRig.h"
+#include "base/Version.h"
 #include "engine/control/StepCalibration.h"
 #include "engine/control/StepGrfPlayer.h"
 #include "engine/control/StepInput.h"
@@ -250,8 +251,8 @@ int runInteractive(const Options& o) {
                                         : silent;
     Session session(store, o.participant, player,
                     {o.experimenter, o.live ? o.audio : "none (data entry, no sound)",
-                     o.clips.empty() ? o.sensor : "clips " + o.clips, UNDERFOOT_VERSION, o.live,
-                     o.takeOver});
+                     o.clips.empty() ? o.sensor : "clips " + o.clips, underfoot::base::version(),
+                     o.live, o.takeOver});
     TrialFlow flow(store, session);
     fmt::print("{} — participant {}, session {}{}{}\n", participantTitle(p), o.participant,
                session.sessionNumber(),

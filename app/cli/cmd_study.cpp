@@ -3,6 +3,7 @@
 // inspect a study, its journal and what replay needs for a trial.
 #include "app/cli/CommandRegistry.h"
 #include "app/wiring/StimulusRender.h"
+#include "base/Version.h"
 #include "experiment/Export.h"
 #include "experiment/Invitations.h"
 #include "experiment/Protocol.h"
@@ -78,8 +79,8 @@ const underfoot::cli::CommandRegistrar registrar{
                     throw UserError(all + "\nstudy create: nothing was created");
                 }
                 for (const auto& w : p.warnings) fmt::print(stderr, "{}\n", w.toString());
-                StudyStore store =
-                    StudyStore::create(o.study, p, {o.code, o.site, o.seed, UNDERFOOT_VERSION});
+                StudyStore store = StudyStore::create(
+                    o.study, p, {o.code, o.site, o.seed, underfoot::base::version()});
                 fmt::print("created {} (study {}, protocol {} sha256 {})\n", o.study, o.code, p.id,
                            p.hash);
             });
