@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "experiment/Simulation.h"
 #include "base/Version.h"
+#include "experiment/Clips.h"
 
 #include <fmt/format.h>
 #include <toml++/toml.h>
@@ -282,9 +283,13 @@ namespace {
 /// seed the clip was rendered with), and the planned seed otherwise.
 class SimulationPlayer final : public StimulusPlayer {
   public:
-    SimulationPlayer(const Protocol& protocol, std::string walker)
-        : protocol_(protocol), walker_(std::move(walker)) {}
+    SimulationPlayer(const Protocol& protocol, std::string walker, const std::string& clipDir)
+        : protocol_(protocol), walker_(std::move(walker)) {
+        if (protocol.clips.enabled && !clipDir.empty())
+            clips_ = std::make_unique<ClipPlayer>(protocol, clipDir); // plays nothing
+    }
     StimulusStart start(const Stimulus& stimulus, std::uint64_t plannedSeed) override {
+        if (clips_) return clips_->start(stimulus, plannedSeed);
         if (protocol_.clips.enabled) {
             // The clip as `underfoot clips` renders it at 48 kHz (its seed and length), so that
             // replay renders a simulated trial's clip like any other; no samples hash, since no
@@ -313,7 +318,8 @@ class SimulationPlayer final : public StimulusPlayer {
 
   private:
     const Protocol& protocol_;
-    std::string walker_; ///< formatSimulatedWalker() of this participant's feet
+    std::string walker_;                ///< formatSimulatedWalker() of this participant's feet
+    std::unique_ptr<ClipPlayer> clips_; ///< the clip folder's manifest, when one is given
 };
 } // namespace
 
@@ -346,7 +352,8 @@ int runSimulatedSession(StudyStore& store, const std::string& code, const Confus
     SimulationPlayer player(store.protocol(),
                             formatSimulatedWalker(drawSimulatedWalker(
                                 deriveSeed(seed, {static_cast<std::uint64_t>(info.index), 0x3A1C}),
-                                store.protocol().timing.trialS)));
+                                store.protocol().timing.trialS)),
+                            settings.clipDir);
     Session session(store, code, player,
                     SessionSettings{"simulation", "none (simulated)", "none (simulated)",
                                     underfoot::base::version(), false},

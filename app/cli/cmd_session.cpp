@@ -424,6 +424,7 @@ int runSimulation(const Options& o) {
             for (const auto& s : problems) all += (all.empty() ? "" : "\n") + s;
             throw UserError(all);
         }
+        settings.clipDir = o.clips; // each simulated trial stores the clip it stands for
     }
     int real = 0;
     for (const auto& p : store.participants()) real += p.simulated ? 0 : 1;

@@ -2,6 +2,7 @@
 #include "app/wiring/StimulusRender.h"
 
 #include "app/wiring/Players.h"
+#include "engine/control/StepGrfPlayer.h"
 #include "engine/render/Renderer.h"
 #include "engine/render/SafetyLimiter.h"
 #include "engine/wading/Wading.h"
@@ -205,6 +206,22 @@ std::vector<std::string> checkStimuliRender(const exp::Protocol& protocol, doubl
             problems.push_back(fmt::format("  the same cause stops {} more stimul{}: {}",
                                            c.stimuli.size() - 1, c.stimuli.size() == 2 ? "us" : "i",
                                            others));
+        }
+    }
+    // Stimuli driven by force-sensing shoes play the shipped heel/toe GRF bank in a session:
+    // it must load (a missing or unreadable file is one cause, named before anything renders).
+    const bool shoes = std::any_of(protocol.stimuli.begin(), protocol.stimuli.end(), [](auto& s) {
+        return !s.clip && s.input.kind == exp::InputKind::Sensor &&
+               s.input.sensor == exp::SensorKind::Fsr;
+    });
+    if (shoes) {
+        try {
+            (void)eng::StepGrfPlayer::loadDefaultBank(48000.0);
+        } catch (const std::exception& e) {
+            problems.insert(problems.begin(),
+                            fmt::format("the GRF bank of the shoes (sensor = \"fsr\") cannot be "
+                                        "loaded: {}",
+                                        e.what()));
         }
     }
     if (rendered) *rendered = count;

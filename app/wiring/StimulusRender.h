@@ -42,7 +42,8 @@ engine::AudioBuffer renderStimulus(const StimulusRender& request);
 
 /// What `protocol check` and `study create` prove before a study starts: every distinct
 /// stimulus (surface, soundscape, reverb, walker or wading settings, modalities) renders a short
-/// piece (`seconds` of walking) through renderStimulus. Lab-supplied clips are not rendered.
+/// piece (`seconds` of walking) through renderStimulus, and the shoes' GRF bank loads when a
+/// stimulus is driven by force-sensing shoes. Lab-supplied clips are not rendered.
 /// Returns one line per cause ("stimulus 'X' (gravel + forest) cannot be rendered: <why>"),
 /// followed, when the same cause stops other stimuli, by an indented line naming them;
 /// empty when every one renders; `rendered` (when given) receives the number of renders made.
