@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "experiment/Export.h"
 
+#include "base/CsvCell.h"
+
 #include <fmt/format.h>
 
 #include <set>
@@ -8,13 +10,7 @@
 namespace underfoot::experiment {
 
 std::string csvField(std::string_view value) {
-    if (value.find_first_of(",\"\r\n") == std::string_view::npos) return std::string(value);
-    std::string out = "\"";
-    for (const char c : value) {
-        if (c == '"') out += '"';
-        out += c;
-    }
-    return out + '"';
+    return base::csvCell(value);
 }
 
 namespace {

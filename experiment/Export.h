@@ -52,7 +52,7 @@ enum class ExportScope { Answered, All };
 /// Whether the rows of simulated participants (`underfoot session --simulate`) are written.
 enum class SimulatedRows { Include, Exclude };
 
-/// RFC 4180 field quoting (quotes when the field has a comma, quote, CR or LF).
+/// One CSV cell: RFC 4180 quoting and formula-leading text made inert (base/CsvCell.h).
 std::string csvField(std::string_view value);
 
 /// Writes the trials CSV; returns the number of rows.

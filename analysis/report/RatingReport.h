@@ -16,6 +16,8 @@ namespace underfoot::analysis {
 /// a label is shown as is.
 struct RatingLabels {
     std::map<std::string, std::string> stimuli; ///< stimulus id -> label
+    /// Simulated participants among those analysed (a banner says so when any).
+    int simulatedParticipants = 0;
     std::string stimulus(const std::string& id) const {
         const auto it = stimuli.find(id);
         return it == stimuli.end() || it->second.empty() ? id : it->second;
