@@ -365,7 +365,8 @@ class StudyStore {
     /// What replay needs for one trial (throws StoreError if the trial never started).
     ReplayInfo trialForReplay(const std::string& code, int trialIndex) const;
 
-    /// Validation of an answer against the protocol; returns the problems (empty: valid).
+    /// Validation of an answer against the protocol (the trial core's answerProblems, in
+    /// TrialFlow.h); returns the problems (empty: valid).
     std::vector<std::string> checkAnswer(const std::string& groupId,
                                          const TrialAnswer& answer) const;
     /// Validation of an answer to one trial: only the scales asked after that stimulus in that
@@ -383,9 +384,6 @@ class StudyStore {
     SQLite::Statement selectTrial(std::int64_t participantId, const std::string& code,
                                   int trialIndex, const std::string& columns) const;
     [[noreturn]] void noSuchTrial(const std::string& code, int trialIndex) const;
-    std::vector<std::string> checkAnswerScales(const std::string& groupId,
-                                               const TrialAnswer& answer,
-                                               const std::vector<const Scale*>& asked) const;
     /// Refuses a write for a participant whose lease another store holds (issue #16).
     void checkLease(std::int64_t participantId, const std::string& code) const;
     /// Re-throws a failed write as a StoreError naming the file, what was being written and

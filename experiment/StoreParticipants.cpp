@@ -2,6 +2,7 @@
 // Participants: registration with balanced group assignment and plan, fields, dropouts.
 #include "experiment/Store.h"
 #include "experiment/StoreInternal.h"
+#include "experiment/TrialFlow.h"
 
 #include <SQLiteCpp/SQLiteCpp.h>
 #include <fmt/format.h>
@@ -139,59 +140,16 @@ std::string StudyStore::nextGroup(int participantIndex) const {
     return counts[best[static_cast<std::size_t>(rng.below(best.size()))]].groupId;
 }
 
+// The trial core's rule (TrialFlow.h), called by the store as its last check before a write.
 std::vector<std::string> StudyStore::checkAnswer(const std::string& groupId,
                                                  const TrialAnswer& answer) const {
-    std::vector<const Scale*> all;
-    for (const auto& s : protocol_->questions.scales) all.push_back(&s);
-    return checkAnswerScales(groupId, answer, all);
+    return answerProblems(*protocol_, groupId, answer);
 }
 
 std::vector<std::string> StudyStore::checkAnswer(const std::string& groupId,
                                                  const TrialAnswer& answer,
                                                  const Stimulus& stimulus, int block) const {
-    return checkAnswerScales(groupId, answer, askedScales(*protocol_, stimulus, block));
-}
-
-std::vector<std::string>
-StudyStore::checkAnswerScales(const std::string& groupId, const TrialAnswer& answer,
-                              const std::vector<const Scale*>& asked) const {
-    std::vector<std::string> problems;
-    const Questions& q = protocol_->questions;
-    if (q.asksSurface()) {
-        if (answer.answer.empty())
-            problems.push_back("the surface answer is missing");
-        else if (!q.surfaceOption(answer.answer))
-            problems.push_back(
-                fmt::format("'{}' is not an option of the answer list", answer.answer));
-    } else if (!answer.answer.empty()) {
-        problems.push_back("this protocol asks no surface question");
-    }
-    for (const Scale* scale : asked) {
-        const auto it = answer.ratings.find(scale->id);
-        if (it == answer.ratings.end())
-            problems.push_back(fmt::format("the rating '{}' is missing", scale->id));
-        else if (it->second < scale->min || it->second > scale->max)
-            problems.push_back(fmt::format("rating '{}' is {}; expected {} to {}", scale->id,
-                                           it->second, scale->min, scale->max));
-    }
-    for (const auto& [scaleId, value] : answer.ratings) {
-        if (!q.scale(scaleId))
-            problems.push_back(fmt::format("unknown scale '{}' (value {})", scaleId, value));
-        else if (std::none_of(asked.begin(), asked.end(),
-                              [&id = scaleId](const Scale* s) { return s->id == id; }))
-            problems.push_back(fmt::format("scale '{}' is not asked in this trial", scaleId));
-    }
-    if (q.asksSoundscape(groupId)) {
-        if (answer.soundscapeAnswer.empty())
-            problems.push_back("the soundscape answer is missing");
-        else if (!q.soundscapeOption(answer.soundscapeAnswer))
-            problems.push_back(fmt::format("'{}' is not an option of the soundscape list",
-                                           answer.soundscapeAnswer));
-    } else if (!answer.soundscapeAnswer.empty()) {
-        problems.push_back("the soundscape question is not asked to this group");
-    }
-    if (!answer.comment.empty() && !q.comment) problems.push_back("this protocol takes no comment");
-    return problems;
+    return answerProblems(*protocol_, groupId, answer, stimulus, block);
 }
 
 ParticipantInfo StudyStore::registerParticipant(const NewParticipant& np) {

@@ -7,6 +7,83 @@
 
 namespace underfoot::experiment {
 
+namespace {
+std::vector<std::string> problemsFor(const Protocol& protocol, const std::string& groupId,
+                                     const TrialAnswer& answer,
+                                     const std::vector<const Scale*>& asked) {
+    std::vector<std::string> problems;
+    const Questions& q = protocol.questions;
+    if (q.asksSurface()) {
+        if (answer.answer.empty())
+            problems.push_back("the surface answer is missing");
+        else if (!q.surfaceOption(answer.answer))
+            problems.push_back(
+                fmt::format("'{}' is not an option of the answer list", answer.answer));
+    } else if (!answer.answer.empty()) {
+        problems.push_back("this protocol asks no surface question");
+    }
+    for (const Scale* scale : asked) {
+        const auto it = answer.ratings.find(scale->id);
+        if (it == answer.ratings.end())
+            problems.push_back(fmt::format("the rating '{}' is missing", scale->id));
+        else if (!ratingInRange(*scale, it->second))
+            problems.push_back(fmt::format("rating '{}' is {}; expected {} to {}", scale->id,
+                                           it->second, scale->min, scale->max));
+    }
+    for (const auto& [scaleId, value] : answer.ratings) {
+        if (!q.scale(scaleId))
+            problems.push_back(fmt::format("unknown scale '{}' (value {})", scaleId, value));
+        else if (std::none_of(asked.begin(), asked.end(),
+                              [&id = scaleId](const Scale* s) { return s->id == id; }))
+            problems.push_back(fmt::format("scale '{}' is not asked in this trial", scaleId));
+    }
+    if (q.asksSoundscape(groupId)) {
+        if (answer.soundscapeAnswer.empty())
+            problems.push_back("the soundscape answer is missing");
+        else if (!q.soundscapeOption(answer.soundscapeAnswer))
+            problems.push_back(fmt::format("'{}' is not an option of the soundscape list",
+                                           answer.soundscapeAnswer));
+    } else if (!answer.soundscapeAnswer.empty()) {
+        problems.push_back("the soundscape question is not asked to this group");
+    }
+    if (!answer.comment.empty() && !q.comment) problems.push_back("this protocol takes no comment");
+    return problems;
+}
+} // namespace
+
+std::vector<std::string> answerProblems(const Protocol& protocol, const std::string& groupId,
+                                        const TrialAnswer& answer, const Stimulus& stimulus,
+                                        int block) {
+    return problemsFor(protocol, groupId, answer, askedScales(protocol, stimulus, block));
+}
+
+std::vector<std::string> answerProblems(const Protocol& protocol, const std::string& groupId,
+                                        const TrialAnswer& answer) {
+    std::vector<const Scale*> all;
+    for (const auto& s : protocol.questions.scales) all.push_back(&s);
+    return problemsFor(protocol, groupId, answer, all);
+}
+
+bool ratingInRange(const Scale& scale, int value) {
+    return value >= scale.min && value <= scale.max;
+}
+
+std::string ratingRangeProblem(const Scale& scale, int value) {
+    if (ratingInRange(scale, value)) return "";
+    return fmt::format("{} is outside the scale {}–{}.", value, scale.min, scale.max);
+}
+
+std::string personSessionRefusal(const ParticipantInfo& participant) {
+    if (!participant.simulated) return "";
+    return fmt::format("participant {} is a simulated participant (made by --simulate); a "
+                       "person's session needs a registered participant",
+                       participant.code);
+}
+
+std::string progressText(int answered, int total) {
+    return fmt::format("{} of {} trials answered", answered, total);
+}
+
 std::vector<std::string> anchorTexts(const Scale& scale) {
     std::vector<std::string> out;
     for (const auto& [value, wording] : scale.anchors)
@@ -150,10 +227,9 @@ FlowResult TrialFlow::typeDigit(int digit) {
     int value = digit;
     if (pendingDigit_ >= 0 && pendingDigit_ * 10 + digit <= sc.max)
         value = pendingDigit_ * 10 + digit;
-    if (value < sc.min || value > sc.max) {
+    if (!ratingInRange(sc, value)) {
         pendingDigit_ = -1;
-        return {Refusal::OutOfRange,
-                fmt::format("{} is outside the scale {}–{}.", value, sc.min, sc.max)};
+        return {Refusal::OutOfRange, ratingRangeProblem(sc, value)};
     }
     draft_.ratings[sc.id] = value;
     if (value != 0 && value * 10 <= sc.max) {
@@ -180,9 +256,8 @@ FlowResult TrialFlow::setRating(const std::string& scaleId, int value) {
     for (std::size_t i = 0; i < sections_.size(); ++i) {
         const auto& s = sections_[i];
         if (s.kind != SectionKind::Scale || s.scale->id != scaleId) continue;
-        if (value < s.scale->min || value > s.scale->max)
-            return {Refusal::OutOfRange, fmt::format("{} is outside the scale {}–{}.", value,
-                                                     s.scale->min, s.scale->max)};
+        if (!ratingInRange(*s.scale, value))
+            return {Refusal::OutOfRange, ratingRangeProblem(*s.scale, value)};
         draft_.ratings[scaleId] = value;
         setActive(static_cast<int>(i));
         return {};
@@ -193,7 +268,7 @@ FlowResult TrialFlow::setRating(const std::string& scaleId, int value) {
 std::vector<std::string> TrialFlow::problems() const {
     if (!inTrial()) return {"no trial is current"};
     const TrialRecord& t = revisedTrial_ ? *revisedTrial_ : session_.current();
-    return store_.checkAnswer(session_.participant().groupId, draft_, t.stimulus, t.block);
+    return answerProblems(protocol(), session_.participant().groupId, draft_, t.stimulus, t.block);
 }
 
 std::vector<int> TrialFlow::unansweredSections() const {

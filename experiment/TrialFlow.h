@@ -61,6 +61,29 @@ struct FlowResult {
     explicit operator bool() const { return refusal == Refusal::None; }
 };
 
+// The trial core's rules, as free functions for every front end and for the store's last check
+// before it writes (one copy each).
+
+/// What is wrong with `answer` to a trial of `stimulus` in `block` for a participant of
+/// `groupId` (empty: valid): the surface answer from the answer list, exactly the scales asked
+/// after that stimulus in that block, each within its range, the soundscape answer when the
+/// group is asked, a comment only when the protocol takes one.
+std::vector<std::string> answerProblems(const Protocol& protocol, const std::string& groupId,
+                                        const TrialAnswer& answer, const Stimulus& stimulus,
+                                        int block);
+/// The same against every scale of the protocol (an answer without its trial).
+std::vector<std::string> answerProblems(const Protocol& protocol, const std::string& groupId,
+                                        const TrialAnswer& answer);
+/// Whether `value` lies on `scale` (min..max inclusive).
+bool ratingInRange(const Scale& scale, int value);
+/// "12 is outside the scale 0–10." (empty when it lies on the scale).
+std::string ratingRangeProblem(const Scale& scale, int value);
+/// Why `participant` cannot have a person's session (a simulated participant of `session
+/// --simulate` never gets one), or "" when it can.
+std::string personSessionRefusal(const ParticipantInfo& participant);
+/// "12 of 40 trials answered" (the progress line of every front end).
+std::string progressText(int answered, int total);
+
 /// Every anchor of a scale as "value = wording" (min and max labels when it has no anchors).
 std::vector<std::string> anchorTexts(const Scale& scale);
 

@@ -209,12 +209,9 @@ int runInteractive(const Options& o) {
     const Protocol& p = store.protocol();
     {
         // A session records only real people's answers, never a simulation's.
-        const ParticipantInfo who = store.participant(o.participant);
-        if (who.simulated)
-            throw UserError(fmt::format("session: participant {} is a simulated participant "
-                                        "(made by --simulate); a person's session needs a "
-                                        "registered participant",
-                                        o.participant));
+        if (const std::string why = personSessionRefusal(store.participant(o.participant));
+            !why.empty())
+            throw UserError("session: " + why);
     }
     SilentPlayer silent; // data entry, unless --live wires the engine in
     if (p.clips.enabled && o.clips.empty())
@@ -338,9 +335,8 @@ int runInteractive(const Options& o) {
         }
     } catch (const Interrupted&) {
         session.interrupt();
-        fmt::print("\nsession interrupted; {} of {} trials answered. Run the same command to "
-                   "resume.\n",
-                   session.answeredCount(), session.trialCount());
+        fmt::print("\nsession interrupted; {}. Run the same command to resume.\n",
+                   progressText(session.answeredCount(), session.trialCount()));
         return 3;
     }
     fmt::print("\nsession complete: {} trials answered\n", session.trialCount());
