@@ -241,7 +241,7 @@ int runInteractive(const Options& o) {
     }
     if (!o.live)
         fmt::print("NO SOUND: this session plays nothing (data entry: the answers are typed in "
-                   "as given; stored with the session). Add --live [--settings audio.toml] to "
+                   "as given; stored with the session). Add --live [--settings FILE] to "
                    "play the stimuli.\n");
     StimulusPlayer& player = clipPlayer ? static_cast<StimulusPlayer&>(*clipPlayer)
                              : rig      ? static_cast<StimulusPlayer&>(*rig->player)
