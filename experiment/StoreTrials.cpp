@@ -2,6 +2,7 @@
 // Trials: starts, answers (durable), replays, laps, audio figures, interruptions, exclusions.
 #include "experiment/Store.h"
 #include "experiment/StoreInternal.h"
+#include "experiment/TrialFlow.h"
 
 #include <SQLiteCpp/SQLiteCpp.h>
 #include <fmt/format.h>
@@ -208,20 +209,14 @@ void StudyStore::commitAnswer(const std::string& code, int trialIndex, const Tri
                                          "stimulus to be played first",
                                          code, trialIndex + 1));
         const bool changing = !cur.getColumn(2).isNull();
-        if (changing) {
-            if (protocol_->lock == LockRule::OnAnswer)
-                throw StoreError(fmt::format("participant '{}' trial {}: answers are locked once "
-                                             "given (protocol rule lock = \"answer\")",
-                                             code, trialIndex + 1));
+        if (changing) { // the trial core's lock rule (TrialFlow.h)
             SQLite::Statement later(*db_, "SELECT 1 FROM trials WHERE participant_id = ? AND "
                                           "trial_index > ? AND started_at IS NOT NULL");
             later.bind(1, p.id);
             later.bind(2, trialIndex);
-            if (later.executeStep())
+            if (const std::string why = lockRefusal(*protocol_, later.executeStep()); !why.empty())
                 throw StoreError(
-                    fmt::format("participant '{}' trial {}: the answer is locked because "
-                                "the next trial has started",
-                                code, trialIndex + 1));
+                    fmt::format("participant '{}' trial {}: {}", code, trialIndex + 1, why));
         }
         SQLite::Statement q(*db_,
                             "UPDATE trials SET answered_at = ?, response_time_s = ?, answer = ?, "

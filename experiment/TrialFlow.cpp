@@ -80,6 +80,15 @@ std::string personSessionRefusal(const ParticipantInfo& participant) {
                        participant.code);
 }
 
+std::string lockRefusal(const Protocol& protocol, bool laterTrialStarted) {
+    if (protocol.lock == LockRule::OnAnswer)
+        return "Answers are locked once given (protocol rule lock = \"answer\").";
+    if (laterTrialStarted)
+        return "The previous answer is locked: a later trial's stimulus has started (protocol "
+               "rule lock = \"next_trial\").";
+    return "";
+}
+
 std::string progressText(int answered, int total) {
     return fmt::format("{} of {} trials answered", answered, total);
 }
@@ -391,12 +400,8 @@ FlowResult TrialFlow::commit() {
 FlowResult TrialFlow::revisePrevious() {
     if (!inTrial()) return {Refusal::NotInTrial, "no trial is current"};
     if (const FlowResult hold = holdRefusal(); !hold) return hold;
-    if (protocol().lock == LockRule::OnAnswer)
-        return {Refusal::Locked,
-                "Answers are locked once given (protocol rule lock = \"answer\")."};
-    if (session_.playing())
-        return {Refusal::Locked, "The previous answer is locked: this trial's stimulus has started "
-                                 "(protocol rule lock = \"next_trial\")."};
+    if (const std::string why = lockRefusal(protocol(), session_.playing()); !why.empty())
+        return {Refusal::Locked, why};
     const int current = session_.current().index;
     std::optional<TrialRecord> previous;
     for (auto& t : store_.trials(session_.participant().code))
@@ -414,9 +419,8 @@ FlowResult TrialFlow::revisePrevious() {
 
 FlowResult TrialFlow::commitRevision() {
     if (!revising_) return {Refusal::NotAllowed, "no answer is being changed"};
-    if (session_.playing())
-        return {Refusal::Locked,
-                "The previous answer is locked: this trial's stimulus has started."};
+    if (const std::string why = lockRefusal(protocol(), session_.playing()); !why.empty())
+        return {Refusal::Locked, why};
     try {
         store_.commitAnswer(session_.participant().code, *revising_, draft_,
                             revisedTrial_->responseTimeS);

@@ -81,6 +81,10 @@ std::string ratingRangeProblem(const Scale& scale, int value);
 /// Why `participant` cannot have a person's session (a simulated participant of `session
 /// --simulate` never gets one), or "" when it can.
 std::string personSessionRefusal(const ParticipantInfo& participant);
+/// The lock rule: why an answer already given may not be changed now ("" when it may). Under
+/// lock = "answer" never; under lock = "next_trial" until a later trial's stimulus starts.
+/// The store asks it before it overwrites an answer, TrialFlow before it offers the change.
+std::string lockRefusal(const Protocol& protocol, bool laterTrialStarted);
 /// "12 of 40 trials answered" (the progress line of every front end).
 std::string progressText(int answered, int total);
 
