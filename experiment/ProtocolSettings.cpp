@@ -147,7 +147,7 @@ void readSettings(ProtocolParse& x) {
             p.lock = *l;
     }
 
-    // [simulation]: the published data synthetic participants answer from (issue #17).
+    // [simulation]: the published data synthetic participants answer from.
     if (auto t = r.table(root, "simulation", "the protocol file", false)) {
         r.checkKeys(*t, {"confusion", "rating_model"}, "[simulation]");
         auto relativePath = [&](const toml::node& node, const std::string& value) {

@@ -44,7 +44,7 @@ struct AnswerSavedButNotCopied : StoreError {
 /// (expertise, listening device...); version 3 adds per-trial audio figures (TrialAudioStats),
 /// the sensor log reference and sensor-fault interruptions; version 4 flags simulated
 /// participants and stores with each session whether sound was played; version 5 adds the
-/// online tables of `underfoot serve` (experiment/Invitations.h); version 6 (issue #16) adds
+/// online tables of `underfoot serve` (experiment/Invitations.h); version 6 adds
 /// session leases: one live session per participant; version 7 stores the clip each
 /// listening-test trial played (PlayedClip). Older studies are migrated when opened
 /// (docs/reference/store-schema.md).
@@ -258,8 +258,8 @@ class StudyStore {
     /// Opens an existing study (migrating an older schema; refusing a newer one).
     static StudyStore open(const std::string& path, Clock clock = {},
                            const Catalogue& catalogue = defaultCatalogue());
-    /// Opens an existing study read-only (issue #16: an archived study, read-only as a file or
-    /// as a folder for this user, still exports and analyzes): no write, no lease, no migration,
+    /// Opens an existing study read-only (an archived study, read-only as a file or as a
+    /// folder for this user, still exports and analyzes): no write, no lease, no migration,
     /// no -wal/-shm created where they cannot be. The integrity check (quick_check) still runs.
     /// A study of an older schema is refused, saying that it needs a migration (a write). When
     /// the file or its folder is not writable and no committed data waits in `<file>-wal`, the
@@ -384,7 +384,7 @@ class StudyStore {
     SQLite::Statement selectTrial(std::int64_t participantId, const std::string& code,
                                   int trialIndex, const std::string& columns) const;
     [[noreturn]] void noSuchTrial(const std::string& code, int trialIndex) const;
-    /// Refuses a write for a participant whose lease another store holds (issue #16).
+    /// Refuses a write for a participant whose lease another store holds.
     void checkLease(std::int64_t participantId, const std::string& code) const;
     /// Re-throws a failed write as a StoreError naming the file, what was being written and
     /// the cause (disk full, read-only file or folder, I/O error), with what to do.

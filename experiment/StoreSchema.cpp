@@ -127,7 +127,7 @@ ALTER TABLE trials ADD COLUMN sensor_log TEXT;
 ALTER TABLE trials ADD COLUMN interruptions INTEGER NOT NULL DEFAULT 0;
 ALTER TABLE trials ADD COLUMN interruption_reason TEXT NOT NULL DEFAULT '';
 )sql",
-    // 3 -> 4 (issue #17, task "honest"): simulated participants are flagged as such (a
+    // 3 -> 4: simulated participants are flagged as such (a
     // simulation never writes into a real participant); each session stores whether sound was
     // played (1), not (0: data entry without sound), or is unknown (NULL, older sessions).
     R"sql(
@@ -135,7 +135,7 @@ ALTER TABLE participants ADD COLUMN simulated INTEGER NOT NULL DEFAULT 0
   CHECK (simulated IN (0, 1));
 ALTER TABLE sessions ADD COLUMN sound_played INTEGER CHECK (sound_played IN (0, 1));
 )sql",
-    // 4 -> 5 (issue 14, `underfoot serve`, task "web"): online invitations (token stored only
+    // 4 -> 5: online invitations (token stored only
     // as its SHA-256), online sessions (user agent, audio output rate) and answer attempts
     // (idempotent submissions, browser response times). Used by experiment/Invitations.cpp.
     R"sql(
@@ -168,7 +168,7 @@ CREATE TABLE IF NOT EXISTS online_answers (
   PRIMARY KEY (invitation_id, trial_index)
 );
 )sql",
-    // 5 -> 6 (issue #16, hardening): session leases, one live session per participant.
+    // 5 -> 6: session leases, one live session per participant.
     R"sql(
 CREATE TABLE session_leases (
   participant_id INTEGER PRIMARY KEY REFERENCES participants(id),

@@ -12,7 +12,7 @@
 
 namespace underfoot::analysis {
 
-/// What people read in place of ids: the protocol's stimulus labels (issue #17). An id without
+/// What people read in place of ids: the protocol's stimulus labels. An id without
 /// a label is shown as is.
 struct RatingLabels {
     std::map<std::string, std::string> stimuli; ///< stimulus id -> label

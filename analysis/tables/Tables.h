@@ -97,7 +97,7 @@ struct ComparisonRow {
     double pHolm = std::numeric_limits<double>::quiet_NaN(); ///< Holm across surfaces
 };
 
-/// The mixed model beside a between-group comparison (issue #15): the participant as a random
+/// The mixed model beside a between-group comparison: the participant as a random
 /// intercept, groupB's coefficient against groupA (log-odds ratio for correct answers, mean
 /// difference for lmer, log-odds ratio of a higher rating for clmm). Filled by
 /// addMixedModelComparisons (report/MixedModelReport.h).

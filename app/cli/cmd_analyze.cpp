@@ -125,7 +125,7 @@ int analyzeRatings(const AnalyzeOptions& o, analysis::ReportFormat format) {
             if (labels.simulatedParticipants > 0)
                 fmt::print(stderr, "analyze: {}\n",
                            analysis::markup::simulatedNotice(labels.simulatedParticipants, 0));
-            labels.stimuli = experiment::stimulusDisplayLabels(store.protocol()); // issue #17
+            labels.stimuli = experiment::stimulusDisplayLabels(store.protocol());
         } else if (!o.ratings.empty()) {
             data = analysis::readRatingData(o.ratings, o.participants, o.scales);
         } else {

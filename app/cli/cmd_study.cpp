@@ -236,7 +236,7 @@ const underfoot::cli::CommandRegistrar registrar{
                         writer(std::cout);
                         return;
                     }
-                    // A missing folder of the output file is created (issue #17).
+                    // A missing folder of the output file is created.
                     if (const auto folder = std::filesystem::path(path).parent_path();
                         !folder.empty()) {
                         std::error_code ec;
@@ -271,7 +271,7 @@ const underfoot::cli::CommandRegistrar registrar{
             exitCode = 0;
         });
 
-        // Online participation (issue 14): one secret link per future participant.
+        // Online participation: one secret link per future participant.
         struct InviteOptions {
             int count = 0;
             std::string group, prefix = "W", baseUrl = "http://127.0.0.1:8080";

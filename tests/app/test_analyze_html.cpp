@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Issue #17, "the HTML report shows labelled figures with confidence intervals": the `underfoot`
+// "the HTML report shows labelled figures with confidence intervals": the `underfoot`
 // program makes two studies with simulated participants (a rating study, wading_listening, and
 // an identification study by group, tvcg2011_exp2) and `underfoot analyze --format html` reports
 // them. The test reads the same stores through the library, computes what the report must say
