@@ -559,6 +559,12 @@ ParticipantScreen TrialFlow::participantScreen() const {
     const TrialRecord& t = session_.current();
     s.page = ParticipantScreen::Page::Trial;
     s.heading = trialLabel(t.index, s.total, t.practice);
+    if (protocol().ordering.blocks == BlockKind::Scale && !t.practice) {
+        const auto asked = askedScales(protocol(), t.stimulus, t.block);
+        if (!asked.empty())
+            s.part = fmt::format("Part {} of {}: {}", t.block, protocol().questions.scales.size(),
+                                 asked.front()->prompt);
+    }
     s.sections = sections_;
     s.activeSection = active_;
     s.draft = draft_;

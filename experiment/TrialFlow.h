@@ -130,6 +130,10 @@ struct ParticipantScreen {
     std::vector<int> unanswered;
     /// Whether the participant may ask to hear the clip again now.
     bool replayOffered = false;
+    /// The part of the session this trial belongs to when the protocol asks one scale per
+    /// block ("Part 2 of 4: How deep is the water?"); empty otherwise. Front ends show it when
+    /// it changes.
+    std::string part;
 };
 
 class TrialFlow {

@@ -259,7 +259,7 @@ int runInteractive(const Options& o) {
                o.showStimulus
                    ? fmt::format(" [experimenter: group {}]", session.participant().groupId)
                    : "");
-    int shownBlock = 0;
+    std::string shownPart;
     try {
         while (session.phase() != SessionPhase::Finished) {
             const ParticipantScreen screen = flow.participantScreen();
@@ -286,11 +286,9 @@ int runInteractive(const Options& o) {
             fmt::print("\n{}{}\n", screen.heading,
                        o.showStimulus ? fmt::format(" [experimenter: stimulus {}]", t.stimulus.id)
                                       : "");
-            if (p.clips.enabled && p.ordering.blocks == BlockKind::Scale && !t.practice &&
-                t.block != shownBlock && !session.askedScales().empty()) {
-                shownBlock = t.block;
-                fmt::print("\nPart {} of {}: {}\n", t.block, p.questions.scales.size(),
-                           session.askedScales().front()->prompt);
+            if (!screen.part.empty() && screen.part != shownPart) {
+                shownPart = screen.part;
+                fmt::print("\n{}\n", screen.part);
             }
             if (!session.playing()) {
                 askLine(p.clips.enabled ? "Press Enter to play the clip. "

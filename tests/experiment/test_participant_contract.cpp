@@ -6,6 +6,7 @@
 #include "TestSupport.h"
 #include "support/ParticipantScreens.h"
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -112,4 +113,48 @@ TEST(ParticipantContract, InjectedLeaksAreFound) {
     EXPECT_TRUE(contains("you walk on gravel.", "gravel", true));
     EXPECT_FALSE(contains("gravel_reverb", "gravel", true));
     EXPECT_TRUE(contains("Group coherent: each surface", "each surf", false));
+}
+
+// The trial core's free rules (TrialFlow.h) that every front end asks.
+TEST(TrialCoreRules, PartRangeLockAndPersonSession) {
+    TempDir dir;
+    const Protocol p = loadProtocol(shipped("wading_listening.toml"));
+    StudyStore store = StudyStore::create(dir.file("w.db"), p, {"W", "lab", 2, "t"});
+    store.registerParticipant({"P1", {}, "", "", "", {}, ""});
+    std::vector<std::string> parts;
+    walkParticipantScreens(store, "P1",
+                           [&](const ParticipantScreen& s, const TrialFlow&, const TrialRecord*) {
+                               if (!s.part.empty() && (parts.empty() || parts.back() != s.part))
+                                   parts.push_back(s.part);
+                           });
+    ASSERT_EQ(parts.size(), p.questions.scales.size()); // one part per scale, in block order
+    EXPECT_EQ(parts.front(), "Part 1 of 4: " + p.questions.scales.front().prompt);
+
+    const Scale& depth = p.questions.scales.front();
+    EXPECT_TRUE(ratingInRange(depth, depth.min));
+    EXPECT_FALSE(ratingInRange(depth, depth.max + 1));
+    EXPECT_EQ(ratingRangeProblem(depth, depth.max + 1),
+              fmt::format("{} is outside the scale {}–{}.", depth.max + 1, depth.min, depth.max));
+    EXPECT_EQ(ratingRangeProblem(depth, depth.min), "");
+
+    Protocol locked = p;
+    locked.lock = LockRule::OnAnswer;
+    EXPECT_NE(lockRefusal(locked, false).find("lock = \"answer\""), std::string::npos);
+    EXPECT_EQ(lockRefusal(p, false), "");
+    EXPECT_NE(lockRefusal(p, true).find("lock = \"next_trial\""), std::string::npos);
+
+    ParticipantInfo person;
+    person.code = "P9";
+    EXPECT_EQ(personSessionRefusal(person), "");
+    person.simulated = true;
+    EXPECT_NE(personSessionRefusal(person).find("simulated participant"), std::string::npos);
+    EXPECT_EQ(progressText(12, 40), "12 of 40 trials answered");
+
+    // answerProblems is the store's rule too: the same problems, one implementation.
+    const TrialRecord t = store.trials("P1").front();
+    TrialAnswer a;
+    a.ratings[depth.id] = depth.max + 1;
+    EXPECT_EQ(answerProblems(p, "all", a, t.stimulus, t.block),
+              store.checkAnswer("all", a, t.stimulus, t.block));
+    EXPECT_FALSE(answerProblems(p, "all", a, t.stimulus, t.block).empty());
 }

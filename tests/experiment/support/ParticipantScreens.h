@@ -20,10 +20,10 @@
 
 namespace underfoot::experiment::test {
 
-/// Every text of a participant screen except its answer lists (heading, text, notice, prompts,
-/// scale anchors), as a front end would show it.
+/// Every text of a participant screen except its answer lists (heading, text, notice, part,
+/// prompts, scale anchors), as a front end would show it.
 inline std::string screenFreeText(const ParticipantScreen& s) {
-    std::string all = s.heading + "\n" + s.text + "\n" + s.notice + "\n";
+    std::string all = s.heading + "\n" + s.text + "\n" + s.notice + "\n" + s.part + "\n";
     for (const auto& sec : s.sections) {
         all += sec.prompt + "\n";
         if (sec.scale)
