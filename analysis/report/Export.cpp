@@ -693,7 +693,7 @@ std::string confusionHeatMapSvg(const ConfusionMatrix& m) {
             const auto col = static_cast<std::size_t>(j);
             const double pct = m.rowPercent(row, col);
             const int x = left + cellW * j;
-            const bool correct = answerIsCorrect(m.rows[row].surfaceId, m.columns.options[col].id);
+            const bool correct = answerIsCorrect(m.columns.options[col].id, m.rows[row].surfaceId);
             out += fmt::format("<rect class=\"cell\" x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\" "
                                "fill=\"{}\" stroke=\"{}\" stroke-width=\"{}\"><title>{} -&gt; "
                                "{}: {} ({}%)</title></rect>\n",
