@@ -64,11 +64,6 @@ std::string baseSurface(std::string_view surfaceId) {
     return std::string(surfaceId);
 }
 
-bool answerIsCorrect(std::string_view answerId, std::string_view stimulusSurfaceId) {
-    if (answerId.empty() || answerId == kDontKnow) return false;
-    return baseSurface(answerId) == baseSurface(stimulusSurfaceId);
-}
-
 std::string closestName(std::string_view name, const std::vector<std::string>& candidates) {
     auto lower = [](char c) {
         return static_cast<char>(std::tolower(static_cast<unsigned char>(c)));

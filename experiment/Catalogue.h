@@ -2,6 +2,8 @@
 #pragma once
 /// The ids a protocol may name: surfaces and soundscapes. The experiment library does not know
 /// the engine; the caller passes the list it knows (the app passes the engine's own list).
+#include "base/AnswerRule.h"
+
 #include <optional>
 #include <string>
 #include <string_view>
@@ -30,7 +32,7 @@ struct Catalogue {
     const CatalogueEntry* surfaceByCode(std::string_view code) const;
 };
 
-/// The catalogue of the reference studies (STUDIES.md): 15 surfaces, 3 reverb variants and
+/// The catalogue of the reference studies: 15 surfaces, 3 reverb variants and
 /// 5 soundscapes. Used by the CLI and the tests until the app passes the engine's list.
 const Catalogue& defaultCatalogue();
 
@@ -50,9 +52,7 @@ inline constexpr std::string_view kReverbSuffix = "_reverb";
 /// ("wood_reverb" -> "wood"); other ids are returned unchanged.
 std::string baseSurface(std::string_view surfaceId);
 
-/// Whether an answer names the surface walked on (STUDIES.md §2: the surface, not the
-/// soundscape; a reverb variant is answered correctly by its base surface). "dont_know" is
-/// never correct.
-bool answerIsCorrect(std::string_view answerId, std::string_view stimulusSurfaceId);
+/// Whether an answer names the surface walked on: the project's one rule (base/AnswerRule.h).
+using base::answerIsCorrect;
 
 } // namespace underfoot::experiment

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "experiment/Export.h"
 
+#include "base/CsvCell.h"
+
 #include <fmt/format.h>
 
 #include <set>
@@ -8,13 +10,7 @@
 namespace underfoot::experiment {
 
 std::string csvField(std::string_view value) {
-    if (value.find_first_of(",\"\r\n") == std::string_view::npos) return std::string(value);
-    std::string out = "\"";
-    for (const char c : value) {
-        if (c == '"') out += '"';
-        out += c;
-    }
-    return out + '"';
+    return base::csvCell(value);
 }
 
 namespace {
@@ -230,7 +226,9 @@ void writeCodebook(const StudyStore& store, std::ostream& out) {
                        info.schemaVersion);
     out << "## trials.csv — one row per trial\n\n"
            "CSV (RFC 4180, CRLF line ends, UTF-8). An empty cell is a missing value; booleans "
-           "are 0/1; times are ISO 8601 UTC with milliseconds.\n\n"
+           "are 0/1; times are ISO 8601 UTC with milliseconds. A text cell that would start "
+           "a spreadsheet formula (=, +, -, @, tab or CR) is written with a leading apostrophe "
+           "('=x); numbers such as -1.5 are written as they are.\n\n"
            "| column | type | meaning |\n|---|---|---|\n";
     const char* const rows[][3] = {
         {"study", "text", "study code"},

@@ -52,7 +52,7 @@ enum class ExportScope { Answered, All };
 /// Whether the rows of simulated participants (`underfoot session --simulate`) are written.
 enum class SimulatedRows { Include, Exclude };
 
-/// RFC 4180 field quoting (quotes when the field has a comma, quote, CR or LF).
+/// One CSV cell: RFC 4180 quoting and formula-leading text made inert (base/CsvCell.h).
 std::string csvField(std::string_view value);
 
 /// Writes the trials CSV; returns the number of rows.
@@ -103,8 +103,8 @@ int writeAudioCsv(const StudyStore& store, std::ostream& out,
 /// (answer options, groups, stimuli, scales) of this study's protocol.
 void writeCodebook(const StudyStore& store, std::ostream& out);
 
-/// What people read for each stimulus id of a protocol (issue #17: reports show labels, not raw
-/// ids): its label; the id when it has none; when several stimuli share a label (those of one
+/// What people read for each stimulus id of a protocol: its label; the id when it has none; when
+/// several stimuli share a label (those of one
 /// [[factorial]]), the label with the stimulus's factor levels ("synthesized wading (algorithm
 /// v1, cadence 27)"), or with the id when the levels do not tell them apart.
 std::map<std::string, std::string> stimulusDisplayLabels(const Protocol& protocol);

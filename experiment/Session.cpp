@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "experiment/Session.h"
 
+#include "experiment/TrialFlow.h"
+
 #include <fmt/format.h>
 
 #include <chrono>
@@ -90,7 +92,7 @@ void Session::play() {
     playing_ = true;
     try {
         store_.markTrialStarted(participant_.code, t.index, sessionNumber_, started.renderSeed,
-                                started.grfRecording);
+                                started.grfRecording, started.clip);
     } catch (...) {
         player_.stop();
         playing_ = false;
@@ -261,11 +263,10 @@ void Session::rate(const std::string& scaleId, int value) {
             fmt::format("rate() for trial {} before its clip was presented", t.index + 1));
     for (const Scale* s : askedScales()) {
         if (s->id != scaleId) continue;
-        if (value < s->min || value > s->max)
-            throw StoreError(fmt::format("participant '{}' trial {}: rating '{}' is {}; expected "
-                                         "{} to {}",
-                                         participant_.code, t.index + 1, scaleId, value, s->min,
-                                         s->max));
+        if (!ratingInRange(*s, value)) // the trial core's rule (TrialFlow.h)
+            throw StoreError(fmt::format("participant '{}' trial {}: rating '{}': {}",
+                                         participant_.code, t.index + 1, scaleId,
+                                         ratingRangeProblem(*s, value)));
         pending_[scaleId] = value;
         return;
     }

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "experiment/Simulation.h"
 #include "base/Version.h"
+#include "experiment/Clips.h"
 
 #include <fmt/format.h>
 #include <toml++/toml.h>
@@ -282,10 +283,28 @@ namespace {
 /// seed the clip was rendered with), and the planned seed otherwise.
 class SimulationPlayer final : public StimulusPlayer {
   public:
-    SimulationPlayer(const Protocol& protocol, std::string walker)
-        : protocol_(protocol), walker_(std::move(walker)) {}
+    SimulationPlayer(const Protocol& protocol, std::string walker, const std::string& clipDir)
+        : protocol_(protocol), walker_(std::move(walker)) {
+        if (protocol.clips.enabled && !clipDir.empty())
+            clips_ = std::make_unique<ClipPlayer>(protocol, clipDir); // plays nothing
+    }
     StimulusStart start(const Stimulus& stimulus, std::uint64_t plannedSeed) override {
-        if (protocol_.clips.enabled) return {clipSeed(protocol_, stimulus), std::nullopt};
+        if (clips_) return clips_->start(stimulus, plannedSeed);
+        if (protocol_.clips.enabled) {
+            // The clip as `underfoot clips` renders it at 48 kHz (its seed and length), so that
+            // replay renders a simulated trial's clip like any other; no samples hash, since no
+            // file was played.
+            StimulusStart started;
+            started.renderSeed = clipSeed(protocol_, stimulus);
+            if (!stimulus.clip) {
+                const double rate = 48000.0;
+                const auto frames =
+                    static_cast<std::uint64_t>(std::llround(protocol_.clips.seconds * rate));
+                started.clip = PlayedClip{clipPath(stimulus, ""),
+                                          static_cast<double>(frames) / rate, frames, rate, ""};
+            }
+            return started;
+        }
         // A sensor stimulus (microphones, shoes, gyroscopes) has no person walking: the
         // simulated participant walks as the virtual walker, for the protocol's trial time, and
         // that control stream is what the trial records (replay regenerates it from the seed).
@@ -299,7 +318,8 @@ class SimulationPlayer final : public StimulusPlayer {
 
   private:
     const Protocol& protocol_;
-    std::string walker_; ///< formatSimulatedWalker() of this participant's feet
+    std::string walker_;                ///< formatSimulatedWalker() of this participant's feet
+    std::unique_ptr<ClipPlayer> clips_; ///< the clip folder's manifest, when one is given
 };
 } // namespace
 
@@ -332,7 +352,8 @@ int runSimulatedSession(StudyStore& store, const std::string& code, const Confus
     SimulationPlayer player(store.protocol(),
                             formatSimulatedWalker(drawSimulatedWalker(
                                 deriveSeed(seed, {static_cast<std::uint64_t>(info.index), 0x3A1C}),
-                                store.protocol().timing.trialS)));
+                                store.protocol().timing.trialS)),
+                            settings.clipDir);
     Session session(store, code, player,
                     SessionSettings{"simulation", "none (simulated)", "none (simulated)",
                                     underfoot::base::version(), false},
@@ -360,8 +381,7 @@ int runSimulatedSession(StudyStore& store, const std::string& code, const Confus
                 }
                 const TrialAnswer a = answerer.answer(trial);
                 simulatedTimeS += answerer.responseTimeS();
-                for (const auto& [scaleId, value] : a.ratings) session.rate(scaleId, value);
-                session.submitRatings(a.comment);
+                session.answer(a); // every question of the trial: surface, scales, soundscape
             } else {
                 session.play();
                 // A resumed trial continues from the laps already walked.

@@ -56,6 +56,11 @@ struct SimulationSettings {
     /// How ratings depend on the stimulus (null: around the middle of each scale, half a point
     /// higher after a correct surface answer). Also gives the replay probability of clips.
     std::shared_ptr<const RatingModel> ratingModel;
+    /// The clip folder of a listening test (from `underfoot clips`), when given: each simulated
+    /// trial stores the manifest's clip (seed, length, samples' SHA-256) as a booth trial does,
+    /// so its replay is checked against those samples. Empty: the clip as `underfoot clips`
+    /// would render it at 48 kHz, without a samples hash.
+    std::string clipDir;
 };
 
 /// One synthetic participant: draws answers from the matrix row of each stimulus.

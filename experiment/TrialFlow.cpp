@@ -7,6 +7,92 @@
 
 namespace underfoot::experiment {
 
+namespace {
+std::vector<std::string> problemsFor(const Protocol& protocol, const std::string& groupId,
+                                     const TrialAnswer& answer,
+                                     const std::vector<const Scale*>& asked) {
+    std::vector<std::string> problems;
+    const Questions& q = protocol.questions;
+    if (q.asksSurface()) {
+        if (answer.answer.empty())
+            problems.push_back("the surface answer is missing");
+        else if (!q.surfaceOption(answer.answer))
+            problems.push_back(
+                fmt::format("'{}' is not an option of the answer list", answer.answer));
+    } else if (!answer.answer.empty()) {
+        problems.push_back("this protocol asks no surface question");
+    }
+    for (const Scale* scale : asked) {
+        const auto it = answer.ratings.find(scale->id);
+        if (it == answer.ratings.end())
+            problems.push_back(fmt::format("the rating '{}' is missing", scale->id));
+        else if (!ratingInRange(*scale, it->second))
+            problems.push_back(fmt::format("rating '{}' is {}; expected {} to {}", scale->id,
+                                           it->second, scale->min, scale->max));
+    }
+    for (const auto& [scaleId, value] : answer.ratings) {
+        if (!q.scale(scaleId))
+            problems.push_back(fmt::format("unknown scale '{}' (value {})", scaleId, value));
+        else if (std::none_of(asked.begin(), asked.end(),
+                              [&id = scaleId](const Scale* s) { return s->id == id; }))
+            problems.push_back(fmt::format("scale '{}' is not asked in this trial", scaleId));
+    }
+    if (q.asksSoundscape(groupId)) {
+        if (answer.soundscapeAnswer.empty())
+            problems.push_back("the soundscape answer is missing");
+        else if (!q.soundscapeOption(answer.soundscapeAnswer))
+            problems.push_back(fmt::format("'{}' is not an option of the soundscape list",
+                                           answer.soundscapeAnswer));
+    } else if (!answer.soundscapeAnswer.empty()) {
+        problems.push_back("the soundscape question is not asked to this group");
+    }
+    if (!answer.comment.empty() && !q.comment) problems.push_back("this protocol takes no comment");
+    return problems;
+}
+} // namespace
+
+std::vector<std::string> answerProblems(const Protocol& protocol, const std::string& groupId,
+                                        const TrialAnswer& answer, const Stimulus& stimulus,
+                                        int block) {
+    return problemsFor(protocol, groupId, answer, askedScales(protocol, stimulus, block));
+}
+
+std::vector<std::string> answerProblems(const Protocol& protocol, const std::string& groupId,
+                                        const TrialAnswer& answer) {
+    std::vector<const Scale*> all;
+    for (const auto& s : protocol.questions.scales) all.push_back(&s);
+    return problemsFor(protocol, groupId, answer, all);
+}
+
+bool ratingInRange(const Scale& scale, int value) {
+    return value >= scale.min && value <= scale.max;
+}
+
+std::string ratingRangeProblem(const Scale& scale, int value) {
+    if (ratingInRange(scale, value)) return "";
+    return fmt::format("{} is outside the scale {}–{}.", value, scale.min, scale.max);
+}
+
+std::string personSessionRefusal(const ParticipantInfo& participant) {
+    if (!participant.simulated) return "";
+    return fmt::format("participant {} is a simulated participant (made by --simulate); a "
+                       "person's session needs a registered participant",
+                       participant.code);
+}
+
+std::string lockRefusal(const Protocol& protocol, bool laterTrialStarted) {
+    if (protocol.lock == LockRule::OnAnswer)
+        return "Answers are locked once given (protocol rule lock = \"answer\").";
+    if (laterTrialStarted)
+        return "The previous answer is locked: a later trial's stimulus has started (protocol "
+               "rule lock = \"next_trial\").";
+    return "";
+}
+
+std::string progressText(int answered, int total) {
+    return fmt::format("{} of {} trials answered", answered, total);
+}
+
 std::vector<std::string> anchorTexts(const Scale& scale) {
     std::vector<std::string> out;
     for (const auto& [value, wording] : scale.anchors)
@@ -24,8 +110,28 @@ std::string trialLabel(int index, int count, bool practice) {
     return fmt::format("{} {} of {}", practice ? "Practice trial" : "Trial", index + 1, count);
 }
 
+std::string participantTitle(const Protocol& protocol) {
+    if (!protocol.participantTitle.empty()) return protocol.participantTitle;
+    return protocol.clips.enabled ? "Listening study" : "Study";
+}
+
+std::string consentBriefing(const Protocol& protocol) {
+    if (!protocol.briefing.empty()) return protocol.briefing;
+    if (protocol.clips.enabled)
+        return "You will hear short sound clips and answer a few questions about each one.";
+    return "You will take part in a short study and answer a few questions after each trial.";
+}
+
 TrialFlow::TrialFlow(StudyStore& store, Session& session) : store_(store), session_(session) {
     reset();
+}
+
+FlowResult TrialFlow::holdRefusal() const {
+    if (session_.paused())
+        return {Refusal::Paused,
+                fmt::format("paused by a sensor fault: {}", session_.pauseReason())};
+    if (held_) return {Refusal::Paused, "paused by the experimenter (resume first)"};
+    return {};
 }
 
 bool TrialFlow::inTrial() const {
@@ -34,6 +140,7 @@ bool TrialFlow::inTrial() const {
 }
 
 void TrialFlow::reset() {
+    refusedDone_ = Refusal::None;
     revising_.reset();
     revisedTrial_.reset();
     draft_ = {};
@@ -94,6 +201,7 @@ FlowResult TrialFlow::chooseLetter(char letter) {
 }
 
 FlowResult TrialFlow::choose(SectionKind kind, char letter) {
+    if (const FlowResult hold = holdRefusal(); !hold) return hold;
     const int section = firstSection(kind);
     if (section < 0 || kind == SectionKind::Scale)
         return {Refusal::NotAllowed, "this trial does not ask that question"};
@@ -111,6 +219,7 @@ FlowResult TrialFlow::choose(SectionKind kind, char letter) {
 FlowResult TrialFlow::typeDigit(int digit) {
     if (sections_.empty() || digit < 0 || digit > 9)
         return {Refusal::NotInTrial, "no rating is asked now"};
+    if (const FlowResult hold = holdRefusal(); !hold) return hold;
     int section = active_;
     if (sections_[static_cast<std::size_t>(section)].kind != SectionKind::Scale) {
         section = -1;
@@ -127,10 +236,9 @@ FlowResult TrialFlow::typeDigit(int digit) {
     int value = digit;
     if (pendingDigit_ >= 0 && pendingDigit_ * 10 + digit <= sc.max)
         value = pendingDigit_ * 10 + digit;
-    if (value < sc.min || value > sc.max) {
+    if (!ratingInRange(sc, value)) {
         pendingDigit_ = -1;
-        return {Refusal::OutOfRange,
-                fmt::format("{} is outside the scale {}–{}.", value, sc.min, sc.max)};
+        return {Refusal::OutOfRange, ratingRangeProblem(sc, value)};
     }
     draft_.ratings[sc.id] = value;
     if (value != 0 && value * 10 <= sc.max) {
@@ -142,7 +250,7 @@ FlowResult TrialFlow::typeDigit(int digit) {
 }
 
 void TrialFlow::adjust(int delta) {
-    if (sections_.empty()) return;
+    if (sections_.empty() || !holdRefusal()) return;
     const auto& s = sections_[static_cast<std::size_t>(active_)];
     if (s.kind != SectionKind::Scale) return;
     const Scale& sc = *s.scale;
@@ -153,12 +261,12 @@ void TrialFlow::adjust(int delta) {
 }
 
 FlowResult TrialFlow::setRating(const std::string& scaleId, int value) {
+    if (const FlowResult hold = holdRefusal(); !hold) return hold;
     for (std::size_t i = 0; i < sections_.size(); ++i) {
         const auto& s = sections_[i];
         if (s.kind != SectionKind::Scale || s.scale->id != scaleId) continue;
-        if (value < s.scale->min || value > s.scale->max)
-            return {Refusal::OutOfRange, fmt::format("{} is outside the scale {}–{}.", value,
-                                                     s.scale->min, s.scale->max)};
+        if (!ratingInRange(*s.scale, value))
+            return {Refusal::OutOfRange, ratingRangeProblem(*s.scale, value)};
         draft_.ratings[scaleId] = value;
         setActive(static_cast<int>(i));
         return {};
@@ -169,14 +277,50 @@ FlowResult TrialFlow::setRating(const std::string& scaleId, int value) {
 std::vector<std::string> TrialFlow::problems() const {
     if (!inTrial()) return {"no trial is current"};
     const TrialRecord& t = revisedTrial_ ? *revisedTrial_ : session_.current();
-    return store_.checkAnswer(session_.participant().groupId, draft_, t.stimulus, t.block);
+    return answerProblems(protocol(), session_.participant().groupId, draft_, t.stimulus, t.block);
+}
+
+std::vector<int> TrialFlow::unansweredSections() const {
+    std::vector<int> open;
+    for (std::size_t i = 0; i < sections_.size(); ++i) {
+        const AnswerSection& s = sections_[i];
+        const bool answered = s.kind == SectionKind::Surface ? !draft_.answer.empty()
+                              : s.kind == SectionKind::Soundscape
+                                  ? !draft_.soundscapeAnswer.empty()
+                                  : draft_.ratings.count(s.scale->id);
+        if (!answered) open.push_back(static_cast<int>(i));
+    }
+    return open;
+}
+
+FlowResult TrialFlow::pause() {
+    if (!inTrial()) return {Refusal::NotInTrial, "no trial is current"};
+    if (held_) return {Refusal::NotAllowed, "the session is paused already"};
+    held_ = true; // held even when the journal cannot be written
+    try {
+        store_.journal("paused", session_.participant().code, session_.current().index, "{}");
+    } catch (const std::exception& e) {
+        return {Refusal::Failed, std::string("paused, but not journaled: ") + e.what()};
+    }
+    return {};
+}
+
+FlowResult TrialFlow::resume() {
+    if (!held_) return {Refusal::NotAllowed, "the session is not paused"};
+    held_ = false;
+    try {
+        store_.journal("resumed", session_.participant().code,
+                       inTrial() ? std::optional<int>(session_.current().index) : std::nullopt,
+                       "{}");
+    } catch (const std::exception& e) {
+        return {Refusal::Failed, std::string("resumed, but not journaled: ") + e.what()};
+    }
+    return {};
 }
 
 FlowResult TrialFlow::start() {
     if (!inTrial()) return {Refusal::NotInTrial, "no trial is current"};
-    if (session_.paused())
-        return {Refusal::Paused,
-                fmt::format("paused by a sensor fault: {}", session_.pauseReason())};
+    if (const FlowResult hold = holdRefusal(); !hold) return hold;
     if (revising_)
         return {Refusal::Locked, "store or cancel the change of the previous answer first"};
     if (session_.playing()) {
@@ -195,6 +339,7 @@ FlowResult TrialFlow::replay() {
     if (!inTrial() || !protocol().clips.enabled)
         return {Refusal::NotAllowed, "only clips of a listening test are replayed"};
     if (!session_.playing()) return start();
+    if (const FlowResult hold = holdRefusal(); !hold) return hold;
     if (!protocol().clips.replay)
         return {Refusal::NotAllowed, "This protocol does not allow replaying a clip."};
     try {
@@ -209,6 +354,7 @@ FlowResult TrialFlow::completeLap() {
     if (!inTrial()) return {Refusal::NotInTrial, "no trial is current"};
     const int total = session_.lapCount();
     if (total == 0) return {Refusal::NotAllowed, "this protocol has no laps"};
+    if (const FlowResult hold = holdRefusal(); !hold) return hold;
     if (!session_.playing())
         return {Refusal::NotStarted, "Start the condition first, then complete each lap."};
     if (session_.lapsDone() >= total)
@@ -225,9 +371,7 @@ FlowResult TrialFlow::completeLap() {
 FlowResult TrialFlow::commit() {
     if (revising_) return commitRevision();
     if (!inTrial()) return {Refusal::NotInTrial, "no trial is current"};
-    if (session_.paused())
-        return {Refusal::Paused,
-                fmt::format("paused by a sensor fault: {}", session_.pauseReason())};
+    if (const FlowResult hold = holdRefusal(); !hold) return hold;
     if (!session_.playing())
         return {Refusal::NotStarted,
                 "Start the stimulus first; the answer belongs to what was heard."};
@@ -239,12 +383,14 @@ FlowResult TrialFlow::commit() {
     if (!missing.empty()) {
         std::string list;
         for (const auto& p : missing) list += (list.empty() ? "" : "; ") + p;
+        refusedDone_ = Refusal::Incomplete;
         return {Refusal::Incomplete, list};
     }
     try {
         session_.answer(draft_);
     } catch (const std::exception& e) {
         if (session_.paused()) return {Refusal::Paused, e.what()};
+        refusedDone_ = Refusal::Failed;
         return {Refusal::Failed, e.what()};
     }
     reset();
@@ -253,12 +399,9 @@ FlowResult TrialFlow::commit() {
 
 FlowResult TrialFlow::revisePrevious() {
     if (!inTrial()) return {Refusal::NotInTrial, "no trial is current"};
-    if (protocol().lock == LockRule::OnAnswer)
-        return {Refusal::Locked,
-                "Answers are locked once given (protocol rule lock = \"answer\")."};
-    if (session_.playing())
-        return {Refusal::Locked, "The previous answer is locked: this trial's stimulus has started "
-                                 "(protocol rule lock = \"next_trial\")."};
+    if (const FlowResult hold = holdRefusal(); !hold) return hold;
+    if (const std::string why = lockRefusal(protocol(), session_.playing()); !why.empty())
+        return {Refusal::Locked, why};
     const int current = session_.current().index;
     std::optional<TrialRecord> previous;
     for (auto& t : store_.trials(session_.participant().code))
@@ -276,9 +419,8 @@ FlowResult TrialFlow::revisePrevious() {
 
 FlowResult TrialFlow::commitRevision() {
     if (!revising_) return {Refusal::NotAllowed, "no answer is being changed"};
-    if (session_.playing())
-        return {Refusal::Locked,
-                "The previous answer is locked: this trial's stimulus has started."};
+    if (const std::string why = lockRefusal(protocol(), session_.playing()); !why.empty())
+        return {Refusal::Locked, why};
     try {
         store_.commitAnswer(session_.participant().code, *revising_, draft_,
                             revisedTrial_->responseTimeS);
@@ -358,6 +500,7 @@ std::string TrialFlow::participantBriefing() const {
         practice += t.practice ? 1 : 0;
     }
     std::string text;
+    if (!p.briefing.empty()) text += p.briefing + "\n\n";
     if (p.clips.enabled)
         text += fmt::format("You will hear {} sound clips{}.", total,
                             practice ? fmt::format(" ({} for practice first)", practice) : "");
@@ -416,11 +559,17 @@ ParticipantScreen TrialFlow::participantScreen() const {
     const TrialRecord& t = session_.current();
     s.page = ParticipantScreen::Page::Trial;
     s.heading = trialLabel(t.index, s.total, t.practice);
+    if (protocol().ordering.blocks == BlockKind::Scale && !t.practice) {
+        const auto asked = askedScales(protocol(), t.stimulus, t.block);
+        if (!asked.empty())
+            s.part = fmt::format("Part {} of {}: {}", t.block, protocol().questions.scales.size(),
+                                 asked.front()->prompt);
+    }
     s.sections = sections_;
     s.activeSection = active_;
     s.draft = draft_;
     const Protocol& p = protocol();
-    if (session_.paused()) {
+    if (!holdRefusal()) {
         s.text = "Please wait a moment.";
     } else if (!session_.playing()) {
         s.text = p.laps.total() > 0 ? "Please wait: the experimenter starts the condition."
@@ -430,8 +579,19 @@ ParticipantScreen TrialFlow::participantScreen() const {
             fmt::format("Lap {} of {}: please walk.", session_.lapsDone() + 1, session_.lapCount());
     } else {
         s.answering = true;
-        s.text = p.clips.enabled && p.clips.replay ? "Please answer. You may listen again."
-                                                   : "Please answer.";
+        s.replayOffered = p.clips.enabled && p.clips.replay;
+        s.text = s.replayOffered ? "Please answer. You may listen again." : "Please answer.";
+    }
+    if (refusedDone_ == Refusal::Incomplete) {
+        s.unanswered = unansweredSections();
+        if (s.unanswered.size() == 1)
+            s.notice = "Please answer this question first: " +
+                       sections_[static_cast<std::size_t>(s.unanswered.front())].prompt;
+        else if (!s.unanswered.empty())
+            s.notice = fmt::format("Please answer the {} questions still open first.",
+                                   s.unanswered.size());
+    } else if (refusedDone_ == Refusal::Failed) {
+        s.notice = "Your answer could not be saved yet. Please wait for the experimenter.";
     }
     return s;
 }

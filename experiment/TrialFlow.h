@@ -12,7 +12,9 @@
 ///   next stimulus starts), replay counts of listening-test clips and laps;
 /// - what the participant may see (ParticipantScreen: a neutral briefing made from the
 ///   questions, the question, the answer list, the scales with their anchors, progress and
-///   breaks) as opposed to what only the experimenter sees (stimulus, order, notes).
+///   breaks, why Done was refused) as opposed to what only the experimenter sees (stimulus,
+///   order, notes);
+/// - the experimenter's pause (journaled), which holds the draft, the stimulus and commits.
 ///
 /// Trial numbers for people are 1-based ("Trial 3 of 40" is the trial stored with index 2).
 /// No Qt, no engine: the front ends map their keys to the calls below.
@@ -59,11 +61,46 @@ struct FlowResult {
     explicit operator bool() const { return refusal == Refusal::None; }
 };
 
+// The trial core's rules, as free functions for every front end and for the store's last check
+// before it writes (one copy each).
+
+/// What is wrong with `answer` to a trial of `stimulus` in `block` for a participant of
+/// `groupId` (empty: valid): the surface answer from the answer list, exactly the scales asked
+/// after that stimulus in that block, each within its range, the soundscape answer when the
+/// group is asked, a comment only when the protocol takes one.
+std::vector<std::string> answerProblems(const Protocol& protocol, const std::string& groupId,
+                                        const TrialAnswer& answer, const Stimulus& stimulus,
+                                        int block);
+/// The same against every scale of the protocol (an answer without its trial).
+std::vector<std::string> answerProblems(const Protocol& protocol, const std::string& groupId,
+                                        const TrialAnswer& answer);
+/// Whether `value` lies on `scale` (min..max inclusive).
+bool ratingInRange(const Scale& scale, int value);
+/// "12 is outside the scale 0–10." (empty when it lies on the scale).
+std::string ratingRangeProblem(const Scale& scale, int value);
+/// Why `participant` cannot have a person's session (a simulated participant of `session
+/// --simulate` never gets one), or "" when it can.
+std::string personSessionRefusal(const ParticipantInfo& participant);
+/// The lock rule: why an answer already given may not be changed now ("" when it may). Under
+/// lock = "answer" never; under lock = "next_trial" until a later trial's stimulus starts.
+/// The store asks it before it overwrites an answer, TrialFlow before it offers the change.
+std::string lockRefusal(const Protocol& protocol, bool laterTrialStarted);
+/// "12 of 40 trials answered" (the progress line of every front end).
+std::string progressText(int answered, int total);
+
 /// Every anchor of a scale as "value = wording" (min and max labels when it has no anchors).
 std::vector<std::string> anchorTexts(const Scale& scale);
 
 /// "Trial 3 of 40" / "Practice trial 1 of 40" (1-based; `index` is the stored 0-based index).
 std::string trialLabel(int index, int count, bool practice);
+
+/// The title participants see: the protocol's participant_title, else "Listening study" for
+/// listening tests and "Study" otherwise (never the study's own title, which may name the design).
+std::string participantTitle(const Protocol& protocol);
+
+/// What a participant reads before registering (the web consent page): the protocol's briefing,
+/// else a neutral sentence made from the kind of test.
+std::string consentBriefing(const Protocol& protocol);
 
 /// What the participant's screen may show. Built only from the protocol's questions, the
 /// session's progress and the participant's own draft: never the stimulus (its id, surface,
@@ -85,6 +122,18 @@ struct ParticipantScreen {
     /// Answered and planned trials of this participant (progress bar).
     int answered = 0;
     int total = 0;
+    /// Why the last Done was refused, in words the participant may read (made only from the
+    /// protocol's prompts: the open question's, or how many are open); empty when nothing was
+    /// refused or the answer has been completed since.
+    std::string notice;
+    /// The sections still without an answer after a refused Done (indices into `sections`).
+    std::vector<int> unanswered;
+    /// Whether the participant may ask to hear the clip again now.
+    bool replayOffered = false;
+    /// The part of the session this trial belongs to when the protocol asks one scale per
+    /// block ("Part 2 of 4: How deep is the water?"); empty otherwise. Front ends show it when
+    /// it changes.
+    std::string part;
 };
 
 class TrialFlow {
@@ -120,6 +169,20 @@ class TrialFlow {
     FlowResult setRating(const std::string& scaleId, int value);
     /// What is still missing before the draft can be committed (empty: it can).
     std::vector<std::string> problems() const;
+    /// The sections of the draft without an answer yet (indices into sections()).
+    std::vector<int> unansweredSections() const;
+
+    // The experimenter's pause: while held (as while a sensor fault pauses the session), the
+    // draft, the stimulus, laps and commits are refused (Refusal::Paused) and the participant
+    // reads "Please wait a moment."; both ends are journaled ("paused", "resumed") with the
+    // current trial. It outlives reset().
+
+    /// Holds the session (refused outside a trial or when already held). When the journal
+    /// cannot be written the session is held all the same and Refusal::Failed says so.
+    FlowResult pause();
+    /// Releases it (refused when not held; released all the same when not journaled).
+    FlowResult resume();
+    bool held() const { return held_; }
 
     // The session's actions, refused with a reason instead of throwing.
 
@@ -161,6 +224,8 @@ class TrialFlow {
 
   private:
     bool inTrial() const;
+    /// Refusal::Paused while a sensor fault or the experimenter holds the session.
+    FlowResult holdRefusal() const;
     void buildSections(const TrialRecord& trial);
     int firstSection(SectionKind kind) const;
 
@@ -172,6 +237,9 @@ class TrialFlow {
     TrialAnswer draft_;
     std::optional<int> revising_;
     std::optional<TrialRecord> revisedTrial_; ///< the trial being changed (its stimulus, block)
+    bool held_ = false;
+    /// The last commit was refused: Incomplete (the screen lists the open questions) or Failed.
+    Refusal refusedDone_ = Refusal::None;
 };
 
 } // namespace underfoot::experiment

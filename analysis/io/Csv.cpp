@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "analysis/io/Csv.h"
 
+#include "base/CsvCell.h"
+
 #include <fmt/format.h>
 
 #include <fstream>
@@ -58,6 +60,7 @@ std::vector<Record> parse(std::string_view text, std::string_view sourceName) {
                     field += text[i++];
                 }
             }
+            base::csvUnprotect(field); // the apostrophe csvCell put before a formula
             record.fields.push_back(field);
             if (i >= text.size()) {
                 endOfRecord = true;
@@ -85,14 +88,7 @@ std::vector<Record> readFile(const std::string& path) {
 }
 
 std::string escape(std::string_view field) {
-    if (field.find_first_of(",\"\r\n") == std::string_view::npos) return std::string(field);
-    std::string out = "\"";
-    for (char c : field) {
-        if (c == '"') out += '"';
-        out += c;
-    }
-    out += '"';
-    return out;
+    return base::csvCell(field);
 }
 
 std::string joinLine(const std::vector<std::string>& fields) {

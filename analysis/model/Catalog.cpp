@@ -125,9 +125,4 @@ AnswerList defaultAnswerList() {
     return list;
 }
 
-bool answerIsCorrect(std::string_view stimulusSurfaceId, std::string_view answerId) {
-    if (answerId.empty() || answerId == kDontKnowId) return false;
-    return answerId == stimulusSurfaceId || answerId == baseSurfaceId(stimulusSurfaceId);
-}
-
 } // namespace underfoot::analysis

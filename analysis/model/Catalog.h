@@ -2,6 +2,8 @@
 #pragma once
 /// The surfaces, soundscapes and answer lists of the reference studies, with the codes of the
 /// published tables (docs/explanation/studies.md; tests/analysis/data/published/README.md).
+#include "base/AnswerRule.h"
+
 #include <optional>
 #include <string>
 #include <string_view>
@@ -71,8 +73,8 @@ struct AnswerList {
 /// The answer sheet of TVCG 2011 exp. 2 / Eurohaptics 2010: 15 surfaces and "I don't know".
 AnswerList defaultAnswerList();
 
-/// Whether an answer names the presented surface: the surface itself or, for a reverb variant,
-/// its base surface. This is the project's single correctness rule.
-bool answerIsCorrect(std::string_view stimulusSurfaceId, std::string_view answerId);
+/// Whether an answer names the surface walked on: the project's one rule (base/AnswerRule.h;
+/// the answer first, then the stimulus's surface).
+using base::answerIsCorrect;
 
 } // namespace underfoot::analysis

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "analysis/report/Markup.h"
 
+#include <fmt/format.h>
+
 namespace underfoot::analysis::markup {
 
 std::string xmlEscape(std::string_view text) {
@@ -100,6 +102,24 @@ std::string markdownCell(std::string_view text) {
             out += c;
     }
     return out;
+}
+
+std::string simulatedNotice(int simulated, int total) {
+    if (simulated <= 0) return "";
+    const std::string who =
+        total > 0 ? fmt::format("{} of {} participants", simulated, total)
+                  : fmt::format("{} participant{}", simulated, simulated == 1 ? "" : "s");
+    return fmt::format("Simulated data: {} in this report {} synthetic (made by `underfoot session "
+                       "--simulate`), not people; its figures describe the simulation.",
+                       who, simulated == 1 && total <= 1 ? "is" : "are");
+}
+
+std::string simulatedBannerHtml(int simulated, int total) {
+    const std::string notice = simulatedNotice(simulated, total);
+    if (notice.empty()) return "";
+    return "<p class=\"banner simulated\" role=\"note\" style=\"background:#fff3cd;border:2px "
+           "solid #b58100;padding:0.6em 1em;font-weight:600\">" +
+           xmlEscape(notice) + "</p>\n";
 }
 
 } // namespace underfoot::analysis::markup

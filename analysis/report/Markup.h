@@ -14,4 +14,10 @@ std::string latexEscape(std::string_view text);
 /// A Markdown table cell: | escaped, line breaks as spaces.
 std::string markdownCell(std::string_view text);
 
+/// What a report that includes simulated participants says at its top: "Simulated data: 6 of 6
+/// participants ..." ("" when `simulated` is 0; `total` 0 leaves the total out).
+std::string simulatedNotice(int simulated, int total);
+/// The notice as an HTML banner (a <p class="banner simulated" role="note">; "" when none).
+std::string simulatedBannerHtml(int simulated, int total);
+
 } // namespace underfoot::analysis::markup

@@ -56,6 +56,8 @@ std::string pText(double p) {
 
 using markup::latexEscape;
 using markup::markdownCell;
+using markup::simulatedBannerHtml;
+using markup::simulatedNotice;
 using markup::xmlEscape;
 
 std::string factorsText(const std::map<std::string, std::string>& factors) {
@@ -450,7 +452,12 @@ std::string renderRatingReport(const RatingStudyAnalysis& a, ReportFormat format
     std::string out;
     switch (format) {
     case ReportFormat::Markdown: {
-        out += fmt::format("# {}\n\n{} participants. {}\n", title, a.participants, kMethods);
+        out += fmt::format("# {}\n\n", title);
+        if (labels.simulatedParticipants > 0)
+            out += "**" +
+                   simulatedNotice(labels.simulatedParticipants, static_cast<int>(a.participants)) +
+                   "**\n\n";
+        out += fmt::format("{} participants. {}\n", a.participants, kMethods);
         for (const auto& s : secs) {
             out += fmt::format("\n## {}\n\n{}\n\n", s.heading, s.text);
             for (const auto& t : s.tables) out += t.markdown() + "\n";
@@ -465,6 +472,7 @@ std::string renderRatingReport(const RatingStudyAnalysis& a, ReportFormat format
                            "solid #ccc;padding:2px 6px}}</style></head><body>\n<h1>{}</h1>\n"
                            "<p>{} participants. {}</p>\n",
                            xmlEscape(title), xmlEscape(title), a.participants, xmlEscape(kMethods));
+        out += simulatedBannerHtml(labels.simulatedParticipants, static_cast<int>(a.participants));
         for (const auto& s : secs) {
             out += fmt::format("<h2>{}</h2>\n", xmlEscape(s.heading));
             std::string text = xmlEscape(s.text);
@@ -495,8 +503,10 @@ std::string renderRatingReport(const RatingStudyAnalysis& a, ReportFormat format
         auto row = [&](const std::string& section, const std::string& scale,
                        const std::string& subject, const std::string& comparison,
                        const std::string& statistic, double value) {
-            out += fmt::format("{},{},{},{},{},{}\n", section, scale, subject, comparison,
-                               statistic, std::isnan(value) ? "" : fmt::format("{:.6g}", value));
+            out +=
+                fmt::format("{},{},{},{},{},{}\n", csv::escape(section), csv::escape(scale),
+                            csv::escape(subject), csv::escape(comparison), csv::escape(statistic),
+                            std::isnan(value) ? "" : fmt::format("{:.6g}", value));
         };
         for (const auto& s : a.scales) {
             for (const auto& c : s.cells) {

@@ -12,10 +12,12 @@
 
 namespace underfoot::analysis {
 
-/// What people read in place of ids: the protocol's stimulus labels (issue #17). An id without
+/// What people read in place of ids: the protocol's stimulus labels. An id without
 /// a label is shown as is.
 struct RatingLabels {
     std::map<std::string, std::string> stimuli; ///< stimulus id -> label
+    /// Simulated participants among those analysed (a banner says so when any).
+    int simulatedParticipants = 0;
     std::string stimulus(const std::string& id) const {
         const auto it = stimuli.find(id);
         return it == stimuli.end() || it->second.empty() ? id : it->second;

@@ -13,7 +13,7 @@ bool entersTables(const TrialRecord& t) {
 
 bool isCorrect(const TrialRecord& t) {
     if (t.recordedCorrect) return *t.recordedCorrect;
-    return answerIsCorrect(t.surfaceId, t.answerId);
+    return answerIsCorrect(t.answerId, t.surfaceId);
 }
 
 bool isDontKnow(const TrialRecord& t) {

@@ -400,7 +400,7 @@ AnalysisReport analyzeConfusions(std::vector<ConfusionMatrix> confusions,
             c.n = m.rowTotal(i);
             for (std::size_t j = 0; j < m.columns.options.size(); ++j) {
                 const auto& id = m.columns.options[j].id;
-                if (answerIsCorrect(m.rows[i].surfaceId, id)) c.correct += m.counts[i][j];
+                if (answerIsCorrect(id, m.rows[i].surfaceId)) c.correct += m.counts[i][j];
                 if (id == kDontKnowId) c.dontKnow += m.counts[i][j];
             }
             if (!std::isnan(m.nominalRowTotal) && c.n != m.nominalRowTotal)

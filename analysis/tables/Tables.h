@@ -146,6 +146,10 @@ struct AnalysisReport {
     std::string mixedModelAdvice;                ///< which test to cite, and why
     bool hasRatings = false;
     std::vector<std::string> notes; ///< import warnings and remarks shown with the report
+    /// Simulated participants among those analysed (`session --simulate`), and all of them:
+    /// a report that includes any says so at its top (HTML banner, Markdown line).
+    int simulatedParticipants = 0;
+    int participants = 0;
 };
 
 /// Confusion matrix of the trials of one group (all trials when `group` is empty).

@@ -5,6 +5,7 @@
 #include "analysis/io/TrialCsv.h"
 #include "analysis/ratings/RatingAnalysis.h"
 #include "analysis/report/Export.h"
+#include "analysis/report/Markup.h"
 #include "analysis/report/MixedModelReport.h"
 #include "analysis/report/RatingReport.h"
 #include "analysis/tables/Tables.h"
@@ -24,6 +25,7 @@
 #include <fstream>
 #include <limits>
 #include <memory>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 
@@ -53,7 +55,31 @@ struct AnalyzeOptions {
     bool includeSimulated = false;
 };
 
-/// Issue #17: simulated participants are left out of an analysis unless asked for; says so.
+/// Simulated participants of a study.
+int simulatedCount(const experiment::StudyStore& store) {
+    int n = 0;
+    for (const auto& p : store.participants()) n += p.simulated ? 1 : 0;
+    return n;
+}
+
+/// The participants a report covers and how many of them are simulated (its banner); the
+/// console hears it too.
+void countParticipants(analysis::AnalysisReport& report,
+                       const std::vector<analysis::TrialRecord>& trials) {
+    std::set<std::string> all, simulated;
+    for (const auto& t : trials) {
+        all.insert(t.participant);
+        if (t.simulated) simulated.insert(t.participant);
+    }
+    report.participants = static_cast<int>(all.size());
+    report.simulatedParticipants = static_cast<int>(simulated.size());
+    if (!simulated.empty())
+        fmt::print(
+            stderr, "analyze: {}\n",
+            analysis::markup::simulatedNotice(report.simulatedParticipants, report.participants));
+}
+
+/// Simulated participants are left out of an analysis unless asked for; says so.
 experiment::SimulatedRows simulatedRows(const AnalyzeOptions& o,
                                         const experiment::StudyStore& store) {
     if (o.includeSimulated) return experiment::SimulatedRows::Include;
@@ -94,7 +120,12 @@ int analyzeRatings(const AnalyzeOptions& o, analysis::ReportFormat format) {
                                              participants.str(), o.study + " (participants)",
                                              scales.str(), o.study + " (scales)");
             data.title = store.protocol().title;
-            labels.stimuli = experiment::stimulusDisplayLabels(store.protocol()); // issue #17
+            if (rows == experiment::SimulatedRows::Include)
+                labels.simulatedParticipants = simulatedCount(store);
+            if (labels.simulatedParticipants > 0)
+                fmt::print(stderr, "analyze: {}\n",
+                           analysis::markup::simulatedNotice(labels.simulatedParticipants, 0));
+            labels.stimuli = experiment::stimulusDisplayLabels(store.protocol());
         } else if (!o.ratings.empty()) {
             data = analysis::readRatingData(o.ratings, o.participants, o.scales);
         } else {
@@ -213,8 +244,9 @@ int analyze(const AnalyzeOptions& o) {
                                                    analysis::labelFor(analysis::kDontKnowId)});
             }
             report = analysis::analyzeTrials(trials, options);
-            analysis::addMixedModelComparisons(report, trials, options); // issue #15
+            analysis::addMixedModelComparisons(report, trials, options);
             report.source = o.study;
+            countParticipants(report, trials);
         } else if (!o.trials.empty()) {
             auto trials = analysis::readTrialCsv(o.trials);
             if (!o.includeSimulated) {
@@ -227,8 +259,9 @@ int analyze(const AnalyzeOptions& o) {
                                before - trials.size());
             }
             report = analysis::analyzeTrials(trials, options);
-            analysis::addMixedModelComparisons(report, trials, options); // issue #15
+            analysis::addMixedModelComparisons(report, trials, options);
             report.source = o.trials;
+            countParticipants(report, trials);
         } else {
             std::vector<analysis::ConfusionMatrix> tables;
             for (std::size_t i = 0; i < o.counts.size(); ++i) {

@@ -3,6 +3,7 @@
 // `underfoot protocol power` lives in cmd_protocol_power.cpp.
 #include "analysis/model/Catalog.h"
 #include "app/cli/CommandRegistry.h"
+#include "app/wiring/StimulusRender.h"
 #include "experiment/Catalogue.h"
 #include "experiment/Plan.h"
 #include "experiment/Protocol.h"
@@ -79,21 +80,23 @@ void printSummary(const Protocol& p, std::uint64_t seed, int participants) {
                    p.groups[i].target > 0 ? std::to_string(p.groups[i].target) : "-",
                    minutes(g.estimatedDurationS));
     }
-    fmt::print("\nBalance over {} simulated participant(s) per group (seed {}): presentations "
-               "per stimulus, times first, mean position (ideal in brackets)\n",
-               participants, seed);
+    fmt::print("\nBalance over {} simulated participant{} per group (seed {}); positions count "
+               "from 1\n",
+               participants, participants == 1 ? "" : "s", seed);
     for (const auto& table : summary.balance) {
         fmt::print("  group {}\n", table.groupId);
+        fmt::print("    {:<20} {:>13} {:>11} {:>13} {:>7}\n", "stimulus", "presentations",
+                   "times first", "mean position", "(ideal)");
         const std::size_t positions = table.counts.empty() ? 0 : table.counts[0].size();
-        const double ideal = positions > 0 ? (static_cast<double>(positions) - 1.0) / 2.0 : 0.0;
+        const double ideal = positions > 0 ? (static_cast<double>(positions) + 1.0) / 2.0 : 0.0;
         for (std::size_t s = 0; s < table.stimulusIds.size(); ++s) {
             int total = 0;
             double weighted = 0;
             for (std::size_t pos = 0; pos < positions; ++pos) {
                 total += table.counts[s][pos];
-                weighted += static_cast<double>(table.counts[s][pos] * static_cast<int>(pos));
+                weighted += static_cast<double>(table.counts[s][pos] * (static_cast<int>(pos) + 1));
             }
-            fmt::print("    {:<20} {:>5} {:>5} {:>7.2f} [{:.1f}]\n", table.stimulusIds[s], total,
+            fmt::print("    {:<20} {:>13} {:>11} {:>13.2f} {:>7.1f}\n", table.stimulusIds[s], total,
                        positions ? table.counts[s][0] : 0, total ? weighted / total : 0.0, ideal);
         }
     }
@@ -131,7 +134,26 @@ const underfoot::cli::CommandRegistrar registrar{
                 for (const auto& g : p.groups) n = std::max(n, g.target);
                 if (n == 0) n = 20;
             }
+            for (const auto& w : p.warnings) fmt::print(stderr, "{}\n", w.toString());
+            // Check means runs: every distinct stimulus renders a short piece now, so that a
+            // protocol that passes never fails at `clips`, `replay` or in a session.
+            int rendered = 0;
+            const auto problems = wiring::checkStimuliRender(p, 0.3, &rendered);
+            if (!problems.empty()) {
+                std::size_t causes = 0;
+                for (const auto& line : problems) {
+                    const bool more = line.rfind("  ", 0) == 0; // the stimuli a cause also stops
+                    causes += more ? 0 : 1;
+                    fmt::print(stderr, "{}{}\n", more ? "" : file + ": ", line);
+                }
+                fmt::print(stderr, "underfoot: {} stimulus problem{} in {}\n", causes,
+                           causes == 1 ? "" : "s", file);
+                exitCode = 2;
+                return;
+            }
             printSummary(p, seed, n);
+            fmt::print("\nrenders: {} distinct stimulus render(s) made, every stimulus renders\n",
+                       rendered);
             exitCode = 0;
         });
     }};

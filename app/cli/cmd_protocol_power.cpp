@@ -242,7 +242,7 @@ int runRatingPower(const PowerArgs& a, const Protocol& p) {
         if (p.simulation.ratingModel.empty())
             throw underfoot::cli::UserError(fmt::format(
                 "{}: protocol {} asks no surface question and names no rating model in "
-                "[simulation]; give --rating-model FILE (protocols/README.md, \"Rating models\")",
+                "[simulation]; give --rating-model FILE (docs/reference/protocol.md, \"Rating models\")",
                 a.file, p.id));
         try {
             modelFile = findProtocolFile(p, p.simulation.ratingModel, a.file);

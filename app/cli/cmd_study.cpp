@@ -2,6 +2,7 @@
 // `underfoot study ...`: create a study file, register / drop participants, exclude trials,
 // inspect a study, its journal and what replay needs for a trial.
 #include "app/cli/CommandRegistry.h"
+#include "app/wiring/StimulusRender.h"
 #include "base/Version.h"
 #include "experiment/Export.h"
 #include "experiment/Invitations.h"
@@ -69,6 +70,15 @@ const underfoot::cli::CommandRegistrar registrar{
         create->callback([&exitCode, &o] {
             guarded([&] {
                 const Protocol p = loadProtocol(o.protocol);
+                // A study is created only from a protocol whose every stimulus renders.
+                if (const auto problems = wiring::checkStimuliRender(p); !problems.empty()) {
+                    std::string all;
+                    for (const auto& line : problems)
+                        all += (all.empty() ? "" : "\n") +
+                               (line.rfind("  ", 0) == 0 ? line : o.protocol + ": " + line);
+                    throw UserError(all + "\nstudy create: nothing was created");
+                }
+                for (const auto& w : p.warnings) fmt::print(stderr, "{}\n", w.toString());
                 StudyStore store = StudyStore::create(
                     o.study, p, {o.code, o.site, o.seed, underfoot::base::version()});
                 fmt::print("created {} (study {}, protocol {} sha256 {})\n", o.study, o.code, p.id,
@@ -226,7 +236,7 @@ const underfoot::cli::CommandRegistrar registrar{
                         writer(std::cout);
                         return;
                     }
-                    // A missing folder of the output file is created (issue #17).
+                    // A missing folder of the output file is created.
                     if (const auto folder = std::filesystem::path(path).parent_path();
                         !folder.empty()) {
                         std::error_code ec;
@@ -261,7 +271,7 @@ const underfoot::cli::CommandRegistrar registrar{
             exitCode = 0;
         });
 
-        // Online participation (issue 14): one secret link per future participant.
+        // Online participation: one secret link per future participant.
         struct InviteOptions {
             int count = 0;
             std::string group, prefix = "W", baseUrl = "http://127.0.0.1:8080";

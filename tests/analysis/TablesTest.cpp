@@ -63,9 +63,11 @@ const SummaryRow& row(const AnalysisReport& r, const std::string& group,
 } // namespace
 
 TEST(ScoringRules, ReverbStimulusIsAnsweredByItsBaseSurface) {
-    EXPECT_TRUE(answerIsCorrect("wood_reverb", "wood"));
+    // The answer first, then the stimulus's surface (base/AnswerRule.h).
+    EXPECT_TRUE(answerIsCorrect("wood", "wood_reverb"));
     EXPECT_TRUE(answerIsCorrect("wood_reverb", "wood_reverb"));
-    EXPECT_FALSE(answerIsCorrect("wood_reverb", "creaking_wood"));
+    EXPECT_FALSE(answerIsCorrect("creaking_wood", "wood_reverb"));
+    EXPECT_TRUE(answerIsCorrect("wood_reverb", "wood")); // compared by base surfaces
     EXPECT_FALSE(answerIsCorrect("wood", "dont_know"));
     EXPECT_EQ(surfaceCategory("metal_reverb"), SurfaceCategory::Solid);
     EXPECT_EQ(surfaceCategory("puddles"), SurfaceCategory::Liquid);

@@ -145,3 +145,14 @@ TEST(TrialCsv, ExperimentLayerExportAgreesWithTheScoringRules) {
     }
     EXPECT_GT(soundscapeChecked, 0);
 }
+
+// The analysis's CSV writer makes formula-leading cells inert and its reader gives the text back
+// exactly (base/CsvCell.h); numbers such as -1.5 are written as they are.
+TEST(Csv, FormulaLeadingCellsRoundTrip) {
+    const std::vector<std::string> cells = {"=1+2", "@x", "-x", "'=y", "\tz", "-1.5", "+3", "a,b"};
+    const std::string line = underfoot::analysis::csv::joinLine(cells);
+    EXPECT_EQ(line, "'=1+2,'@x,'-x,''=y,'\tz,-1.5,+3,\"a,b\"");
+    const auto records = underfoot::analysis::csv::parse(line + "\n", "round.csv");
+    ASSERT_EQ(records.size(), 1u);
+    EXPECT_EQ(records[0].fields, cells);
+}

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Issue #17, "the HTML report shows labelled figures with confidence intervals": the `underfoot`
+// "the HTML report shows labelled figures with confidence intervals": the `underfoot`
 // program makes two studies with simulated participants (a rating study, wading_listening, and
 // an identification study by group, tvcg2011_exp2) and `underfoot analyze --format html` reports
 // them. The test reads the same stores through the library, computes what the report must say
@@ -99,6 +99,10 @@ TEST(AnalyzeHtml, RatingStudyShowsLabelledMeansWithIntervalsPointsAndTestsInWord
     const auto a = an::analyzeRatingStudy(data);
     ASSERT_FALSE(a.scales.empty());
     EXPECT_EQ(a.participants, 8u);
+    // Every participant here is simulated: the report says so at its top.
+    EXPECT_NE(page.find("<p class=\"banner simulated\""), std::string::npos);
+    EXPECT_NE(page.find(an::markup::xmlEscape(an::markup::simulatedNotice(8, 8))),
+              std::string::npos);
 
     std::size_t cells = 0, points = 0;
     for (const auto& s : a.scales) {
@@ -183,6 +187,8 @@ TEST(AnalyzeHtml, IdentificationStudyShowsHeatMapsWithCountsAndRowPercentsAndTes
     const auto r = an::analyzeTrials(trials, options);
     ASSERT_FALSE(r.confusions.empty());
     ASSERT_FALSE(r.comparisons.empty());
+    EXPECT_EQ(occurrences(page, "<p class=\"banner simulated\""), 1u);
+    EXPECT_NE(page.find("Simulated data: "), std::string::npos);
 
     EXPECT_EQ(occurrences(page, ">Answer given</text>"), r.confusions.size());
     EXPECT_EQ(occurrences(page, ">Presented stimulus</text>"), r.confusions.size());

@@ -207,3 +207,35 @@ TEST(ExperimentExport, RatingsCarryFactorLevels) {
         EXPECT_EQ(row[11], "1") << "every participant of simulateStudy is simulated";
     }
 }
+
+// Every CSV the project writes makes formula-leading cells inert (base/CsvCell.h): =, +, -, @,
+// tab and CR get a leading apostrophe, except whole numbers such as -1.5 (read as numbers).
+TEST(Export, FormulaLeadingCellsAreInertAndNumbersStayNumbers) {
+    EXPECT_EQ(csvField("=HYPERLINK(\"http://x\")"), "\"'=HYPERLINK(\"\"http://x\"\")\"");
+    EXPECT_EQ(csvField("=1+2"), "'=1+2");
+    EXPECT_EQ(csvField("@SUM(A1)"), "'@SUM(A1)");
+    EXPECT_EQ(csvField("+x"), "'+x");
+    EXPECT_EQ(csvField("-x"), "'-x");
+    EXPECT_EQ(csvField("-"), "'-");
+    EXPECT_EQ(csvField("\tx"), "'\tx");
+    EXPECT_EQ(csvField("\rx"), "\"'\rx\"");
+    EXPECT_EQ(csvField("-nan"), "'-nan");
+    EXPECT_EQ(csvField("-inf"), "'-inf");
+    EXPECT_EQ(csvField("-0x10"), "'-0x10");
+    EXPECT_EQ(csvField("'=x"), "''=x"); // protected again, so reading back is exact
+    for (const char* number : {"-1.5", "+3", "-2e-05", "-0", "12", "0.25"})
+        EXPECT_EQ(csvField(number), number);
+    EXPECT_EQ(csvField("a,b"), "\"a,b\"");
+    EXPECT_EQ(csvField("plain"), "plain");
+}
+
+TEST(Export, AFormulaInAParticipantCommentIsExportedInert) {
+    TempDir dir;
+    StudyStore store = StudyStore::create(dir.file("s.db"), parseProtocol(miniProtocol(), "m"),
+                                          {"S", "lab", 1, "t"});
+    store.registerParticipant({"P1", {}, "=cmd|' /C calc'!A0", "", "", {}, ""});
+    std::ostringstream out;
+    writeParticipantsCsv(store, out, SimulatedRows::Include);
+    EXPECT_NE(out.str().find(",'=cmd|' /C calc'!A0,"), std::string::npos) << out.str();
+    EXPECT_EQ(out.str().find(",=cmd"), std::string::npos) << out.str();
+}

@@ -49,6 +49,7 @@ void renderClips(const Protocol& p, const std::string& dir, double seconds) {
                      seconds,
                      0,
                      0,
+                     {},
                      {}};
         if (job.source == ClipSource::Wading) {
             auto options =
@@ -247,7 +248,10 @@ TEST(WadingListeningMode, VersionOneStudyFilesAreMigrated) {
     {
         // Turn the file back into schema version 1 (what Underfoot wrote before this version).
         SQLite::Database db(path, SQLite::OPEN_READWRITE);
-        db.exec("DROP TABLE IF EXISTS session_leases"); // version 6's (issue #16)
+        for (const char* column :
+             {"clip_file", "clip_seconds", "clip_frames", "clip_sample_rate_hz", "clip_sha256"})
+            db.exec(std::string("ALTER TABLE trials DROP COLUMN ") + column); // version 7's
+        db.exec("DROP TABLE IF EXISTS session_leases");                       // version 6's
         for (const char* column :
              {"audio_sample_rate_hz", "audio_block_size", "audio_frames", "audio_xruns",
               "audio_average_load_percent", "audio_max_load_percent", "audio_max_block_ms",

@@ -166,10 +166,10 @@ TEST(WadingProtocols, MissingLabClipIsReportedAtItsProtocolLine) {
     std::filesystem::create_directories(dir + "/real");
     auto problems = checkClipFiles(p, dir);
     ASSERT_EQ(problems.size(), 3u);
-    EXPECT_EQ(problems[0].line, 49); // clip = "real/wading_27spm.wav" in wading_realism.toml
+    EXPECT_EQ(problems[0].line, 50); // clip = "real/wading_27spm.wav" in wading_realism.toml
     EXPECT_EQ(problems[0].column, 8);
     EXPECT_NE(problems[0].message.find("real/wading_27spm.wav"), std::string::npos);
-    EXPECT_NE(problems[0].toString().find("wading_realism.toml:49:8:"), std::string::npos);
+    EXPECT_NE(problems[0].toString().find("wading_realism.toml:50:8:"), std::string::npos);
     std::ofstream(dir + "/real/wading_27spm.wav") << "";
     problems = checkClipFiles(p, dir);
     ASSERT_EQ(problems.size(), 3u);
