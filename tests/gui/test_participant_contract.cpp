@@ -311,6 +311,8 @@ class ParticipantContractTest : public QObject {
                 QTest::keyClick(pw, Qt::Key_Return);
                 QCOMPARE(run->session()->current().index, index);
                 QVERIFY2(!pw->notice().isEmpty(), qPrintable(at));
+                // In the participant's words (the protocol's prompts), not the console's.
+                QVERIFY2(pw->notice().startsWith("Please answer"), qPrintable(pw->notice()));
                 checkScreen(*pw, p, secrets, at + ", Done refused");
                 checkLayout(*pw, at + ", Done refused");
                 if (!shotsDir_.isEmpty() && static_cast<int>(sections.size()) == maxQuestions)
