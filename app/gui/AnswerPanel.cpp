@@ -55,7 +55,10 @@ void AnswerPanel::rebuild(exp::TrialFlow* flow) {
     for (std::size_t i = 0; i < list.size(); ++i) {
         QFrame* frame = addSection(list[i]);
         frame->show(); // shown with the panel, even when the panel is on screen already
-        if (list[i].kind == exp::SectionKind::Scale) {
+        // A scale of up to seven values shares its row; longer ones and answer lists take one.
+        const bool narrow =
+            list[i].kind == exp::SectionKind::Scale && list[i].scale->max - list[i].scale->min < 7;
+        if (narrow) {
             grid_->addWidget(frame, row, column);
             if (++column == columns) column = 0, ++row;
         } else {

@@ -29,7 +29,8 @@ struct AnswerPanelStyle {
     int optionHeight = 36;
     /// Size of a scale's value button.
     QSize valueButton{48, 36};
-    /// Scale questions side by side (answer lists always take a whole row).
+    /// Scale questions of up to seven values side by side (answer lists and longer scales take
+    /// a whole row).
     int columns = 1;
     /// The keys after each prompt ("keys a–p", "digits 1–7"): the experimenter's keyboard.
     bool keyHints = false;

@@ -2,6 +2,7 @@
 #include "app/gui/HeatMap.h"
 
 #include "app/gui/Figures.h"
+#include "app/gui/QtText.h"
 
 #include <QHelpEvent>
 #include <QPainter>
@@ -20,10 +21,13 @@ HeatMap::HeatMap(QWidget* parent) : QWidget(parent) {
 
 void HeatMap::setMatrix(const analysis::ConfusionMatrix& matrix) {
     matrix_ = matrix;
-    setAccessibleDescription(tr("%1 stimuli by %2 answers, %3 answers in total")
-                                 .arg(matrix_.rows.size())
-                                 .arg(matrix_.columns.options.size())
-                                 .arg(total()));
+    setAccessibleDescription(
+        tr("%1 by %2, %3 in total")
+            .arg(
+                counted(static_cast<long long>(matrix_.rows.size()), tr("stimulus"), tr("stimuli")),
+                counted(static_cast<long long>(matrix_.columns.options.size()), tr("answer"),
+                        tr("answers")),
+                counted(std::llround(total()), tr("answer"), tr("answers"))));
     update();
 }
 

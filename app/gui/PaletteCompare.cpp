@@ -257,9 +257,9 @@ bool PaletteCompare::useMaterial(const QString& material) {
     referenceMaterial_ = material;
     material_->setCurrentText(material);
     const QString label =
-        tr("%1 recordings of %2 from %3 (%4)")
-            .arg(chosen.size())
-            .arg(material, sources.join(", "), QDir::toNativeSeparators(cacheDir_));
+        tr("%1 of %2 from %3 (%4)")
+            .arg(counted(static_cast<long long>(chosen.size()), tr("recording"), tr("recordings")),
+                 material, sources.join(", "), QDir::toNativeSeparators(cacheDir_));
     startReference(std::move(chosen), label);
     return true;
 }
@@ -354,10 +354,10 @@ void PaletteCompare::referenceDone(quint64 generation, std::shared_ptr<PaletteRe
     }
     reference_ = ref;
     referenceLabel_->setText(
-        tr("Reference: %1 — %2 steps; compared on %3 Hz – %4 kHz (the band render and recordings "
+        tr("Reference: %1 — %2; compared on %3 Hz – %4 kHz (the band render and recordings "
            "share)")
             .arg(ref->label)
-            .arg(ref->steps.size())
+            .arg(counted(static_cast<long long>(ref->steps.size()), tr("step"), tr("steps")))
             .arg(ref->options.minHz, 0, 'f', 0)
             .arg(ref->options.maxHz / 1000, 0, 'f', 2));
     refPlot_->setSpectrogram(ref->example, tr("Reference: a typical recorded step"));
@@ -616,7 +616,7 @@ void PaletteCompare::fitDone(const PaletteFitOutcome& outcome) {
         progress_->setFormat(
             outcome.cancelled
                 ? tr("cancelled after evaluation %1 of %2").arg(r.evaluations).arg(fitBudget_)
-                : tr("done: %1 evaluations").arg(r.evaluations));
+                : tr("done: %1").arg(counted(r.evaluations, tr("evaluation"), tr("evaluations"))));
         fitLabel_->setText(
             tr("%1 Distance before %2 → after %3 (%4 evaluations, %5 s, %6; knobs: %7). Apply "
                "puts the fitted values into the palette; Save writes the fitted preset with its "

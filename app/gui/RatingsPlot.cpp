@@ -3,6 +3,7 @@
 
 #include "analysis/stats/Tests.h"
 #include "app/gui/Figures.h"
+#include "app/gui/QtText.h"
 
 #include <QPainter>
 #include <QPainterPath>
@@ -104,7 +105,8 @@ RatingsPlot::RatingsPlot(QWidget* parent) : QWidget(parent) {
 void RatingsPlot::setSeries(RatingSeries series) {
     series_ = std::move(series);
     setAccessibleDescription(
-        tr("%1: %2 conditions").arg(series_.title).arg(series_.conditions.size()));
+        tr("%1: %2").arg(series_.title, counted(static_cast<long long>(series_.conditions.size()),
+                                                tr("condition"), tr("conditions"))));
     update();
 }
 

@@ -117,10 +117,10 @@ bool RunView::registerAndStart() {
         return false;
     }
     if (session_) return false;
-    const auto np = start_->participantFromForm();
-    if (!np) return false;
+    const auto form = start_->registrationFromForm();
+    if (!form) return false;
     try {
-        context_.store().registerParticipant(*np);
+        context_.store().registerParticipant(form->participant, form->fields);
     } catch (const std::exception& e) {
         start_->setMessage(tr("%1\nNothing was registered; correct the form and press "
                               "Ctrl+Enter again.")
@@ -129,7 +129,7 @@ bool RunView::registerAndStart() {
     }
     start_->clearForm();
     context_.notifyDataChanged();
-    return startSession(q(np->code));
+    return startSession(q(form->participant.code));
 }
 
 bool RunView::startSession(const QString& code) {

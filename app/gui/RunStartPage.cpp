@@ -74,6 +74,10 @@ RunStartPage::RunStartPage(StudyContext& context, QWidget* parent)
     experimenter_ = new QLineEdit(reg);
     experimenter_->setPlaceholderText(tr("recorded with the session"));
     addRow(tr("E&xperimenter:"), experimenter_, tr("Experimenter"));
+    fieldsHost_ = new QWidget(reg); // the protocol's own questions ([[participant_fields]])
+    new QFormLayout(fieldsHost_);
+    fieldsHost_->layout()->setContentsMargins(0, 0, 0, 0);
+    fl->addRow(fieldsHost_);
     auto* registerButton = new QPushButton(tr("Register and start  (Ctrl+Enter)"), reg);
     registerButton->setMinimumHeight(40);
     registerButton->setAccessibleName(tr("Register and start"));
@@ -183,6 +187,7 @@ void RunStartPage::refresh() {
     group_->clear();
     resumeBanner_->hide();
     refreshClips();
+    rebuildParticipantFields();
     if (!context_.hasStudy()) {
         setMessage(tr("No study open: create or open one in the Study view (Ctrl+1)."));
         return;
@@ -234,7 +239,7 @@ void RunStartPage::refresh() {
     }
 }
 
-std::optional<exp::NewParticipant> RunStartPage::participantFromForm() {
+std::optional<Registration> RunStartPage::registrationFromForm() {
     exp::NewParticipant np;
     np.code = code_->text().trimmed().toStdString();
     if (np.code.empty()) {
@@ -257,13 +262,46 @@ std::optional<exp::NewParticipant> RunStartPage::participantFromForm() {
             return std::nullopt;
         }
     }
-    return np;
+    Registration r{np, {}};
+    for (const auto& [id, field] : fields_) {
+        const QString answer = qobject_cast<QComboBox*>(field)
+                                   ? qobject_cast<QComboBox*>(field)->currentData().toString()
+                                   : qobject_cast<QLineEdit*>(field)->text().trimmed();
+        if (!answer.isEmpty()) r.fields[id] = answer.toStdString();
+    }
+    return r;
+}
+
+void RunStartPage::rebuildParticipantFields() {
+    auto* form = static_cast<QFormLayout*>(fieldsHost_->layout());
+    while (form->rowCount() > 0) form->removeRow(0);
+    fields_.clear();
+    if (!context_.hasStudy()) return;
+    for (const auto& f : context_.store().protocol().participantFields) {
+        QWidget* field = nullptr;
+        if (f.options.empty()) {
+            auto* edit = new QLineEdit(fieldsHost_);
+            edit->setPlaceholderText(f.required ? tr("required") : tr("optional"));
+            field = edit;
+        } else {
+            auto* box = new QComboBox(fieldsHost_);
+            box->addItem(f.required ? tr("(choose; required)") : tr("(not given)"), QString());
+            for (const auto& o : f.options) box->addItem(q(o), q(o));
+            field = box;
+        }
+        field->setAccessibleName(q(f.label));
+        auto* label = new QLabel(q(f.label) + ":", fieldsHost_);
+        label->setBuddy(field);
+        form->addRow(label, field);
+        fields_.emplace_back(f.id, field);
+    }
 }
 
 void RunStartPage::clearForm() {
     code_->clear();
     age_->setValue(0);
     overrideReason_->clear();
+    rebuildParticipantFields();
 }
 
 void RunStartPage::fillForm(const QString& code, int age, const QString& gender,

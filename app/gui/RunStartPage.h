@@ -4,12 +4,17 @@
 /// balanced group or an override with its reason, the experimenter), the participants who have
 /// not finished (an interrupted session named in a banner), and for listening tests the clips
 /// every participant hears (checked against their manifest, rendered on a worker thread).
-/// Registering and starting a session are the Run view's; this page only collects and shows.
+/// The protocol's own registration questions ([[participant_fields]]) follow the standard ones,
+/// each named by its label. Registering and starting a session are the Run view's; this page
+/// only collects and shows.
 #include "experiment/Store.h"
 
 #include <QWidget>
 
+#include <map>
 #include <optional>
+#include <string>
+#include <vector>
 
 class QComboBox;
 class QGroupBox;
@@ -24,6 +29,13 @@ namespace underfoot::gui {
 
 class StudyContext;
 
+/// What the form registers: the participant and the answers to the protocol's own
+/// [[participant_fields]] (field id -> answer).
+struct Registration {
+    experiment::NewParticipant participant;
+    std::map<std::string, std::string> fields;
+};
+
 class RunStartPage : public QWidget {
     Q_OBJECT
   public:
@@ -33,8 +45,8 @@ class RunStartPage : public QWidget {
     /// Redraws the group choice, the list of participants to resume and the clip status.
     void refresh();
     /// The participant the form describes, or nullopt with what is missing in the message line
-    /// (and the focus on that field).
-    std::optional<experiment::NewParticipant> participantFromForm();
+    /// (and the focus on that field). The protocol's fields are checked by the store.
+    std::optional<Registration> registrationFromForm();
     /// Empties the form after a registration.
     void clearForm();
     /// The experimenter's name typed in the form ("" when none).
@@ -71,6 +83,7 @@ class RunStartPage : public QWidget {
 
   private:
     void refreshClips();
+    void rebuildParticipantFields();
 
     StudyContext& context_;
     QLineEdit* code_ = nullptr;
@@ -81,6 +94,8 @@ class RunStartPage : public QWidget {
     QComboBox* group_ = nullptr;
     QLineEdit* overrideReason_ = nullptr;
     QLineEdit* experimenter_ = nullptr;
+    QWidget* fieldsHost_ = nullptr;
+    std::vector<std::pair<std::string, QWidget*>> fields_; ///< protocol's field id -> its widget
     QListWidget* resumeList_ = nullptr;
     QLabel* resumeBanner_ = nullptr;
     QLabel* message_ = nullptr;

@@ -343,7 +343,7 @@ void StudyView::refresh() {
     const auto& info = progress.info;
     info_->setText(
         tr("<b>%1</b><br>%2<br>Protocol <tt>%3</tt> v%4 · %5 design · answers lock %6 "
-           "· seed %7 · created %8 · %9 participants")
+           "· seed %7 · created %8 · %9")
             .arg(q(p.title).toHtmlEscaped(), q(p.reference).toHtmlEscaped(), q(info.protocolId))
             .arg(info.protocolVersion)
             .arg(q(exp::toString(p.design)), p.lock == exp::LockRule::OnAnswer
@@ -351,7 +351,8 @@ void StudyView::refresh() {
                                                  : tr("when the next trial starts"))
             .arg(info.seed)
             .arg(q(info.createdAt))
-            .arg(progress.participants.size()));
+            .arg(counted(static_cast<long long>(progress.participants.size()), tr("participant"),
+                         tr("participants"))));
     groups_->setRowCount(static_cast<int>(progress.groups.size()));
     for (std::size_t i = 0; i < progress.groups.size(); ++i) {
         const auto& g = progress.groups[i];

@@ -385,6 +385,25 @@ lock = "answer"
         QCOMPARE(w->context().store().participant("R7").status, ue::ParticipantStatus::Dropped);
     }
 
+    void studySummaryCountsParticipantsInWords() {
+        auto w = makeWindow();
+        const QString file = home_.filePath("plural.db");
+        QVERIFY(
+            createStudy(*w, QString(UNDERFOOT_SOURCE_DIR) + "/protocols/tvcg2011_exp1.toml", file));
+        QLabel* summary = nullptr;
+        for (auto* l : w->studyView()->findChildren<QLabel*>())
+            if (l->accessibleName() == "Study information") summary = l;
+        QVERIFY(summary);
+        QVERIFY2(summary->text().endsWith("· 0 participants"), qPrintable(summary->text()));
+        registerParticipant(*w, "S1");
+        QVERIFY(w->runView()->session());
+        w->runView()->closeSession();
+        QVERIFY2(summary->text().endsWith("· 1 participant"), qPrintable(summary->text()));
+        registerParticipant(*w, "S2");
+        w->runView()->closeSession();
+        QVERIFY2(summary->text().endsWith("· 2 participants"), qPrintable(summary->text()));
+    }
+
     void sessionRunsWhetherOrNotTheAudioOutputStarts() {
         gui::MainWindow::Options o;
         o.dataDir = home_.filePath("data");

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The sound palette's "compare with a recording" and "fit to recording" (issue #13), driven on
+// The sound palette's "compare with a recording" and "fit to recording", driven on
 // Qt's offscreen platform. The "recordings" are renders written to temporary WAV files, so the
 // expected answers are known: a surface against its own render is at distance ~0, against
 // another surface's render far; the level of a recording does not matter; a parameter change
