@@ -138,6 +138,11 @@ int WebStudy::openSessions() const {
     return static_cast<int>(sessions_.size());
 }
 
+bool WebStudy::isInvitation(const std::string& token) const {
+    std::lock_guard lock(mutex_);
+    return invitations_->find(token).has_value();
+}
+
 Invitation WebStudy::invitation(const std::string& token) {
     auto inv = invitations_->find(token);
     if (!inv)

@@ -72,6 +72,9 @@ class WebStudy {
     nlohmann::json finishBreak(const std::string& token, const nlohmann::json& body);
     /// The clip of the participant's current trial.
     ClipFile clip(const std::string& token, int trialIndex);
+    /// Whether `token` opens an invitation of this study (the HTTP layer asks before it reads
+    /// a request's body and keys the rate limit by it).
+    bool isInvitation(const std::string& token) const;
 
     /// Closes every open session as interrupted (resumable); the server's clean stop.
     void stop();
