@@ -12,7 +12,7 @@ PACKAGES=(
   librtaudio-dev libserialport-dev liblo-dev jackd2 libjack-jackd2-dev socat
   # files, CLI, formatting
   libtomlplusplus-dev libcli11-dev libfmt-dev nlohmann-json3-dev
-  # statistics and real-time containers
+  # statistics, real-time containers, and the HTTP server of `underfoot serve` (Beast, Asio)
   libboost-dev
   # mixed-effects models (analysis/stats/MixedModels): linear algebra and optimisation
   libeigen3-dev libnlopt-cxx-dev
@@ -27,9 +27,9 @@ PACKAGES=(
   qt6-svg-dev  # console figures exported as SVG (QSvgGenerator)
   # tests and benchmarks
   googletest libgtest-dev libgmock-dev libbenchmark-dev valgrind
-  # online listening tests (`underfoot serve`, app/web): HTTP server; the browser test drives
-  # Debian's Chromium with puppeteer-core from npm (tests/web/browser)
-  libcpp-httplib-dev chromium
+  # online listening tests: the browser test drives Debian's Chromium with puppeteer-core from
+  # npm (tests/web/browser)
+  chromium
   # fuzzing (libFuzzer: tests/fuzz, scripts/test.sh's fuzz build)
   clang-14 libclang-rt-14-dev
 )
