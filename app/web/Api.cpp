@@ -12,7 +12,6 @@
 #include <cstdint>
 #include <functional>
 #include <mutex>
-#include <regex>
 #include <unordered_set>
 
 namespace underfoot::web {
@@ -70,6 +69,18 @@ const char* errorText(int status) {
     default:
         return "bad request";
     }
+}
+
+/// What follows `prefix` in `path` when it is 1 to `maxLength` characters that all pass
+/// `allowed`; "" otherwise.
+template <typename Allowed>
+std::string suffix(const std::string& path, std::string_view prefix, std::size_t maxLength,
+                   Allowed allowed) {
+    if (path.size() <= prefix.size() || path.size() > prefix.size() + maxLength ||
+        path.compare(0, prefix.size(), prefix) != 0)
+        return {};
+    const std::string rest = path.substr(prefix.size());
+    return std::all_of(rest.begin(), rest.end(), allowed) ? rest : std::string();
 }
 
 /// A link token as `study invite` writes it: 43 characters of base64url (256 bits).
@@ -269,24 +280,25 @@ struct WebApi::Impl {
     }
 
     void route(const HttpRequest& req, HttpAnswer& res) {
-        static const std::regex assetPath(R"(/assets/([A-Za-z0-9_.-]+))");
-        static const std::regex clipPath(R"(/api/clip/([0-9]{1,6}))");
         const bool get = req.method == "GET" || req.method == "HEAD";
         const bool post = req.method == "POST";
         const std::string& p = req.path;
-        std::smatch m;
+        const std::string assetName = suffix(p, "/assets/", 64, [](unsigned char c) {
+            return std::isalnum(c) || c == '_' || c == '.' || c == '-';
+        });
+        const std::string clipIndex =
+            suffix(p, "/api/clip/", 6, [](unsigned char c) { return std::isdigit(c) != 0; });
         if (get && p == "/") {
             res.contentType = "text/plain; charset=utf-8";
             res.body = "Underfoot online study. Please open the personal link you received.\n";
         } else if (get && p == "/p") {
             asset("index.html", res);
-        } else if (get && std::regex_match(p, m, assetPath)) {
+        } else if (get && !assetName.empty()) {
             // Embedded files only, looked up by exact name: no file system access, no listing.
-            const std::string name = m[1];
-            if (name == "index.html" || name.find("..") != std::string::npos)
+            if (assetName == "index.html" || assetName.find("..") != std::string::npos)
                 sendJson(res, 404, {{"error", errorText(404)}});
             else
-                asset(name, res);
+                asset(assetName, res);
         } else if (get && p == "/api/state") {
             api(req, res, [this](const std::string& t, const json&) { return study.state(t); });
         } else if (post && p == "/api/consent") {
@@ -308,11 +320,11 @@ struct WebApi::Impl {
         } else if (post && p == "/api/break") {
             api(req, res,
                 [this](const std::string& t, const json& b) { return study.finishBreak(t, b); });
-        } else if (get && std::regex_match(p, m, clipPath)) {
+        } else if (get && !clipIndex.empty()) {
             // The clip of the participant's current trial, by trial index (never by file name,
             // which would tell the answer; never a path from the request).
             ClipFile clip;
-            if (!guarded(req, res, [&] { clip = study.clip(bearer(req), std::stoi(m[1].str())); }))
+            if (!guarded(req, res, [&] { clip = study.clip(bearer(req), std::stoi(clipIndex)); }))
                 return;
             res.headers.emplace_back("Cache-Control", "private, no-store");
             res.contentType = clip.contentType;
