@@ -17,11 +17,26 @@ namespace underfoot::analysis {
 using nlohmann::json;
 
 const std::vector<std::string>& statsTestNames() {
-    static const std::vector<std::string> names{
-        "binom",   "chisq",   "chisq_gof", "fisher",   "friedman", "glmm",
-        "kendall", "kruskal", "levene",    "lmm",      "p_adjust", "pairwise_wilcoxon",
-        "pearson", "prop",    "shapiro",   "spearman", "t",        "wilcoxon",
-        "wilson"};
+    static const std::vector<std::string> names{"binom",
+                                                "chisq",
+                                                "chisq_gof",
+                                                "clmm",
+                                                "fisher",
+                                                "friedman",
+                                                "glmm",
+                                                "kendall",
+                                                "kruskal",
+                                                "levene",
+                                                "lmm",
+                                                "p_adjust",
+                                                "pairwise_wilcoxon",
+                                                "pearson",
+                                                "prop",
+                                                "shapiro",
+                                                "spearman",
+                                                "t",
+                                                "wilcoxon",
+                                                "wilson"};
     return names;
 }
 

@@ -299,7 +299,8 @@ std::string audioSettingsToToml(const AudioSettings& s) {
         }
         return out + "\"";
     };
-    std::string t = "# Underfoot audio settings (docs/live.md). Channel numbers start at 1.\n";
+    std::string t =
+        "# Underfoot audio settings (docs/reference/settings.md). Channel numbers start at 1.\n";
     t += "[audio]\n";
     t += fmt::format("api = {}\n", q(s.api));
     t += fmt::format("device = {}\n", q(s.device));
