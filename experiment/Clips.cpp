@@ -62,7 +62,7 @@ std::vector<ClipJob> clipJobs(const Protocol& protocol, const std::string& clipD
 
 namespace {
 std::string manifestPath(const std::string& clipDir) {
-    return (std::filesystem::path(clipDir) / kClipManifest).string();
+    return (std::filesystem::path(clipDir) / kClipManifest).lexically_normal().string();
 }
 std::vector<std::string> splitComma(const std::string& line) {
     std::vector<std::string> out;
@@ -86,13 +86,13 @@ void writeClipManifest(const std::string& clipDir, const std::vector<ClipRecord>
     const std::string path = manifestPath(clipDir);
     std::ofstream out(path, std::ios::binary | std::ios::trunc);
     if (!out) throw std::runtime_error(fmt::format("{}: cannot write the clip manifest", path));
-    out << "stimulus_id,file,source,seed,seconds,sample_rate_hz,frames,sha256\n";
+    out << "stimulus_id,file,source,seed,seconds,sample_rate_hz,frames,sha256,samples_sha256\n";
     for (const auto& r : records) {
         if (r.file.find(',') != std::string::npos)
             throw std::runtime_error(
                 fmt::format("{}: clip file name '{}' contains a comma", path, r.file));
-        out << fmt::format("{},{},{},{},{},{},{},{}\n", r.stimulusId, r.file, toString(r.source),
-                           r.seed, r.seconds, r.sampleRateHz, r.frames, r.sha256);
+        out << fmt::format("{},{},{},{},{},{},{},{},{}\n", r.stimulusId, r.file, toString(r.source),
+                           r.seed, r.seconds, r.sampleRateHz, r.frames, r.sha256, r.samplesSha256);
     }
     if (!out) throw std::runtime_error(fmt::format("{}: writing the clip manifest failed", path));
 }
@@ -109,9 +109,10 @@ std::vector<ClipRecord> readClipManifest(const std::string& clipDir) {
         if (!line.empty() && line.back() == '\r') line.pop_back();
         if (lineNo == 1 || line.empty()) continue;
         const auto cells = splitComma(line);
-        if (cells.size() != 8)
+        if (cells.size() != 8 && cells.size() != 9)
             throw std::runtime_error(fmt::format(
-                "{}:{}: expected 8 comma-separated fields, found {}", path, lineNo, cells.size()));
+                "{}:{}: expected 9 comma-separated fields (8 in older manifests), found {}", path,
+                lineNo, cells.size()));
         ClipRecord r;
         r.stimulusId = cells[0];
         r.file = cells[1];
@@ -147,6 +148,7 @@ std::vector<ClipRecord> readClipManifest(const std::string& clipDir) {
         real(cells[5], "sample_rate_hz", r.sampleRateHz);
         whole(cells[6], "frames", r.frames);
         r.sha256 = cells[7];
+        if (cells.size() == 9) r.samplesSha256 = cells[8];
         out.push_back(std::move(r));
     }
     return out;
@@ -173,9 +175,9 @@ std::vector<std::string> checkClips(const Protocol& protocol, const std::string&
         }
         const auto it = manifest.find(job.stimulus.id);
         if (it == manifest.end()) {
-            problems.push_back(fmt::format("clip {} is not in the manifest {}/{}; render the "
+            problems.push_back(fmt::format("clip {} is not in the manifest {}; render the "
                                            "clips again with `underfoot clips`",
-                                           job.path, clipDir, kClipManifest));
+                                           job.path, manifestPath(clipDir)));
             continue;
         }
         if (it->second.seed != job.seed)
@@ -184,8 +186,8 @@ std::vector<std::string> checkClips(const Protocol& protocol, const std::string&
                                            job.path, it->second.seed, job.seed));
         else if (fileSha256(job.path) != it->second.sha256)
             problems.push_back(fmt::format("clip {} changed since it was rendered (SHA-256 "
-                                           "differs from {}/{}); render the clips again",
-                                           job.path, clipDir, kClipManifest));
+                                           "differs from {}); render the clips again",
+                                           job.path, manifestPath(clipDir)));
     }
     return problems;
 }
@@ -203,15 +205,49 @@ ClipPlayer::ClipPlayer(const Protocol& protocol, std::string clipDir, PlayFuncti
     for (auto& r : readClipManifest(clipDir_)) manifest_[r.stimulusId] = std::move(r);
 }
 
+const ClipRecord* ClipPlayer::record(const std::string& stimulusId) const {
+    const auto it = manifest_.find(stimulusId);
+    return it == manifest_.end() ? nullptr : &it->second;
+}
+
 StimulusStart ClipPlayer::start(const Stimulus& stimulus, std::uint64_t) {
     const std::string path = clipPath(stimulus, clipDir_);
     if (!std::filesystem::exists(path))
-        throw StoreError(fmt::format("clip of stimulus '{}' is missing: {}", stimulus.id, path));
+        throw StoreError(fmt::format("the clip of this trial is missing: {}", path));
+    const ClipRecord* r = record(stimulus.id);
+    if (!r && stimulus.clip) {
+        // A lab-supplied file that `underfoot clips` has not recorded yet: stored by name only
+        // (`underfoot clips` records its length and samples for replay).
+        lastPath_ = path;
+        ++presentations_;
+        if (play_) play_(path);
+        StimulusStart started;
+        started.renderSeed = clipSeed(protocol_, stimulus);
+        started.clip = PlayedClip{*stimulus.clip, 0.0, 0, 0.0, ""};
+        return started;
+    }
+    if (!r)
+        throw StoreError(fmt::format("{} is not in the manifest {}; render the clips again "
+                                     "with `underfoot clips`",
+                                     path, manifestPath(clipDir_)));
+    // What is played is what the manifest describes (and what the trial will store).
+    if (fileSha256(path) != r->sha256)
+        throw StoreError(fmt::format("{} changed since it was rendered (SHA-256 differs from "
+                                     "{}); render the clips again",
+                                     path, manifestPath(clipDir_)));
     lastPath_ = path;
     ++presentations_;
     if (play_) play_(path);
-    const auto it = manifest_.find(stimulus.id);
-    return {it != manifest_.end() ? it->second.seed : clipSeed(protocol_, stimulus), std::nullopt};
+    StimulusStart started;
+    started.renderSeed = r->seed;
+    PlayedClip c;
+    c.file = r->file;
+    c.seconds = r->sampleRateHz > 0 ? static_cast<double>(r->frames) / r->sampleRateHz : 0.0;
+    c.frames = r->frames;
+    c.sampleRateHz = r->sampleRateHz;
+    c.samplesSha256 = r->samplesSha256;
+    started.clip = c;
+    return started;
 }
 
 void ClipPlayer::stop() {

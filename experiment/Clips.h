@@ -48,16 +48,18 @@ struct ClipRecord {
     double seconds = 0.0;
     double sampleRateHz = 0.0;
     std::size_t frames = 0;
-    std::string sha256; ///< of the file's bytes
+    std::string sha256;        ///< of the file's bytes
+    std::string samplesSha256; ///< of its float32 samples (wiring::samplesSha256); "" in old
+                               ///< manifests
 };
 
 /// The manifest file name inside a clip folder.
 inline constexpr const char* kClipManifest = "clips.csv";
 /// Writes `clipDir/clips.csv` (stimulus_id,file,source,seed,seconds,sample_rate_hz,frames,
-/// sha256).
+/// sha256,samples_sha256); `seconds` is the file's length, frames / sample_rate_hz.
 void writeClipManifest(const std::string& clipDir, const std::vector<ClipRecord>& records);
-/// Reads `clipDir/clips.csv`; an absent manifest gives an empty list. Throws std::runtime_error
-/// naming file:line for a malformed one.
+/// Reads `clipDir/clips.csv` (8 columns in manifests written before samples_sha256); an absent
+/// manifest gives an empty list. Throws std::runtime_error naming file:line for a malformed one.
 std::vector<ClipRecord> readClipManifest(const std::string& clipDir);
 /// SHA-256 of a file's bytes (lower-case hex). Throws std::runtime_error when unreadable.
 std::string fileSha256(const std::string& path);
@@ -67,8 +69,11 @@ std::string fileSha256(const std::string& path);
 std::vector<std::string> checkClips(const Protocol& protocol, const std::string& clipDir);
 
 /// Presents pre-rendered and lab-supplied clips. The audio itself is the application's: the
-/// `play` callback receives each file path (the GUI wires its audio output; the terminal and
-/// simulations pass none). The render seed reported is the clip's seed from the manifest.
+/// `play` callback receives each file path (the GUI and the terminal wire their audio output;
+/// the web server and simulations pass none: the browser fetches the clip). Every start checks
+/// the file against the manifest's SHA-256 (a replaced file is refused) and reports the clip's
+/// seed from the manifest as the render seed, and the clip itself (StimulusStart::clip), which
+/// the session stores with the trial.
 class ClipPlayer final : public StimulusPlayer {
   public:
     using PlayFunction = std::function<void(const std::string& path)>;
@@ -81,6 +86,9 @@ class ClipPlayer final : public StimulusPlayer {
     const std::string& lastPath() const { return lastPath_; }
     /// Number of start() calls (first presentations and replays).
     int presentations() const { return presentations_; }
+    /// The manifest row of a stimulus's clip (nullptr when absent).
+    const ClipRecord* record(const std::string& stimulusId) const;
+    const std::string& clipDir() const { return clipDir_; }
 
   private:
     const Protocol& protocol_;

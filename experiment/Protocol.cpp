@@ -673,13 +673,32 @@ Protocol parseProtocol(const std::string& text, const std::string& sourceName,
 
     // [protocol]
     if (auto t = r.table(root, "protocol", "the protocol file", true)) {
-        r.checkKeys(*t, {"id", "version", "title", "reference", "description"}, "[protocol]");
+        r.checkKeys(*t,
+                    {"id", "version", "title", "participant_title", "reference", "briefing",
+                     "notes", "description"},
+                    "[protocol]");
         p.id = r.id(*t, "id", "[protocol]", true).value_or("");
         p.version =
             static_cast<int>(r.integer(*t, "version", "[protocol]", true, 1, 1000000).value_or(1));
         p.title = r.string(*t, "title", "[protocol]", true).value_or("");
         p.reference = r.string(*t, "reference", "[protocol]", false).value_or("");
-        p.description = r.string(*t, "description", "[protocol]", false).value_or("");
+        p.participantTitle = r.string(*t, "participant_title", "[protocol]", false).value_or("");
+        p.briefing = r.string(*t, "briefing", "[protocol]", false).value_or("");
+        p.notes = r.string(*t, "notes", "[protocol]", false).value_or("");
+        if (auto d = r.string(*t, "description", "[protocol]", false)) {
+            const toml::node& where = *t->get("description");
+            if (t->get("notes"))
+                r.problem(where, "[protocol] has both 'description' and 'notes'; 'description' "
+                                 "is the older name of 'notes': keep one");
+            else
+                p.notes = *d;
+            p.warnings.push_back(
+                {sourceName, static_cast<int>(where.source().begin.line),
+                 static_cast<int>(where.source().begin.column),
+                 "'description' in [protocol] is read as 'notes' (the experimenter's notes, never "
+                 "shown to participants); rename it to 'notes', and put what participants read "
+                 "in 'briefing'"});
+        }
     }
 
     // [design]

@@ -193,13 +193,36 @@ struct Timing {
     double breakS = 60.0;
 };
 
+/// One problem found while loading a protocol.
+struct ProtocolProblem {
+    std::string file;
+    int line = 0;
+    int column = 0;
+    std::string message;
+    /// A consequence of an earlier problem (listed after the root causes).
+    bool derived = false;
+    /// "file:line:column: message".
+    std::string toString() const;
+};
+
 /// A loaded, validated protocol.
 struct Protocol {
     std::string id;
     int version = 1;
+    /// The study's title (the experimenter's screens, reports).
     std::string title;
+    /// The title participants see (web pages, participant window); empty: a neutral "Listening
+    /// study" / "Study". Never the study's title by default: it may name the design.
+    std::string participantTitle;
     std::string reference;
-    std::string description;
+    /// What participants read before the first trial ([protocol] briefing; optional: empty
+    /// gives a neutral briefing made from the questions).
+    std::string briefing;
+    /// The experimenter's notes ([protocol] notes; the older `description` is read as notes):
+    /// never shown to a participant.
+    std::string notes;
+    /// Non-fatal remarks found while loading (deprecated keys), for `protocol check`.
+    std::vector<ProtocolProblem> warnings;
     DesignKind design = DesignKind::Within;
     std::vector<Stimulus> stimuli;
     std::vector<Group> groups;
@@ -225,16 +248,6 @@ struct Protocol {
     const Stimulus* stimulus(const std::string& stimulusId) const;
     const Group* group(const std::string& groupId) const;
     const ParticipantField* participantField(const std::string& fieldId) const;
-};
-
-/// One problem found while loading a protocol.
-struct ProtocolProblem {
-    std::string file;
-    int line = 0;
-    int column = 0;
-    std::string message;
-    /// "file:line:column: message".
-    std::string toString() const;
 };
 
 /// Thrown when a protocol has problems; carries every problem found.

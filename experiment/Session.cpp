@@ -90,7 +90,7 @@ void Session::play() {
     playing_ = true;
     try {
         store_.markTrialStarted(participant_.code, t.index, sessionNumber_, started.renderSeed,
-                                started.grfRecording);
+                                started.grfRecording, started.clip);
     } catch (...) {
         player_.stop();
         playing_ = false;

@@ -25,6 +25,8 @@ struct StimulusStart {
     std::optional<std::string> grfRecording;
     /// Reference of the trial's sensor log (frames, step events, GRFs), when one is written.
     std::optional<std::string> sensorLog = std::nullopt;
+    /// The clip presented (listening tests): stored with the trial for replay.
+    std::optional<PlayedClip> clip = std::nullopt;
 };
 
 /// Plays stimuli described as data. Implementations: the engine (app), a fake (tests), a

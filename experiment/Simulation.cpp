@@ -285,7 +285,21 @@ class SimulationPlayer final : public StimulusPlayer {
     SimulationPlayer(const Protocol& protocol, std::string walker)
         : protocol_(protocol), walker_(std::move(walker)) {}
     StimulusStart start(const Stimulus& stimulus, std::uint64_t plannedSeed) override {
-        if (protocol_.clips.enabled) return {clipSeed(protocol_, stimulus), std::nullopt};
+        if (protocol_.clips.enabled) {
+            // The clip as `underfoot clips` renders it at 48 kHz (its seed and length), so that
+            // replay renders a simulated trial's clip like any other; no samples hash, since no
+            // file was played.
+            StimulusStart started;
+            started.renderSeed = clipSeed(protocol_, stimulus);
+            if (!stimulus.clip) {
+                const double rate = 48000.0;
+                const auto frames =
+                    static_cast<std::uint64_t>(std::llround(protocol_.clips.seconds * rate));
+                started.clip = PlayedClip{clipPath(stimulus, ""),
+                                          static_cast<double>(frames) / rate, frames, rate, ""};
+            }
+            return started;
+        }
         // A sensor stimulus (microphones, shoes, gyroscopes) has no person walking: the
         // simulated participant walks as the virtual walker, for the protocol's trial time, and
         // that control stream is what the trial records (replay regenerates it from the seed).
@@ -360,8 +374,7 @@ int runSimulatedSession(StudyStore& store, const std::string& code, const Confus
                 }
                 const TrialAnswer a = answerer.answer(trial);
                 simulatedTimeS += answerer.responseTimeS();
-                for (const auto& [scaleId, value] : a.ratings) session.rate(scaleId, value);
-                session.submitRatings(a.comment);
+                session.answer(a); // every question of the trial: surface, scales, soundscape
             } else {
                 session.play();
                 // A resumed trial continues from the laps already walked.

@@ -45,8 +45,10 @@ struct AnswerSavedButNotCopied : StoreError {
 /// the sensor log reference and sensor-fault interruptions; version 4 flags simulated
 /// participants and stores with each session whether sound was played; version 5 adds the
 /// online tables of `underfoot serve` (experiment/Invitations.h); version 6 (issue #16) adds
-/// session leases: one live session per participant. Older studies are migrated when opened.
-inline constexpr int kSchemaVersion = 6;
+/// session leases: one live session per participant; version 7 stores the clip each
+/// listening-test trial played (PlayedClip). Older studies are migrated when opened
+/// (docs/reference/store-schema.md).
+inline constexpr int kSchemaVersion = 7;
 
 /// Time source (injectable for tests).
 struct Clock {
@@ -176,6 +178,16 @@ struct TrialAudioStats {
     std::uint64_t droppedGrfFrames = 0; ///< GRF frames lost by the recording (0 = complete)
 };
 
+/// The clip a listening-test trial played: what replay renders again and compares.
+struct PlayedClip {
+    std::string file;          ///< relative to the clip folder
+    double seconds = 0;        ///< the file's length (frames / rate)
+    std::uint64_t frames = 0;  ///< frames of the file
+    double sampleRateHz = 0;   ///< the file's rate
+    std::string samplesSha256; ///< SHA-256 of its float32 samples (wiring::samplesSha256)
+    bool operator==(const PlayedClip&) const = default;
+};
+
 /// A stored trial.
 struct TrialRecord {
     std::string participant;
@@ -208,6 +220,8 @@ struct TrialRecord {
     int interruptions = 0;
     /// The last interruption's fault reason ("" when never interrupted).
     std::string interruptionReason;
+    /// The clip played (listening tests; nullopt otherwise).
+    std::optional<PlayedClip> clip;
 };
 
 /// Everything needed to re-render a trial exactly.
@@ -221,6 +235,8 @@ struct ReplayInfo {
     std::optional<std::string> grfRecording;
     std::string audioConfig;
     std::string sensorConfig;
+    /// The clip the trial played (listening tests).
+    std::optional<PlayedClip> clip;
 };
 
 /// One journal entry.
@@ -311,10 +327,11 @@ class StudyStore {
     /// Index of the first unanswered trial, or nullopt when all are answered.
     std::optional<int> firstUnanswered(const std::string& code) const;
 
-    /// Records that a trial's stimulus started (render seed, GRF recording reference); locks the
-    /// previous trial's answer under the "next_trial" rule.
+    /// Records that a trial's stimulus started (render seed, GRF recording reference, the clip
+    /// of a listening test); locks the previous trial's answer under the "next_trial" rule.
     void markTrialStarted(const std::string& code, int trialIndex, int sessionNumber,
-                          std::uint64_t renderSeed, const std::optional<std::string>& grfRecording);
+                          std::uint64_t renderSeed, const std::optional<std::string>& grfRecording,
+                          const std::optional<PlayedClip>& clip = std::nullopt);
     /// Records the sensor log reference of a started trial (the path like grfRecording).
     void setSensorLog(const std::string& code, int trialIndex, const std::string& sensorLog);
     /// Stores the audio figures of a trial's last presentation (replacing earlier ones).

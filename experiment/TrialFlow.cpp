@@ -24,6 +24,18 @@ std::string trialLabel(int index, int count, bool practice) {
     return fmt::format("{} {} of {}", practice ? "Practice trial" : "Trial", index + 1, count);
 }
 
+std::string participantTitle(const Protocol& protocol) {
+    if (!protocol.participantTitle.empty()) return protocol.participantTitle;
+    return protocol.clips.enabled ? "Listening study" : "Study";
+}
+
+std::string consentBriefing(const Protocol& protocol) {
+    if (!protocol.briefing.empty()) return protocol.briefing;
+    if (protocol.clips.enabled)
+        return "You will hear short sound clips and answer a few questions about each one.";
+    return "You will take part in a short study and answer a few questions after each trial.";
+}
+
 TrialFlow::TrialFlow(StudyStore& store, Session& session) : store_(store), session_(session) {
     reset();
 }
@@ -358,6 +370,7 @@ std::string TrialFlow::participantBriefing() const {
         practice += t.practice ? 1 : 0;
     }
     std::string text;
+    if (!p.briefing.empty()) text += p.briefing + "\n\n";
     if (p.clips.enabled)
         text += fmt::format("You will hear {} sound clips{}.", total,
                             practice ? fmt::format(" ({} for practice first)", practice) : "");

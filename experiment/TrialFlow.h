@@ -65,6 +65,14 @@ std::vector<std::string> anchorTexts(const Scale& scale);
 /// "Trial 3 of 40" / "Practice trial 1 of 40" (1-based; `index` is the stored 0-based index).
 std::string trialLabel(int index, int count, bool practice);
 
+/// The title participants see: the protocol's participant_title, else "Listening study" for
+/// listening tests and "Study" otherwise (never the study's own title, which may name the design).
+std::string participantTitle(const Protocol& protocol);
+
+/// What a participant reads before registering (the web consent page): the protocol's briefing,
+/// else a neutral sentence made from the kind of test.
+std::string consentBriefing(const Protocol& protocol);
+
 /// What the participant's screen may show. Built only from the protocol's questions, the
 /// session's progress and the participant's own draft: never the stimulus (its id, surface,
 /// soundscape, input), the order of the plan, the group or the experimenter's notes.

@@ -109,8 +109,8 @@ int runClips(const ClipsArgs& a) {
                    (fs::path(a.output) / r.file).string());
     const double elapsed =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-    fmt::print("clips: {} clips in {} ({:.1f} s); manifest {}/{}\n", records.size(), a.output,
-               elapsed, a.output, exp::kClipManifest);
+    fmt::print("clips: {} clips in {} ({:.1f} s); manifest {}\n", records.size(), a.output, elapsed,
+               (fs::path(a.output) / exp::kClipManifest).lexically_normal().string());
     if (a.live) playClips(a, jobs);
     return 0;
 }

@@ -28,7 +28,8 @@ int runReplay(ReplayArgs a) {
         throw UserError(std::string("replay: ") + e.what());
     }
     fmt::print("{} -> {}\n", r.description, a.output);
-    return 0;
+    // A replay that is not what was heard must not pass for it (exit 1; the file is kept).
+    return r.matchesHeard == false ? 1 : 0;
 }
 
 CommandRegistrar reg("replay", [](CLI::App& app, int& exitCode) {
@@ -52,6 +53,9 @@ CommandRegistrar reg("replay", [](CLI::App& app, int& exitCode) {
     cmd->add_option("--block", q.blockSize,
                     "render block size (default: the live trial's; else 256)")
         ->check(CLI::Range(1, 65536));
+    cmd->add_option("--clips", q.clipsDir,
+                    "clip folder, for a trial that played a lab-supplied clip (default: the "
+                    "session's)");
     cmd->add_option("-o,--output", args->output, "output .wav")->required();
     cmd->callback([args, &exitCode] { exitCode = runReplay(*args); });
 });

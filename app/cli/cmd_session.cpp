@@ -8,6 +8,7 @@
 #include "app/wiring/Adapters.h"
 #include "app/wiring/ClipPlayer.h"
 #include "app/wiring/Players.h"
+#include "app/wiring/SessionRig.h"
 #include "base/Version.h"
 #include "engine/control/StepCalibration.h"
 #include "engine/control/StepGrfPlayer.h"
@@ -22,6 +23,7 @@
 #include "experiment/Session.h"
 #include "experiment/Simulation.h"
 #include "experiment/Store.h"
+#include "experiment/TrialFlow.h"
 
 #include <fmt/core.h>
 
@@ -69,99 +71,37 @@ namespace wir = underfoot::wiring;
 
 std::string askLine(const std::string& prompt);
 
-/// The audio device, the sensors and the player of a live session (all optional parts stay
-/// null when not asked for). Torn down sensors first (their reader threads push steps into the
-/// player's step queues: stopping them after the player was a use-after-free ASan found), then
-/// the player, then the engine.
-struct LiveRig {
-    std::unique_ptr<wir::ClipAudio> clipAudio; ///< listening tests: clips through the device
-    std::shared_ptr<eng::SerialSource> shoes;
-    std::shared_ptr<eng::StepInput> steps;
-    std::shared_ptr<eng::OscGyroReceiver> gyros;
-    std::unique_ptr<eng::LiveEngine> engine;
-    std::unique_ptr<wir::LivePlayer> player;
-    ~LiveRig() {
-        if (shoes) shoes->stop();
-        if (gyros) gyros->stop();
-        clipAudio.reset();
-        player.reset();
-        if (engine) engine->close();
-    }
-};
-
-/// Opens the audio device for a listening test's clips (no sensors, no footstep player).
-std::unique_ptr<LiveRig> openClipRig(const Options& o) {
-    auto rig = std::make_unique<LiveRig>();
-    eng::AudioSettings settings;
-    try {
-        if (!o.settings.empty()) settings = eng::loadAudioSettings(o.settings);
-        rig->engine = std::make_unique<eng::LiveEngine>();
-        rig->engine->open(settings);
-        rig->engine->start();
-    } catch (const std::exception& e) {
-        throw UserError(std::string("session --live: no sound can be played: ") + e.what());
-    }
-    rig->clipAudio = std::make_unique<wir::ClipAudio>(*rig->engine);
-    fmt::print("live audio: clips play through {} / {} at {} Hz, block {}\n",
-               rig->engine->openedApi(), rig->engine->openedDevice(),
-               rig->engine->settings().sampleRateHz, rig->engine->settings().blockSize);
-    return rig;
+wir::SessionRigOptions rigOptions(const Options& o) {
+    wir::SessionRigOptions r;
+    r.settingsFile = o.settings;
+    r.studyFile = o.study;
+    r.recordings = o.recordings;
+    r.serial = o.serial;
+    r.baud = o.baud;
+    r.thresholds = o.thresholds;
+    r.stepSeed = o.stepSeed;
+    r.oscPort = o.oscPort;
+    return r;
 }
 
-std::unique_ptr<LiveRig> openLiveRig(const Options& o) {
-    auto rig = std::make_unique<LiveRig>();
-    eng::AudioSettings settings;
+std::unique_ptr<wir::SessionRig> openClipRig(const Options& o) {
     try {
-        if (!o.settings.empty()) settings = eng::loadAudioSettings(o.settings);
-    } catch (const std::exception& e) {
-        throw UserError(std::string("session --settings: ") + e.what());
-    }
-    const std::filesystem::path studyFolder = std::filesystem::absolute(o.study).parent_path();
-    wir::LivePlayerOptions options;
-    options.studyFolder = studyFolder.string();
-    options.recordingFolder =
-        o.recordings.empty() ? (studyFolder / "recordings").string() : o.recordings;
-    try {
-        if (!o.serial.empty()) {
-            eng::SerialConfig config;
-            config.path = o.serial;
-            config.baud = o.baud;
-            rig->shoes = std::make_shared<eng::SerialSource>(config);
-            eng::StepGrfPlayerConfig playerConfig;
-            playerConfig.seed = o.stepSeed;
-            auto player = std::make_shared<eng::StepGrfPlayer>(
-                eng::StepGrfPlayer::loadDefaultBank(settings.sampleRateHz), playerConfig);
-            rig->steps = std::make_shared<eng::StepInput>(
-                o.thresholds.empty() ? eng::StepThresholds{}
-                                     : eng::loadStepThresholds(o.thresholds));
-            rig->steps->attach(*rig->shoes, player.get());
-            rig->shoes->start();
-            options.scene.fsrSource = std::make_shared<wir::StepGrfSource>(player);
-            options.shoes = rig->shoes;
-            options.shoeSteps = rig->steps;
-        }
-        if (o.oscPort >= 0) {
-            eng::OscGyroConfig config;
-            config.port = o.oscPort;
-            rig->gyros = std::make_shared<eng::OscGyroReceiver>(config);
-            rig->gyros->start();
-            options.scene.gyroReceiver = rig->gyros;
-        }
-        rig->engine = std::make_unique<eng::LiveEngine>();
-        rig->engine->open(settings);
-        rig->engine->start();
-    } catch (const UserError&) {
-        throw;
+        auto rig = wir::SessionRig::openForClips(rigOptions(o));
+        fmt::print("live audio: clips play through {}\n", rig->summary());
+        return rig;
     } catch (const std::exception& e) {
         throw UserError(std::string("session --live: no sound can be played: ") + e.what());
     }
-    rig->player = std::make_unique<wir::LivePlayer>(*rig->engine, std::move(options));
-    fmt::print("live audio: {} / {} at {} Hz, block {}{}{}\n", rig->engine->openedApi(),
-               rig->engine->openedDevice(), rig->engine->settings().sampleRateHz,
-               rig->engine->settings().blockSize,
-               rig->shoes ? fmt::format(", FSR shoes on {}", o.serial) : "",
-               rig->gyros ? fmt::format(", gyroscopes on UDP {}", rig->gyros->port()) : "");
-    return rig;
+}
+
+std::unique_ptr<wir::SessionRig> openLiveRig(const Options& o) {
+    try {
+        auto rig = wir::SessionRig::openLive(rigOptions(o));
+        fmt::print("live audio: {}\n", rig->summary());
+        return rig;
+    } catch (const std::exception& e) {
+        throw UserError(std::string("session --live: no sound can be played: ") + e.what());
+    }
 }
 
 /// While the session is paused by a sensor fault: says why, and resumes when the experimenter
@@ -204,50 +144,71 @@ std::string askLine(const std::string& prompt) {
     return line;
 }
 
-std::string askOption(const std::string& prompt, const std::vector<AnswerOption>& options) {
-    fmt::print("{}\n", prompt);
-    for (const auto& o : options) fmt::print("  {}. {}\n", o.letter, o.label);
-    while (true) {
-        const std::string line = askLine("letter> ");
-        if (line.size() == 1)
-            for (const auto& o : options)
-                if (o.letter == line[0]) return o.id;
-        fmt::print("expected one of the letters {}-{} (or 'quit' to interrupt)\n",
-                   options.front().letter, options.back().letter);
-    }
-}
-
 std::string anchorsText(const Scale& s) {
-    if (s.anchors.empty()) return fmt::format("{} .. {}", s.min, s.max);
     std::string out;
-    for (const auto& [value, label] : s.anchors)
-        out += fmt::format("{}{} = {}", out.empty() ? "" : ", ", value, label);
-    return fmt::format("{} .. {}; {}", s.min, s.max, out);
+    for (const auto& text : anchorTexts(s)) out += (out.empty() ? "" : ", ") + text;
+    return out;
 }
 
-int askScale(const Scale& s, bool replayable = false) {
+/// Asks one question of the trial flow until the flow takes the answer. 'r' replays the clip of a
+/// listening test (counted); 'quit' interrupts.
+void askSection(TrialFlow& flow, const AnswerSection& section, bool clips) {
     while (true) {
-        const std::string line =
-            askLine(s.anchors.empty() ? fmt::format("{} [{} {} .. {} {}]> ", s.prompt, s.min,
-                                                    s.minLabel, s.max, s.maxLabel)
-                                      : fmt::format("{} [{}]> ", s.prompt, anchorsText(s)));
-        if (replayable && line == "r") return s.min - 1; // caller replays the clip
-        try {
+        if (section.kind == SectionKind::Scale) {
+            const Scale& s = *section.scale;
+            const std::string line =
+                askLine(s.anchors.empty() ? fmt::format("{} [{} {} .. {} {}]> ", s.prompt, s.min,
+                                                        s.minLabel, s.max, s.maxLabel)
+                                          : fmt::format("{} [{} .. {}; {}]> ", s.prompt, s.min,
+                                                        s.max, anchorsText(s)));
+            if (clips && line == "r") {
+                if (const auto r = flow.replay(); !r) fmt::print("{}\n", r.message);
+                continue;
+            }
+            int v = 0;
             std::size_t used = 0;
-            const int v = std::stoi(line, &used);
-            if (used == line.size() && v >= s.min && v <= s.max) return v;
-        } catch (const std::exception&) {
+            try {
+                v = std::stoi(line, &used);
+            } catch (const std::exception&) {
+                used = 0;
+            }
+            if (used == 0 || used != line.size()) {
+                fmt::print("expected a whole number from {} to {}\n", s.min, s.max);
+                continue;
+            }
+            const auto r = flow.setRating(s.id, v);
+            if (r) return;
+            fmt::print("{}\n", r.message);
+            continue;
         }
-        fmt::print("expected a whole number from {} to {}\n", s.min, s.max);
+        fmt::print("{}\n", section.prompt);
+        for (const auto& option : section.options)
+            fmt::print("  {}. {}\n", option.letter, option.label);
+        const std::string line = askLine(clips ? "letter (r: listen again)> " : "letter> ");
+        if (clips && line == "r") {
+            if (const auto r = flow.replay(); !r) fmt::print("{}\n", r.message);
+            continue;
+        }
+        if (line.size() == 1) {
+            const auto r = flow.choose(section.kind, line[0]);
+            if (r) return;
+            fmt::print("{}\n", r.message);
+            continue;
+        }
+        fmt::print("expected one of the letters {}-{} (or 'quit' to interrupt)\n",
+                   section.options.front().letter, section.options.back().letter);
     }
 }
 
+/// The terminal's session: a thin adapter of experiment::TrialFlow. It prints the participant's
+/// screen model (heading, text, questions) and forwards what is typed; the experimenter's lines
+/// (stimulus, group, clip file) appear only with --show-stimulus and are marked as such.
 int runInteractive(const Options& o) {
     StudyStore store = StudyStore::open(o.study);
     if (!o.protocol.empty()) store.verifyProtocol(loadProtocol(o.protocol));
     const Protocol& p = store.protocol();
     {
-        // Issue #17: a session records only real people's answers, never a simulation's.
+        // A session records only real people's answers, never a simulation's.
         const ParticipantInfo who = store.participant(o.participant);
         if (who.simulated)
             throw UserError(fmt::format("session: participant {} is a simulated participant "
@@ -261,19 +222,21 @@ int runInteractive(const Options& o) {
                                     "FOLDER (made by `underfoot clips --protocol ... -o "
                                     "FOLDER`)",
                                     p.id));
-    std::unique_ptr<LiveRig> rig;
+    std::unique_ptr<wir::SessionRig> rig;
     if (o.live) rig = p.clips.enabled ? openClipRig(o) : openLiveRig(o);
     std::unique_ptr<ClipPlayer> clipPlayer;
     if (p.clips.enabled) {
-        ClipPlayer::PlayFunction play = [](const std::string& path) {
-            fmt::print("  [no sound: clip {}]\n", path);
+        const bool show = o.showStimulus;
+        ClipPlayer::PlayFunction play = [show](const std::string& path) {
+            fmt::print("  [no sound: the clip would play now{}]\n",
+                       show ? " — experimenter: " + path : std::string());
         };
         std::function<void()> stop;
         if (rig) {
             wir::ClipAudio* audio = rig->clipAudio.get();
-            play = [audio](const std::string& path) {
+            play = [audio, show](const std::string& path) {
                 audio->play(path);
-                fmt::print("  [playing {}]\n", path);
+                fmt::print("  [playing{}]\n", show ? " — experimenter: " + path : std::string());
             };
             stop = [audio] { audio->stop(); };
         }
@@ -290,103 +253,88 @@ int runInteractive(const Options& o) {
                     {o.experimenter, o.live ? o.audio : "none (data entry, no sound)",
                      o.clips.empty() ? o.sensor : "clips " + o.clips, underfoot::base::version(),
                      o.live, o.takeOver});
-    const Questions& q = p.questions;
-    fmt::print("{} — participant {} (group {}), session {}{}\n", p.title, o.participant,
-               session.participant().groupId, session.sessionNumber(),
+    TrialFlow flow(store, session);
+    fmt::print("{} — participant {}, session {}{}{}\n", participantTitle(p), o.participant,
+               session.sessionNumber(),
                session.resumed() ? fmt::format(", resuming at trial {} of {}",
                                                session.current().index + 1, session.trialCount())
-                                 : "");
+                                 : "",
+               o.showStimulus
+                   ? fmt::format(" [experimenter: group {}]", session.participant().groupId)
+                   : "");
     int shownBlock = 0;
     try {
         while (session.phase() != SessionPhase::Finished) {
-            switch (session.phase()) {
-            case SessionPhase::Briefing:
-                if (!p.description.empty()) fmt::print("\n{}\n", p.description);
+            const ParticipantScreen screen = flow.participantScreen();
+            switch (screen.page) {
+            case ParticipantScreen::Page::Briefing:
+                fmt::print("\n{}\n\n{}\n", screen.heading, screen.text);
                 askLine("\nBriefing done? Press Enter to start. ");
                 session.finishBriefing();
-                break;
-            case SessionPhase::Break:
-                askLine("\nBreak. Press Enter to continue. ");
+                flow.reset();
+                continue;
+            case ParticipantScreen::Page::Break:
+                fmt::print("\n{}. {}\n", screen.heading, screen.text);
+                askLine("Press Enter to continue. ");
                 session.finishBreak();
+                flow.reset();
+                continue;
+            case ParticipantScreen::Page::Finished:
+            case ParticipantScreen::Page::Waiting:
+                continue;
+            case ParticipantScreen::Page::Trial:
                 break;
-            case SessionPhase::Practice:
-            case SessionPhase::Trial: {
-                const TrialRecord t = session.current();
-                fmt::print("\n{} {} of {}{}\n", t.practice ? "Practice trial" : "Trial",
-                           t.index + 1, session.trialCount(),
-                           o.showStimulus ? fmt::format(" — stimulus {}", t.stimulus.id) : "");
-                if (p.clips.enabled) {
-                    if (p.ordering.blocks == BlockKind::Scale && !t.practice &&
-                        t.block != shownBlock && !session.askedScales().empty()) {
-                        shownBlock = t.block;
-                        fmt::print("\nPart {} of {}: {}\n", t.block, q.scales.size(),
-                                   session.askedScales().front()->prompt);
-                    }
-                    askLine("Press Enter to play the clip. ");
-                    session.presentClip();
-                    while (true) {
-                        for (const Scale* s : session.askedScales()) {
-                            int v = 0;
-                            while ((v = askScale(*s, p.clips.replay)) < s->min) {
-                                session.presentClip();
-                                fmt::print("  (replay {})\n", session.replayCount());
-                            }
-                            session.rate(s->id, v);
-                        }
-                        const std::string comment =
-                            q.comment ? askLine("comment (Enter for none)> ") : std::string();
-                        try {
-                            session.submitRatings(comment);
-                        } catch (const StoreError& e) {
-                            fmt::print("not stored: {}\n", e.what());
-                            continue;
-                        }
-                        break;
-                    }
-                    if (o.ack) fmt::print("ack {} {}\n", o.participant, t.index + 1);
-                    break;
+            }
+            const TrialRecord t = session.current();
+            fmt::print("\n{}{}\n", screen.heading,
+                       o.showStimulus ? fmt::format(" [experimenter: stimulus {}]", t.stimulus.id)
+                                      : "");
+            if (p.clips.enabled && p.ordering.blocks == BlockKind::Scale && !t.practice &&
+                t.block != shownBlock && !session.askedScales().empty()) {
+                shownBlock = t.block;
+                fmt::print("\nPart {} of {}: {}\n", t.block, p.questions.scales.size(),
+                           session.askedScales().front()->prompt);
+            }
+            if (!session.playing()) {
+                askLine(p.clips.enabled ? "Press Enter to play the clip. "
+                                        : "Press Enter to start the stimulus. ");
+                if (const auto r = flow.start(); !r) {
+                    fmt::print("not started: {}\n", r.message);
+                    if (session.paused()) waitOutSensorFault(session);
+                    flow.reset();
+                    continue;
                 }
-                askLine("Press Enter to start the stimulus. ");
-                session.play();
-                bool faulted = false;
-                for (int lap = session.lapsDone(); lap < session.lapCount(); ++lap) {
-                    askLine(
-                        fmt::format("Lap {} of {} ({}). Press Enter when it is walked. ", lap + 1,
-                                    session.lapCount(),
+            }
+            bool faulted = false;
+            while (session.lapsDone() < session.lapCount()) {
+                askLine(fmt::format("Lap {} of {} ({}). Press Enter when it is walked. ",
+                                    session.lapsDone() + 1, session.lapCount(),
                                     session.currentLapSilent() ? "silent baseline" : "with sound"));
-                    if ((faulted = session.checkSensors())) break;
-                    session.completeLap();
-                }
-                if (faulted || session.checkSensors()) {
-                    waitOutSensorFault(session);
-                    break; // the same trial again, from the start
-                }
-                while (true) {
-                    TrialAnswer a;
-                    if (q.asksSurface()) a.answer = askOption(q.surfacePrompt, q.surfaceOptions);
-                    for (const Scale* s : session.askedScales()) a.ratings[s->id] = askScale(*s);
-                    if (q.asksSoundscape(session.participant().groupId))
-                        a.soundscapeAnswer = askOption(q.soundscapePrompt, q.soundscapeOptions);
-                    if (q.comment) a.comment = askLine("comment (Enter for none)> ");
-                    if (session.checkSensors()) break; // nothing stored: the trial comes again
-                    try {
-                        session.answer(a);
-                    } catch (const StoreError& e) {
-                        fmt::print("not stored: {}\n", e.what());
-                        continue;
-                    }
-                    if (o.ack) fmt::print("ack {} {}\n", o.participant, t.index + 1);
-                    break;
-                }
+                if ((faulted = session.checkSensors())) break;
+                if (const auto r = flow.completeLap(); !r) fmt::print("{}\n", r.message);
+            }
+            if (faulted || session.checkSensors()) {
+                waitOutSensorFault(session);
+                flow.reset();
+                continue; // the same trial again, from the start
+            }
+            for (const AnswerSection& section : flow.sections())
+                askSection(flow, section, p.clips.enabled);
+            if (p.questions.comment) flow.setComment(askLine("comment (Enter for none)> "));
+            if (session.checkSensors()) { // nothing stored: the trial comes again
+                waitOutSensorFault(session);
+                flow.reset();
+                continue;
+            }
+            if (const auto r = flow.commit(); !r) {
+                fmt::print("not stored: {}\n", r.message);
                 if (session.paused()) {
                     waitOutSensorFault(session);
-                    break;
+                    flow.reset();
                 }
-                break;
+                continue; // the same trial: its questions again
             }
-            case SessionPhase::Finished:
-                break;
-            }
+            if (o.ack) fmt::print("ack {} {}\n", o.participant, t.index + 1);
         }
     } catch (const Interrupted&) {
         session.interrupt();

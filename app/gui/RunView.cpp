@@ -711,7 +711,7 @@ void RunView::showPhase() {
                 .arg(session_->trialCount())
                 .arg(practice)
                 .arg(answerKeyShown_ ? tr("<p><b>Experimenter's notes:</b> %1</p>")
-                                           .arg(q(p.description).toHtmlEscaped().replace("\n", " "))
+                                           .arg(q(p.notes).toHtmlEscaped().replace("\n", " "))
                                      : QString(),
                      participantText));
         pages_->setCurrentIndex(BriefingPage);

@@ -2,6 +2,8 @@
 #include "app/web/WebStudy.h"
 #include "base/Version.h"
 
+#include "experiment/TrialFlow.h"
+
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -115,6 +117,12 @@ WebStudy::WebStudy(const std::string& studyPath, WebOptions options)
         throw std::runtime_error(fmt::format("{}: clips missing (render them with `underfoot "
                                              "clips --protocol ... -o {}`):{}",
                                              options_.clipsDir, options_.clipsDir, missing));
+    try {
+        player_ = std::make_unique<ClipPlayer>(store_.protocol(), options_.clipsDir);
+    } catch (const StoreError& e) {
+        throw std::runtime_error(
+            fmt::format("{}: the clips cannot be served:\n{}", options_.clipsDir, e.what()));
+    }
     invitations_ = std::make_unique<Invitations>(store_);
 }
 
@@ -191,7 +199,7 @@ Session* WebStudy::session(const Invitation& inv) {
     settings.appVersion = underfoot::base::version();
     std::unique_ptr<Session> s;
     try {
-        s = std::make_unique<Session>(store_, code, player_, settings);
+        s = std::make_unique<Session>(store_, code, *player_, settings);
     } catch (const StoreError&) {
         return nullptr; // every trial answered: marked completed by the session
     }
@@ -243,7 +251,9 @@ json WebStudy::stateOf(const Invitation& inv) {
     const Protocol& protocol = store_.protocol();
     json j;
     j["participant"] = inv.participantCode;
-    j["study"] = {{"title", protocol.title}, {"description", protocol.description}};
+    // What participants may read about the study: never its title or notes, which may name the
+    // design (groups, conditions), only the participant-facing title and briefing.
+    j["study"] = {{"title", participantTitle(protocol)}, {"briefing", consentBriefing(protocol)}};
     std::optional<ParticipantInfo> p;
     try {
         p = store_.participant(inv.participantCode);
@@ -570,6 +580,24 @@ ClipFile WebStudy::clip(const std::string& token, int trialIndex) {
     if (!fs::is_regular_file(file, ec))
         refuse(inv, trial, "clip", 404,
                fmt::format("clip: the clip of trial index {} is missing", trial));
+    // Only the file the manifest describes (and the trial stores): a replaced file, or a hard
+    // link to another file put in its place, is refused.
+    const ClipRecord* record = player_->record(stimulus.id);
+    std::string hash;
+    try {
+        hash = fileSha256(file.string());
+    } catch (const std::exception&) {
+    }
+    if (!stimulus.clip && (!record || hash != record->sha256))
+        refuse(inv, trial, "clip", 409,
+               fmt::format("clip: the clip of trial index {} does not match the clip manifest; "
+                           "the experimenter must render the clips again",
+                           trial));
+    if (stimulus.clip && record && hash != record->sha256)
+        refuse(inv, trial, "clip", 409,
+               fmt::format("clip: the clip of trial index {} changed since it was recorded in "
+                           "the clip manifest",
+                           trial));
     return {file.string(), contentTypeOf(file), fs::file_size(file, ec)};
 }
 

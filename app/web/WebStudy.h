@@ -4,10 +4,13 @@
 /// participant's link token and a JSON body and returns JSON, or throws ApiError (status code
 /// and a message for the page). It drives one experiment::Session per participant (the same
 /// plans, lock rule, replay counts and ratings as the terminal session and the console) with a
-/// silent player: the browser plays the clip, the server stores what happened.
+/// ClipPlayer that plays nothing (the browser fetches and plays the clip) but stores, with each
+/// trial, the clip's seed, length and samples' SHA-256 from the manifest, as the booth does. A
+/// clip is served only while its file matches the manifest.
 ///
 /// Everything is validated against the protocol before it is stored; a refused request of a
 /// known participant is journaled ("online_refused"). One mutex serialises the store.
+#include "experiment/Clips.h"
 #include "experiment/Invitations.h"
 #include "experiment/Session.h"
 #include "experiment/Store.h"
@@ -102,7 +105,7 @@ class WebStudy {
     mutable std::mutex mutex_;
     experiment::StudyStore store_;
     std::unique_ptr<experiment::Invitations> invitations_;
-    experiment::SilentPlayer player_;
+    std::unique_ptr<experiment::ClipPlayer> player_;
     std::map<std::string, std::unique_ptr<experiment::Session>> sessions_;
     /// The last play id of each participant (trial:attempt), for idempotent presentations.
     std::map<std::string, std::string> lastPresent_;

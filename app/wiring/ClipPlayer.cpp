@@ -1,9 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "app/wiring/ClipPlayer.h"
 
-#include "engine/render/Renderer.h"
+#include "app/wiring/StimulusRender.h"
 #include "engine/scene/LiveScene.h"
-#include "engine/wading/Wading.h"
 
 #include <fmt/core.h>
 
@@ -18,30 +17,6 @@ namespace exp = underfoot::experiment;
 namespace fs = std::filesystem;
 
 namespace {
-
-// The same renders as `underfoot clips` (app/cli/cmd_clips.cpp), so a folder made here and one
-// made there hold the same samples for the same protocol and rate.
-eng::AudioBuffer renderFootsteps(const exp::ClipJob& job, double rate) {
-    std::string spec;
-    for (const auto& [key, value] : exp::parameterStrings(job.stimulus.input.walker))
-        spec += fmt::format("{}{}={}", spec.empty() ? "" : ",", key, value);
-    const auto walker = spec.empty() ? eng::WalkerParameters{} : eng::WalkerParameters::parse(spec);
-    const auto grf = eng::walkerGrf(walker, job.seconds, rate, job.seed);
-    eng::RenderOptions options;
-    options.sampleRateHz = rate;
-    options.seed = job.seed;
-    options.tailSeconds = 0.5;
-    if (job.stimulus.reverb) options.scene.impulseResponse = *job.stimulus.reverb;
-    return eng::renderSurface(job.stimulus.surface, grf, options).audio;
-}
-
-eng::AudioBuffer renderWadingClip(const exp::ClipJob& job, double rate) {
-    eng::WadingOptions options =
-        eng::wadingOptionsFromParameters(exp::parameterStrings(job.stimulus.wading));
-    options.seed = job.seed;
-    options.sampleRateHz = rate;
-    return eng::renderWading(options, job.seconds);
-}
 
 /// A whole clip held in memory, played once as the scene's stereo ambience.
 class ClipAmbience final : public eng::AmbienceSource {
@@ -103,20 +78,25 @@ renderClipFolder(const exp::Protocol& protocol, const std::string& clipDir, doub
         r.source = job.source;
         r.seed = job.seed;
         try {
+            eng::AudioBuffer audio;
             if (job.source == exp::ClipSource::Lab) {
-                const auto audio = eng::readAudioFile(job.path);
-                r.sampleRateHz = audio.sampleRateHz;
-                r.frames = audio.frames();
-                r.seconds = static_cast<double>(r.frames) / audio.sampleRateHz;
+                audio = eng::readAudioFile(job.path);
             } else {
-                const auto audio = job.source == exp::ClipSource::Wading
-                                       ? renderWadingClip(job, sampleRateHz)
-                                       : renderFootsteps(job, sampleRateHz);
-                eng::writeAudioFile(job.path, audio);
-                r.sampleRateHz = audio.sampleRateHz;
-                r.frames = audio.frames();
-                r.seconds = job.seconds;
+                // The whole stimulus (soundscape included) through the one renderer, exactly
+                // job.seconds long, stored as float so that the file holds the rendered samples
+                // and a replay of a trial that played it gives them back bit for bit.
+                StimulusRender q;
+                q.stimulus = job.stimulus;
+                q.seed = job.seed;
+                q.sampleRateHz = sampleRateHz;
+                q.clipSeconds = job.seconds;
+                audio = renderStimulus(q);
+                eng::writeAudioFile(job.path, audio, eng::SampleFormat::Float32);
             }
+            r.sampleRateHz = audio.sampleRateHz;
+            r.frames = audio.frames();
+            r.seconds = static_cast<double>(r.frames) / audio.sampleRateHz;
+            r.samplesSha256 = samplesSha256(audio);
         } catch (const std::exception& e) {
             throw std::runtime_error(fmt::format("clip of stimulus '{}' ({}): {}", job.stimulus.id,
                                                  protocol.sourceName, e.what()));

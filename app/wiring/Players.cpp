@@ -2,13 +2,11 @@
 #include "app/wiring/Players.h"
 
 #include "app/wiring/Adapters.h"
+#include "app/wiring/StimulusRender.h"
 #include "engine/io/sensors/OscGyroReceiver.h"
 #include "engine/io/sensors/SensorClock.h"
 #include "engine/io/sensors/SensorLog.h"
 #include "engine/render/Renderer.h"
-#include "engine/render/SafetyLimiter.h"
-#include "soundscapes/Library.h"
-#include "soundscapes/Renderer.h"
 
 #include <fmt/format.h>
 
@@ -384,57 +382,14 @@ std::optional<exp::TrialAudioStats> LivePlayer::stoppedTrialStats() const {
     return a;
 }
 
-eng::AudioBuffer renderStimulusFromGrf(const exp::Stimulus& stimulus, const eng::GrfSignal& grf,
-                                       std::uint64_t seed, double rate, int blockSize) {
-    eng::RenderOptions options;
-    options.sampleRateHz = rate;
-    options.blockSize = blockSize;
-    options.seed = seed;
-    options.tailSeconds = 1.0;
-    if (stimulus.reverb) options.scene.impulseResponse = *stimulus.reverb;
-    // The live engine limits each output after the soundscape is mixed in: so does the replay.
-    options.limit = false;
-    auto r = eng::renderSurface(stimulus.surface, grf, options);
-    if (stimulus.soundscape && stimulus.modalities != exp::Modalities::Haptic) {
-        // As the live scene mixes it: same seed, unity gain.
-        soundscapes::SoundscapeRenderer ambience(soundscapes::loadSoundscape(*stimulus.soundscape));
-        ambience.prepare({rate, 1024});
-        ambience.reset(seed);
-        const std::size_t n = r.audio.frames();
-        std::vector<float> l(n), rr(n);
-        ambience.process(l.data(), rr.data(), static_cast<int>(n));
-        for (std::size_t i = 0; i < n; ++i) {
-            r.audio.samples[2 * i] += l[i];
-            r.audio.samples[2 * i + 1] += rr[i];
-        }
-    }
-    const std::size_t n = r.audio.frames();
-    std::vector<float> l(n), rr(n);
-    for (std::size_t i = 0; i < n; ++i) {
-        l[i] = r.audio.samples[2 * i];
-        rr[i] = r.audio.samples[2 * i + 1];
-    }
-    eng::StereoSafetyLimiter limiter;
-    limiter.prepare(rate);
-    limiter.process(l.data(), rr.data(), static_cast<int>(n));
-    for (std::size_t i = 0; i < n; ++i) {
-        r.audio.samples[2 * i] = l[i];
-        r.audio.samples[2 * i + 1] = rr[i];
-    }
-    return std::move(r.audio);
-}
-
-eng::AudioBuffer renderStimulus(const exp::Stimulus& stimulus, std::uint64_t seed, double seconds,
-                                double rate, int blockSize) {
-    const auto walker = stimulus.input.kind == exp::InputKind::Walker
-                            ? walkerFromStimulus(stimulus.input.walker)
-                            : eng::WalkerParameters{};
-    return renderStimulusFromGrf(stimulus, eng::walkerGrf(walker, seconds, rate, seed), seed, rate,
-                                 blockSize);
-}
-
 exp::StimulusStart OfflinePlayer::start(const exp::Stimulus& stimulus, std::uint64_t plannedSeed) {
-    last_ = renderStimulus(stimulus, plannedSeed, seconds_, rate_);
+    StimulusRender q;
+    q.stimulus = stimulus;
+    q.seed = plannedSeed;
+    q.sampleRateHz = rate_;
+    q.blockSize = 64;
+    q.walkSeconds = seconds_;
+    last_ = renderStimulus(q);
     return {plannedSeed, std::nullopt};
 }
 

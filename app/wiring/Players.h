@@ -8,9 +8,9 @@
 ///    folder, so `underfoot replay` re-renders the trial), and submits it to a running
 ///    LiveEngine with the engine's crossfade; stop() fades it out, waits for the audio thread to
 ///    hand it back and closes the recording.
-///  - OfflinePlayer: renders a stimulus to memory (the GUI palette's preview, headless runs):
-///    the virtual walker for `seconds`, the offline renderer, the soundscape mixed in as
-///    `underfoot replay` does. Sensor stimuli are previewed with the default walker.
+///  - OfflinePlayer: renders a stimulus to memory (the GUI palette's preview, headless runs)
+///    through the one offline renderer (StimulusRender.h). Sensor stimuli are previewed with
+///    the default walker.
 #include "app/wiring/WadingSource.h"
 #include "engine/control/StepInput.h"
 #include "engine/io/AudioFile.h"
@@ -153,20 +153,6 @@ class LivePlayer final : public experiment::StimulusPlayer {
     std::thread sensorLogThread_;
     std::atomic<bool> sensorLogRunning_{false};
 };
-
-/// Renders `stimulus` offline: `seconds` of the walker (the stimulus's, or the default walker
-/// for sensor inputs) plus a 1 s tail, stereo at `sampleRateHz`, block `blockSize`.
-engine::AudioBuffer renderStimulus(const experiment::Stimulus& stimulus, std::uint64_t seed,
-                                   double seconds, double sampleRateHz = 48000.0,
-                                   int blockSize = 64);
-
-/// The offline twin of a footstep LiveScene: `grf` through the stimulus's surface (the
-/// stimulus's impulse response, or the preset's reverb) plus a 1 s tail, with the soundscape
-/// mixed in at unity gain from the same seed (not for haptic-only stimuli, whose scenes have no
-/// headphone mix). What renderStimulus and the trial replay render.
-engine::AudioBuffer renderStimulusFromGrf(const experiment::Stimulus& stimulus,
-                                          const engine::GrfSignal& grf, std::uint64_t seed,
-                                          double sampleRateHz, int blockSize);
 
 /// A player that renders each started stimulus to memory (lastRender()).
 class OfflinePlayer final : public experiment::StimulusPlayer {

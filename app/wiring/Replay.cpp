@@ -2,6 +2,7 @@
 #include "app/wiring/Replay.h"
 
 #include "app/wiring/Players.h"
+#include "app/wiring/StimulusRender.h"
 #include "engine/control/GrfFile.h"
 #include "engine/render/Renderer.h"
 #include "engine/scene/WadingNode.h"
@@ -35,6 +36,58 @@ LiveMeters readMetersFile(const fs::path& recording) {
     return parseLiveMeters(text.str(), meters.string());
 }
 
+/// A listening-test trial: the clip it played, rendered again from the stimulus, its seed and
+/// length through the one renderer (a lab-supplied clip is read from the clip folder), and its
+/// samples compared with the SHA-256 stored with the trial.
+ReplayRender replayClip(const ReplayRequest& q, const exp::ReplayInfo& info) {
+    const exp::PlayedClip& clip = *info.clip;
+    ReplayRender out;
+    out.seed = info.renderSeed;
+    out.clipSha256 = clip.samplesSha256;
+    try {
+        if (info.stimulus.clip) {
+            std::string dir = q.clipsDir;
+            if (dir.empty() && info.sensorConfig.rfind("clips ", 0) == 0)
+                dir = info.sensorConfig.substr(6);
+            if (dir.empty())
+                throw ReplayError(fmt::format(
+                    "trial {} of {} played the lab-supplied clip `{}`; give the clip folder "
+                    "(--clips DIR) to read it back",
+                    q.trial + 1, q.participant, clip.file));
+            out.audio = eng::readAudioFile((fs::path(dir) / clip.file).string());
+        } else {
+            if (!(clip.sampleRateHz >= 8000 && clip.sampleRateHz <= 384000) || clip.frames == 0)
+                throw ReplayError(fmt::format("trial {} of {}: the stored clip has no usable "
+                                              "length or rate ({} frames at {} Hz)",
+                                              q.trial + 1, q.participant, clip.frames,
+                                              clip.sampleRateHz));
+            StimulusRender render;
+            render.stimulus = info.stimulus;
+            render.seed = info.renderSeed;
+            render.sampleRateHz = clip.sampleRateHz;
+            render.clipSeconds = static_cast<double>(clip.frames) / clip.sampleRateHz;
+            out.audio = renderStimulus(render);
+        }
+    } catch (const ReplayError&) {
+        throw;
+    } catch (const std::exception& e) {
+        throw ReplayError(e.what());
+    }
+    out.sampleRateHz = out.audio.sampleRateHz;
+    out.blockSize = 256;
+    const std::string hash = samplesSha256(out.audio);
+    if (!clip.samplesSha256.empty()) out.matchesHeard = hash == clip.samplesSha256;
+    out.description = fmt::format(
+        "{} trial {} (clip {}): {:.2f} s, seed {}; {}", info.participant, info.trialIndex + 1,
+        clip.file, double(out.audio.frames()) / out.sampleRateHz, out.seed,
+        !out.matchesHeard ? "no samples hash was stored with the trial (an older study)"
+        : *out.matchesHeard
+            ? "the samples are those the participant heard (SHA-256 " + hash.substr(0, 12) + ")"
+            : "DIFFERENT from the clip the participant heard (SHA-256 " + hash.substr(0, 12) +
+                  ", stored " + clip.samplesSha256.substr(0, 12) + ")");
+    return out;
+}
+
 } // namespace
 
 LiveMeters parseLiveMeters(const std::string& text, const std::string& file) {
@@ -62,6 +115,7 @@ ReplayRender renderTrialReplay(const ReplayRequest& q) {
         throw ReplayError(e.what());
     }
     const auto& stimulus = info.stimulus;
+    if (info.clip) return replayClip(q, info);
     if (stimulus.clip)
         throw ReplayError(fmt::format(
             "trial {} of {} played the lab-supplied clip `{}` (in the study's clip folder); that "
@@ -120,7 +174,13 @@ ReplayRender renderTrialReplay(const ReplayRequest& q) {
                 source = "recorded gait " + recording->string() +
                          " on its 100 Hz grid (no arrivals file: not sample-exact)";
             } else {
-                out.audio = eng::renderWading(options, q.walkSeconds);
+                StimulusRender render;
+                render.stimulus = stimulus;
+                render.seed = info.renderSeed;
+                render.sampleRateHz = rate;
+                render.blockSize = out.blockSize;
+                render.walkSeconds = q.walkSeconds;
+                out.audio = renderStimulus(render);
                 source = fmt::format("virtual gait, {} steps/min", options.cadenceStepsPerMin);
             }
             out.description = fmt::format("{} trial {} (wading): {:.1f} s from {}, seed {}",
@@ -159,7 +219,13 @@ ReplayRender renderTrialReplay(const ReplayRequest& q) {
                 "it, so what was heard cannot be re-rendered exactly",
                 q.trial + 1, q.participant));
         }
-        out.audio = renderStimulusFromGrf(stimulus, grf, info.renderSeed, rate, out.blockSize);
+        StimulusRender render;
+        render.stimulus = stimulus;
+        render.seed = info.renderSeed;
+        render.sampleRateHz = rate;
+        render.blockSize = out.blockSize;
+        render.grf = &grf;
+        out.audio = renderStimulus(render);
         out.description =
             fmt::format("{} trial {} ({}{}{}): {:.1f} s from {}, render seed {}, block {}{}",
                         info.participant, info.trialIndex + 1, stimulus.surface,

@@ -29,6 +29,8 @@ struct ReplayRequest {
     double walkSeconds = 10; ///< length when a virtual walker or gait drove the trial
     std::optional<double> sampleRateHz; ///< default: the live trial's, else 48 kHz
     std::optional<int> blockSize;       ///< default: the live trial's, else 256
+    /// Clip folder, for trials that played a lab-supplied clip (default: the session's).
+    std::string clipsDir;
 };
 
 struct ReplayRender {
@@ -37,6 +39,10 @@ struct ReplayRender {
     std::uint64_t seed = 0;
     double sampleRateHz = 0;
     int blockSize = 0;
+    /// Listening-test trials: whether the samples are those of the clip the participant heard
+    /// (SHA-256 stored with the trial); nullopt when the trial stored none.
+    std::optional<bool> matchesHeard;
+    std::string clipSha256; ///< the stored samples hash ("" when none)
 };
 
 /// What the live engine wrote next to a trial's recording, `<recording>.meters.toml`
@@ -48,8 +54,10 @@ struct LiveMeters {
 /// Parses the text of a `.meters.toml` file; throws ReplayError naming `file`:line:column.
 LiveMeters parseLiveMeters(const std::string& text, const std::string& file);
 
-/// Renders one stored trial. Throws ReplayError with a message naming the study, the trial and
-/// what is missing (a live sensor trial without recording, a lab-supplied clip, a bad file).
+/// Renders one stored trial. A listening-test trial renders its clip again (the same stimulus,
+/// seed and length through the one renderer) and says whether the samples are those heard.
+/// Throws ReplayError with a message naming the study, the trial and what is missing (a live
+/// sensor trial without recording, a lab-supplied clip without its folder, a bad file).
 ReplayRender renderTrialReplay(const ReplayRequest& request);
 
 } // namespace underfoot::wiring

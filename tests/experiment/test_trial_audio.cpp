@@ -57,7 +57,10 @@ TrialAnswer answerFor(const TrialRecord& t) {
 /// Turns a current file back into what version `version` (1 or 2) wrote.
 void downgrade(const std::string& path, int version) {
     SQLite::Database db(path, SQLite::OPEN_READWRITE);
-    db.exec("DROP TABLE IF EXISTS session_leases"); // version 6's (issue #16)
+    for (const char* column : // version 7's: the clip a listening-test trial played
+         {"clip_file", "clip_seconds", "clip_frames", "clip_sample_rate_hz", "clip_sha256"})
+        db.exec(std::string("ALTER TABLE trials DROP COLUMN ") + column);
+    db.exec("DROP TABLE IF EXISTS session_leases"); // version 6's
     db.exec("DROP TABLE IF EXISTS online_answers"); // version 5's (issue #14)
     db.exec("DROP TABLE IF EXISTS online_sessions");
     db.exec("DROP TABLE IF EXISTS online_invitations");

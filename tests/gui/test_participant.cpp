@@ -90,7 +90,7 @@ class ParticipantTest : public QObject {
         QCOMPARE(run->pageName(), QString("briefing"));
 
         // Briefing: the participant reads the questions, not the notes, title or group.
-        const QString notesStart = QString::fromStdString(p.description).left(40);
+        const QString notesStart = QString::fromStdString(p.notes).left(40);
         QVERIFY(!notesStart.isEmpty());
         QVERIFY2(!run->briefingText().contains(notesStart), qPrintable(run->briefingText()));
         QString briefing = pw->visibleTexts().join("\n");

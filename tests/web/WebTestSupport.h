@@ -5,6 +5,7 @@
 // connect from any loopback address (127.0.0.0/8), so that tests can play many clients.
 #include "app/web/Server.h"
 #include "app/web/WebStudy.h"
+#include "experiment/Clips.h"
 #include "experiment/Invitations.h"
 #include "experiment/Protocol.h"
 #include "experiment/Store.h"
@@ -109,7 +110,24 @@ struct StudyFixture {
         experiment::Invitations inv(store);
         links = inv.create(store, invites, std::nullopt);
         fs::create_directories(clips);
-        for (const auto& s : p.stimuli) writeWav(experiment::clipPath(s, clips));
+        std::vector<experiment::ClipRecord> manifest;
+        for (const auto& s : p.stimuli) {
+            const std::string path = experiment::clipPath(s, clips);
+            writeWav(path);
+            // The manifest `underfoot clips` writes (a test tone stands for the render): the
+            // server serves and stores only clips that match it.
+            experiment::ClipRecord r;
+            r.stimulusId = s.id;
+            r.file = fs::path(path).filename().string();
+            r.source = s.clip ? experiment::ClipSource::Lab : experiment::ClipSource::Footsteps;
+            r.seed = experiment::clipSeed(p, s);
+            r.sampleRateHz = 48000;
+            r.frames = 4800;
+            r.seconds = 0.1;
+            r.sha256 = experiment::fileSha256(path);
+            manifest.push_back(r);
+        }
+        experiment::writeClipManifest(clips, manifest);
     }
 };
 

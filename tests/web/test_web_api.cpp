@@ -38,8 +38,12 @@ TEST(WebApi, ParticipantRunsFromConsentToCompletionCode) {
     ASSERT_EQ(r.status, 200) << r.raw;
     EXPECT_EQ(r.body["phase"], "consent");
     EXPECT_EQ(r.body["fields"][0]["id"], "listening_device");
-    // The protocol's texts are sent as data (the page shows them with textContent).
-    EXPECT_EQ(r.body["study"]["title"], "Web <b>identification</b> & \"escape\"");
+    // Participants read the participant-facing title and briefing, never the study's title or
+    // the experimenter's notes (sent as data; the page shows them with textContent).
+    EXPECT_EQ(r.body["study"]["title"], "Listening study");
+    EXPECT_EQ(r.body["study"]["briefing"],
+              "You will hear short sound clips and answer a few questions about each one.");
+    EXPECT_EQ(r.raw.find("identification"), std::string::npos);
     json state = startParticipant(c);
     ASSERT_EQ(state["phase"], "practice") << state.dump();
     EXPECT_TRUE(state["trial"]["practice"]);

@@ -169,7 +169,7 @@
     show(el('h1', { text: (s.study && s.study.title) || 'Listening test' }),
          el('div', { class: 'card' },
             el('h2', { text: 'Information' }),
-            el('p', { class: 'lead', text: (s.study && s.study.description) || '' }),
+            el('p', { class: 'lead', text: (s.study && s.study.briefing) || '' }),
             el('p', { text: 'Please use headphones in a quiet room. The test starts with a short headphone check and a volume setting.' })),
          form);
     onKeys(null);
