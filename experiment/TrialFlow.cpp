@@ -40,12 +40,21 @@ TrialFlow::TrialFlow(StudyStore& store, Session& session) : store_(store), sessi
     reset();
 }
 
+FlowResult TrialFlow::holdRefusal() const {
+    if (session_.paused())
+        return {Refusal::Paused,
+                fmt::format("paused by a sensor fault: {}", session_.pauseReason())};
+    if (held_) return {Refusal::Paused, "paused by the experimenter (resume first)"};
+    return {};
+}
+
 bool TrialFlow::inTrial() const {
     const SessionPhase p = session_.phase();
     return p == SessionPhase::Trial || p == SessionPhase::Practice;
 }
 
 void TrialFlow::reset() {
+    refusedDone_ = Refusal::None;
     revising_.reset();
     revisedTrial_.reset();
     draft_ = {};
@@ -106,6 +115,7 @@ FlowResult TrialFlow::chooseLetter(char letter) {
 }
 
 FlowResult TrialFlow::choose(SectionKind kind, char letter) {
+    if (const FlowResult hold = holdRefusal(); !hold) return hold;
     const int section = firstSection(kind);
     if (section < 0 || kind == SectionKind::Scale)
         return {Refusal::NotAllowed, "this trial does not ask that question"};
@@ -123,6 +133,7 @@ FlowResult TrialFlow::choose(SectionKind kind, char letter) {
 FlowResult TrialFlow::typeDigit(int digit) {
     if (sections_.empty() || digit < 0 || digit > 9)
         return {Refusal::NotInTrial, "no rating is asked now"};
+    if (const FlowResult hold = holdRefusal(); !hold) return hold;
     int section = active_;
     if (sections_[static_cast<std::size_t>(section)].kind != SectionKind::Scale) {
         section = -1;
@@ -154,7 +165,7 @@ FlowResult TrialFlow::typeDigit(int digit) {
 }
 
 void TrialFlow::adjust(int delta) {
-    if (sections_.empty()) return;
+    if (sections_.empty() || !holdRefusal()) return;
     const auto& s = sections_[static_cast<std::size_t>(active_)];
     if (s.kind != SectionKind::Scale) return;
     const Scale& sc = *s.scale;
@@ -165,6 +176,7 @@ void TrialFlow::adjust(int delta) {
 }
 
 FlowResult TrialFlow::setRating(const std::string& scaleId, int value) {
+    if (const FlowResult hold = holdRefusal(); !hold) return hold;
     for (std::size_t i = 0; i < sections_.size(); ++i) {
         const auto& s = sections_[i];
         if (s.kind != SectionKind::Scale || s.scale->id != scaleId) continue;
@@ -184,11 +196,47 @@ std::vector<std::string> TrialFlow::problems() const {
     return store_.checkAnswer(session_.participant().groupId, draft_, t.stimulus, t.block);
 }
 
+std::vector<int> TrialFlow::unansweredSections() const {
+    std::vector<int> open;
+    for (std::size_t i = 0; i < sections_.size(); ++i) {
+        const AnswerSection& s = sections_[i];
+        const bool answered = s.kind == SectionKind::Surface ? !draft_.answer.empty()
+                              : s.kind == SectionKind::Soundscape
+                                  ? !draft_.soundscapeAnswer.empty()
+                                  : draft_.ratings.count(s.scale->id);
+        if (!answered) open.push_back(static_cast<int>(i));
+    }
+    return open;
+}
+
+FlowResult TrialFlow::pause() {
+    if (!inTrial()) return {Refusal::NotInTrial, "no trial is current"};
+    if (held_) return {Refusal::NotAllowed, "the session is paused already"};
+    held_ = true; // held even when the journal cannot be written
+    try {
+        store_.journal("paused", session_.participant().code, session_.current().index, "{}");
+    } catch (const std::exception& e) {
+        return {Refusal::Failed, std::string("paused, but not journaled: ") + e.what()};
+    }
+    return {};
+}
+
+FlowResult TrialFlow::resume() {
+    if (!held_) return {Refusal::NotAllowed, "the session is not paused"};
+    held_ = false;
+    try {
+        store_.journal("resumed", session_.participant().code,
+                       inTrial() ? std::optional<int>(session_.current().index) : std::nullopt,
+                       "{}");
+    } catch (const std::exception& e) {
+        return {Refusal::Failed, std::string("resumed, but not journaled: ") + e.what()};
+    }
+    return {};
+}
+
 FlowResult TrialFlow::start() {
     if (!inTrial()) return {Refusal::NotInTrial, "no trial is current"};
-    if (session_.paused())
-        return {Refusal::Paused,
-                fmt::format("paused by a sensor fault: {}", session_.pauseReason())};
+    if (const FlowResult hold = holdRefusal(); !hold) return hold;
     if (revising_)
         return {Refusal::Locked, "store or cancel the change of the previous answer first"};
     if (session_.playing()) {
@@ -207,6 +255,7 @@ FlowResult TrialFlow::replay() {
     if (!inTrial() || !protocol().clips.enabled)
         return {Refusal::NotAllowed, "only clips of a listening test are replayed"};
     if (!session_.playing()) return start();
+    if (const FlowResult hold = holdRefusal(); !hold) return hold;
     if (!protocol().clips.replay)
         return {Refusal::NotAllowed, "This protocol does not allow replaying a clip."};
     try {
@@ -221,6 +270,7 @@ FlowResult TrialFlow::completeLap() {
     if (!inTrial()) return {Refusal::NotInTrial, "no trial is current"};
     const int total = session_.lapCount();
     if (total == 0) return {Refusal::NotAllowed, "this protocol has no laps"};
+    if (const FlowResult hold = holdRefusal(); !hold) return hold;
     if (!session_.playing())
         return {Refusal::NotStarted, "Start the condition first, then complete each lap."};
     if (session_.lapsDone() >= total)
@@ -237,9 +287,7 @@ FlowResult TrialFlow::completeLap() {
 FlowResult TrialFlow::commit() {
     if (revising_) return commitRevision();
     if (!inTrial()) return {Refusal::NotInTrial, "no trial is current"};
-    if (session_.paused())
-        return {Refusal::Paused,
-                fmt::format("paused by a sensor fault: {}", session_.pauseReason())};
+    if (const FlowResult hold = holdRefusal(); !hold) return hold;
     if (!session_.playing())
         return {Refusal::NotStarted,
                 "Start the stimulus first; the answer belongs to what was heard."};
@@ -251,12 +299,14 @@ FlowResult TrialFlow::commit() {
     if (!missing.empty()) {
         std::string list;
         for (const auto& p : missing) list += (list.empty() ? "" : "; ") + p;
+        refusedDone_ = Refusal::Incomplete;
         return {Refusal::Incomplete, list};
     }
     try {
         session_.answer(draft_);
     } catch (const std::exception& e) {
         if (session_.paused()) return {Refusal::Paused, e.what()};
+        refusedDone_ = Refusal::Failed;
         return {Refusal::Failed, e.what()};
     }
     reset();
@@ -265,6 +315,7 @@ FlowResult TrialFlow::commit() {
 
 FlowResult TrialFlow::revisePrevious() {
     if (!inTrial()) return {Refusal::NotInTrial, "no trial is current"};
+    if (const FlowResult hold = holdRefusal(); !hold) return hold;
     if (protocol().lock == LockRule::OnAnswer)
         return {Refusal::Locked,
                 "Answers are locked once given (protocol rule lock = \"answer\")."};
@@ -433,7 +484,7 @@ ParticipantScreen TrialFlow::participantScreen() const {
     s.activeSection = active_;
     s.draft = draft_;
     const Protocol& p = protocol();
-    if (session_.paused()) {
+    if (!holdRefusal()) {
         s.text = "Please wait a moment.";
     } else if (!session_.playing()) {
         s.text = p.laps.total() > 0 ? "Please wait: the experimenter starts the condition."
@@ -443,8 +494,19 @@ ParticipantScreen TrialFlow::participantScreen() const {
             fmt::format("Lap {} of {}: please walk.", session_.lapsDone() + 1, session_.lapCount());
     } else {
         s.answering = true;
-        s.text = p.clips.enabled && p.clips.replay ? "Please answer. You may listen again."
-                                                   : "Please answer.";
+        s.replayOffered = p.clips.enabled && p.clips.replay;
+        s.text = s.replayOffered ? "Please answer. You may listen again." : "Please answer.";
+    }
+    if (refusedDone_ == Refusal::Incomplete) {
+        s.unanswered = unansweredSections();
+        if (s.unanswered.size() == 1)
+            s.notice = "Please answer this question first: " +
+                       sections_[static_cast<std::size_t>(s.unanswered.front())].prompt;
+        else if (!s.unanswered.empty())
+            s.notice = fmt::format("Please answer the {} questions still open first.",
+                                   s.unanswered.size());
+    } else if (refusedDone_ == Refusal::Failed) {
+        s.notice = "Your answer could not be saved yet. Please wait for the experimenter.";
     }
     return s;
 }

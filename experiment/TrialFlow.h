@@ -12,7 +12,9 @@
 ///   next stimulus starts), replay counts of listening-test clips and laps;
 /// - what the participant may see (ParticipantScreen: a neutral briefing made from the
 ///   questions, the question, the answer list, the scales with their anchors, progress and
-///   breaks) as opposed to what only the experimenter sees (stimulus, order, notes).
+///   breaks, why Done was refused) as opposed to what only the experimenter sees (stimulus,
+///   order, notes);
+/// - the experimenter's pause (journaled), which holds the draft, the stimulus and commits.
 ///
 /// Trial numbers for people are 1-based ("Trial 3 of 40" is the trial stored with index 2).
 /// No Qt, no engine: the front ends map their keys to the calls below.
@@ -93,6 +95,14 @@ struct ParticipantScreen {
     /// Answered and planned trials of this participant (progress bar).
     int answered = 0;
     int total = 0;
+    /// Why the last Done was refused, in words the participant may read (made only from the
+    /// protocol's prompts: the open question's, or how many are open); empty when nothing was
+    /// refused or the answer has been completed since.
+    std::string notice;
+    /// The sections still without an answer after a refused Done (indices into `sections`).
+    std::vector<int> unanswered;
+    /// Whether the participant may ask to hear the clip again now.
+    bool replayOffered = false;
 };
 
 class TrialFlow {
@@ -128,6 +138,20 @@ class TrialFlow {
     FlowResult setRating(const std::string& scaleId, int value);
     /// What is still missing before the draft can be committed (empty: it can).
     std::vector<std::string> problems() const;
+    /// The sections of the draft without an answer yet (indices into sections()).
+    std::vector<int> unansweredSections() const;
+
+    // The experimenter's pause: while held (as while a sensor fault pauses the session), the
+    // draft, the stimulus, laps and commits are refused (Refusal::Paused) and the participant
+    // reads "Please wait a moment."; both ends are journaled ("paused", "resumed") with the
+    // current trial. It outlives reset().
+
+    /// Holds the session (refused outside a trial or when already held). When the journal
+    /// cannot be written the session is held all the same and Refusal::Failed says so.
+    FlowResult pause();
+    /// Releases it (refused when not held; released all the same when not journaled).
+    FlowResult resume();
+    bool held() const { return held_; }
 
     // The session's actions, refused with a reason instead of throwing.
 
@@ -169,6 +193,8 @@ class TrialFlow {
 
   private:
     bool inTrial() const;
+    /// Refusal::Paused while a sensor fault or the experimenter holds the session.
+    FlowResult holdRefusal() const;
     void buildSections(const TrialRecord& trial);
     int firstSection(SectionKind kind) const;
 
@@ -180,6 +206,9 @@ class TrialFlow {
     TrialAnswer draft_;
     std::optional<int> revising_;
     std::optional<TrialRecord> revisedTrial_; ///< the trial being changed (its stimulus, block)
+    bool held_ = false;
+    /// The last commit was refused: Incomplete (the screen lists the open questions) or Failed.
+    Refusal refusedDone_ = Refusal::None;
 };
 
 } // namespace underfoot::experiment

@@ -1,30 +1,31 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
-/// The participant's window: full screen on a second screen when there is one, showing only
-/// what experiment::TrialFlow::participantScreen() lets the participant see — the briefing made
-/// from the protocol's questions, the question, the answer list, the scales with every anchor,
-/// progress and breaks. Never the stimulus (its id, surface, soundscape, input), the order of
-/// the plan, the group or the experimenter's notes: those stay in the Run view.
+/// The participant's window: full screen on a second screen when there is one, drawing only
+/// experiment::TrialFlow::participantScreen() — the briefing, the questions with their answers
+/// and every anchor, progress, breaks, what to do now, and why Done was refused (the questions
+/// still open, framed in red). Never the stimulus (its id, surface, soundscape, input, clip),
+/// the order of the plan, the group or the experimenter's notes: those stay in the Run view.
 ///
 /// The participant answers by pointer (buttons) or keys (letters, digits, Up/Down, Left/Right,
-/// Enter commits, Space or R replays a listening-test clip); the experimenter's Run view shows
-/// the same draft and keeps control (start, laps, breaks, pause, exclusions).
+/// Enter commits, Space or R asks to hear the clip again); the keys go to the flow, which
+/// decides. The experimenter's Run view shows the same draft and keeps control (start, laps,
+/// breaks, pause, exclusions). At 1280×800 every question of the shipped protocols fits without
+/// scrolling (tests/gui/test_participant_contract.cpp).
 #include <QWidget>
-
-#include <vector>
 
 class QLabel;
 class QProgressBar;
 class QPushButton;
-class QGroupBox;
-class QVBoxLayout;
 class QScreen;
+class QScrollArea;
 
 namespace underfoot::experiment {
 class TrialFlow;
 }
 
 namespace underfoot::gui {
+
+class AnswerPanel;
 
 class ParticipantWindow : public QWidget {
     Q_OBJECT
@@ -33,17 +34,21 @@ class ParticipantWindow : public QWidget {
 
     /// Shows `flow` (null: a waiting page). Not owned; call again whenever it changes.
     void setFlow(experiment::TrialFlow* flow);
-    /// Redraws from the flow.
+    /// Redraws from the flow's participant screen.
     void refresh();
-    /// The experimenter paused the session (Ctrl+P): "Please wait", answers disabled.
-    void setHeld(bool held);
     /// Shows the window full screen on a screen other than `experimenterScreen` when there is
     /// one (returns true), else as a window on the same screen (returns false).
     bool showOnParticipantScreen(QScreen* experimenterScreen);
-    /// Every text its widgets show (labels, buttons, group titles, tooltips), for tests.
+    /// Every text its visible widgets show (labels, buttons, tooltips, accessible names).
     QStringList visibleTexts() const;
     /// The heading ("Trial 3 of 40", "Break", ...).
     QString heading() const;
+    /// Why Done was refused ("" when nothing was).
+    QString notice() const;
+    /// The questions (layout checks).
+    AnswerPanel* answers() const { return answers_; }
+    /// The area the questions are shown in (what lies outside it needs scrolling).
+    QScrollArea* answerArea() const { return scroll_; }
 
   signals:
     /// The participant changed the draft (chose an answer or a rating).
@@ -60,24 +65,16 @@ class ParticipantWindow : public QWidget {
     void closeEvent(QCloseEvent* event) override;
 
   private:
-    void rebuildSections();
-    void renderDraft();
-
     experiment::TrialFlow* flow_ = nullptr;
-    bool held_ = false;
     QLabel* heading_ = nullptr;
     QLabel* text_ = nullptr;
+    QLabel* notice_ = nullptr;
     QProgressBar* progress_ = nullptr;
-    QWidget* sectionsHost_ = nullptr;
-    QVBoxLayout* sectionsLayout_ = nullptr;
+    AnswerPanel* answers_ = nullptr;
+    QScrollArea* scroll_ = nullptr;
     QPushButton* done_ = nullptr;
     QPushButton* replay_ = nullptr;
-    struct Section {
-        QGroupBox* box = nullptr;
-        std::vector<QPushButton*> buttons;
-    };
-    std::vector<Section> sections_;
-    QString shownKey_; ///< heading + page of the sections built last (rebuilt when it changes)
+    QString shownKey_; ///< page + heading + revision of the questions built last
 };
 
 } // namespace underfoot::gui

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 /// The Run view: register a participant (pseudonymous code, demographics, group) or resume an
-/// interrupted session, then run the trials from the keyboard.
+/// interrupted session (RunStartPage), then run the trials from the keyboard (RunTrialPage).
 ///
 /// Keyboard map of a trial (also shown on the buttons):
 ///   Space         start the stimulus            a–p     surface answer (soundscape answer
@@ -19,34 +19,28 @@
 /// answer letter) completes the lap being walked; Next is refused until every lap is done.
 /// Every answer is committed to the study file (durably) by Next before anything else happens.
 ///
-/// The trial logic (answer draft, validation, lock rule, laps, clip replays, what the participant
-/// may see) is experiment::TrialFlow's; this view only maps keys and buttons onto it. The
-/// participant window (ParticipantWindow, F11) shows the same flow to the participant; while it
-/// shares the screen with this view, the answer key (stimulus, plan, notes) is hidden here.
+/// This view is an adapter of experiment::TrialFlow: it maps keys and buttons onto the flow's
+/// calls and shows the flow's refusals with the console's keys; the rules (answer draft,
+/// validation, lock rule, laps, clip replays, the pause, what the participant may see) are the
+/// flow's. The participant window (ParticipantWindow, F11) draws the same flow for the
+/// participant; while it shares the screen with this view, the answer key (stimulus, plan,
+/// group, notes) is hidden here.
 #include "experiment/Session.h"
 #include "experiment/TrialFlow.h"
 
 #include <QPointer>
-
 #include <QWidget>
 
 #include <functional>
-#include <map>
 #include <memory>
-#include <optional>
-#include <string>
-#include <vector>
 
+class QComboBox;
+class QKeyEvent;
 class QLabel;
 class QLineEdit;
-class QComboBox;
-class QSpinBox;
-class QPushButton;
-class QStackedWidget;
 class QListWidget;
-class QProgressBar;
-class QGroupBox;
-class QPlainTextEdit;
+class QSpinBox;
+class QStackedWidget;
 class QTimer;
 
 namespace underfoot::engine {
@@ -70,10 +64,11 @@ struct LiveSensors {
 class StudyContext;
 class WalkerPlayer;
 struct GrfMeter;
-class TrialPanel;
 class AudioOutput;
 class ConsolePlayer;
 class ParticipantWindow;
+class RunStartPage;
+class RunTrialPage;
 
 class RunView : public QWidget {
     Q_OBJECT
@@ -98,16 +93,17 @@ class RunView : public QWidget {
     int revising() const { return flow_ && flow_->revising() ? *flow_->revising() : -1; }
     /// Folder of the listening-test clips of the open study (default: `clips/<protocol id>`
     /// next to the study file; empty when the protocol has no [clips]).
-    QString clipFolder() const { return clipDir_; }
+    QString clipFolder() const;
     /// Uses `folder` for the clips (checked at the next session start).
     void setClipFolder(const QString& folder);
     /// Problems that stop the listening test from starting (empty: the clips are ready).
     QStringList clipProblems() const;
     /// Renders the protocol's clips into clipFolder() on a worker thread (progress bar on the
-    /// start page). Returns false when already rendering or the protocol has no [clips].
+    /// start page). Returns false when already rendering, a session runs or the protocol has no
+    /// [clips].
     bool renderClips();
     /// Whether clips are being rendered.
-    bool renderingClips() const { return rendering_; }
+    bool renderingClips() const;
     /// The clip status line of the start page.
     QString clipStatus() const;
     /// The message line of the start page.
@@ -166,11 +162,6 @@ class RunView : public QWidget {
     /// The briefing page's text.
     QString briefingText() const;
 
-  signals:
-    /// The session, the trial or the draft changed (the participant window refreshes).
-    void flowChanged();
-
-  public:
     /// The widget that receives the trial keys (answer letters, digits, Enter, Space).
     QWidget* trialPanel() const;
     /// Milliseconds the last Next took to commit the answer to the store.
@@ -181,48 +172,36 @@ class RunView : public QWidget {
     QString pageName() const;
 
     // Form fields (exposed for tests).
-    QLineEdit* codeEdit() const { return code_; }
-    QSpinBox* ageBox() const { return age_; }
-    QComboBox* genderBox() const { return gender_; }
-    QComboBox* groupBox() const { return group_; }
-    QListWidget* resumeList() const { return resumeList_; }
-    QLabel* resumeBanner() const { return resumeBanner_; }
+    QLineEdit* codeEdit() const;
+    QSpinBox* ageBox() const;
+    QComboBox* genderBox() const;
+    QComboBox* groupBox() const;
+    QListWidget* resumeList() const;
+    QLabel* resumeBanner() const;
+
+  signals:
+    /// The session, the trial or the draft changed (the participant window refreshes).
+    void flowChanged();
 
   private:
-    friend class TrialPanel;
-    using SectionKind = experiment::SectionKind;
-    struct Section {
-        SectionKind kind = SectionKind::Surface;
-        const experiment::Scale* scale = nullptr;
-        QGroupBox* box = nullptr;
-        std::vector<QPushButton*> buttons;
-    };
-
-    void buildStartPage();
-    void buildTrialPage();
-    void refreshStart();
+    QWidget* addMessagePage(QLabel*& label, const QString& button, const QString& name,
+                            std::function<void()> action);
     void showPhase();
     void showTrial();
-    void rebuildAnswerSections();
-    void showFlowResult(const experiment::FlowResult& result);
-    void refreshClips();
-    void completeLap();
-    void replayClip();
-    void refreshProtocolStatus();
+    void showResult(const experiment::FlowResult& result, const QString& done = {});
     void renderDraft();
-    bool handleTrialKey(int key, Qt::KeyboardModifiers modifiers, const QString& text);
-    void chooseOption(SectionKind kind, char letter);
-    void typeDigit(int digit);
-    void adjustRating(int delta);
-    void setActive(int section);
-    void play();
+    void refreshProtocolStatus();
+    bool handleTrialKey(QKeyEvent* event);
+    void start();
+    void replayClip();
+    void completeLap();
     void next();
     void togglePause();
     void showSensorFault();
     void askExclusion(bool previous);
     void onMeter(const GrfMeter& meter);
     void setMessage(const QString& text, bool error = true);
-    void endSessionUi();
+    QString audioText() const;
 
     StudyContext& context_;
     WalkerPlayer* player_ = nullptr;
@@ -232,64 +211,25 @@ class RunView : public QWidget {
     std::unique_ptr<ConsolePlayer> console_;
     std::function<LiveSensors()> sensors_;
     engine::LiveEngine* engineOverride_ = nullptr;
+    experiment::StimulusPlayer* injected_ = nullptr;
     std::unique_ptr<experiment::Session> session_;
     std::unique_ptr<experiment::TrialFlow> flow_;
     QPointer<ParticipantWindow> participantWindow_;
     bool answerKeyShown_ = true;
+
     QStackedWidget* pages_ = nullptr;
-
-    // Start page.
-    QLineEdit* code_ = nullptr;
-    QSpinBox* age_ = nullptr;
-    QComboBox* gender_ = nullptr;
-    QLineEdit* shoes_ = nullptr;
-    QComboBox* hearing_ = nullptr;
-    QComboBox* group_ = nullptr;
-    QLineEdit* overrideReason_ = nullptr;
-    QLineEdit* experimenter_ = nullptr;
-    QListWidget* resumeList_ = nullptr;
-    QLabel* resumeBanner_ = nullptr;
-    QLabel* startMessage_ = nullptr;
-    QGroupBox* clipBox_ = nullptr;
-    QLabel* clipStatus_ = nullptr;
-    QProgressBar* clipProgress_ = nullptr;
-    QPushButton* clipRender_ = nullptr;
-    QString clipDir_;
-    bool rendering_ = false;
-
-    // Briefing, break and finished pages.
+    RunStartPage* start_ = nullptr;
+    RunTrialPage* trial_ = nullptr;
+    QWidget* briefingPage_ = nullptr;
+    QWidget* breakPage_ = nullptr;
+    QWidget* finishedPage_ = nullptr;
     QLabel* briefing_ = nullptr;
     QLabel* breakLabel_ = nullptr;
     QLabel* finishedLabel_ = nullptr;
-
-    // Trial page.
-    TrialPanel* trial_ = nullptr;
-    QLabel* header_ = nullptr;
-    QLabel* stimulus_ = nullptr;
-    QLabel* lockRule_ = nullptr;
-    QProgressBar* leftMeter_ = nullptr;
-    QProgressBar* rightMeter_ = nullptr;
-    QLabel* stepLabel_ = nullptr;
-    QLabel* engineLabel_ = nullptr;
-    QLabel* protocolStatus_ = nullptr;
-    QPushButton* playButton_ = nullptr;
-    QPushButton* nextButton_ = nullptr;
-    QPushButton* pauseButton_ = nullptr;
-    QLabel* pausedLabel_ = nullptr;
-    QLabel* faultBanner_ = nullptr;
     QTimer* sensorTimer_ = nullptr;
-    experiment::StimulusPlayer* injected_ = nullptr;
-    QLineEdit* comment_ = nullptr;
-    QLabel* message_ = nullptr;
-    QListWidget* planList_ = nullptr;
-    QWidget* sectionsHost_ = nullptr;
-    std::vector<Section> sections_;
-    bool paused_ = false;
 
     double lastCommitMs_ = 0;
     QString lastTrialStats_; ///< the live engine's figures of the trial just answered
-    QString notes_;          ///< the briefing page's experimenter notes (protocol description)
-    QLabel* notesLabel_ = nullptr;
 };
 
 } // namespace underfoot::gui

@@ -248,3 +248,73 @@ TEST(TrialFlow, LapsAndClipsOfTheShippedProtocols) {
         EXPECT_NE(text.find(flow.sections()[0].prompt), std::string::npos);
     }
 }
+
+TEST(TrialFlow, RefusedDoneTellsTheParticipantWhichQuestionsAreOpen) {
+    TempDir dir;
+    StudyStore store = makeStudy(dir, "next_trial");
+    FakePlayer player;
+    Session session(store, "P1", player, {});
+    session.finishBriefing();
+    TrialFlow flow(store, session);
+    ASSERT_TRUE(flow.start());
+    EXPECT_TRUE(flow.participantScreen().notice.empty()) << "nothing refused yet";
+    flow.chooseLetter('a');
+    EXPECT_EQ(flow.unansweredSections(), (std::vector<int>{1, 2}));
+    ASSERT_EQ(flow.commit().refusal, Refusal::Incomplete);
+    ParticipantScreen s = flow.participantScreen();
+    EXPECT_EQ(s.unanswered, (std::vector<int>{1, 2}));
+    // The participant reads how many questions are open (or the open one's prompt), never the
+    // store's wording (scale ids).
+    EXPECT_EQ(s.notice, "Please answer the 2 questions still open first.");
+    flow.typeDigit(3);
+    s = flow.participantScreen();
+    EXPECT_EQ(s.unanswered, (std::vector<int>{2})) << "the list follows the draft";
+    EXPECT_EQ(s.notice, "Please answer this question first: " + flow.sections()[2].prompt);
+    flow.setRating("quality", 4);
+    EXPECT_TRUE(flow.participantScreen().notice.empty()) << "complete: nothing to say";
+    ASSERT_TRUE(flow.commit());
+    EXPECT_TRUE(flow.participantScreen().notice.empty()) << "a new trial starts clean";
+}
+
+TEST(TrialFlow, ExperimenterPauseHoldsEverythingAndIsJournaled) {
+    TempDir dir;
+    StudyStore store = makeStudy(dir, "next_trial");
+    FakePlayer player;
+    Session session(store, "P1", player, {});
+    TrialFlow flow(store, session);
+    EXPECT_EQ(flow.pause().refusal, Refusal::NotInTrial) << "only a trial is paused";
+    session.finishBriefing();
+    flow.reset();
+    ASSERT_TRUE(flow.start());
+    ASSERT_TRUE(flow.pause());
+    EXPECT_TRUE(flow.held());
+    EXPECT_EQ(flow.pause().refusal, Refusal::NotAllowed);
+    EXPECT_EQ(flow.chooseLetter('a').refusal, Refusal::Paused);
+    EXPECT_EQ(flow.typeDigit(3).refusal, Refusal::Paused);
+    EXPECT_EQ(flow.setRating("quality", 3).refusal, Refusal::Paused);
+    flow.adjust(1);
+    EXPECT_TRUE(flow.draft().answer.empty() && flow.draft().ratings.empty());
+    EXPECT_EQ(flow.commit().refusal, Refusal::Paused);
+    flow.reset(); // a redraw by the front end keeps the pause
+    ParticipantScreen s = flow.participantScreen();
+    EXPECT_FALSE(s.answering);
+    EXPECT_EQ(s.text, "Please wait a moment.");
+    ASSERT_TRUE(flow.resume());
+    EXPECT_EQ(flow.resume().refusal, Refusal::NotAllowed);
+    EXPECT_TRUE(flow.participantScreen().answering);
+    EXPECT_TRUE(flow.chooseLetter('a'));
+    // A sensor fault holds the draft the same way.
+    session.sensorFault("FSR shoes unplugged");
+    const FlowResult faulted = flow.typeDigit(4);
+    EXPECT_EQ(faulted.refusal, Refusal::Paused);
+    EXPECT_NE(faulted.message.find("FSR shoes unplugged"), std::string::npos) << faulted.message;
+    EXPECT_FALSE(flow.participantScreen().answering);
+    session.resumeAfterFault();
+    int paused = 0, resumed = 0;
+    for (const auto& e : store.events()) {
+        paused += e.kind == "paused";
+        resumed += e.kind == "resumed";
+    }
+    EXPECT_EQ(paused, 1);
+    EXPECT_EQ(resumed, 1);
+}

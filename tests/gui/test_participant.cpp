@@ -3,6 +3,7 @@
 // participant's briefing, the questions, answer lists, scales with anchors and 1-based progress,
 // and never the answer key (stimulus ids, surfaces or soundscapes played, the plan's order),
 // the group or the experimenter's notes. Answers given on either window are stored.
+#include "app/gui/AnswerPanel.h"
 #include "app/gui/MainWindow.h"
 #include "app/gui/ParticipantWindow.h"
 #include "app/gui/RunView.h"
@@ -230,13 +231,15 @@ class ParticipantTest : public QObject {
                 for (const auto& a : ue::anchorTexts(*s.scale))
                     QVERIFY2(all.contains(QString::fromStdString(a)), a.c_str());
         // A click on a scale button of the participant window sets the rating in the Run view.
-        for (const auto& s : sections) {
+        for (std::size_t i = 0; i < sections.size(); ++i) {
+            const auto& s = sections[i];
             if (!s.scale) continue;
             QPushButton* pick = nullptr;
-            for (auto* g : pw->findChildren<QGroupBox*>())
-                if (g->title() == QString::fromStdString(s.prompt))
-                    for (auto* b : g->findChildren<QPushButton*>())
-                        if (b->text() == QString::number(s.scale->max)) pick = b;
+            QWidget* question = pw->answers()->section(static_cast<int>(i));
+            QVERIFY(question);
+            QCOMPARE(question->accessibleName(), QString::fromStdString(s.prompt));
+            for (auto* b : question->findChildren<QPushButton*>())
+                if (b->text() == QString::number(s.scale->max)) pick = b;
             QVERIFY(pick);
             QTest::mouseClick(pick, Qt::LeftButton);
             QCOMPARE(run->flow()->draft().ratings.at(s.scale->id), s.scale->max);
