@@ -236,6 +236,8 @@ struct WebApi::Impl {
             return true;
         } catch (const ApiError& e) {
             ++refused;
+            if (e.retryAfter > 0)
+                res.headers.emplace_back("Retry-After", std::to_string(e.retryAfter));
             sendJson(res, e.status, {{"error", e.what()}});
         } catch (const experiment::StoreError& e) {
             ++refused;

@@ -197,11 +197,27 @@ Session* WebStudy::session(const Invitation& inv) {
     settings.audioConfig = "browser";
     settings.sensorConfig = "none";
     settings.appVersion = underfoot::base::version();
+    // The server is the study's only online writer: a lease of another host name (a re-created
+    // container) is taken over, journaled; dead holders and reused PIDs always are.
+    settings.takeOverForeign = true;
     std::unique_ptr<Session> s;
     try {
         s = std::make_unique<Session>(store_, code, *player_, settings);
-    } catch (const StoreError&) {
-        return nullptr; // every trial answered: marked completed by the session
+    } catch (const StoreError& e) {
+        // Finished means every trial answered, and nothing else: any other failure (a live
+        // lease holder, a busy or failing store) is retryable and never shows the end page.
+        if (!store_.firstUnanswered(code)) return nullptr; // marked completed by the session
+        try {
+            store_.journal("online_unavailable", code, std::nullopt,
+                           jsonObject({{"participant", code}, {"reason", e.what()}}));
+        } catch (const std::exception&) {
+        }
+        throw ApiError(503,
+                       dynamic_cast<const LeaseHeld*>(&e)
+                           ? "your session is still held by the previous server process; please "
+                             "wait a moment, it resumes where you left off"
+                           : "your session cannot be opened just now; please wait a moment",
+                       5);
     }
     // Consent is the briefing: a participant who consented goes straight to the trials.
     if (s->phase() == SessionPhase::Briefing) s->finishBriefing();
@@ -278,10 +294,14 @@ json WebStudy::stateOf(const Invitation& inv) {
     }
     Session* s = session(inv);
     if (!s) {
+        // session() returns null for a registered, not dropped participant only when every
+        // trial is answered; checked again here so that nothing else can show the end page.
         const auto trials = store_.trials(p->code);
-        j["progress"] = {{"answered", std::count_if(trials.begin(), trials.end(),
-                                                    [](const auto& t) { return t.answered; })},
-                         {"total", trials.size()}};
+        const auto answered =
+            std::count_if(trials.begin(), trials.end(), [](const auto& t) { return t.answered; });
+        if (answered != static_cast<std::ptrdiff_t>(trials.size()))
+            throw ApiError(503, "your session cannot be opened just now; please wait a moment", 5);
+        j["progress"] = {{"answered", answered}, {"total", trials.size()}};
         j["phase"] = "finished";
         j["completionCode"] = inv.completionCode;
         return j;
@@ -300,10 +320,12 @@ json WebStudy::stateOf(const Invitation& inv) {
         j["phase"] = s->phase() == SessionPhase::Practice ? "practice" : "trial";
         j["trial"] = trialJson(*s);
         break;
-    default:
+    case SessionPhase::Finished:
         j["phase"] = "finished";
         j["completionCode"] = inv.completionCode;
         break;
+    default:
+        throw ApiError(503, "your session cannot be opened just now; please wait a moment", 5);
     }
     return j;
 }

@@ -28,9 +28,11 @@ namespace underfoot::web {
 
 /// A refused request: HTTP status and a message naming what was expected.
 struct ApiError : std::runtime_error {
-    ApiError(int statusCode, const std::string& message)
-        : std::runtime_error(message), status(statusCode) {}
+    ApiError(int statusCode, const std::string& message, int retryAfterSeconds = 0)
+        : std::runtime_error(message), status(statusCode), retryAfter(retryAfterSeconds) {}
     int status;
+    /// Seconds for a Retry-After header (0: none): the request may succeed later as it is.
+    int retryAfter;
 };
 
 /// What happens when a participant fails the headphone screening.
@@ -91,7 +93,9 @@ class WebStudy {
         std::unique_ptr<experiment::Session> session;
     };
     experiment::Invitation invitation(const std::string& token);
-    /// The participant's session, opened (or resumed) when needed; null when finished/dropped.
+    /// The participant's session, opened (or resumed) when needed; null when not registered yet,
+    /// dropped, or finished (every trial answered: nothing else counts as finished). A session
+    /// that cannot be opened now (its lease held by a live process) is a retryable 503.
     experiment::Session* session(const experiment::Invitation& inv);
     nlohmann::json stateOf(const experiment::Invitation& inv);
     nlohmann::json trialJson(const experiment::Session& s) const;
