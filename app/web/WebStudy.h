@@ -2,8 +2,10 @@
 #pragma once
 /// The online participant API of `underfoot serve`, independent of HTTP: every call takes the
 /// participant's link token and a JSON body and returns JSON, or throws ApiError (status code
-/// and a message for the page). It drives one experiment::Session per participant (the same
-/// plans, lock rule, replay counts and ratings as the terminal session and the console) with a
+/// and a message for the page). It is an adapter of experiment::TrialFlow, one per participant
+/// (the same screen model, progress text, answer and rating validation, commit and replay
+/// counts as the terminal session and the console): it renders the flow's participant screen
+/// as JSON and forwards the page's answers to it. Each session plays through a
 /// ClipPlayer that plays nothing (the browser fetches and plays the clip) but stores, with each
 /// trial, the clip's seed, length and samples' SHA-256 from the manifest, as the booth does. A
 /// clip is served only while its file matches the manifest.
@@ -14,6 +16,7 @@
 #include "experiment/Invitations.h"
 #include "experiment/Session.h"
 #include "experiment/Store.h"
+#include "experiment/TrialFlow.h"
 
 #include <nlohmann/json.hpp>
 
@@ -98,7 +101,12 @@ class WebStudy {
     /// that cannot be opened now (its lease held by a live process) is a retryable 503.
     experiment::Session* session(const experiment::Invitation& inv);
     nlohmann::json stateOf(const experiment::Invitation& inv);
-    nlohmann::json trialJson(const experiment::Session& s) const;
+    /// The participant's trial flow (made with the session; null when there is none).
+    experiment::TrialFlow* flow(const std::string& code);
+    /// Drops a participant's flow and session (in that order: the flow refers to the session).
+    void close(const std::string& code);
+    /// The current trial as TrialFlow's participant screen shows it.
+    nlohmann::json trialJson(const experiment::TrialFlow& flow) const;
     [[noreturn]] void refuse(const experiment::Invitation& inv, std::optional<int> trial,
                              const std::string& request, int status, const std::string& reason);
     int currentTrialChecked(const experiment::Invitation& inv, experiment::Session* s,
@@ -111,6 +119,7 @@ class WebStudy {
     std::unique_ptr<experiment::Invitations> invitations_;
     std::unique_ptr<experiment::ClipPlayer> player_;
     std::map<std::string, std::unique_ptr<experiment::Session>> sessions_;
+    std::map<std::string, std::unique_ptr<experiment::TrialFlow>> flows_;
     /// The last play id of each participant (trial:attempt), for idempotent presentations.
     std::map<std::string, std::string> lastPresent_;
 };
