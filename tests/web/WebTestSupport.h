@@ -103,8 +103,10 @@ struct StudyFixture {
     std::string clips = dir.file("clips");
     std::vector<experiment::NewInvitation> links;
 
-    explicit StudyFixture(int invites, const std::string& protocolText = webProtocol()) {
-        const experiment::Protocol p = experiment::parseProtocol(protocolText, "web.toml");
+    explicit StudyFixture(int invites, const std::string& protocolText = webProtocol())
+        : StudyFixture(invites, experiment::parseProtocol(protocolText, "web.toml")) {}
+
+    StudyFixture(int invites, const experiment::Protocol& p) {
         experiment::StudyStore store =
             experiment::StudyStore::create(study, p, {"WEB", "web", 4, "test"});
         experiment::Invitations inv(store);
@@ -113,6 +115,7 @@ struct StudyFixture {
         std::vector<experiment::ClipRecord> manifest;
         for (const auto& s : p.stimuli) {
             const std::string path = experiment::clipPath(s, clips);
+            fs::create_directories(fs::path(path).parent_path()); // lab clips in sub-folders
             writeWav(path);
             // The manifest `underfoot clips` writes (a test tone stands for the render): the
             // server serves and stores only clips that match it.
