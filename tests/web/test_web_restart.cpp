@@ -187,5 +187,31 @@ TEST(WebRestart, LiveHolderGetsRetryableUnavailableNeverTheEndPage) {
     EXPECT_EQ(leaseEvents(f).back(), "lease_recovered:dead");
 }
 
+TEST(WebRestart, ReplaysBeforeAKillAreKept) {
+    StudyFixture f(1);
+    const std::string code = f.links[0].participantCode;
+    auto first = std::make_unique<ServeProcess>(f, 0);
+    ApiClient c(first->port(), f.links[0].token);
+    json state = startParticipant(c);
+    const int index = state.at("trial").at("index").get<int>();
+    for (const char* play : {"p1", "p2", "p3"}) // one presentation, two replays
+        ASSERT_EQ(c.post("/api/present", {{"trial", index}, {"attempt", play}}).status, 200);
+    first->kill9();
+    ServeProcess second(f, 0);
+    c.setPort(second.port());
+    Reply r = c.get("/api/state");
+    ASSERT_EQ(r.status, 200) << r.raw;
+    EXPECT_EQ(r.body.at("trial").at("replays"), 2) << r.raw;
+    r = c.post("/api/answer", validAnswer(r.body, "a1"));
+    ASSERT_EQ(r.status, 200) << r.raw;
+    SQLite::Database db(f.study, SQLite::OPEN_READONLY);
+    SQLite::Statement q(db, "SELECT replays FROM trials WHERE trial_index = ? AND participant_id = "
+                            "(SELECT id FROM participants WHERE code = ?)");
+    q.bind(1, index);
+    q.bind(2, code);
+    ASSERT_TRUE(q.executeStep());
+    EXPECT_EQ(q.getColumn(0).getInt(), 2);
+}
+
 } // namespace
 } // namespace underfoot::web::test
