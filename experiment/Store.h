@@ -31,6 +31,12 @@ struct StoreError : std::runtime_error {
     using std::runtime_error::runtime_error;
 };
 
+/// The participant's session lease is held by a live process on this host (which may still
+/// write): the session cannot start now; it can once that process ends.
+struct LeaseHeld : StoreError {
+    using StoreError::StoreError;
+};
+
 /// The answer was committed (durably, in the study's write-ahead log `<study>-wal`), but copying
 /// it into the study file failed afterwards. The answer counts: a session advances past it and
 /// must not ask for it again (asking again would store it as a changed answer). The message
@@ -46,9 +52,10 @@ struct AnswerSavedButNotCopied : StoreError {
 /// participants and stores with each session whether sound was played; version 5 adds the
 /// online tables of `underfoot serve` (experiment/Invitations.h); version 6 adds
 /// session leases: one live session per participant; version 7 stores the clip each
-/// listening-test trial played (PlayedClip). Older studies are migrated when opened
+/// listening-test trial played (PlayedClip); version 8 names a lease's holder by PID, process
+/// start time and boot id (experiment/LeaseHolder.h). Older studies are migrated when opened
 /// (docs/reference/store-schema.md).
-inline constexpr int kSchemaVersion = 7;
+inline constexpr int kSchemaVersion = 8;
 
 /// Time source (injectable for tests).
 struct Clock {
@@ -141,6 +148,10 @@ struct SessionSettings {
     /// Take over the participant's session lease even when another live process holds it
     /// (`underfoot session --take-over`, after a crash on another machine); journaled.
     bool takeOver = false;
+    /// Also take over leases of another host name (a re-created container, a moved study
+    /// file); `underfoot serve` sets it: it is the only writer of an online study. Leases of
+    /// dead processes, reused PIDs and earlier boots of this host are always taken over.
+    bool takeOverForeign = false;
 };
 
 /// A stored session of a participant.
@@ -307,10 +318,12 @@ class StudyStore {
 
     /// Opens a session for a participant; returns its number (1, 2, ... per participant).
     /// A participant's session is exclusive: it takes the participant's lease (a row in the
-    /// store naming process, host, experimenter and since when). A lease held by another live
-    /// process is refused with who holds it and since when, unless settings.takeOver; a lease
-    /// of a dead process on this host (a crash) is recovered; both are journaled. While another
-    /// store holds the lease, markTrialStarted and commitAnswer of this store are refused.
+    /// store naming process (PID, start time, boot id), host, experimenter and since when). A
+    /// lease held by another live process is refused (LeaseHeld) with who holds it and since
+    /// when, unless settings.takeOver; a lease of a dead process, a reused PID or an earlier
+    /// boot of this host is recovered, one of another host is taken over with
+    /// settings.takeOverForeign (else refused); each is journaled with the holder's state. While
+    /// another store holds the lease, markTrialStarted and commitAnswer of this store are refused.
     int startSession(const std::string& code, const SessionSettings& settings);
     /// The sessions of a participant, in order.
     std::vector<SessionRecord> sessions(const std::string& code) const;

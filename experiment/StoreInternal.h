@@ -74,10 +74,4 @@ inline std::string newLeaseToken() {
     return fmt::format("{:08x}{:08x}{:08x}", rd(), rd(), static_cast<unsigned>(::getpid()));
 }
 
-/// True when `pid` on this host is certainly gone (a crashed session).
-inline bool processIsGone(std::int64_t pid) {
-    if (pid <= 0) return true;
-    return ::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH;
-}
-
 } // namespace underfoot::experiment::store_detail

@@ -189,6 +189,12 @@ ALTER TABLE trials ADD COLUMN clip_frames INTEGER;
 ALTER TABLE trials ADD COLUMN clip_sample_rate_hz REAL;
 ALTER TABLE trials ADD COLUMN clip_sha256 TEXT;
 )sql",
+    // 7 -> 8: a lease names its holder by PID, process start time and boot id, so that a
+    // reused PID or a reboot is not mistaken for a live holder.
+    R"sql(
+ALTER TABLE session_leases ADD COLUMN start_ticks INTEGER;
+ALTER TABLE session_leases ADD COLUMN boot_id TEXT NOT NULL DEFAULT '';
+)sql",
 };
 constexpr int kMigrationCount = static_cast<int>(sizeof(kMigrations) / sizeof(kMigrations[0]));
 static_assert(kMigrationCount == kSchemaVersion);

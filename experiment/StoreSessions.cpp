@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Sessions and their leases (one live session per participant).
+#include "experiment/LeaseHolder.h"
 #include "experiment/Store.h"
 #include "experiment/StoreInternal.h"
 
@@ -40,31 +41,43 @@ int StudyStore::startSession(const std::string& code, const SessionSettings& set
         n.bind(1, p.id);
         n.executeStep();
         const int number = n.getColumn(0).getInt();
-        // The participant's lease (issue #16): one live session per participant.
-        const std::string host = hostName();
-        const std::int64_t myPid = ::getpid();
+        // The participant's lease: one live session per participant.
+        const LeaseHolder me = thisProcess();
         {
             SQLite::Statement lease(*db_, "SELECT token, pid, host, experimenter, since, "
-                                          "session_number FROM session_leases WHERE "
-                                          "participant_id = ?");
+                                          "session_number, start_ticks, boot_id FROM "
+                                          "session_leases WHERE participant_id = ?");
             lease.bind(1, p.id);
             if (lease.executeStep() && lease.getColumn(0).getString() != leaseToken_) {
-                const std::int64_t holderPid = lease.getColumn(1).getInt64();
-                const std::string holderHost = lease.getColumn(2).getString();
-                const bool sameProcess = holderHost == host && holderPid == myPid;
-                const bool gone = holderHost == host && processIsGone(holderPid);
-                if (!sameProcess && !gone && !settings.takeOver)
-                    throw StoreError(fmt::format(
+                LeaseHolder holder;
+                holder.pid = lease.getColumn(1).getInt64();
+                holder.host = lease.getColumn(2).getString();
+                if (!lease.getColumn(6).isNull())
+                    holder.startTicks = fromDb(lease.getColumn(6).getInt64());
+                holder.bootId = columnText(lease.getColumn(7));
+                const HolderState state = classifyHolder(holder, me);
+                const bool recoverable = state == HolderState::Self || state == HolderState::Dead ||
+                                         state == HolderState::Reused ||
+                                         state == HolderState::OtherBoot;
+                const bool takeOver = settings.takeOver ||
+                                      (state == HolderState::OtherHost && settings.takeOverForeign);
+                if (!recoverable && !takeOver) {
+                    const std::string what = fmt::format(
                         "{}: participant '{}' is in session {} held by process {} on host {} "
-                        "(experimenter '{}') since {}; one session per participant at a time. If "
-                        "that session crashed or its machine is gone, take the session over with "
-                        "`underfoot session ... --take-over`",
-                        path_, code, lease.getColumn(5).getInt(), holderPid, holderHost,
-                        lease.getColumn(3).getString(), lease.getColumn(4).getString()));
-                appendEvent(sameProcess || gone ? "lease_recovered" : "lease_taken_over", p.id,
+                        "(experimenter '{}') since {}; one session per participant at a time",
+                        path_, code, lease.getColumn(5).getInt(), holder.pid, holder.host,
+                        lease.getColumn(3).getString(), lease.getColumn(4).getString());
+                    const std::string hint =
+                        ". If that session crashed or its machine is gone, take the session "
+                        "over with `underfoot session ... --take-over`";
+                    if (state == HolderState::Live) throw LeaseHeld(what + hint);
+                    throw StoreError(what + hint);
+                }
+                appendEvent(recoverable ? "lease_recovered" : "lease_taken_over", p.id,
                             std::nullopt,
-                            jsonObject({{"pid", std::to_string(holderPid)},
-                                        {"host", holderHost},
+                            jsonObject({{"pid", std::to_string(holder.pid)},
+                                        {"host", holder.host},
+                                        {"holder", toString(state)},
                                         {"experimenter", lease.getColumn(3).getString()},
                                         {"since", lease.getColumn(4).getString()},
                                         {"session", std::to_string(lease.getColumn(5).getInt())}}));
@@ -72,15 +85,17 @@ int StudyStore::startSession(const std::string& code, const SessionSettings& set
         }
         SQLite::Statement take(*db_,
                                "INSERT OR REPLACE INTO session_leases (participant_id, token, "
-                               "pid, host, experimenter, session_number, since) VALUES "
-                               "(?, ?, ?, ?, ?, ?, ?)");
+                               "pid, host, experimenter, session_number, since, start_ticks, "
+                               "boot_id) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?)");
         take.bind(1, p.id);
         take.bind(2, leaseToken_);
-        take.bind(3, myPid);
-        take.bind(4, host);
+        take.bind(3, me.pid);
+        take.bind(4, me.host);
         take.bind(5, settings.experimenter);
         take.bind(6, number);
         take.bind(7, now());
+        if (me.startTicks) take.bind(8, toDb(*me.startTicks));
+        take.bind(9, me.bootId);
         take.exec();
         SQLite::Statement ins(*db_, "INSERT INTO sessions (participant_id, number, group_id, seed, "
                                     "app_version, audio_config, sensor_config, experimenter, "

@@ -13,7 +13,8 @@ UNDERFOOT_BUILD_PACKAGES=(
   jackd2 # the usual audio server of the live path
   # files, CLI, formatting
   libtomlplusplus-dev libcli11-dev libfmt-dev nlohmann-json3-dev
-  # statistics and real-time containers
+  # statistics, real-time containers, and the HTTP server of `underfoot serve` (Boost.Beast,
+  # Boost.Asio: app/web)
   libboost-dev
   # mixed-effects models (analysis/stats/MixedModels): linear algebra and optimisation
   libeigen3-dev libnlopt-cxx-dev
@@ -21,8 +22,6 @@ UNDERFOOT_BUILD_PACKAGES=(
   liblapacke-dev
   # storage; SHA-256 of protocol texts (experiment/)
   libsqlite3-dev libsqlitecpp-dev libssl-dev
-  # online listening tests (`underfoot serve`, app/web): HTTP server
-  libcpp-httplib-dev
   # the console
   qt6-base-dev qt6-charts-dev libqt6opengl6-dev libqt6sql6-sqlite libgl-dev
   qt6-svg-dev # console figures exported as SVG (QSvgGenerator)

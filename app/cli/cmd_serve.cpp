@@ -1,9 +1,10 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// `underfoot serve`: runs a study's listening test online (issue 14). Participants open their
+// `underfoot serve`: runs a study's listening test online. Participants open their
 // secret link (`underfoot study invite`); the page drives the same experiment::Session as the
 // terminal and the console, and every answer is a durable transaction in the same study file.
 // Binds 127.0.0.1 unless told otherwise; Ctrl+C or SIGTERM stops cleanly (open sessions are
-// closed as interrupted and resume at the first unanswered trial).
+// closed as interrupted and resume at the first unanswered trial). The limits and options are
+// listed in docs/reference/web-server.md.
 #include "app/cli/CommandRegistry.h"
 #include "app/web/Server.h"
 #include "app/web/WebStudy.h"
@@ -15,6 +16,7 @@
 #include <cstdio>
 #include <pthread.h>
 #include <thread>
+#include <vector>
 
 namespace underfoot::cli::serve_command {
 namespace {
@@ -30,6 +32,11 @@ struct Options {
     std::string screening = "flag";
     double rate = 20.0;
     std::size_t maxBody = 16 * 1024;
+    std::vector<std::string> trustedProxies;
+    double requestTimeout = 10.0;
+    double idleTimeout = 5.0;
+    std::size_t maxConnections = 1024;
+    std::size_t maxConnectionsPerAddress = 64;
 };
 
 Options& opts() {
@@ -63,19 +70,27 @@ int serve(const Options& o) {
     so.ratePerSecond = o.rate;
     so.burst = o.rate * 3;
     so.maxBodyBytes = o.maxBody;
-    web::WebServer server(*study, so);
+    so.trustedProxies = o.trustedProxies;
+    so.requestTimeoutS = o.requestTimeout;
+    so.idleTimeoutS = o.idleTimeout;
+    so.maxConnections = o.maxConnections;
+    so.maxConnectionsPerAddress = o.maxConnectionsPerAddress;
+    std::unique_ptr<web::WebServer> serverPtr;
     int port = 0;
     try {
-        port = server.bind();
+        serverPtr = std::make_unique<web::WebServer>(*study, so);
+        port = serverPtr->bind();
     } catch (const std::exception& e) {
         throw UserError(fmt::format("serve: {}", e.what()));
     }
+    web::WebServer& server = *serverPtr;
     const std::string host = o.bind.find(':') != std::string::npos ? "[" + o.bind + "]" : o.bind;
     fmt::print("underfoot serve: study {} listening on http://{}:{}/ (participant links: "
                "http://{}:{}/p#TOKEN); Ctrl+C stops\n",
                o.study, host, port, host, port);
     if (o.bind != "127.0.0.1" && o.bind != "::1" && o.bind != "localhost")
-        fmt::print("underfoot serve: bound to {}: put a TLS reverse proxy in front (docs/web.md)\n",
+        fmt::print("underfoot serve: bound to {}: put a TLS reverse proxy in front "
+                   "(docs/howto/online-test.md)\n",
                    o.bind);
     std::fflush(stdout);
 
@@ -93,11 +108,11 @@ int serve(const Options& o) {
     study->stop();
     const auto c = server.counters();
     fmt::print("underfoot serve: stopped ({}); {} open sessions closed as interrupted; {} "
-               "requests, {} refused, {} rate-limited\n",
+               "requests, {} refused, {} rate-limited, {} timed out; {} connections refused\n",
                caught == SIGTERM  ? "SIGTERM"
                : caught == SIGINT ? "SIGINT"
                                   : "server ended",
-               open, c.requests, c.refused, c.rateLimited);
+               open, c.requests, c.refused, c.rateLimited, c.timedOut, c.connectionsRefused);
     std::fflush(stdout);
     return 0;
 }
@@ -120,10 +135,28 @@ const underfoot::cli::CommandRegistrar registrar{
                         "a failed headphone screening 'flag's the participant (stored, the test "
                         "goes on) or 'end's the session (participant dropped)")
             ->check(CLI::IsMember({"flag", "end"}));
-        cmd->add_option("--rate", o.rate, "requests per second allowed per link (burst: 3x)")
+        cmd->add_option("--rate", o.rate,
+                        "API requests per second per invitation, and per client address for "
+                        "requests without a real invitation's token (burst: 3x; the page and "
+                        "its files are not limited)")
             ->check(CLI::Range(1.0, 10000.0));
-        cmd->add_option("--max-body", o.maxBody, "largest request body in bytes")
+        cmd->add_option("--max-body", o.maxBody,
+                        "largest request body in bytes (chunked bodies too; larger: 413)")
             ->check(CLI::Range(1024, 1024 * 1024));
+        cmd->add_option("--trusted-proxy", o.trustedProxies,
+                        "address of a reverse proxy whose X-Forwarded-For names the client "
+                        "(repeatable; e.g. 127.0.0.1 for a proxy on this machine)");
+        cmd->add_option("--request-timeout", o.requestTimeout,
+                        "seconds within which a request's header and body must arrive")
+            ->check(CLI::Range(1.0, 300.0));
+        cmd->add_option("--idle-timeout", o.idleTimeout,
+                        "seconds a connection may wait without a request in progress")
+            ->check(CLI::Range(1.0, 300.0));
+        cmd->add_option("--max-connections", o.maxConnections, "open connections in all")
+            ->check(CLI::Range(16, 100000));
+        cmd->add_option("--max-connections-per-address", o.maxConnectionsPerAddress,
+                        "open connections from one address (trusted proxies excepted)")
+            ->check(CLI::Range(1, 100000));
         cmd->callback([&exitCode, &o] { exitCode = serve(o); });
     }};
 

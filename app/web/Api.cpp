@@ -1,15 +1,18 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "app/web/Api.h"
 
+#include "app/web/Limits.h"
+
 #include <fmt/format.h>
 
 #include <algorithm>
 #include <cctype>
-#include <chrono>
+#include <climits>
+#include <cmath>
+#include <cstdint>
 #include <functional>
 #include <mutex>
-#include <regex>
-#include <unordered_map>
+#include <unordered_set>
 
 namespace underfoot::web {
 
@@ -27,35 +30,6 @@ std::string HttpRequest::header(const std::string& name) const {
 }
 
 namespace {
-
-/// Token buckets per key (link token or address), bounded in number.
-class RateLimiter {
-  public:
-    RateLimiter(double rate, double burst) : rate_(rate), burst_(burst) {}
-    bool allow(const std::string& key) {
-        const double now =
-            std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch())
-                .count();
-        std::lock_guard lock(mutex_);
-        if (buckets_.size() > 100000) buckets_.clear(); // bounded memory under a flood of keys
-        auto [it, fresh] = buckets_.try_emplace(key, Bucket{burst_, now});
-        Bucket& b = it->second;
-        if (!fresh) b.tokens = std::min(burst_, b.tokens + (now - b.at) * rate_);
-        b.at = now;
-        if (b.tokens < 1.0) return false;
-        b.tokens -= 1.0;
-        return true;
-    }
-
-  private:
-    struct Bucket {
-        double tokens;
-        double at;
-    };
-    double rate_, burst_;
-    std::mutex mutex_;
-    std::unordered_map<std::string, Bucket> buckets_;
-};
 
 std::string bearer(const HttpRequest& req) {
     const std::string h = req.header("Authorization");
@@ -83,39 +57,175 @@ void sendJson(HttpAnswer& res, int status, const json& body) {
 }
 
 const char* errorText(int status) {
-    return status == 413 ? "request too large" : status == 404 ? "not found" : "bad request";
+    switch (status) {
+    case 404:
+        return "not found";
+    case 413:
+        return "request body too large";
+    case 431:
+        return "request header too large or too many header fields";
+    case 503:
+        return "the server is busy; retry in a moment";
+    default:
+        return "bad request";
+    }
+}
+
+/// What follows `prefix` in `path` when it is 1 to `maxLength` characters that all pass
+/// `allowed`; "" otherwise.
+template <typename Allowed>
+std::string suffix(const std::string& path, std::string_view prefix, std::size_t maxLength,
+                   Allowed allowed) {
+    if (path.size() <= prefix.size() || path.size() > prefix.size() + maxLength ||
+        path.compare(0, prefix.size(), prefix) != 0)
+        return {};
+    const std::string rest = path.substr(prefix.size());
+    return std::all_of(rest.begin(), rest.end(), allowed) ? rest : std::string();
+}
+
+/// A link token as `study invite` writes it: 43 characters of base64url (256 bits).
+bool plausibleToken(const std::string& t) {
+    return t.size() == 43 && std::all_of(t.begin(), t.end(), [](unsigned char c) {
+               return std::isalnum(c) || c == '-' || c == '_';
+           });
+}
+
+/// What is wrong with the numbers or the nesting of a request body ("" when nothing): every
+/// integer must fit in 32 bits (trial indices, ratings and counts do; 2^32 + n must not turn
+/// into n), every number must be finite, objects and arrays nest at most 8 deep.
+std::string numberProblem(const json& body) {
+    constexpr int maxDepth = 8;
+    std::vector<std::pair<const json*, int>> todo{{&body, 0}};
+    while (!todo.empty()) {
+        const auto [j, depth] = todo.back();
+        todo.pop_back();
+        if (j->is_number_unsigned()) {
+            if (j->get<std::uint64_t>() > static_cast<std::uint64_t>(INT32_MAX))
+                return fmt::format("the integer {} is out of range (at most {})", j->dump(),
+                                   INT32_MAX);
+        } else if (j->is_number_integer()) {
+            const auto v = j->get<std::int64_t>();
+            if (v < INT32_MIN || v > INT32_MAX)
+                return fmt::format("the integer {} is out of range ({} to {})", v, INT32_MIN,
+                                   INT32_MAX);
+        } else if (j->is_number_float()) {
+            if (!std::isfinite(j->get<double>())) return "a number is not finite";
+        } else if (j->is_structured()) {
+            if (depth >= maxDepth)
+                return fmt::format("objects and arrays nest deeper than {} levels", maxDepth);
+            for (const auto& child : *j) todo.emplace_back(&child, depth + 1);
+        }
+    }
+    return {};
 }
 
 } // namespace
 
 HttpAnswer WebApi::error(int status) {
     HttpAnswer a;
+    securityHeaders(a);
     sendJson(a, status, {{"error", errorText(status)}});
     return a;
+}
+
+bool WebApi::touchesStudy(const HttpRequest& request) {
+    return request.path.rfind("/api/", 0) == 0;
 }
 
 struct WebApi::Impl {
     WebStudy& study;
     ServerOptions options;
+    TrustedProxies proxies;
     RateLimiter limiter;
     std::atomic<std::size_t> requests{0}, refused{0}, rateLimited{0};
+    /// Tokens known to open an invitation (only real ones: bounded by the invitations).
+    std::mutex knownMutex;
+    std::unordered_set<std::string> known;
+    std::atomic<bool> warnedForwarded{false};
 
     Impl(WebStudy& s, const ServerOptions& o)
-        : study(s), options(o), limiter(options.ratePerSecond, options.burst) {}
+        : study(s), options(o), proxies(o.trustedProxies),
+          limiter(o.ratePerSecond, o.burst, o.rateBuckets) {}
 
-    /// Counts the request, sets the security headers, applies the rate limit; false when the
-    /// request is answered already (429).
+    bool isKnown(const std::string& token) {
+        std::lock_guard lock(knownMutex);
+        return known.count(token) != 0;
+    }
+
+    /// The client's address (behind a trusted proxy: from X-Forwarded-For).
+    std::string clientAddress(const HttpRequest& req) {
+        const std::string peer = canonicalAddress(req.remoteAddr).value_or(req.remoteAddr);
+        std::vector<std::string> forwarded;
+        for (auto [it, end] = req.headers.equal_range("X-Forwarded-For"); it != end; ++it)
+            forwarded.push_back(it->second);
+        if (!forwarded.empty() && !proxies.trusts(peer) && !warnedForwarded.exchange(true))
+            fmt::print(stderr,
+                       "serve: requests from {} carry X-Forwarded-For, but {} is not a "
+                       "--trusted-proxy: every client behind it shares that address's limits\n",
+                       peer, peer);
+        return proxies.client(peer, forwarded);
+    }
+
+    /// Refuses bad framing; "" when the request may go on.
+    static std::pair<int, std::string> framingProblem(const HttpRequest& req,
+                                                      std::size_t maxFields) {
+        if (req.headers.size() > maxFields)
+            return {431, fmt::format("{} header fields; at most {} are accepted",
+                                     req.headers.size(), maxFields)};
+        const auto te = req.headers.count("Transfer-Encoding");
+        const auto cl = req.headers.count("Content-Length");
+        if (te > 0 && cl > 0)
+            return {400, "a request with both Content-Length and Transfer-Encoding is refused "
+                         "(RFC 9112 §6.1)"};
+        if (te > 1 || cl > 1) return {400, "a repeated Content-Length or Transfer-Encoding"};
+        if (te == 1) {
+            std::string v = req.header("Transfer-Encoding");
+            std::transform(v.begin(), v.end(), v.begin(),
+                           [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+            if (v != "chunked")
+                return {400, "Transfer-Encoding '" + req.header("Transfer-Encoding") +
+                                 "': only 'chunked' is accepted"};
+        }
+        return {0, {}};
+    }
+
+    /// Counts the request, sets the security headers, refuses bad framing, applies the rate
+    /// limit and checks the token of API requests; false when the request is answered already.
     bool admit(const HttpRequest& req, HttpAnswer& res) {
         ++requests;
         securityHeaders(res);
-        std::string key = bearer(req);
-        if (key.size() != 43) key = "addr:" + req.remoteAddr;
+        if (const auto [status, why] = framingProblem(req, options.maxHeaderFields); status) {
+            ++refused;
+            sendJson(res, status, {{"error", why}});
+            return false;
+        }
+        // The page and its assets are static, embedded and served without the study: no rate
+        // limit (the connection caps bound what one address can hold).
+        if (!touchesStudy(req)) return true;
+        const std::string token = bearer(req);
+        const bool knownToken = !token.empty() && isKnown(token);
+        // A real invitation has its own bucket; anything else shares its address's.
+        const std::string key = knownToken ? "t:" + token : "a:" + addressKey(clientAddress(req));
         if (!limiter.allow(key)) {
             ++rateLimited;
             res.headers.emplace_back("Retry-After", "1");
             sendJson(res, 429, {{"error", "too many requests; retry in a second"}});
             return false;
         }
+        if (knownToken) return true;
+        bool real = false;
+        if (plausibleToken(token)) {
+            if (!guarded(req, res, [&] { real = study.isInvitation(token); })) return false;
+        }
+        if (!real) {
+            ++refused;
+            sendJson(res, 403,
+                     {{"error", "this link is not valid (unknown or mistyped token); please use "
+                                "the exact link you received"}});
+            return false;
+        }
+        std::lock_guard lock(knownMutex);
+        known.insert(token);
         return true;
     }
 
@@ -126,6 +236,8 @@ struct WebApi::Impl {
             return true;
         } catch (const ApiError& e) {
             ++refused;
+            if (e.retryAfter > 0)
+                res.headers.emplace_back("Retry-After", std::to_string(e.retryAfter));
             sendJson(res, e.status, {{"error", e.what()}});
         } catch (const experiment::StoreError& e) {
             ++refused;
@@ -149,6 +261,11 @@ struct WebApi::Impl {
                 sendJson(res, 400, {{"error", "the request body is not a JSON object"}});
                 return;
             }
+            if (const std::string problem = numberProblem(body); !problem.empty()) {
+                ++refused;
+                sendJson(res, 400, {{"error", req.path + ": " + problem}});
+                return;
+            }
         }
         guarded(req, res, [&] { sendJson(res, 200, call(bearer(req), body)); });
     }
@@ -165,24 +282,25 @@ struct WebApi::Impl {
     }
 
     void route(const HttpRequest& req, HttpAnswer& res) {
-        static const std::regex assetPath(R"(/assets/([A-Za-z0-9_.-]+))");
-        static const std::regex clipPath(R"(/api/clip/([0-9]{1,6}))");
         const bool get = req.method == "GET" || req.method == "HEAD";
         const bool post = req.method == "POST";
         const std::string& p = req.path;
-        std::smatch m;
+        const std::string assetName = suffix(p, "/assets/", 64, [](unsigned char c) {
+            return std::isalnum(c) || c == '_' || c == '.' || c == '-';
+        });
+        const std::string clipIndex =
+            suffix(p, "/api/clip/", 6, [](unsigned char c) { return std::isdigit(c) != 0; });
         if (get && p == "/") {
             res.contentType = "text/plain; charset=utf-8";
             res.body = "Underfoot online study. Please open the personal link you received.\n";
         } else if (get && p == "/p") {
             asset("index.html", res);
-        } else if (get && std::regex_match(p, m, assetPath)) {
+        } else if (get && !assetName.empty()) {
             // Embedded files only, looked up by exact name: no file system access, no listing.
-            const std::string name = m[1];
-            if (name == "index.html" || name.find("..") != std::string::npos)
+            if (assetName == "index.html" || assetName.find("..") != std::string::npos)
                 sendJson(res, 404, {{"error", errorText(404)}});
             else
-                asset(name, res);
+                asset(assetName, res);
         } else if (get && p == "/api/state") {
             api(req, res, [this](const std::string& t, const json&) { return study.state(t); });
         } else if (post && p == "/api/consent") {
@@ -204,11 +322,11 @@ struct WebApi::Impl {
         } else if (post && p == "/api/break") {
             api(req, res,
                 [this](const std::string& t, const json& b) { return study.finishBreak(t, b); });
-        } else if (get && std::regex_match(p, m, clipPath)) {
+        } else if (get && !clipIndex.empty()) {
             // The clip of the participant's current trial, by trial index (never by file name,
             // which would tell the answer; never a path from the request).
             ClipFile clip;
-            if (!guarded(req, res, [&] { clip = study.clip(bearer(req), std::stoi(m[1].str())); }))
+            if (!guarded(req, res, [&] { clip = study.clip(bearer(req), std::stoi(clipIndex)); }))
                 return;
             res.headers.emplace_back("Cache-Control", "private, no-store");
             res.contentType = clip.contentType;
@@ -227,12 +345,17 @@ HttpAnswer WebApi::handle(const HttpRequest& request) {
     HttpAnswer res;
     if (!impl_->admit(request, res)) return res;
     if (request.body.size() > impl_->options.maxBodyBytes) {
-        HttpAnswer big = error(413);
-        big.headers.insert(big.headers.begin(), res.headers.begin(), res.headers.end());
-        return big;
+        ++impl_->refused;
+        return error(413);
     }
     impl_->route(request, res);
     return res;
+}
+
+bool WebApi::admitAsksStudy(const HttpRequest& request) const {
+    if (!touchesStudy(request)) return false;
+    const std::string token = bearer(request);
+    return plausibleToken(token) && !impl_->isKnown(token);
 }
 
 bool WebApi::admit(const HttpRequest& request, HttpAnswer& answer) {
@@ -244,7 +367,11 @@ void WebApi::route(const HttpRequest& request, HttpAnswer& answer) {
 }
 
 ServerCounters WebApi::counters() const {
-    return {impl_->requests.load(), impl_->refused.load(), impl_->rateLimited.load()};
+    ServerCounters c;
+    c.requests = impl_->requests.load();
+    c.refused = impl_->refused.load();
+    c.rateLimited = impl_->rateLimited.load();
+    return c;
 }
 
 } // namespace underfoot::web

@@ -132,6 +132,7 @@ WebStudy::~WebStudy() {
 
 void WebStudy::stop() {
     std::lock_guard lock(mutex_);
+    flows_.clear();
     for (auto& [code, s] : sessions_) {
         try {
             if (s && s->phase() != SessionPhase::Finished) s->interrupt();
@@ -145,6 +146,11 @@ void WebStudy::stop() {
 int WebStudy::openSessions() const {
     std::lock_guard lock(mutex_);
     return static_cast<int>(sessions_.size());
+}
+
+bool WebStudy::isInvitation(const std::string& token) const {
+    std::lock_guard lock(mutex_);
+    return invitations_->find(token).has_value();
 }
 
 Invitation WebStudy::invitation(const std::string& token) {
@@ -177,7 +183,7 @@ Session* WebStudy::session(const Invitation& inv) {
     const std::string& code = inv.participantCode;
     if (auto it = sessions_.find(code); it != sessions_.end()) {
         if (it->second->phase() != SessionPhase::Finished) return it->second.get();
-        sessions_.erase(it);
+        close(code);
     }
     ParticipantInfo p;
     try {
@@ -192,53 +198,90 @@ Session* WebStudy::session(const Invitation& inv) {
     settings.audioConfig = "browser";
     settings.sensorConfig = "none";
     settings.appVersion = underfoot::base::version();
+    // The server is the study's only online writer: a lease of another host name (a re-created
+    // container) is taken over, journaled; dead holders and reused PIDs always are.
+    settings.takeOverForeign = true;
     std::unique_ptr<Session> s;
     try {
         s = std::make_unique<Session>(store_, code, *player_, settings);
-    } catch (const StoreError&) {
-        return nullptr; // every trial answered: marked completed by the session
+    } catch (const StoreError& e) {
+        // Finished means every trial answered, and nothing else: any other failure (a live
+        // lease holder, a busy or failing store) is retryable and never shows the end page.
+        if (!store_.firstUnanswered(code)) return nullptr; // marked completed by the session
+        try {
+            store_.journal("online_unavailable", code, std::nullopt,
+                           jsonObject({{"participant", code}, {"reason", e.what()}}));
+        } catch (const std::exception&) {
+        }
+        throw ApiError(503,
+                       dynamic_cast<const LeaseHeld*>(&e)
+                           ? "your session is still held by the previous server process; please "
+                             "wait a moment, it resumes where you left off"
+                           : "your session cannot be opened just now; please wait a moment",
+                       5);
     }
     // Consent is the briefing: a participant who consented goes straight to the trials.
     if (s->phase() == SessionPhase::Briefing) s->finishBriefing();
     Session* raw = s.get();
+    flows_[code] = std::make_unique<TrialFlow>(store_, *raw);
     sessions_[code] = std::move(s);
     return raw;
 }
 
-json WebStudy::trialJson(const Session& s) const {
-    const Protocol& protocol = store_.protocol();
-    const Questions& q = protocol.questions;
+TrialFlow* WebStudy::flow(const std::string& code) {
+    const auto it = flows_.find(code);
+    return it == flows_.end() ? nullptr : it->second.get();
+}
+
+void WebStudy::close(const std::string& code) {
+    flows_.erase(code);
+    sessions_.erase(code);
+}
+
+json WebStudy::trialJson(const TrialFlow& flow) const {
+    const ParticipantScreen screen = flow.participantScreen();
+    const Session& s = flow.session();
     const TrialRecord& t = s.current();
     json j;
     j["index"] = t.index;
     j["practice"] = t.practice;
+    j["heading"] = screen.heading;
+    j["text"] = screen.text;
     j["presented"] = s.playing();
     j["replays"] = t.replays;
-    j["replayAllowed"] = protocol.clips.replay;
-    if (q.asksSurface()) {
-        j["surface"] = {
-            {"prompt", q.surfacePrompt.empty() ? "Which surface is it?" : q.surfacePrompt},
-            {"options", optionsJson(q.surfaceOptions)}};
-    }
+    j["replayAllowed"] = flow.protocol().clips.replay;
     json scales = json::array();
-    for (const Scale* sc : s.askedScales()) {
-        json anchors = json::array();
-        for (const auto& [v, label] : sc->anchors)
-            anchors.push_back({{"value", v}, {"label", label}});
-        scales.push_back({{"id", sc->id},
-                          {"prompt", sc->prompt},
-                          {"min", sc->min},
-                          {"max", sc->max},
-                          {"minLabel", sc->minLabel},
-                          {"maxLabel", sc->maxLabel},
-                          {"anchors", anchors}});
+    for (const AnswerSection& section : screen.sections) {
+        switch (section.kind) {
+        case SectionKind::Surface:
+            j["surface"] = {
+                {"prompt", section.prompt.empty() ? "Which surface is it?" : section.prompt},
+                {"options", optionsJson(section.options)}};
+            break;
+        case SectionKind::Soundscape:
+            if (section.options.empty()) break;
+            j["soundscape"] = {
+                {"prompt", section.prompt.empty() ? "Which environment is it?" : section.prompt},
+                {"options", optionsJson(section.options)}};
+            break;
+        case SectionKind::Scale: {
+            const Scale& sc = *section.scale;
+            json anchors = json::array();
+            for (const auto& [v, label] : sc.anchors)
+                anchors.push_back({{"value", v}, {"label", label}});
+            scales.push_back({{"id", sc.id},
+                              {"prompt", section.prompt},
+                              {"min", sc.min},
+                              {"max", sc.max},
+                              {"minLabel", sc.minLabel},
+                              {"maxLabel", sc.maxLabel},
+                              {"anchors", anchors}});
+            break;
+        }
+        }
     }
     j["scales"] = scales;
-    if (q.asksSoundscape(s.participant().groupId) && !q.soundscapeOptions.empty())
-        j["soundscape"] = {{"prompt", q.soundscapePrompt.empty() ? "Which environment is it?"
-                                                                 : q.soundscapePrompt},
-                           {"options", optionsJson(q.soundscapeOptions)}};
-    j["comment"] = q.comment;
+    j["comment"] = flow.protocol().questions.comment;
     return j;
 }
 
@@ -273,10 +316,14 @@ json WebStudy::stateOf(const Invitation& inv) {
     }
     Session* s = session(inv);
     if (!s) {
+        // session() returns null for a registered, not dropped participant only when every
+        // trial is answered; checked again here so that nothing else can show the end page.
         const auto trials = store_.trials(p->code);
-        j["progress"] = {{"answered", std::count_if(trials.begin(), trials.end(),
-                                                    [](const auto& t) { return t.answered; })},
-                         {"total", trials.size()}};
+        const auto answered =
+            std::count_if(trials.begin(), trials.end(), [](const auto& t) { return t.answered; });
+        if (answered != static_cast<std::ptrdiff_t>(trials.size()))
+            throw ApiError(503, "your session cannot be opened just now; please wait a moment", 5);
+        j["progress"] = {{"answered", answered}, {"total", trials.size()}};
         j["phase"] = "finished";
         j["completionCode"] = inv.completionCode;
         return j;
@@ -293,12 +340,14 @@ json WebStudy::stateOf(const Invitation& inv) {
     case SessionPhase::Practice:
     case SessionPhase::Trial:
         j["phase"] = s->phase() == SessionPhase::Practice ? "practice" : "trial";
-        j["trial"] = trialJson(*s);
+        j["trial"] = trialJson(*flow(inv.participantCode));
         break;
-    default:
+    case SessionPhase::Finished:
         j["phase"] = "finished";
         j["completionCode"] = inv.completionCode;
         break;
+    default:
+        throw ApiError(503, "your session cannot be opened just now; please wait a moment", 5);
     }
     return j;
 }
@@ -395,7 +444,7 @@ json WebStudy::screening(const std::string& token, const json& body) {
                    inv.participantCode, std::nullopt, detail);
     if (!passed && options_.screeningFailure == ScreeningFailure::End) {
         s->interrupt();
-        sessions_.erase(inv.participantCode);
+        close(inv.participantCode);
         store_.dropParticipant(inv.participantCode, "failed the headphone screening (online)");
     }
     return stateOf(invitations_->byCode(inv.participantCode));
@@ -438,11 +487,10 @@ json WebStudy::present(const std::string& token, const json& body) {
     const std::string playId = playAttempt ? fmt::format("{}:{}", trial, *playAttempt) : "";
     std::string& last = lastPresent_[inv.participantCode];
     if (playId.empty() || playId != last) {
-        try {
-            s->presentClip();
-        } catch (const StoreError& e) {
-            refuse(inv, trial, "present", 409, fmt::format("present: {}", e.what()));
-        }
+        // The flow plays the clip the first time and counts (and stores) each replay after.
+        if (const FlowResult r = flow(inv.participantCode)->start(); !r)
+            refuse(inv, trial, "present", r.refusal == Refusal::Failed ? 503 : 409,
+                   fmt::format("present: {}", r.message));
         last = playId;
     }
     json j = stateOf(inv);
@@ -494,52 +542,69 @@ json WebStudy::answer(const std::string& token, const json& body) {
     Session* s = session(inv);
     const int trial = currentTrialChecked(inv, s, body, request);
     const TrialRecord& t = s->current();
-    TrialAnswer a;
-    a.answer = member<std::string>(body, "answer", request).value_or("");
-    a.soundscapeAnswer = member<std::string>(body, "soundscape", request).value_or("");
-    a.comment = member<std::string>(body, "comment", request).value_or("");
-    if (a.answer.size() > options_.maxText || a.soundscapeAnswer.size() > options_.maxText ||
-        a.comment.size() > options_.maxText)
+    const std::string answer = member<std::string>(body, "answer", request).value_or("");
+    const std::string soundscape = member<std::string>(body, "soundscape", request).value_or("");
+    const std::string comment = member<std::string>(body, "comment", request).value_or("");
+    if (answer.size() > options_.maxText || soundscape.size() > options_.maxText ||
+        comment.size() > options_.maxText)
         refuse(inv, trial, request, 400,
                fmt::format("answer: texts are limited to {} characters", options_.maxText));
-    if (!store_.protocol().questions.comment && !a.comment.empty())
+    if (!store_.protocol().questions.comment && !comment.empty())
         refuse(inv, trial, request, 422, "answer: this protocol asks no comment");
+    const auto clientMs = member<double>(body, "clientMs", request);
+    if (clientMs && (*clientMs < 0 || *clientMs > 86400000.0))
+        refuse(inv, trial, request, 400, "answer: 'clientMs' must be 0 to 86400000 ms");
+    if (!s->playing() && t.startedAt.empty())
+        refuse(inv, trial, request, 409,
+               fmt::format("answer: trial index {} was not presented yet; play the clip first",
+                           trial));
+    // The page's answer goes into the participant's trial flow, which validates it (options of
+    // the questions asked, ratings of the scales asked, on their range) and commits it.
+    TrialFlow& f = *flow(inv.participantCode);
+    f.reset();
+    // Presented before a server restart: the presentation is restored (journaled as a restart
+    // of the trial by the store), then the answer is committed.
+    if (!s->playing())
+        if (const FlowResult r = f.start(); !r)
+            refuse(inv, trial, request, 409, "answer: " + r.message);
+    const auto chooseId = [&](SectionKind kind, const std::string& id, const char* what) {
+        if (id.empty()) return;
+        for (const AnswerSection& section : f.sections()) {
+            if (section.kind != kind) continue;
+            for (const AnswerOption& o : section.options)
+                if (o.id == id) {
+                    if (const FlowResult r = f.choose(kind, o.letter); !r)
+                        refuse(inv, trial, request, 422, "answer: " + r.message);
+                    return;
+                }
+        }
+        refuse(inv, trial, request, 422,
+               fmt::format("answer: {} '{}' is not one of the options of this trial", what, id));
+    };
+    chooseId(SectionKind::Surface, answer, "answer");
+    chooseId(SectionKind::Soundscape, soundscape, "soundscape");
     if (const auto r = body.find("ratings"); r != body.end() && !r->is_null()) {
         if (!r->is_object() || r->size() > 64)
             refuse(inv, trial, request, 400,
                    "answer: 'ratings' must be an object scale -> integer");
         for (const auto& [k, v] : r->items()) {
-            if (!v.is_number_integer() || v.get<std::int64_t>() < -1000000 ||
-                v.get<std::int64_t>() > 1000000)
+            if (!v.is_number_integer())
                 refuse(inv, trial, request, 422,
                        fmt::format("answer: rating '{}' must be an integer on its scale", k));
-            a.ratings[k] = v.get<int>();
+            if (const FlowResult res = f.setRating(k, v.get<int>()); !res)
+                refuse(inv, trial, request, 422,
+                       fmt::format("answer: rating '{}': {}", k, res.message));
         }
     }
-    const auto clientMs = member<double>(body, "clientMs", request);
-    if (clientMs && (*clientMs < 0 || *clientMs > 86400000.0))
-        refuse(inv, trial, request, 400, "answer: 'clientMs' must be 0 to 86400000 ms");
-    if (const auto problems = store_.checkAnswer(s->participant().groupId, a, t.stimulus, t.block);
-        !problems.empty()) {
+    f.setComment(comment);
+    if (const auto problems = f.problems(); !problems.empty()) {
         std::string all;
         for (const auto& p : problems) all += (all.empty() ? "" : "; ") + p;
         refuse(inv, trial, request, 422, "answer: " + all);
     }
-    if (!s->playing()) {
-        if (t.startedAt.empty())
-            refuse(inv, trial, request, 409,
-                   fmt::format("answer: trial index {} was not presented yet; play the clip first",
-                               trial));
-        // Presented before a server restart: the presentation is restored (journaled as a
-        // restart of the trial by the store), then the answer is committed.
-        s->play();
-    }
     invitations_->recordAttempt(inv.id, trial, *attempt, clientMs);
-    try {
-        s->answer(a);
-    } catch (const StoreError& e) {
-        refuse(inv, trial, request, 422, fmt::format("answer: {}", e.what()));
-    }
+    if (const FlowResult r = f.commit(); !r)
+        refuse(inv, trial, request, 422, "answer: " + r.message);
     json j = stateOf(inv);
     j["stored"] = true;
     j["duplicate"] = false;
@@ -551,7 +616,10 @@ json WebStudy::finishBreak(const std::string& token, const json& body) {
     std::lock_guard lock(mutex_);
     const Invitation inv = invitation(token);
     Session* s = session(inv);
-    if (s && s->phase() == SessionPhase::Break) s->finishBreak();
+    if (s && s->phase() == SessionPhase::Break) {
+        s->finishBreak();
+        flow(inv.participantCode)->reset(); // the next trial's questions
+    }
     return stateOf(inv);
 }
 

@@ -2,8 +2,10 @@
 #pragma once
 /// The online participant API of `underfoot serve`, independent of HTTP: every call takes the
 /// participant's link token and a JSON body and returns JSON, or throws ApiError (status code
-/// and a message for the page). It drives one experiment::Session per participant (the same
-/// plans, lock rule, replay counts and ratings as the terminal session and the console) with a
+/// and a message for the page). It is an adapter of experiment::TrialFlow, one per participant
+/// (the same screen model, progress text, answer and rating validation, commit and replay
+/// counts as the terminal session and the console): it renders the flow's participant screen
+/// as JSON and forwards the page's answers to it. Each session plays through a
 /// ClipPlayer that plays nothing (the browser fetches and plays the clip) but stores, with each
 /// trial, the clip's seed, length and samples' SHA-256 from the manifest, as the booth does. A
 /// clip is served only while its file matches the manifest.
@@ -14,6 +16,7 @@
 #include "experiment/Invitations.h"
 #include "experiment/Session.h"
 #include "experiment/Store.h"
+#include "experiment/TrialFlow.h"
 
 #include <nlohmann/json.hpp>
 
@@ -28,9 +31,11 @@ namespace underfoot::web {
 
 /// A refused request: HTTP status and a message naming what was expected.
 struct ApiError : std::runtime_error {
-    ApiError(int statusCode, const std::string& message)
-        : std::runtime_error(message), status(statusCode) {}
+    ApiError(int statusCode, const std::string& message, int retryAfterSeconds = 0)
+        : std::runtime_error(message), status(statusCode), retryAfter(retryAfterSeconds) {}
     int status;
+    /// Seconds for a Retry-After header (0: none): the request may succeed later as it is.
+    int retryAfter;
 };
 
 /// What happens when a participant fails the headphone screening.
@@ -75,6 +80,9 @@ class WebStudy {
     nlohmann::json finishBreak(const std::string& token, const nlohmann::json& body);
     /// The clip of the participant's current trial.
     ClipFile clip(const std::string& token, int trialIndex);
+    /// Whether `token` opens an invitation of this study (the HTTP layer asks before it reads
+    /// a request's body and keys the rate limit by it).
+    bool isInvitation(const std::string& token) const;
 
     /// Closes every open session as interrupted (resumable); the server's clean stop.
     void stop();
@@ -88,10 +96,17 @@ class WebStudy {
         std::unique_ptr<experiment::Session> session;
     };
     experiment::Invitation invitation(const std::string& token);
-    /// The participant's session, opened (or resumed) when needed; null when finished/dropped.
+    /// The participant's session, opened (or resumed) when needed; null when not registered yet,
+    /// dropped, or finished (every trial answered: nothing else counts as finished). A session
+    /// that cannot be opened now (its lease held by a live process) is a retryable 503.
     experiment::Session* session(const experiment::Invitation& inv);
     nlohmann::json stateOf(const experiment::Invitation& inv);
-    nlohmann::json trialJson(const experiment::Session& s) const;
+    /// The participant's trial flow (made with the session; null when there is none).
+    experiment::TrialFlow* flow(const std::string& code);
+    /// Drops a participant's flow and session (in that order: the flow refers to the session).
+    void close(const std::string& code);
+    /// The current trial as TrialFlow's participant screen shows it.
+    nlohmann::json trialJson(const experiment::TrialFlow& flow) const;
     [[noreturn]] void refuse(const experiment::Invitation& inv, std::optional<int> trial,
                              const std::string& request, int status, const std::string& reason);
     int currentTrialChecked(const experiment::Invitation& inv, experiment::Session* s,
@@ -104,6 +119,7 @@ class WebStudy {
     std::unique_ptr<experiment::Invitations> invitations_;
     std::unique_ptr<experiment::ClipPlayer> player_;
     std::map<std::string, std::unique_ptr<experiment::Session>> sessions_;
+    std::map<std::string, std::unique_ptr<experiment::TrialFlow>> flows_;
     /// The last play id of each participant (trial:attempt), for idempotent presentations.
     std::map<std::string, std::string> lastPresent_;
 };

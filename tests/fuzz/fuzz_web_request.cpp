@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // HTTP requests and answer payloads of `underfoot serve` (app/web/Api.h: WebApi::handle, which
-// applies the limits, routes and validates every request and drives WebStudy), in process and
-// without a socket. An input is a sequence of up to 16 requests separated by lines "%%":
+// applies the framing rules, limits and token check, routes and validates every request and
+// drives WebStudy), in process and without a socket. An input is a sequence of up to 16
+// requests separated by lines "%%":
 //
 //     POST /api/answer HTTP/1.1
 //     Authorization: Bearer @TOKEN0@
@@ -9,14 +10,17 @@
 //     {"trial": 0, "attempt": "a1", "answer": "wood", "ratings": {"realism": 7}}
 //
 // (request line, header lines, an empty line, the body). @TOKEN0@ and @TOKEN1@ stand for the
-// link tokens of the two invited participants (random per run). The HTTP syntax itself is
-// cpp-httplib's and not fuzzed here; everything our code does with any method, path, header
-// and body is. Each input starts from the same fresh study (a copy of a template), so a finding
-// replays alone. Every answer must be one of the documented statuses with a JSON object body
-// (an "error" message on refusals); 500 (an unexpected exception) is a finding; a clip is
-// always a file inside the clips folder.
+// link tokens of the two invited participants (random per run). The request target goes
+// through decodeTargetPath (app/web/Limits.h) as in the server; the peer is 127.0.0.1, a
+// trusted proxy, so X-Forwarded-For headers are read. The HTTP syntax itself is Boost.Beast's
+// and not fuzzed here; everything our code does with any method, target, header and body is.
+// Each input starts from the same fresh study (a copy of a template), so a finding replays
+// alone. Every answer must be one of the documented statuses with a JSON object body (an
+// "error" message on refusals); 500 (an unexpected exception) is a finding; a clip is always a
+// file inside the clips folder.
 #include "FuzzSupport.h"
 #include "app/web/Api.h"
+#include "app/web/Limits.h"
 #include "app/web/WebStudy.h"
 #include "experiment/Invitations.h"
 #include "experiment/Protocol.h"
@@ -117,7 +121,8 @@ void replaceAll(std::string& s, const std::string& from, const std::string& to) 
         s.replace(at, from.size(), to);
 }
 
-web::HttpRequest parseRequest(std::string text, const Template& t) {
+/// The request in `text`, or nullopt when its target is not a path (the server answers 400).
+std::optional<web::HttpRequest> parseRequest(std::string text, const Template& t) {
     for (std::size_t i = 0; i < t.tokens.size(); ++i)
         replaceAll(text, "@TOKEN" + std::to_string(i) + "@", t.tokens[i]);
     web::HttpRequest r;
@@ -135,11 +140,11 @@ web::HttpRequest parseRequest(std::string text, const Template& t) {
     const std::string first = line().value_or("");
     const std::size_t sp = first.find(' ');
     r.method = first.substr(0, sp);
-    if (sp != std::string::npos) {
-        std::string target = first.substr(sp + 1);
-        target = target.substr(0, target.find(' '));
-        r.path = target.substr(0, target.find('?'));
-    }
+    if (sp == std::string::npos) return std::nullopt;
+    std::string target = first.substr(sp + 1);
+    const auto path = web::decodeTargetPath(target.substr(0, target.find(' ')));
+    if (!path) return std::nullopt;
+    r.path = *path;
     while (const auto l = line()) {
         if (l->empty()) break;
         const std::size_t colon = l->find(':');
@@ -155,7 +160,7 @@ web::HttpRequest parseRequest(std::string text, const Template& t) {
 }
 
 void check(const web::HttpRequest& req, const web::HttpAnswer& a, const Template& t) {
-    static const std::set<int> documented{200, 400, 403, 404, 409, 413, 422, 429};
+    static const std::set<int> documented{200, 400, 403, 404, 409, 413, 422, 429, 431, 503};
     const std::string what = req.method + " " + req.path;
     if (a.status == 500) fuzz::fail(what + ": 500 (an unexpected exception): " + a.body);
     if (!documented.count(a.status))
@@ -187,11 +192,14 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     so.maxBodyBytes = 16 * 1024;
     so.ratePerSecond = 1e9; // the rate limit is tested by tests/web, not fuzzed
     so.burst = 1e9;
+    so.trustedProxies = {"127.0.0.1"};
     web::WebStudy study(t.work, wo);
     web::WebApi api(study, so);
     const bool verbose = std::getenv("UNDERFOOT_FUZZ_VERBOSE") != nullptr;
     for (const std::string& text : splitRequests(fuzz::text(data, size))) {
-        const web::HttpRequest req = parseRequest(text, t);
+        const auto parsed = parseRequest(text, t);
+        if (!parsed) continue;
+        const web::HttpRequest& req = *parsed;
         web::HttpAnswer a;
         try {
             a = api.handle(req);

@@ -1,8 +1,10 @@
 #!/usr/bin/env python3
 # Writes the seed corpus of fuzz_web_request (tests/fuzz/corpus/web_request/): the requests of
-# tests/web/test_web_api.cpp (the participant flow, retries, bad tokens, another participant's
-# trial, invalid answers, traversal paths, oversized and non-JSON bodies), in the target's
-# format: requests separated by lines "%%", @TOKEN0@/@TOKEN1@ for the two link tokens.
+# tests/web/test_web_api.cpp and test_web_attacks.cpp (the participant flow, retries, bad
+# tokens, another participant's trial, invalid answers, out-of-range numbers, traversal paths,
+# oversized and non-JSON bodies, conflicting framing, many header fields, X-Forwarded-For), in
+# the target's format: requests separated by lines "%%", @TOKEN0@/@TOKEN1@ for the two link
+# tokens.
 import json, os
 
 d = os.path.join(os.path.dirname(os.path.abspath(__file__)), "corpus", "web_request")
@@ -78,6 +80,27 @@ seeds = {
     "methods": seq(req("PUT", "/api/answer", {}), req("DELETE", "/api/state"),
                    req("HEAD", "/p"), req("POST", "/api/state", {}), req("GET", "/api/answer")),
     "oversized": req("POST", "/api/consent", " " * 20000),
+    "numbers": seq(*start, present(0), answer(0, "n1", trial=2**32), answer(0, "n2", trial=2**31),
+                   answer(0, "n3", trial=-2**31 - 1), answer(0, "n4", ratings={"realism": 2**32 + 7}),
+                   answer(0, "n5", trial=2**64 - 1), req("POST", "/api/answer", '{"trial": 1e400}'),
+                   req("POST", "/api/answer", '{"x": [[[[[[[[[1]]]]]]]]]}'),
+                   present(2**32), req("GET", "/api/clip/4294967296")),
+    "framing": seq(req("POST", "/api/state", "0\r\n\r\n",
+                       extra=["Content-Length: 5", "Transfer-Encoding: chunked"]),
+                   req("POST", "/api/answer", "{}", extra=["Transfer-Encoding: gzip"]),
+                   req("POST", "/api/answer", "{}",
+                       extra=["Transfer-Encoding: chunked", "Transfer-Encoding: chunked"]),
+                   req("GET", "/p", extra=[f"X-H{i}: v" for i in range(70)]),
+                   req("GET", "/api/state", extra=[f"X-H{i}: v" for i in range(50)])),
+    "forwarded": seq(req("GET", "/api/state", token="nonsense", extra=["X-Forwarded-For: 203.0.113.9"]),
+                     req("GET", "/api/state", extra=["X-Forwarded-For: 1.1.1.1, 203.0.113.9",
+                                                     "X-Forwarded-For: [2001:db8::5]"]),
+                     req("GET", "/api/state", token="A" * 43,
+                         extra=["X-Forwarded-For: nonsense, 127.0.0.1"]),
+                     req("GET", "/p", token=None, extra=["X-Forwarded-For: ::ffff:192.0.2.7"])),
+    "targets": seq(*[req("GET", p) for p in [
+        "/api/state?x=1", "/p#frag", "/assets/app%2Ejs", "/%", "/%zz", "/a%00", "*",
+        "http://example.org/p", "/api/clip/0?trial=1"]]),
 }
 for name, text in seeds.items():
     with open(os.path.join(d, name), "w", newline="") as f:

@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // Shared helpers of the web tests: a study with invitations and clips in a temporary folder,
-// an in-process server on a loopback port, and a small JSON client over cpp-httplib.
+// an in-process server on a loopback port, and a small JSON client over Boost.Beast that can
+// connect from any loopback address (127.0.0.0/8), so that tests can play many clients.
 #include "app/web/Server.h"
 #include "app/web/WebStudy.h"
 #include "experiment/Clips.h"
@@ -9,13 +10,19 @@
 #include "experiment/Protocol.h"
 #include "experiment/Store.h"
 
-#include <httplib.h>
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/ip/tcp.hpp>
+#include <boost/beast/core/flat_buffer.hpp>
+#include <boost/beast/http.hpp>
+#include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <memory>
 #include <string>
 #include <thread>
@@ -96,8 +103,10 @@ struct StudyFixture {
     std::string clips = dir.file("clips");
     std::vector<experiment::NewInvitation> links;
 
-    explicit StudyFixture(int invites, const std::string& protocolText = webProtocol()) {
-        const experiment::Protocol p = experiment::parseProtocol(protocolText, "web.toml");
+    explicit StudyFixture(int invites, const std::string& protocolText = webProtocol())
+        : StudyFixture(invites, experiment::parseProtocol(protocolText, "web.toml")) {}
+
+    StudyFixture(int invites, const experiment::Protocol& p) {
         experiment::StudyStore store =
             experiment::StudyStore::create(study, p, {"WEB", "web", 4, "test"});
         experiment::Invitations inv(store);
@@ -106,6 +115,7 @@ struct StudyFixture {
         std::vector<experiment::ClipRecord> manifest;
         for (const auto& s : p.stimuli) {
             const std::string path = experiment::clipPath(s, clips);
+            fs::create_directories(fs::path(path).parent_path()); // lab clips in sub-folders
             writeWav(path);
             // The manifest `underfoot clips` writes (a test tone stands for the render): the
             // server serves and stores only clips that match it.
@@ -148,52 +158,120 @@ struct InProcessServer {
 
 /// One HTTP answer: status and parsed JSON (null when not JSON).
 struct Reply {
+    /// 0: no answer (no connection, closed, or no answer within the time allowed).
     int status = 0;
     json body;
     std::string raw;
+    std::map<std::string, std::string> headers;
 };
 
-/// A participant's client (a fresh connection per call when `fresh`).
+using Headers = std::vector<std::pair<std::string, std::string>>;
+
+/// One request on a fresh connection from `source` (a loopback address) to 127.0.0.1:`port`;
+/// the request is written while the answer is read, so an answer sent before the server read
+/// the whole body is seen.
+inline Reply exchange(int port, const std::string& method, const std::string& path,
+                      const Headers& headers, const std::string& body,
+                      const std::string& source = "127.0.0.1", double timeoutS = 10.0) {
+    namespace asio = boost::asio;
+    namespace http = boost::beast::http;
+    using tcp = asio::ip::tcp;
+    asio::io_context ioc;
+    tcp::socket socket(ioc);
+    boost::system::error_code ec;
+    socket.open(tcp::v4(), ec);
+    if (!ec) socket.bind(tcp::endpoint(asio::ip::make_address(source), 0), ec);
+    if (!ec) socket.set_option(tcp::no_delay(true), ec);
+    Reply out;
+    if (ec) return out;
+    http::request<http::string_body> req;
+    const http::verb verb = http::string_to_verb(method);
+    if (verb == http::verb::unknown)
+        req.method_string(method);
+    else
+        req.method(verb);
+    req.target(path);
+    req.version(11);
+    req.set(http::field::host, "127.0.0.1");
+    for (const auto& [name, value] : headers) req.set(name, value);
+    if (method == "POST" || !body.empty()) {
+        req.body() = body;
+        req.prepare_payload();
+    }
+    boost::beast::flat_buffer buffer;
+    http::response_parser<http::string_body> parser;
+    parser.body_limit(std::uint64_t{1} << 30);
+    if (method == "HEAD") parser.skip(true);
+    bool done = false;
+    socket.async_connect(
+        tcp::endpoint(asio::ip::make_address("127.0.0.1"), static_cast<unsigned short>(port)),
+        [&](boost::system::error_code e) {
+            if (e) return;
+            http::async_write(socket, req, [](boost::system::error_code, std::size_t) {});
+            http::async_read(socket, buffer, parser,
+                             [&](boost::system::error_code r, std::size_t) { done = !r; });
+        });
+    ioc.run_for(std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+        std::chrono::duration<double>(timeoutS)));
+    if (!done) return out;
+    const auto& res = parser.get();
+    out.status = static_cast<int>(res.result_int());
+    out.raw = res.body();
+    for (const auto& f : res) out.headers[std::string(f.name_string())] = std::string(f.value());
+    out.body = json::parse(out.raw, nullptr, false);
+    if (out.body.is_discarded()) out.body = nullptr;
+    return out;
+}
+
+/// A participant's client (a fresh connection per call), from a chosen loopback address.
 class ApiClient {
   public:
-    ApiClient(int port, std::string token) : port_(port), token_(std::move(token)) {}
+    ApiClient(int port, std::string token, std::string source = "127.0.0.1")
+        : port_(port), token_(std::move(token)), source_(std::move(source)) {}
     void setToken(std::string token) { token_ = std::move(token); }
     void setPort(int port) { port_ = port; }
 
     Reply get(const std::string& path) const {
-        httplib::Client c("127.0.0.1", port_);
-        c.set_connection_timeout(2, 0);
-        c.set_read_timeout(10, 0);
-        return convert(c.Get(path.c_str(), headers()));
+        return exchange(port_, "GET", path, headers(), "", source_);
     }
     Reply post(const std::string& path, const json& body) const {
         return postRaw(path, body.dump());
     }
     Reply postRaw(const std::string& path, const std::string& body) const {
-        httplib::Client c("127.0.0.1", port_);
-        c.set_connection_timeout(2, 0);
-        c.set_read_timeout(10, 0);
-        return convert(c.Post(path.c_str(), headers(), body, "application/json"));
+        Headers h = headers();
+        h.emplace_back("Content-Type", "application/json");
+        return exchange(port_, "POST", path, h, body, source_);
     }
 
   private:
-    httplib::Headers headers() const {
-        httplib::Headers h{{"User-Agent", "underfoot-web-test/1"}};
-        if (!token_.empty()) h.emplace("Authorization", "Bearer " + token_);
+    Headers headers() const {
+        Headers h{{"User-Agent", "underfoot-web-test/1"}};
+        if (!token_.empty()) h.emplace_back("Authorization", "Bearer " + token_);
         return h;
-    }
-    static Reply convert(const httplib::Result& r) {
-        Reply out;
-        if (!r) return out; // status 0: no connection
-        out.status = r->status;
-        out.raw = r->body;
-        out.body = json::parse(r->body, nullptr, false);
-        if (out.body.is_discarded()) out.body = nullptr;
-        return out;
     }
     int port_;
     std::string token_;
+    std::string source_;
 };
+
+/// The loopback address of simulated client `i` (127.0.1.1, 127.0.1.2, ...; all reach the
+/// server over the loopback interface, each seen as its own address).
+inline std::string clientAddress(int i) {
+    return "127.0." + std::to_string(1 + i / 250) + "." + std::to_string(1 + i % 250);
+}
+
+/// Consent + screening; returns the state of the first trial.
+inline json startParticipant(const ApiClient& c) {
+    Reply r = c.post("/api/consent",
+                     {{"consent", true}, {"fields", {{"listening_device", "headphones"}}}});
+    EXPECT_EQ(r.status, 200) << r.raw;
+    EXPECT_EQ(r.body["phase"], "screening");
+    r = c.post("/api/client", {{"sampleRate", 48000}});
+    EXPECT_EQ(r.status, 200) << r.raw;
+    r = c.post("/api/screening", {{"correct", 6}, {"total", 6}});
+    EXPECT_EQ(r.status, 200) << r.raw;
+    return r.body;
+}
 
 /// The answer a simulated participant gives to the trial in `state` (valid for webProtocol()).
 inline json validAnswer(const json& state, const std::string& attempt) {

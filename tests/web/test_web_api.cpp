@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The online API over loopback (cpp-httplib client): the whole flow, idempotent retries and
-// every security rule of issue 14 (bad token, another participant's trial, traversal,
-// oversized body, invalid answers, rate limits), each refusal journaled.
+// The online API over loopback (an in-process server, the tests' Beast client): the whole flow,
+// idempotent retries and every rule of docs/reference/web-server.md about what a request may
+// do (bad token, another participant's trial, traversal, oversized body, invalid answers,
+// out-of-range numbers, rate limits, HEAD), each refusal journaled.
 #include "WebTestSupport.h"
 
 #include <SQLiteCpp/SQLiteCpp.h>
@@ -14,19 +15,6 @@ namespace underfoot::web::test {
 namespace {
 
 using experiment::StudyStore;
-
-/// Consent + screening; returns the state of the first trial.
-json startParticipant(const ApiClient& c) {
-    Reply r = c.post("/api/consent",
-                     {{"consent", true}, {"fields", {{"listening_device", "headphones"}}}});
-    EXPECT_EQ(r.status, 200) << r.raw;
-    EXPECT_EQ(r.body["phase"], "screening");
-    r = c.post("/api/client", {{"sampleRate", 48000}});
-    EXPECT_EQ(r.status, 200) << r.raw;
-    r = c.post("/api/screening", {{"correct", 6}, {"total", 6}});
-    EXPECT_EQ(r.status, 200) << r.raw;
-    return r.body;
-}
 
 /// Presents and answers the current trial; returns the reply.
 Reply answerCurrent(const ApiClient& c, const json& state, const std::string& attempt) {
@@ -218,6 +206,37 @@ TEST(WebApi, InvalidAnswersAreRefusedAndJournaled) {
     EXPECT_EQ(fresh.post("/api/client", {{"sampleRate", -5}}).status, 400);
 }
 
+TEST(WebApi, OutOfRangeNumbersAreRefusedNotTruncated) {
+    StudyFixture f(1);
+    InProcessServer s(f);
+    ApiClient c(s.port, f.links[0].token);
+    const json state = startParticipant(c);
+    const int t = state["trial"]["index"];
+    ASSERT_EQ(c.post("/api/present", {{"trial", t}}).status, 200);
+    const json good = validAnswer(state, "g1");
+    constexpr std::int64_t two32 = std::int64_t{1} << 32;
+    // 2^32 + t once became trial t, and 2^31 became -2147483648.
+    for (const json& bad : {json(two32 + t), json(std::int64_t{1} << 31),
+                            json(-(std::int64_t{1} << 31) - 1), json(~std::uint64_t{0})}) {
+        json a = good;
+        a["trial"] = bad;
+        const Reply r = c.post("/api/answer", a);
+        EXPECT_EQ(r.status, 400) << bad.dump() << " " << r.raw;
+        EXPECT_NE(r.raw.find("out of range"), std::string::npos) << r.raw;
+        EXPECT_EQ(c.post("/api/present", {{"trial", bad}}).status, 400) << bad.dump();
+    }
+    json rating = good;
+    rating["ratings"]["realism"] = two32 + 7;
+    EXPECT_EQ(c.post("/api/answer", rating).status, 400);
+    // Numbers JSON cannot hold as doubles, and nesting deeper than 8 levels.
+    EXPECT_EQ(c.postRaw("/api/answer", R"({"trial": 1e400})").status, 400);
+    EXPECT_EQ(c.postRaw("/api/answer", R"({"x": [[[[[[[[[1]]]]]]]]]})").status, 400);
+    EXPECT_EQ(c.get("/api/clip/4294967296").status, 404); // paths take at most 6 digits
+    StudyStore store = StudyStore::open(f.study);
+    EXPECT_FALSE(store.trial(f.links[0].participantCode, t).answered);
+    EXPECT_EQ(c.post("/api/answer", good).status, 200);
+}
+
 TEST(WebApi, ConsentNeedsTheProtocolsRequiredFields) {
     StudyFixture f(1);
     InProcessServer s(f);
@@ -348,6 +367,42 @@ TEST(WebApi, OversizedBodiesAndFloodsAreRefused) {
     limited = 0;
     for (int i = 0; i < 40; ++i) limited += bad.get("/api/state").status == 429;
     EXPECT_GE(limited, 20);
+}
+
+TEST(WebApi, HeadAnswersLikeGetWithoutABody) {
+    StudyFixture f(1);
+    InProcessServer s(f);
+    const json st = startParticipant(ApiClient(s.port, f.links[0].token));
+    for (const auto& [path, token] :
+         {std::pair<std::string, std::string>{"/p", ""},
+          {"/assets/app.js", ""},
+          {"/api/clip/" + std::to_string(st["trial"]["index"].get<int>()), f.links[0].token}}) {
+        Headers h;
+        if (!token.empty()) h.emplace_back("Authorization", "Bearer " + token);
+        const Reply get = exchange(s.port, "GET", path, h, "");
+        const Reply head = exchange(s.port, "HEAD", path, h, "");
+        EXPECT_EQ(head.status, 200) << path;
+        EXPECT_TRUE(head.raw.empty()) << path;
+        EXPECT_EQ(head.headers.at("Content-Length"), std::to_string(get.raw.size())) << path;
+        EXPECT_EQ(head.headers.at("Content-Type"), get.headers.at("Content-Type")) << path;
+    }
+}
+
+TEST(WebApi, ATrustedProxyMustBeAnAddress) {
+    StudyFixture f(1);
+    WebOptions wo;
+    wo.clipsDir = f.clips;
+    WebStudy study(f.study, wo);
+    ServerOptions so;
+    so.trustedProxies = {"127.0.0.1", "proxy.example.org"};
+    try {
+        WebServer server(study, so);
+        FAIL() << "a host name was taken as a trusted proxy";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("'proxy.example.org': not an IP address"),
+                  std::string::npos)
+            << e.what();
+    }
 }
 
 TEST(WebApi, ProtocolsThatCannotRunOnlineAreRefusedClearly) {

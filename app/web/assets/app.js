@@ -382,8 +382,8 @@
       submit(a);
     });
 
-    const heading = t.practice ? 'Practice' : 'Sound ' + ((s.progress ? s.progress.answered : 0) + 1) + ' of ' + (s.progress ? s.progress.total : '?');
-    show(el('h1', { text: heading }),
+    // The heading ("Trial 3 of 40", "Practice trial 1 of 40") is the trial core's.
+    show(el('h1', { text: t.heading }),
          el('div', { class: 'card' }, el('p', { text: t.practice ? 'A practice sound: it is not part of the results.' : 'Listen, then answer.' }),
             el('div', { class: 'row' }, playBtn, replayInfo)),
          form);

@@ -126,13 +126,13 @@ try {
       reloaded = true;
       await page.reload({ waitUntil: 'load' });
     }
-    await waitFor(() => ['Thank you!', 'Break', 'Practice', 'Set the volume'].includes(document.querySelector('h1')?.textContent)
-      || /^Sound \d+ of \d+$/.test(document.querySelector('h1')?.textContent || ''), 'the next page');
+    await waitFor(() => ['Thank you!', 'Break', 'Set the volume'].includes(document.querySelector('h1')?.textContent)
+      || /^(Practice trial|Trial) \d+ of \d+$/.test(document.querySelector('h1')?.textContent || ''), 'the next page');
     const h = await heading();
     if (h === 'Thank you!') { await shot('9-end'); break; }
     if (h === 'Set the volume') { await page.keyboard.press('Enter'); await waitFor(() => document.querySelector('h1')?.textContent !== 'Set the volume', 'the trials after the reload'); continue; }
     if (h === 'Break') { await shot('6-break'); await page.keyboard.press('Enter'); await waitFor(() => document.querySelector('h1')?.textContent !== 'Break', 'the end of the break'); continue; }
-    const label = h === 'Practice' ? '4-practice' : '5-trial';
+    const label = h.startsWith('Practice') ? '4-practice' : '5-trial';
     await waitFor(() => document.activeElement && document.activeElement.id === 'play', 'the play button');
     await page.keyboard.press('Space'); // play (presented, stored, then heard)
     await waitFor(() => !document.querySelector('main form').hidden, 'the questions');
