@@ -55,7 +55,10 @@ function(underfoot_add_gtest target label)
   endif()
   add_executable(${target} ${ARG_SOURCES})
   target_link_libraries(${target} PRIVATE ${ARG_LIBS} GTest::gtest GTest::gtest_main GTest::gmock)
+  # Tests (only they) may name files of the source tree; the programs find their data through
+  # base/DataDir.h.
   target_compile_definitions(${target} PRIVATE UNDERFOOT_TEST_DATA_DIR="${PROJECT_SOURCE_DIR}/tests/data"
+                                               UNDERFOOT_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
                                                UNDERFOOT_BINARY_DIR="${PROJECT_BINARY_DIR}")
   underfoot_target_defaults(${target})
   gtest_discover_tests(${target} PROPERTIES LABELS ${label} TIMEOUT ${ARG_TIMEOUT}

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "experiment/Protocol.h"
 
+#include "base/DataDir.h"
 #include "experiment/Random.h"
 
 #include <fmt/format.h>
@@ -192,7 +193,7 @@ const char* toString(DesignKind design) {
 }
 
 std::string shippedProtocolDir() {
-    return std::string(UNDERFOOT_SOURCE_DIR) + "/protocols";
+    return base::dataDirectory(base::DataKind::Protocols);
 }
 
 // ----------------------------------------------------------------------------------------------

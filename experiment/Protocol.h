@@ -284,7 +284,8 @@ std::string stimulusToToml(const Stimulus& stimulus);
 /// Parses the text written by stimulusToToml. Throws std::runtime_error on malformed text.
 Stimulus stimulusFromToml(const std::string& text);
 
-/// Folder of the shipped protocols (source tree at build time).
+/// Folder of the shipped protocols ($UNDERFOOT_PROTOCOLS_DIR, else as base::dataDirectory finds
+/// it: installed share/underfoot/protocols or the source tree's protocols/).
 std::string shippedProtocolDir();
 
 } // namespace underfoot::experiment

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "experiment/Simulation.h"
+#include "base/Version.h"
 
 #include <fmt/format.h>
 #include <toml++/toml.h>
@@ -334,7 +335,7 @@ int runSimulatedSession(StudyStore& store, const std::string& code, const Confus
                                 store.protocol().timing.trialS)));
     Session session(store, code, player,
                     SessionSettings{"simulation", "none (simulated)", "none (simulated)",
-                                    UNDERFOOT_VERSION, false},
+                                    underfoot::base::version(), false},
                     [&] { return simulatedTimeS; });
     int committed = 0;
     while (session.phase() != SessionPhase::Finished) {

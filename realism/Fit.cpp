@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "realism/Fit.h"
+#include "base/Version.h"
 
 #include "engine/render/Renderer.h"
 #include "engine/surfaces/Surface.h"
@@ -775,7 +776,7 @@ FitResult fitSurface(const std::string& presetFile, const std::vector<Recording>
             }) == sources.end())
             sources.push_back(r.package);
     }
-    prov.insert("tool", fmt::format("underfoot fit {}", UNDERFOOT_VERSION));
+    prov.insert("tool", fmt::format("underfoot fit {}", underfoot::base::version()));
     prov.insert("optimiser", result.optimiser);
     prov.insert("recordings", files);
     prov.insert("sources", sources);

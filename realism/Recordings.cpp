@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "realism/Recordings.h"
 
+#include "base/DataDir.h"
 #include <fmt/core.h>
 
 #include <algorithm>
@@ -15,12 +16,7 @@ namespace underfoot::realism {
 namespace fs = std::filesystem;
 
 std::string defaultRecordingsDir() {
-    if (const char* env = std::getenv("UNDERFOOT_RECORDINGS"); env && *env) return env;
-#ifdef UNDERFOOT_SOURCE_DIR
-    return std::string(UNDERFOOT_SOURCE_DIR) + "/build/recordings";
-#else
-    return "build/recordings";
-#endif
+    return base::recordingsDirectory();
 }
 
 std::vector<Recording> loadManifest(const std::string& dir) {

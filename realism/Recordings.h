@@ -20,7 +20,8 @@ struct Recording {
     std::string recordist;
 };
 
-/// Where the recordings cache is: $UNDERFOOT_RECORDINGS, else <source tree>/build/recordings.
+/// Where the recordings cache is: $UNDERFOOT_RECORDINGS, else <source tree>/build/recordings for
+/// a program of the build tree, else ~/.cache/underfoot/recordings (base::recordingsDirectory).
 std::string defaultRecordingsDir();
 
 /// Reads DIR/manifest.csv. Throws std::runtime_error naming the file and line when it is

@@ -4,7 +4,15 @@
 # extracts them into a cache folder with a manifest, for `underfoot compare`, the realism
 # listener and the tests in tests/realism (which skip, saying so, when the cache is absent).
 #
-#   bash scripts/fetch-recordings.sh [CACHE_DIR]     # default: build/recordings
+#   bash scripts/fetch-recordings.sh [--large] [CACHE_DIR]
+#
+# CACHE_DIR defaults to $UNDERFOOT_RECORDINGS, else build/recordings in a source tree, else
+# ~/.cache/underfoot/recordings (where an installed `underfoot compare` looks).
+# By default only the four small packages are fetched (about 100 MB: minetest-data 3.6 MB,
+# openarena-data 44 MB, ufoai-sound 19 MB, lugaru-data 34 MB; 90 files). --large (or
+# UNDERFOOT_RECORDINGS_LARGE=1) adds the three large ones (about 1.24 GB more: nexuiz-data
+# 267 MB, openclonk-data 113 MB, redeclipse-data 862 MB; 114 files in all), which the realism
+# figures of docs/explanation/realism.md were measured on.
 #
 # Layout: CACHE_DIR/<source>/<material>/<file> and CACHE_DIR/manifest.csv with the columns
 # file,source,package,version,licence,material,recordist (file relative to CACHE_DIR).
@@ -36,15 +44,24 @@
 #                  (CC-BY-SA-3.0, Red Eclipse Team). footstep*.ogg, the default step, names
 #                  no material and is left out.
 #
-# The first four are required: a failed download stops the script, naming the package. The
-# last three can be left out on purpose (each is then named on the output), e.g. where 1.35 GB
-# is too much to download:
-#   UNDERFOOT_RECORDINGS_SKIP="redeclipse-data nexuiz-data openclonk-data" bash scripts/fetch-recordings.sh
-# With nexuiz-data left out UFO:AI's metal1 and metal3 are kept (the four-source cache of
-# before, 90 files). The tests and `underfoot compare` read whatever the manifest lists.
+# The first four are fetched always: a failed download stops the script, naming the package.
+# The last three only with --large; UNDERFOOT_RECORDINGS_SKIP="nexuiz-data ..." then still
+# leaves some of them out (each is named on the output).
+# Without nexuiz-data UFO:AI's metal1 and metal3 are kept (the four-source cache, 90 files).
+# The tests and `underfoot compare` read whatever the manifest lists.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
-cache="${1:-${UNDERFOOT_RECORDINGS:-$root/build/recordings}}"
+large="${UNDERFOOT_RECORDINGS_LARGE:-0}"
+if [ "${1:-}" = "--large" ]; then
+    large=1
+    shift
+fi
+if [ -f "$root/CMakeLists.txt" ]; then
+    default_cache="$root/build/recordings" # a source tree
+else
+    default_cache="${XDG_CACHE_HOME:-$HOME/.cache}/underfoot/recordings" # installed
+fi
+cache="${1:-${UNDERFOOT_RECORDINGS:-$default_cache}}"
 mkdir -p "$cache"
 cache="$(cd "$cache" && pwd)"
 work="$(mktemp -d)"
@@ -64,10 +81,17 @@ keep() { # file source package version licence material recordist: into the cach
     echo "$2/$6/$(basename "$1"),$2,$3,$4,$5,$6,$7" >>"$manifest.tmp"
 }
 
-skipped() { # package -> true when UNDERFOOT_RECORDINGS_SKIP names it
+skipped() { # package -> true when it is a large one and --large was not given, or
+    # UNDERFOOT_RECORDINGS_SKIP names it
+    [ "$large" = 1 ] || return 0
     case " ${UNDERFOOT_RECORDINGS_SKIP:-} " in *" $1 "*) return 0 ;; esac
     return 1
 }
+if [ "$large" != 1 ]; then
+    echo "fetch-recordings: the four small sources (about 100 MB); --large (or" \
+        "UNDERFOOT_RECORDINGS_LARGE=1) adds nexuiz-data, openclonk-data and redeclipse-data" \
+        "(about 1.24 GB more)"
+fi
 for p in ${UNDERFOOT_RECORDINGS_SKIP:-}; do
     case "$p" in
     nexuiz-data | openclonk-data | redeclipse-data) echo "fetch-recordings: leaving out $p (UNDERFOOT_RECORDINGS_SKIP)" ;;

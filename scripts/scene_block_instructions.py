@@ -22,10 +22,11 @@ self instructions per function, from callgrind's call graph).
 It prints each valgrind command it runs (stderr), e.g.
 
     valgrind --tool=callgrind --combine-dumps=yes --instr-atstart=no
-        --callgrind-out-file=DIR/wood_reverb.callgrind DIR/underfoot
+        --callgrind-out-file=DIR/wood_reverb.callgrind build/app/cli/underfoot-nodebug-PID
         bench --only scene-instructions --seconds 5 --scene wood_reverb
 
-where DIR/underfoot is build/app/cli/underfoot without its debug sections (see program_copy).
+where underfoot-nodebug-PID is build/app/cli/underfoot without its debug sections, beside it so
+that it reads the source tree's data (see program_copy), removed afterwards.
 The counts depend on the binary (compiler, flags) and, by a few instructions in glibc's memcpy,
 on where the heap's buffers fall (the program's path changes that). Instructions are not time:
 a division, a cache miss or a denormal costs one instruction and many cycles. valgrind runs
@@ -298,7 +299,10 @@ def program_copy(underfoot, work):
         print("scene_block_instructions: no objcopy (binutils): running the program with its "
               "debug sections (larger dumps, slower)", file=sys.stderr)
         return underfoot
-    copy = os.path.join(work, "underfoot")
+    # Beside the program, so that the copy still runs from its build tree and reads the source
+    # tree's data (base/DataDir.h: a program elsewhere reads only an installed share/underfoot).
+    copy = os.path.join(os.path.dirname(os.path.abspath(underfoot)),
+                        f"underfoot-nodebug-{os.getpid()}")
     subprocess.run(["objcopy", "--strip-debug", underfoot, copy], check=True)
     return copy
 
@@ -416,11 +420,14 @@ def main(argv=None):
         listed = subprocess.run([underfoot, "bench", "--only", "scene-instructions",
                                  "--list-scenes"], capture_output=True, text=True, check=True)
         scenes = listed.stdout.split()
+    copies = []
     work = args.keep or tempfile.mkdtemp(prefix="scene_blocks_")
     os.makedirs(work, exist_ok=True)
     t0 = time.monotonic()
     try:
         program = underfoot if args.with_debug else program_copy(underfoot, work)
+        if program != underfoot:
+            copies.append(program)
         with ThreadPoolExecutor(max_workers=max(1, args.jobs)) as pool:
             results = list(pool.map(
                 lambda s: run_scene(program, work, args.seconds, s, bool(args.keep)), scenes))
@@ -428,6 +435,8 @@ def main(argv=None):
         print(f"scene_block_instructions: {e}", file=sys.stderr)
         return 1
     finally:
+        for c in copies:
+            os.remove(c)
         if not args.keep:
             shutil.rmtree(work, ignore_errors=True)
     wall = time.monotonic() - t0

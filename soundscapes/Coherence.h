@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 /// Which soundscape is coherent with which surface, and the incoherent pairings of a study
-/// (TVCG 2011 experiment 2, STUDIES.md §2), as data (soundscapes/data/coherence.toml):
+/// (Nordahl, Turchet & Serafin, IEEE TVCG 17(9), 2011, experiment 2), as data (soundscapes/data/coherence.toml):
 ///
 /// ```toml
 /// [[coherent]]

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "soundscapes/Library.h"
 
+#include "base/DataDir.h"
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -10,8 +11,7 @@
 namespace underfoot::soundscapes {
 
 std::string soundscapeDataDirectory() {
-    if (const char* env = std::getenv("UNDERFOOT_SOUNDSCAPES_DIR"); env && *env) return env;
-    return UNDERFOOT_SOUNDSCAPES_DATA_DIR;
+    return base::dataDirectory(base::DataKind::Soundscapes);
 }
 
 std::vector<std::string> builtinSoundscapeIds() {

@@ -8,8 +8,8 @@
 
 namespace underfoot::soundscapes {
 
-/// The folder of the shipped definitions: $UNDERFOOT_SOUNDSCAPES_DIR when set, else the
-/// source tree's soundscapes/data.
+/// The folder of the shipped definitions: $UNDERFOOT_SOUNDSCAPES_DIR when set, else as
+/// base::dataDirectory finds it (installed share/underfoot/soundscapes or the source tree).
 std::string soundscapeDataDirectory();
 /// Ids of the shipped soundscapes (file names without .toml, coherence.toml excluded), sorted.
 std::vector<std::string> builtinSoundscapeIds();

@@ -17,11 +17,26 @@ namespace underfoot::analysis {
 using nlohmann::json;
 
 const std::vector<std::string>& statsTestNames() {
-    static const std::vector<std::string> names{
-        "binom",   "chisq",   "chisq_gof", "fisher",   "friedman", "glmm",
-        "kendall", "kruskal", "levene",    "lmm",      "p_adjust", "pairwise_wilcoxon",
-        "pearson", "prop",    "shapiro",   "spearman", "t",        "wilcoxon",
-        "wilson"};
+    static const std::vector<std::string> names{"binom",
+                                                "chisq",
+                                                "chisq_gof",
+                                                "clmm",
+                                                "fisher",
+                                                "friedman",
+                                                "glmm",
+                                                "kendall",
+                                                "kruskal",
+                                                "levene",
+                                                "lmm",
+                                                "p_adjust",
+                                                "pairwise_wilcoxon",
+                                                "pearson",
+                                                "prop",
+                                                "shapiro",
+                                                "spearman",
+                                                "t",
+                                                "wilcoxon",
+                                                "wilson"};
     return names;
 }
 
@@ -188,7 +203,7 @@ json run(const std::string& test, const json& body) {
     if (test == "fisher") {
         const Request q(body, {"table", "conf_level", "alternative"});
         const auto table = q.matrix("table");
-        // r x c tables (issue #15): exact p by enumeration, two-sided only, as R.
+        // r x c tables: exact p by enumeration, two-sided only, as R.
         if (table.size() != 2 || std::any_of(table.begin(), table.end(),
                                              [](const auto& row) { return row.size() != 2; })) {
             if (q.alternative() != Alternative::TwoSided)
@@ -224,7 +239,7 @@ json run(const std::string& test, const json& body) {
         o.exactness = q.exactness();
         if (!q.has("y") && o.pairing == Pairing::Paired)
             throw RequestError("'y' is missing for paired test");
-        if (q.flag("conf_int", false)) { // Hodges-Lehmann estimate and interval (issue #15)
+        if (q.flag("conf_int", false)) { // Hodges-Lehmann estimate and interval
             const double level = q.number("conf_level", 0.95);
             if (!q.has("y")) return resultJson(test, wilcoxonTestCi(q.numbers("x"), o, level));
             return resultJson(test, wilcoxonTestCi(q.numbers("x"), q.numbers("y"), o, level));

@@ -105,17 +105,23 @@ std::vector<std::string> levelList(const json& body, const char* key) {
     return out;
 }
 
-json resultObject(std::string_view test, const MixedModelResult& r) {
-    json fixed = json::array();
-    for (const auto& f : r.fixed) {
+json coefficients(std::string_view test, const std::vector<FixedEffect>& terms, bool withP) {
+    json out = json::array();
+    for (const auto& f : terms) {
         json c{{"name", f.name},
                {"estimate", num(f.estimate)},
                {"se", num(f.se)},
-               {"statistic", num(f.statistic)},
-               {"p", num(f.p)}};
+               {"statistic", num(f.statistic)}};
+        if (withP) c["p"] = num(f.p);
         if (test == "lmm") c["df"] = num(f.df);
-        fixed.push_back(c);
+        out.push_back(c);
     }
+    return out;
+}
+
+json resultObject(std::string_view test, const MixedModelResult& r,
+                  const OrdinalMixedResult* ordinal = nullptr) {
+    const json fixed = coefficients(test, r.fixed, true);
     json out{
         {"test", std::string(test)},
         {"method", r.method},
@@ -135,17 +141,35 @@ json resultObject(std::string_view test, const MixedModelResult& r) {
         out["residual_variance"] = num(r.residualVariance);
     else
         out["nAGQ"] = r.nAGQ;
+    if (const auto* o = ordinal) {
+        out["thresholds"] = coefficients(test, o->thresholds, false);
+        out["link"] = o->link;
+        out["levels"] = o->categories;
+    }
+    return out;
+}
+
+/// The scale's categories of a clmm request ("levels": numbers in increasing order).
+std::vector<double> categoryList(const json& body) {
+    if (!body.contains("levels") || body.at("levels").is_null()) return {};
+    const json& v = body.at("levels");
+    if (!v.is_array())
+        throw MixedRequestError("'levels' must be an array of numbers (the scale's categories)");
+    std::vector<double> out;
+    for (std::size_t i = 0; i < v.size(); ++i) {
+        if (!v[i].is_number())
+            throw MixedRequestError(fmt::format("'levels[{}]' must be a number", i));
+        out.push_back(v[i].get<double>());
+    }
     return out;
 }
 
 json run(std::string_view test, const json& body) {
     if (!body.is_object()) throw MixedRequestError("the request must be a JSON object");
-    const std::set<std::string> allowed =
-        test == "glmm"
-            ? std::set<std::string>{"y",    "condition",        "participant",   "surface",
-                                    "nAGQ", "condition_levels", "surface_levels"}
-            : std::set<std::string>{"y",       "condition",        "participant",
-                                    "surface", "condition_levels", "surface_levels"};
+    std::set<std::string> allowed{"y",       "condition",        "participant",
+                                  "surface", "condition_levels", "surface_levels"};
+    if (test != "lmm") allowed.insert("nAGQ");
+    if (test == "clmm") allowed.insert({"link", "levels"});
     for (const auto& [key, value] : body.items())
         if (!allowed.count(key))
             throw MixedRequestError(fmt::format("unknown field '{}' (expected one of: {})", key,
@@ -167,6 +191,19 @@ json run(std::string_view test, const json& body) {
             throw MixedRequestError("'nAGQ' must be an integer from 1 (Laplace) to 25");
         nAGQ = static_cast<int>(v.get<long long>());
     }
+    if (test == "clmm") {
+        OrdinalOptions o;
+        o.nAGQ = nAGQ;
+        o.categories = categoryList(body);
+        if (body.contains("link") && !body.at("link").is_null()) {
+            const json& v = body.at("link");
+            if (!v.is_string() || !parseOrdinalLink(v.get<std::string>(), o.link))
+                throw MixedRequestError("'link' must be \"logit\", \"probit\" or \"cloglog\"");
+        }
+        const OrdinalMixedResult r = fitOrdinalMixedModel(data, o);
+        if (!r.ok()) throw MixedRequestError(r.error);
+        return resultObject(test, r, &r);
+    }
     const MixedModelResult r =
         test == "glmm" ? fitLogisticMixedModel(data, nAGQ) : fitLinearMixedModel(data);
     if (!r.ok()) throw MixedRequestError(r.error);
@@ -180,17 +217,22 @@ std::string dump(const json& j) {
 } // namespace
 
 bool isMixedModelTest(std::string_view test) {
-    return test == "glmm" || test == "lmm";
+    return test == "glmm" || test == "lmm" || test == "clmm";
 }
 
 std::string mixedModelResultJson(std::string_view test, const MixedModelResult& result) {
     return dump(resultObject(test, result));
 }
 
+std::string ordinalModelResultJson(const OrdinalMixedResult& result) {
+    return dump(resultObject("clmm", result, &result));
+}
+
 StatsResponse runMixedModelRequest(std::string_view test, std::string_view requestJson) {
     try {
         if (!isMixedModelTest(test))
-            throw MixedRequestError(fmt::format("unknown mixed model '{}' (glmm or lmm)", test));
+            throw MixedRequestError(
+                fmt::format("unknown mixed model '{}' (glmm, lmm or clmm)", test));
         const json body = json::parse(requestJson.begin(), requestJson.end());
         return {true, dump(run(test, body))};
     } catch (const json::parse_error& e) {

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 /// The surfaces, soundscapes and answer lists of the reference studies, with the codes of the
-/// published tables (STUDIES.md, data/published/README.md).
+/// published tables (docs/explanation/studies.md; tests/analysis/data/published/README.md).
 #include <optional>
 #include <string>
 #include <string_view>

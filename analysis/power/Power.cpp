@@ -2,6 +2,7 @@
 #include "analysis/power/Power.h"
 
 #include "analysis/stats/MixedModels.h"
+#include "analysis/stats/OrdinalMixed.h"
 #include "analysis/stats/Tests.h"
 
 #include <fmt/format.h>
@@ -30,35 +31,50 @@ struct Outcome {
     bool mixed = false;
     bool mixedFailed = false;
     bool mixedSingular = false;
+    bool ordinal = false; ///< ratings: the clmm's LRT
+    bool ordinalFailed = false;
 };
 
 Outcome analyse(const std::vector<SimulatedAnswer>& answers, int groups,
                 const PowerOptions& options) {
     Outcome o;
     CountTable table(static_cast<std::size_t>(groups), std::vector<double>(2, 0.0));
-    for (const auto& a : answers)
+    for (const auto& a : answers) {
+        if (a.group < 0 || a.group >= groups)
+            throw std::invalid_argument(
+                fmt::format("simulated answer of participant {}: group {} (0..{} expected)",
+                            a.participant, a.group, groups - 1));
         table.at(static_cast<std::size_t>(a.group))[a.correct ? 0 : 1] += 1;
+    }
     const auto chi =
         chisqTest(table, options.yates ? Continuity::Corrected : Continuity::Uncorrected);
     o.classic = chi.ok() && chi.p < options.alpha;
     if (!options.mixedModel) return o;
-    MixedModelData d;
+    // one binomial cell per (participant, group, surface): the same likelihood as the answers
+    // one by one, built without strings
     const bool surface =
         options.withSurface && std::any_of(answers.begin(), answers.end(),
                                            [](const SimulatedAnswer& a) { return a.surface >= 0; });
-    d.y.reserve(answers.size());
-    for (const auto& a : answers) {
-        d.y.push_back(a.correct ? 1.0 : 0.0);
-        d.condition.push_back(fmt::format("g{:03d}", a.group));
-        d.participant.push_back(fmt::format("p{:06d}", a.participant));
-        if (surface) d.surface.push_back(fmt::format("s{:03d}", std::max(a.surface, 0)));
+    std::vector<std::array<int, 4>> keys; // participant, group, surface, correct
+    keys.reserve(answers.size());
+    for (const auto& a : answers)
+        keys.push_back(
+            {a.participant, a.group, surface ? std::max(a.surface, 0) : -1, a.correct ? 1 : 0});
+    std::sort(keys.begin(), keys.end());
+    std::vector<BinomialCell> cells;
+    for (const auto& k : keys) {
+        if (cells.empty() || cells.back().participant != k[0] || cells.back().condition != k[1] ||
+            cells.back().surface != k[2])
+            cells.push_back({k[0], k[1], k[2], 0.0, 0.0});
+        cells.back().trials += 1;
+        cells.back().successes += k[3];
     }
-    const auto fit = fitLogisticMixedModel(d, options.nAGQ, false); // LRT only
-    if (!fit.ok() || std::isnan(fit.lrt.p)) {
+    const auto fit = logisticLikelihoodRatio(cells, options.nAGQ);
+    if (!fit.error.empty() || std::isnan(fit.p)) {
         o.mixedFailed = true;
         return o;
     }
-    o.mixed = fit.lrt.p < options.alpha;
+    o.mixed = fit.p < options.alpha;
     o.mixedSingular = fit.randomVariance < 1e-8;
     return o;
 }
@@ -126,17 +142,21 @@ void runSimulations(const std::function<Outcome(int, std::uint64_t)>& analyseOne
     for (std::size_t s = 0; s < sizes; ++s) {
         PowerPoint p;
         p.participantsPerGroup = options.participantsPerGroup[s];
-        double classic = 0, mixed = 0;
+        double classic = 0, mixed = 0, ordinal = 0;
         for (std::size_t k = 0; k < sims; ++k) {
             const Outcome& o = outcomes[s * sims + k];
             classic += o.classic ? 1 : 0;
             mixed += o.mixed ? 1 : 0;
+            ordinal += o.ordinal ? 1 : 0;
             p.mixedFailures += o.mixedFailed ? 1 : 0;
             p.mixedSingular += o.mixedSingular ? 1 : 0;
+            p.ordinalFailures += o.ordinalFailed ? 1 : 0;
         }
         p.classic = estimate(classic, static_cast<double>(sims), options.confLevel);
         if (options.mixedModel)
             p.mixed = estimate(mixed, static_cast<double>(sims), options.confLevel);
+        if (curve.ordinal)
+            p.ordinal = estimate(ordinal, static_cast<double>(sims), options.confLevel);
         curve.points.push_back(p);
     }
     std::vector<PowerPoint> sorted = curve.points;
@@ -148,6 +168,8 @@ void runSimulations(const std::function<Outcome(int, std::uint64_t)>& analyseOne
             curve.smallestClassic = p.participantsPerGroup;
         if (options.mixedModel && curve.smallestMixed < 0 && p.mixed.power >= options.target)
             curve.smallestMixed = p.participantsPerGroup;
+        if (curve.ordinal && curve.smallestOrdinal < 0 && p.ordinal.power >= options.target)
+            curve.smallestOrdinal = p.participantsPerGroup;
     }
 }
 
@@ -186,10 +208,24 @@ Outcome analyseRatings(const std::vector<SimulatedRating>& ratings, const PowerO
     const FixedEffect* effect = fit.ok() ? fit.coefficient("conditionc1") : nullptr;
     if (!effect || std::isnan(effect->p)) {
         o.mixedFailed = true;
-        return o;
+    } else {
+        o.mixed = effect->p < options.alpha;
+        o.mixedSingular = fit.randomVariance < 1e-8;
     }
-    o.mixed = effect->p < options.alpha;
-    o.mixedSingular = fit.randomVariance < 1e-8;
+    const bool whole = std::all_of(ratings.begin(), ratings.end(), [](const SimulatedRating& r) {
+        return std::floor(r.value) == r.value && std::fabs(r.value) < 1e6;
+    });
+    if (options.ordinalModel && !whole) {
+        o.ordinalFailed = true; // ratings between categories: no ordinal model
+    } else if (options.ordinalModel) {
+        OrdinalOptions ord;
+        ord.standardErrors = false; // the LRT only
+        const auto clmm = fitOrdinalMixedModel(d, ord);
+        if (!clmm.ok() || std::isnan(clmm.lrt.p))
+            o.ordinalFailed = true;
+        else
+            o.ordinal = clmm.lrt.p < options.alpha;
+    }
     return o;
 }
 
@@ -221,6 +257,9 @@ PowerCurve simulateRatingPower(const RatingStudySimulator& simulator, const Powe
                           "condition";
     curve.mixedMethod = "lmer(rating ~ condition + (1 | participant)), REML: Satterthwaite "
                         "t-test of condition (lmerTest)";
+    curve.ordinal = options.mixedModel && options.ordinalModel;
+    curve.ordinalMethod = "clmm(ordered(rating) ~ condition + (1 | participant), logit, "
+                          "Laplace): likelihood-ratio test of condition (ordinal)";
     runSimulations(
         [&](int size, std::uint64_t seed) {
             return analyseRatings(simulator(size, seed), options);

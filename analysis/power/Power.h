@@ -39,7 +39,8 @@ struct PowerOptions {
     bool mixedModel = true;  ///< also fit the logistic mixed model
     bool withSurface = true; ///< surface as a fixed factor in the mixed model when present
     int nAGQ = 1;
-    double confLevel = 0.95; ///< of the Monte-Carlo intervals
+    bool ordinalModel = true; ///< ratings: also fit the cumulative link mixed model (clmm)
+    double confLevel = 0.95;  ///< of the Monte-Carlo intervals
     /// Progress (tasks done, total), called under a lock from the worker threads.
     std::function<void(std::size_t, std::size_t)> progress;
 };
@@ -59,6 +60,8 @@ struct PowerPoint {
     PowerEstimate mixed;
     int mixedFailures = 0; ///< fits that stopped (counted as not significant)
     int mixedSingular = 0; ///< singular fits (participant variance estimated as 0)
+    PowerEstimate ordinal; ///< ratings: the clmm's likelihood-ratio test
+    int ordinalFailures = 0;
 };
 
 struct PowerCurve {
@@ -67,8 +70,11 @@ struct PowerCurve {
     /// Smallest simulated group size whose power estimate reaches the target; -1 = none.
     int smallestClassic = -1;
     int smallestMixed = -1;
+    int smallestOrdinal = -1;
     std::string classicMethod;
     std::string mixedMethod;
+    bool ordinal = false; ///< the curve has the clmm's power (ratings)
+    std::string ordinalMethod;
 };
 
 /// 64-bit seed of one task (SplitMix64 of the study seed, the group size and the simulation).
@@ -93,7 +99,9 @@ using RatingStudySimulator =
 /// Monte-Carlo power of a within-subject comparison of two conditions on a rating scale: the
 /// classic test is the paired t-test on each participant's mean rating per condition (t.test(x,
 /// y, paired = TRUE)); the mixed model lmerTest::lmer(rating ~ condition + (1 | participant)) by
-/// REML, the Satterthwaite t-test of the condition. `participantsPerGroup` holds the numbers of
+/// REML, the Satterthwaite t-test of the condition; with `ordinalModel` also the cumulative link
+/// mixed model ordinal::clmm(ordered(rating) ~ condition + (1 | participant)), the
+/// likelihood-ratio test of the condition. `participantsPerGroup` holds the numbers of
 /// participants; `yates`, `withSurface` and `nAGQ` are not used.
 PowerCurve simulateRatingPower(const RatingStudySimulator& simulator, const PowerOptions& options);
 

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "analysis/ratings/RatingAnalysis.h"
 
+#include "analysis/ratings/RatingModels.h"
+
 #include "analysis/stats/Numerics.h"
 #include "analysis/stats/Tests.h"
 
@@ -354,6 +356,7 @@ RatingStudyAnalysis analyzeRatingStudy(const RatingData& data,
             }
             sa.groups.push_back(std::move(gc));
         }
+        sa.models = fitScaleModels(data, info, sa.omnibus);
         out.scales.push_back(std::move(sa));
     }
 

@@ -11,6 +11,7 @@
 /// that scale (the paper averages the two ratings of each clip). Within-subject tests use the
 /// participants with a value in every compared cell (complete cases, as R and SPSS).
 #include "analysis/ratings/RatingData.h"
+#include "analysis/stats/OrdinalMixed.h"
 #include "analysis/stats/TestResult.h"
 
 #include <limits>
@@ -21,7 +22,7 @@
 namespace underfoot::analysis {
 
 /// Quartiles of R's quantile(type = 7) (the default of R and of boxplot.stats' fivenum differs:
-/// see analysis/README.md; SPSS's "weighted average" is type 6).
+/// see docs/reference/statistics.md; SPSS's "weighted average" is type 6).
 double quantileType7(std::vector<double> values, double probability);
 
 /// Tukey box-plot statistics of one cell, with the paper's outlier classes: outliers beyond
@@ -119,6 +120,17 @@ struct GroupComparison {
     std::vector<Pair> pairs;
 };
 
+/// The stimulus (cell) effect on every rating of a scale by mixed models, the participant as a
+/// random intercept, beside the Friedman test of the cells (analysis/ratings/RatingModels.h).
+struct ScaleModels {
+    MixedModelResult lmm;    ///< lmerTest::lmer(rating ~ stimulus + (1 | participant))
+    OrdinalMixedResult clmm; ///< ordinal::clmm(ordered(rating) ~ stimulus + (1 | participant))
+    std::string clmmSkipped; ///< why the clmm was not fitted (e.g. ratings between categories)
+    std::string advice;      ///< which test to cite, in one sentence
+    std::size_t ratings = 0; ///< observations the models used
+    bool fitted = false;     ///< false: fewer than two stimuli or participants
+};
+
 /// The analysis of one scale.
 struct ScaleAnalysis {
     RatingScaleInfo scale;
@@ -129,6 +141,7 @@ struct ScaleAnalysis {
     std::vector<PairedComparison> planned;
     std::vector<FactorEffect> factorEffects;
     std::vector<GroupComparison> groups;
+    ScaleModels models;
 };
 
 /// Spearman correlation of two scales over (participant, stimulus) pairs rated on both.

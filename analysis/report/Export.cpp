@@ -204,13 +204,27 @@ TextTable comparisonTable(const AnalysisReport& r, bool words = true) {
 TextTable mixedModelTable(const AnalysisReport& r) {
     TextTable t;
     t.caption = "Mixed models beside the comparisons (participant as random intercept): "
-                "logistic (glmer) on correct answers, linear (lmer, REML, Satterthwaite df) on "
-                "ratings; estimate = group B against group A (log-odds ratio / mean difference); "
-                "LRT = likelihood-ratio test of the group; \"all\" has surface as a fixed factor";
-    t.header = {"Measure", "Surface",  "Groups", "Model",   "Estimate (SE)",    "z / t",
-                "df",      "p (Wald)", "LRT X²", "p (LRT)", "Participant var.", "Classic p",
+                "logistic (glmer) on correct answers; linear (lmer, REML, Satterthwaite df) and "
+                "cumulative link (clmm, logit) on ratings; estimate = group B against group A "
+                "(log-odds ratio / mean difference / log-odds ratio of a higher rating); LRT = "
+                "likelihood-ratio test of the group; \"all\" has surface as a fixed factor; "
+                "classic p = chi-square / t-test; Mann-Whitney p = wilcox.test of the ratings";
+    t.header = {"Measure",
+                "Surface",
+                "Groups",
+                "Model",
+                "Estimate (SE)",
+                "z / t",
+                "df",
+                "p (Wald)",
+                "LRT X²",
+                "p (LRT)",
+                "Participant var.",
+                "Classic p",
+                "Mann-Whitney p",
                 "Warnings"};
-    t.numeric = {false, false, false, false, true, true, true, true, true, true, true, true, false};
+    t.numeric = {false, false, false, false, true, true, true,
+                 true,  true,  true,  true,  true, true, false};
     for (const auto& m : r.mixedModels) {
         std::vector<std::string> row{measureName(m.measure),
                                      m.surfaceId.empty() ? "all" : labelFor(m.surfaceId),
@@ -219,6 +233,7 @@ TextTable mixedModelTable(const AnalysisReport& r) {
             row.push_back(m.error);
             for (int k = 0; k < 7; ++k) row.push_back("");
             row.push_back(std::isnan(m.classicP) ? "" : pValue(m.classicP));
+            row.push_back(std::isnan(m.nonparametricP) ? "" : pValue(m.nonparametricP));
             row.push_back("");
         } else {
             row.push_back(fixed(m.estimate, 3) + " (" + fixed(m.se, 3) + ")");
@@ -229,6 +244,7 @@ TextTable mixedModelTable(const AnalysisReport& r) {
             row.push_back(pValue(m.lrtP));
             row.push_back(fixed(m.randomVariance, 3));
             row.push_back(std::isnan(m.classicP) ? "" : pValue(m.classicP));
+            row.push_back(std::isnan(m.nonparametricP) ? "" : pValue(m.nonparametricP));
             std::string w;
             for (const auto& x : m.warnings) {
                 std::string one = x.substr(0, x.find('\n'));
@@ -351,6 +367,7 @@ std::string renderCsv(const AnalysisReport& r) {
         row("lrt_p", m.lrtP);
         row("random_variance", m.randomVariance);
         row("classic_p", m.classicP);
+        if (!std::isnan(m.nonparametricP)) row("mann_whitney_p", m.nonparametricP);
     }
     if (!r.mixedModelAdvice.empty())
         tidy(out, "mixed_model_advice", "", "", "", "", "", std::nan(""), r.mixedModelAdvice);

@@ -2,6 +2,8 @@
 #include "analysis/report/MixedModelReport.h"
 
 #include "analysis/stats/MixedModels.h"
+#include "analysis/stats/OrdinalMixed.h"
+#include "analysis/stats/Tests.h"
 #include "analysis/tables/ScoringRules.h"
 
 #include <fmt/format.h>
@@ -36,8 +38,11 @@ double valueOf(const Obs& o, Measure m) {
     return std::nan("");
 }
 
+/// The model of a row: glmer on correct answers; lmer or clmm on ratings.
+enum class Model { Logistic, Linear, Ordinal };
+
 MixedComparisonRow fitOne(const std::vector<Obs>& obs, Measure measure, const std::string& surface,
-                          const std::string& ga, const std::string& gb, int nAGQ) {
+                          const std::string& ga, const std::string& gb, int nAGQ, Model kind) {
     MixedComparisonRow row;
     row.measure = measure;
     row.surfaceId = surface;
@@ -46,6 +51,7 @@ MixedComparisonRow fitOne(const std::vector<Obs>& obs, Measure measure, const st
     MixedModelData d;
     d.conditionLevels = {ga, gb};
     std::set<std::string> people;
+    std::vector<double> xa, xb; // for the Mann-Whitney test of the pooled ratings
     for (const auto& o : obs) {
         if (o.group != ga && o.group != gb) continue;
         if (!surface.empty() && o.surface != surface) continue;
@@ -54,6 +60,7 @@ MixedComparisonRow fitOne(const std::vector<Obs>& obs, Measure measure, const st
         d.y.push_back(y);
         d.condition.push_back(o.group);
         d.participant.push_back(o.participant);
+        (o.group == ga ? xa : xb).push_back(y);
         if (surface.empty()) d.surface.push_back(o.surface);
         people.insert(o.participant);
     }
@@ -63,10 +70,30 @@ MixedComparisonRow fitOne(const std::vector<Obs>& obs, Measure measure, const st
     }
     row.observations = static_cast<double>(d.y.size());
     row.participants = static_cast<double>(people.size());
-    const bool counts = measure == Measure::Correct;
-    const MixedModelResult r = counts ? fitLogisticMixedModel(d, nAGQ) : fitLinearMixedModel(d);
-    row.model = counts ? (nAGQ == 1 ? "glmer (Laplace)" : fmt::format("glmer (nAGQ = {})", nAGQ))
-                       : "lmer (REML, Satterthwaite df)";
+    if (kind != Model::Logistic) {
+        const auto mw = wilcoxonTest(xa, xb);
+        if (mw.ok()) row.nonparametricP = mw.p;
+    }
+    OrdinalMixedResult ordinal;
+    if (kind == Model::Ordinal) {
+        for (double y : d.y)
+            if (std::floor(y) != y) {
+                ordinal.error =
+                    fmt::format("rating {} is not a whole point: the clmm needs ordered "
+                                "categories",
+                                y);
+                break;
+            }
+        if (ordinal.error.empty()) ordinal = fitOrdinalMixedModel(d);
+    }
+    const MixedModelResult r = kind == Model::Logistic ? fitLogisticMixedModel(d, nAGQ)
+                               : kind == Model::Linear
+                                   ? fitLinearMixedModel(d)
+                                   : static_cast<const MixedModelResult&>(ordinal);
+    row.model = kind == Model::Logistic
+                    ? (nAGQ == 1 ? "glmer (Laplace)" : fmt::format("glmer (nAGQ = {})", nAGQ))
+                : kind == Model::Linear ? "lmer (REML, Satterthwaite df)"
+                                        : "clmm (Laplace, logit)";
     if (!r.ok()) {
         row.error = r.error;
         return row;
@@ -125,18 +152,23 @@ void addMixedModelComparisons(AnalysisReport& report, std::span<const TrialRecor
                     if (s.measure == m && s.groupA == g[i] && s.groupB == g[j] &&
                         !s.surfaceId.empty())
                         list.push_back(s.surfaceId);
-                for (const auto& surface : list) {
-                    auto row = fitOne(obs, m, surface, g[i], g[j], nAGQ);
-                    for (const auto& c : report.comparisons)
-                        if (c.measure == m && c.groupA == g[i] && c.groupB == g[j] &&
-                            c.surfaceId == surface && c.test.ok())
-                            row.classicP = c.test.p;
-                    if (!std::isnan(row.classicP) && !std::isnan(row.lrtP)) {
-                        ++compared;
-                        if ((row.classicP < 0.05) != (row.lrtP < 0.05)) ++disagreements;
+                const std::vector<Model> models =
+                    m == Measure::Correct ? std::vector<Model>{Model::Logistic}
+                                          : std::vector<Model>{Model::Linear, Model::Ordinal};
+                for (const auto& surface : list)
+                    for (const Model kind : models) {
+                        auto row = fitOne(obs, m, surface, g[i], g[j], nAGQ, kind);
+                        for (const auto& c : report.comparisons)
+                            if (c.measure == m && c.groupA == g[i] && c.groupB == g[j] &&
+                                c.surfaceId == surface && c.test.ok())
+                                row.classicP = c.test.p;
+                        if (kind != Model::Linear && !std::isnan(row.classicP) &&
+                            !std::isnan(row.lrtP)) {
+                            ++compared;
+                            if ((row.classicP < 0.05) != (row.lrtP < 0.05)) ++disagreements;
+                        }
+                        report.mixedModels.push_back(std::move(row));
                     }
-                    report.mixedModels.push_back(std::move(row));
-                }
             }
     report.mixedModelAdvice = fmt::format(
         "Which test to cite: the mixed models. Each participant gave up to {} answers per "
@@ -144,11 +176,18 @@ void addMixedModelComparisons(AnalysisReport& report, std::span<const TrialRecor
         "pool them as if they were, which understates their p-values when participants differ, "
         "while the mixed models (participant as random intercept; lme4 glmer / lmerTest lmer, "
         "likelihood-ratio test of the group) account for it. The chi-square / t-tests are shown "
-        "to compare with the reference papers{}.",
+        "to compare with the reference papers{}.{}",
         repeated,
         compared > 0 ? fmt::format(" (here they disagree about p < 0.05 in {} of {} comparisons)",
                                    disagreements, compared)
-                     : std::string());
+                     : std::string(),
+        report.hasRatings
+            ? " For the ratings cite the cumulative link mixed model (clmm, ordinal::clmm): a "
+              "rating scale is ordered categories, not equally spaced numbers, and the clmm "
+              "models them as such, while lmer and the t-test assume equal steps and normal "
+              "errors; the Mann-Whitney test (wilcox.test) is the nonparametric check, and it "
+              "too pools the answers of a participant."
+            : "");
 }
 
 } // namespace underfoot::analysis

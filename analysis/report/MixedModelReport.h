@@ -1,9 +1,10 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
-/// Mixed models beside the between-group comparisons of `underfoot analyze` (issue #15): for
-/// every pair of groups, the logistic mixed model on correct answers and the linear mixed model
-/// on each rating, per surface and over all surfaces (surface as a fixed factor), with the
-/// participant as a random intercept; and the sentence saying which test to cite.
+/// Mixed models beside the between-group comparisons of `underfoot analyze`: for
+/// every pair of groups, the logistic mixed model on correct answers and, on each rating, the
+/// linear and the cumulative link mixed model (with the Mann-Whitney test), per surface and over
+/// all surfaces (surface as a fixed factor), with the participant as a random intercept; and the
+/// sentence saying which test to cite.
 #include "analysis/tables/Tables.h"
 
 #include <span>

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "analysis/report/RatingReport.h"
 
+#include "analysis/io/Csv.h"
+
 #include "analysis/report/Markup.h"
 #include "analysis/report/Words.h"
 #include "analysis/stats/Numerics.h"
@@ -147,6 +149,41 @@ struct Section {
     std::vector<Figure> figures;
 };
 
+std::string warningsText(const std::vector<std::string>& warnings) {
+    std::string w;
+    for (const auto& x : warnings) w += (w.empty() ? "" : "; ") + x.substr(0, x.find('\n'));
+    return w;
+}
+
+/// The Friedman (or Wilcoxon) test of the cells, the LMM and the clmm on every rating.
+Table modelTable(const ScaleAnalysis& s) {
+    const auto& m = s.models;
+    Table t{
+        {"test of the stimulus", "on", "statistic", "df", "p", "participant variance", "warnings"},
+        {}};
+    t.rows.push_back({s.omnibus.conditions.size() >= 3 ? "Friedman (friedman.test)"
+                                                       : "Wilcoxon signed-rank (wilcox.test)",
+                      fmt::format("cell means of {} participants", s.omnibus.participants),
+                      num(s.omnibus.result.statistic),
+                      s.omnibus.result.df.empty() ? "" : num(s.omnibus.result.df[0], 3),
+                      pText(s.omnibus.result.p), "", s.omnibus.result.error});
+    auto model = [&](const std::string& name, const MixedModelResult& r) {
+        if (!r.ok()) {
+            t.rows.push_back({name, fmt::format("{} ratings", m.ratings), "", "", "", "", r.error});
+            return;
+        }
+        t.rows.push_back({name, fmt::format("{} ratings", static_cast<std::size_t>(r.nObs)),
+                          "LRT X² = " + num(r.lrt.statistic), num(r.lrt.df, 3), pText(r.lrt.p),
+                          num(r.randomVariance), warningsText(r.warnings)});
+    };
+    model("LMM (lmerTest::lmer, REML; LRT by ML)", m.lmm);
+    if (m.clmmSkipped.empty())
+        model("clmm (ordinal::clmm, logit, Laplace)", m.clmm);
+    else
+        t.rows.push_back({"clmm (ordinal::clmm)", "", "", "", "", "", m.clmmSkipped});
+    return t;
+}
+
 std::vector<Section> sections(const RatingStudyAnalysis& a, const RatingLabels& labels) {
     std::vector<Section> out;
     for (const auto& s : a.scales) {
@@ -161,6 +198,15 @@ std::vector<Section> sections(const RatingStudyAnalysis& a, const RatingLabels& 
             s.omnibus.conditions.size() >= 3 ? "Friedman test" : "Wilcoxon signed-rank test",
             s.omnibus.participants, statisticText(s.omnibus.result));
         sec.tables.push_back(cellTable(s, labels));
+        if (s.models.fitted) {
+            sec.text += fmt::format(
+                "\n\nMixed models of the stimulus effect on every rating ({} ~ stimulus + (1 | "
+                "participant)), beside the {}. {}",
+                s.scale.id,
+                s.omnibus.conditions.size() >= 3 ? "Friedman test" : "Wilcoxon signed-rank test",
+                s.models.advice);
+            sec.tables.push_back(modelTable(s));
+        }
         if (!s.planned.empty()) sec.tables.push_back(pairTable(s.planned, labels));
         for (const auto& fe : s.factorEffects) {
             Table t{{"level of " + fe.factor, "n", "median", "IQR (Q1-Q3)"}, {}};
@@ -435,8 +481,11 @@ std::string renderRatingReport(const RatingStudyAnalysis& a, ReportFormat format
     }
     case ReportFormat::Latex: {
         out += fmt::format("% {}\n", title);
-        for (const auto& s : secs) {
+        for (std::size_t i = 0; i < secs.size(); ++i) {
+            const auto& s = secs[i];
             out += fmt::format("% {}\n", s.heading);
+            if (i < a.scales.size() && !a.scales[i].models.advice.empty())
+                out += "% " + a.scales[i].models.advice + "\n";
             for (const auto& t : s.tables) out += t.latex() + "\n";
         }
         break;
@@ -459,6 +508,21 @@ std::string renderRatingReport(const RatingStudyAnalysis& a, ReportFormat format
             row("omnibus", s.scale.id, "cells", "", s.omnibus.result.statisticName,
                 s.omnibus.result.statistic);
             row("omnibus", s.scale.id, "cells", "", "p", s.omnibus.result.p);
+            if (s.models.fitted) {
+                const bool clmm = s.models.clmmSkipped.empty() && s.models.clmm.ok();
+                auto model = [&](const char* name, const MixedModelResult& r, bool cite) {
+                    if (!r.ok()) return;
+                    const std::string cmp = cite ? "cite" : "";
+                    row("model", s.scale.id, name, cmp, "lrt_statistic", r.lrt.statistic);
+                    row("model", s.scale.id, name, cmp, "lrt_df", r.lrt.df);
+                    row("model", s.scale.id, name, cmp, "lrt_p", r.lrt.p);
+                    row("model", s.scale.id, name, cmp, "participant_variance", r.randomVariance);
+                    row("model", s.scale.id, name, cmp, "loglik", r.logLik);
+                };
+                model("lmm", s.models.lmm, !clmm);
+                if (clmm) model("clmm", s.models.clmm, true);
+                out += fmt::format("advice,{},{},,,\n", s.scale.id, csv::escape(s.models.advice));
+            }
             for (const auto& p : s.planned) {
                 const std::string cmp = p.first + " vs " + p.second;
                 row("planned", s.scale.id, p.context, cmp, "z", p.test.z);

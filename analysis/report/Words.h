@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
-/// Test results in words, as a paper writes them beside the numbers (issue #17):
+/// Test results in words, as a paper writes them beside the numbers:
 /// "χ²(1) = 8.90, p = 0.003", "t(13.4) = 2.45, p = 0.028", "Z = -2.31, p = 0.021",
 /// "W = 12.00, p = 0.041", "ρ = 0.52, p < 0.001". Shared by the confusion and rating reports.
 #include "analysis/stats/TestResult.h"

@@ -2,17 +2,18 @@
 // Mixed-effects models with one random intercept per participant (see MixedModels.h).
 #include "analysis/stats/MixedModels.h"
 
+#include "analysis/stats/MixedDesign.h"
+
 #include "analysis/stats/Numerics.h"
 
 #include <Eigen/Dense>
-#include <boost/math/tools/minima.hpp>
 #include <fmt/format.h>
 #include <nlopt.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
-#include <numbers>
 #include <stdexcept>
 #include <string_view>
 
@@ -24,195 +25,7 @@ using Eigen::MatrixXd;
 using Eigen::VectorXd;
 using numerics::dbl;
 using numerics::kNaN;
-
-// ------------------------------------------------------------------------------ design
-
-/// Fixed-effects design matrix, response and grouping of one model.
-struct Design {
-    MatrixXd X;
-    std::vector<std::string> names;
-    VectorXd y;
-    std::vector<int> group; ///< 0-based participant index per observation
-    int nGroups = 0;
-    std::vector<std::vector<int>> members; ///< observations of each participant
-    int conditionColumns = 0;              ///< condition dummies kept in X
-    std::vector<std::string> warnings;
-    std::string error;
-};
-
-std::vector<std::string> levelsOf(const std::vector<std::string>& values,
-                                  const std::vector<std::string>& order) {
-    std::vector<std::string> present(values);
-    std::sort(present.begin(), present.end());
-    present.erase(std::unique(present.begin(), present.end()), present.end());
-    if (order.empty()) return present;
-    std::vector<std::string> out;
-    for (const auto& l : order)
-        if (std::binary_search(present.begin(), present.end(), l) &&
-            std::find(out.begin(), out.end(), l) == out.end())
-            out.push_back(l);
-    for (const auto& l : present) // values not named in the order follow, sorted
-        if (std::find(out.begin(), out.end(), l) == out.end()) out.push_back(l);
-    return out;
-}
-
-/// Builds X for `~ condition (+ surface)` (treatment contrasts, as R's model.matrix), drops
-/// rows with a missing value (R's na.omit) and aliased columns (lme4's chkRank.drop.cols).
-Design buildDesign(const MixedModelData& data, bool withCondition) {
-    Design d;
-    const std::size_t n = data.y.size();
-    const bool hasSurface = !data.surface.empty();
-    if (data.condition.size() != n || data.participant.size() != n ||
-        (hasSurface && data.surface.size() != n)) {
-        d.error = fmt::format(
-            "y, condition, participant{} must have the same length ({}, {}, {}{})",
-            hasSurface ? ", surface" : "", n, data.condition.size(), data.participant.size(),
-            hasSurface ? fmt::format(", {}", data.surface.size()) : "");
-        return d;
-    }
-    std::vector<std::size_t> rows;
-    for (std::size_t i = 0; i < n; ++i) {
-        if (std::isinf(data.y[i])) {
-            d.error = fmt::format("y[{}] is infinite (only finite values or missing)", i);
-            return d;
-        }
-        if (std::isnan(data.y[i]) || data.condition[i].empty() || data.participant[i].empty() ||
-            (hasSurface && data.surface[i].empty()))
-            continue;
-        rows.push_back(i);
-    }
-    if (rows.empty()) {
-        d.error = "no complete observations (0 (non-NA) cases)";
-        return d;
-    }
-    auto pick = [&](const std::vector<std::string>& v) {
-        std::vector<std::string> out;
-        out.reserve(rows.size());
-        for (auto r : rows) out.push_back(v[r]);
-        return out;
-    };
-    const auto cond = pick(data.condition);
-    const auto part = pick(data.participant);
-    const auto surf = hasSurface ? pick(data.surface) : std::vector<std::string>{};
-    const auto condLevels = levelsOf(cond, data.conditionLevels);
-    const auto surfLevels =
-        hasSurface ? levelsOf(surf, data.surfaceLevels) : std::vector<std::string>{};
-    const auto partLevels = levelsOf(part, {});
-    if (withCondition && condLevels.size() < 2) {
-        d.error = "contrasts can be applied only to factors with 2 or more levels (condition has "
-                  "one level)";
-        return d;
-    }
-    if (hasSurface && surfLevels.size() < 2) {
-        d.error = "contrasts can be applied only to factors with 2 or more levels (surface has "
-                  "one level)";
-        return d;
-    }
-    const std::size_t m = rows.size();
-    // candidate columns: intercept, condition dummies, surface dummies
-    std::vector<VectorXd> columns;
-    std::vector<std::string> names;
-    std::vector<bool> isCondition;
-    columns.push_back(VectorXd::Ones(static_cast<Eigen::Index>(m)));
-    names.emplace_back("(Intercept)");
-    isCondition.push_back(false);
-    auto addFactor = [&](const std::vector<std::string>& v, const std::vector<std::string>& levels,
-                         const std::string& prefix, bool condition) {
-        std::map<std::string_view, std::size_t> levelOf; // one lookup per row
-        for (std::size_t l = 0; l < levels.size(); ++l) levelOf.emplace(levels[l], l);
-        const std::size_t first = columns.size();
-        for (std::size_t l = 1; l < levels.size(); ++l) {
-            columns.push_back(VectorXd::Zero(static_cast<Eigen::Index>(m)));
-            names.push_back(prefix + levels[l]);
-            isCondition.push_back(condition);
-        }
-        for (std::size_t i = 0; i < m; ++i)
-            if (const std::size_t l = levelOf.at(v[i]); l > 0)
-                columns[first + l - 1](static_cast<Eigen::Index>(i)) = 1.0;
-    };
-    if (withCondition) addFactor(cond, condLevels, "condition", true);
-    if (hasSurface) addFactor(surf, surfLevels, "surface", false);
-    // keep a column when it is not (numerically) in the span of the kept ones
-    std::vector<VectorXd> basis;
-    std::vector<std::size_t> kept;
-    for (std::size_t c = 0; c < columns.size(); ++c) {
-        VectorXd r = columns[c];
-        const double norm0 = r.norm();
-        for (int pass = 0; pass < 2; ++pass)
-            for (const auto& q : basis) r -= q * q.dot(r);
-        if (norm0 > 0 && r.norm() > 1e-7 * norm0) {
-            basis.push_back(r / r.norm());
-            kept.push_back(c);
-        }
-    }
-    const std::size_t dropped = columns.size() - kept.size();
-    if (dropped > 0)
-        d.warnings.push_back(
-            fmt::format("fixed-effect model matrix is rank deficient so dropping {} column{} / "
-                        "coefficient{}",
-                        dropped, dropped == 1 ? "" : "s", dropped == 1 ? "" : "s"));
-    d.X.resize(static_cast<Eigen::Index>(m), static_cast<Eigen::Index>(kept.size()));
-    for (std::size_t k = 0; k < kept.size(); ++k) {
-        d.X.col(static_cast<Eigen::Index>(k)) = columns[kept[k]];
-        d.names.push_back(names[kept[k]]);
-        if (isCondition[kept[k]]) ++d.conditionColumns;
-    }
-    d.y.resize(static_cast<Eigen::Index>(m));
-    for (std::size_t i = 0; i < m; ++i) d.y(static_cast<Eigen::Index>(i)) = data.y[rows[i]];
-    std::map<std::string, int> index;
-    for (std::size_t g = 0; g < partLevels.size(); ++g) index[partLevels[g]] = static_cast<int>(g);
-    d.nGroups = static_cast<int>(partLevels.size());
-    d.members.resize(partLevels.size());
-    for (std::size_t i = 0; i < m; ++i) {
-        const int g = index[part[i]];
-        d.group.push_back(g);
-        d.members[static_cast<std::size_t>(g)].push_back(static_cast<int>(i));
-    }
-    if (d.nGroups < 2) {
-        d.error = "grouping factors must have > 1 sampled level (participant has one level)";
-        return d;
-    }
-    return d;
-}
-
-/// Symmetric matrix inverse through the eigen decomposition; fails (returns false) when not
-/// positive definite.
-bool invertPositiveDefinite(const MatrixXd& h, MatrixXd& inverse) {
-    Eigen::LDLT<MatrixXd> ldlt(h);
-    if (ldlt.info() != Eigen::Success || !ldlt.isPositive()) return false;
-    const auto d = ldlt.vectorD();
-    for (Eigen::Index i = 0; i < d.size(); ++i)
-        if (!(d(i) > 0)) return false;
-    inverse = ldlt.solve(MatrixXd::Identity(h.rows(), h.cols()));
-    return true;
-}
-
-/// Gradient and Hessian by central differences, as lme4's deriv12 (delta = 1e-4).
-void deriv12(const std::function<double(const std::vector<double>&)>& f,
-             const std::vector<double>& x, double fx, VectorXd& gradient, MatrixXd& hessian,
-             double delta = 1e-4) {
-    const auto k = static_cast<Eigen::Index>(x.size());
-    gradient.resize(k);
-    hessian.resize(k, k);
-    for (Eigen::Index i = 0; i < k; ++i) {
-        auto xa = x, xs = x;
-        xa[static_cast<std::size_t>(i)] += delta;
-        xs[static_cast<std::size_t>(i)] -= delta;
-        const double fa = f(xa), fs = f(xs);
-        hessian(i, i) = (fa - 2 * fx + fs) / (delta * delta);
-        gradient(i) = (fa - fs) / (2 * delta);
-        for (Eigen::Index j = 0; j < i; ++j) {
-            auto xaa = x, xas = x, xsa = x, xss = x;
-            const auto ui = static_cast<std::size_t>(i), uj = static_cast<std::size_t>(j);
-            xaa[ui] += delta, xaa[uj] += delta;
-            xas[ui] += delta, xas[uj] -= delta;
-            xsa[ui] -= delta, xsa[uj] += delta;
-            xss[ui] -= delta, xss[uj] -= delta;
-            hessian(i, j) = hessian(j, i) =
-                (f(xaa) - f(xas) - f(xsa) + f(xss)) / (4 * delta * delta);
-        }
-    }
-}
+using namespace mixed;
 
 // ------------------------------------------------------------------------------ logistic
 
@@ -223,34 +36,78 @@ void deriv12(const std::function<double(const std::vector<double>&)>& f,
 // PIRLS); Pinheiro & Bates (1995), J. Comput. Graph. Stat. 4(1) (adaptive Gauss-Hermite).
 class LogisticDeviance {
   public:
-    LogisticDeviance(const Design& design, int nAGQ)
-        : d_(design), u_(static_cast<std::size_t>(design.nGroups), 0.0) {
-        if (nAGQ > 1) gaussHermiteRule(nAGQ, nodes_, weights_);
-        for (double w : weights_) logWeights_.push_back(std::log(w));
-        // Observations of one participant with the same fixed-effects row share their linear
-        // predictor: summed as binomial counts (the same likelihood, far fewer terms).
+    /// The cells of a design: observations of one participant with the same fixed-effects row
+    /// are summed as binomial counts (the same likelihood, far fewer terms).
+    LogisticDeviance(const Design& design, int nAGQ) : LogisticDeviance(nAGQ) {
         cells_.resize(design.members.size());
-        for (std::size_t g = 0; g < design.members.size(); ++g) {
-            auto& cells = cells_[g];
-            for (int i : design.members[g]) {
-                // a participant has few distinct rows: a linear search, no allocation
-                std::size_t c = 0;
-                while (c < cells.size() && design.X.row(cells[c].row) != design.X.row(i)) ++c;
-                if (c == cells.size()) cells.push_back({i, 0.0, 0.0});
-                cells[c].n += 1;
-                cells[c].successes += design.y(i);
-            }
+        std::vector<int> patternOf(static_cast<std::size_t>(design.y.size()), -1);
+        std::vector<int> firstRow; // one observation per distinct row
+        for (Eigen::Index i = 0; i < design.X.rows(); ++i) {
+            std::size_t k = 0;
+            while (k < firstRow.size() && design.X.row(firstRow[k]) != design.X.row(i)) ++k;
+            if (k == firstRow.size()) firstRow.push_back(static_cast<int>(i));
+            patternOf[static_cast<std::size_t>(i)] = static_cast<int>(k);
         }
+        patterns_.resize(static_cast<Eigen::Index>(firstRow.size()), design.X.cols());
+        for (std::size_t k = 0; k < firstRow.size(); ++k)
+            patterns_.row(static_cast<Eigen::Index>(k)) = design.X.row(firstRow[k]);
+        for (std::size_t g = 0; g < design.members.size(); ++g)
+            for (int i : design.members[g])
+                addCell(g, patternOf[static_cast<std::size_t>(i)], 1.0, design.y(i));
+        u_.assign(cells_.size(), 0.0);
+    }
+
+    /// Cells given directly: `patterns` holds the distinct fixed-effects rows, `cells[g]` the
+    /// (pattern, trials, successes) of participant g.
+    LogisticDeviance(MatrixXd patterns, std::vector<std::vector<std::array<double, 3>>> cells,
+                     int nAGQ)
+        : LogisticDeviance(nAGQ) {
+        patterns_ = std::move(patterns);
+        cells_.resize(cells.size());
+        for (std::size_t g = 0; g < cells.size(); ++g)
+            for (const auto& c : cells[g]) addCell(g, static_cast<int>(c[0]), c[1], c[2]);
+        u_.assign(cells_.size(), 0.0);
+    }
+
+    [[nodiscard]] Eigen::Index columns() const { return patterns_.cols(); }
+    [[nodiscard]] bool laplace() const { return nodes_.empty(); }
+
+    /// Logistic regression without random effect (R's glm IRLS on the counts per distinct
+    /// row), the starting point of the fit.
+    [[nodiscard]] VectorXd glmStart() const {
+        const auto k = patterns_.rows(), p = patterns_.cols();
+        VectorXd n = VectorXd::Zero(k), succ = VectorXd::Zero(k);
+        for (const auto& cells : cells_)
+            for (const Cell& c : cells) n(c.row) += c.n, succ(c.row) += c.successes;
+        VectorXd beta = VectorXd::Zero(p);
+        for (int it = 0; it < 25; ++it) {
+            const VectorXd eta = patterns_ * beta;
+            VectorXd w(k), z(k);
+            for (Eigen::Index i = 0; i < k; ++i) {
+                const double mu = 1.0 / (1.0 + std::exp(-eta(i)));
+                const double v = std::max(mu * (1 - mu), 1e-10);
+                w(i) = n(i) * v;
+                z(i) = n(i) > 0 ? eta(i) + (succ(i) / n(i) - mu) / v : 0.0;
+            }
+            const MatrixXd xtw = patterns_.transpose() * w.asDiagonal();
+            const VectorXd next = (xtw * patterns_).ldlt().solve(xtw * z);
+            if (!next.allFinite()) break;
+            const double change = (next - beta).norm();
+            beta = next;
+            if (change < 1e-10 * (1 + beta.norm())) break;
+        }
+        for (Eigen::Index j = 0; j < p; ++j) beta(j) = std::clamp(beta(j), -20.0, 20.0);
+        return beta;
     }
 
     double operator()(const std::vector<double>& par) {
         const double theta = par[0];
-        VectorXd beta(d_.X.cols());
+        VectorXd beta(patterns_.cols());
         for (Eigen::Index j = 0; j < beta.size(); ++j)
             beta(j) = par[static_cast<std::size_t>(j) + 1];
-        const VectorXd offset = d_.X * beta;
+        const VectorXd offset = patterns_ * beta;
         double dev = 0;
-        for (std::size_t g = 0; g < d_.members.size(); ++g) dev += groupDeviance(g, theta, offset);
+        for (std::size_t g = 0; g < cells_.size(); ++g) dev += groupDeviance(g, theta, offset);
         return dev;
     }
 
@@ -259,10 +116,10 @@ class LogisticDeviance {
     /// function theorem (du^/dpsi = -g_upsi / g_uu). Used by the power simulations' optimiser.
     double laplaceGradient(const std::vector<double>& par, std::vector<double>& grad) {
         const double theta = par[0];
-        const auto p = d_.X.cols();
+        const auto p = patterns_.cols();
         beta_.resize(p);
         for (Eigen::Index j = 0; j < p; ++j) beta_(j) = par[static_cast<std::size_t>(j) + 1];
-        offset_.noalias() = d_.X * beta_;
+        offset_.noalias() = patterns_ * beta_;
         grad.assign(par.size(), 0.0);
         gBeta_.resize(p), wx_.resize(p), tx_.resize(p);
         double dev = 0;
@@ -282,7 +139,7 @@ class LogisticDeviance {
                 const double w = c.n * e / ((1.0 + e) * (1.0 + e));
                 const double t = w * (1.0 - 2.0 * mu);
                 sr += r, sw += w, st += t;
-                const auto x = d_.X.row(c.row);
+                const auto x = patterns_.row(c.row);
                 gBeta_.noalias() += r * x.transpose();
                 wx_.noalias() += w * x.transpose();
                 tx_.noalias() += t * x.transpose();
@@ -309,10 +166,10 @@ class LogisticDeviance {
     MatrixXd rxVcov(const std::vector<double>& par) {
         (*this)(par); // conditional modes at par
         const double theta = par[0];
-        const auto p = d_.X.cols();
+        const auto p = patterns_.cols();
         VectorXd beta(p);
         for (Eigen::Index j = 0; j < p; ++j) beta(j) = par[static_cast<std::size_t>(j) + 1];
-        const VectorXd offset = d_.X * beta;
+        const VectorXd offset = patterns_ * beta;
         MatrixXd info = MatrixXd::Zero(p, p);
         for (std::size_t g = 0; g < cells_.size(); ++g) {
             VectorXd s = VectorXd::Zero(p);
@@ -320,7 +177,7 @@ class LogisticDeviance {
             for (const Cell& c : cells_[g]) {
                 const double mu = 1.0 / (1.0 + std::exp(-(offset(c.row) + theta * u_[g])));
                 const double w = c.n * mu * (1 - mu);
-                const VectorXd x = d_.X.row(c.row).transpose();
+                const VectorXd x = patterns_.row(c.row).transpose();
                 info += w * x * x.transpose();
                 s += w * x;
                 wsum += w;
@@ -412,89 +269,31 @@ class LogisticDeviance {
     }
 
     struct Cell {
-        int row = 0; ///< an observation with this fixed-effects row
+        int row = 0; ///< the index of its distinct fixed-effects row
         double n = 0, successes = 0;
     };
-    const Design& d_;
+
+    explicit LogisticDeviance(int nAGQ) {
+        if (nAGQ > 1) gaussHermiteRule(nAGQ, nodes_, weights_);
+        for (double w : weights_) logWeights_.push_back(std::log(w));
+    }
+
+    void addCell(std::size_t g, int pattern, double n, double successes) {
+        auto& cells = cells_[g];
+        std::size_t c = 0;
+        while (c < cells.size() && cells[c].row != pattern) ++c;
+        if (c == cells.size()) cells.push_back({pattern, 0.0, 0.0});
+        cells[c].n += n;
+        cells[c].successes += successes;
+    }
+
+    MatrixXd patterns_; ///< distinct rows of the fixed-effects design
     std::vector<double> u_;
     std::vector<double> nodes_, weights_, logWeights_;
     std::vector<double> terms_;                ///< scratch of the quadrature sum
     VectorXd beta_, offset_, gBeta_, wx_, tx_; ///< scratch of laplaceGradient
     std::vector<std::vector<Cell>> cells_;
 };
-
-/// Logistic regression without random effect (R's glm IRLS), used as the starting point.
-VectorXd glmStart(const Design& d) {
-    const auto p = d.X.cols();
-    VectorXd beta = VectorXd::Zero(p);
-    for (int it = 0; it < 25; ++it) {
-        const VectorXd eta = d.X * beta;
-        VectorXd w(eta.size()), z(eta.size());
-        for (Eigen::Index i = 0; i < eta.size(); ++i) {
-            const double mu = 1.0 / (1.0 + std::exp(-eta(i)));
-            const double v = std::max(mu * (1 - mu), 1e-10);
-            w(i) = v;
-            z(i) = eta(i) + (d.y(i) - mu) / v;
-        }
-        const MatrixXd xtw = d.X.transpose() * w.asDiagonal();
-        const VectorXd next = (xtw * d.X).ldlt().solve(xtw * z);
-        if (!next.allFinite()) break;
-        const double change = (next - beta).norm();
-        beta = next;
-        if (change < 1e-10 * (1 + beta.norm())) break;
-    }
-    for (Eigen::Index j = 0; j < p; ++j) beta(j) = std::clamp(beta(j), -20.0, 20.0);
-    return beta;
-}
-
-struct Optimum {
-    std::vector<double> x;
-    double value = kNaN;
-    bool converged = true;
-    std::string message;
-};
-
-/// Minimises f with NLopt's BOBYQA (bounds: theta >= 0), then restarts from the optimum with a
-/// small step until the value stops improving, so the optimum is reached tightly.
-Optimum minimise(const std::function<double(const std::vector<double>&)>& f, std::vector<double> x,
-                 const std::vector<double>& lower, double step) {
-    Optimum out;
-    struct Ctx {
-        const std::function<double(const std::vector<double>&)>* f;
-    } ctx{&f};
-    auto thunk = [](const std::vector<double>& v, std::vector<double>&, void* data) {
-        const double r = (*static_cast<Ctx*>(data)->f)(v);
-        return std::isfinite(r) ? r : 1e300;
-    };
-    double best = f(x);
-    for (int round = 0; round < 4; ++round) {
-        nlopt::opt opt(nlopt::LN_BOBYQA, static_cast<unsigned>(x.size()));
-        opt.set_lower_bounds(lower);
-        opt.set_min_objective(thunk, &ctx);
-        opt.set_xtol_rel(1e-10);
-        opt.set_ftol_abs(1e-12);
-        opt.set_maxeval(20000);
-        opt.set_initial_step(round == 0 ? step : step * 0.01);
-        for (std::size_t i = 0; i < x.size(); ++i) x[i] = std::max(x[i], lower[i]);
-        double value = best;
-        try {
-            const auto status = opt.optimize(x, value);
-            if (status == nlopt::MAXEVAL_REACHED) {
-                out.converged = false;
-                out.message = "maximum number of function evaluations exceeded";
-            }
-        } catch (const std::exception& e) {
-            out.converged = false;
-            out.message = e.what();
-        }
-        const bool improved = value < best - 1e-9;
-        best = std::min(best, value);
-        if (!improved && round > 0) break;
-    }
-    out.x = x;
-    out.value = f(x);
-    return out;
-}
 
 /// Minimises the Laplace deviance with its analytic gradient (NLopt's L-BFGS): the optimum
 /// BOBYQA reaches, in a fraction of the deviance evaluations. Used where only the optimum is
@@ -610,10 +409,9 @@ struct LogisticFit {
     bool vcovOk = false;
 };
 
-LogisticFit fitLogistic(const Design& d, int nAGQ, bool derivatives) {
+LogisticFit fitLogistic(LogisticDeviance& deviance, bool derivatives) {
     LogisticFit fit;
-    LogisticDeviance deviance(d, nAGQ);
-    const VectorXd start = glmStart(d);
+    const VectorXd start = deviance.glmStart();
     std::vector<double> x{1.0};
     for (Eigen::Index j = 0; j < start.size(); ++j) x.push_back(start(j));
     std::vector<double> lower(x.size(), -numerics::kInf);
@@ -621,7 +419,8 @@ LogisticFit fitLogistic(const Design& d, int nAGQ, bool derivatives) {
     std::function<double(const std::vector<double>&)> f = [&](const std::vector<double>& v) {
         return deviance(v);
     };
-    fit.opt = !derivatives && nAGQ == 1 ? minimiseLaplace(deviance, x) : minimise(f, x, lower, 0.2);
+    fit.opt = !derivatives && deviance.laplace() ? minimiseLaplace(deviance, x)
+                                                 : minimise(f, x, lower, 0.2);
     if (fit.opt.x[0] > 0) { // a flat deviance near the boundary: the optimum is theta = 0
         auto x0 = fit.opt.x;
         x0[0] = 0.0;
@@ -636,7 +435,7 @@ LogisticFit fitLogistic(const Design& d, int nAGQ, bool derivatives) {
     const bool boundary = fit.opt.x[0] < 1e-4;
     checkConvergence(gradient, hessian, boundary, fit.warnings);
     MatrixXd inverse;
-    const auto p = d.X.cols();
+    const auto p = deviance.columns();
     if (invertPositiveDefinite(hessian, inverse)) {
         fit.vcov = 2.0 * inverse.bottomRightCorner(p, p); // lme4's calc.vcov.hess
     } else {
@@ -647,18 +446,6 @@ LogisticFit fitLogistic(const Design& d, int nAGQ, bool derivatives) {
     }
     fit.vcovOk = fit.vcov.allFinite();
     return fit;
-}
-
-} // namespace
-
-namespace {
-
-/// Records the design's size in `r`; false (with R's message in r.error) when R would stop.
-bool describeDesign(const Design& d, MixedModelResult& r) {
-    r.nObs = dbl(d.y.size());
-    r.nGroups = d.nGroups;
-    r.error = d.error;
-    return d.error.empty();
 }
 
 } // namespace
@@ -716,7 +503,8 @@ MixedModelResult fitLogisticMixedModel(const MixedModelData& data, int nAGQ, boo
     }
     r.warnings = d.warnings;
     separationWarnings(d, r.warnings);
-    LogisticFit fit = fitLogistic(d, nAGQ, standardErrors);
+    LogisticDeviance deviance(d, nAGQ);
+    LogisticFit fit = fitLogistic(deviance, standardErrors);
     const double theta = fit.opt.x[0];
     r.randomVariance = theta * theta;
     r.deviance = fit.opt.value;
@@ -738,7 +526,8 @@ MixedModelResult fitLogisticMixedModel(const MixedModelData& data, int nAGQ, boo
     if (d.conditionColumns > 0) {
         Design reduced = buildDesign(data, false);
         if (reduced.error.empty()) {
-            const LogisticFit fit0 = fitLogistic(reduced, nAGQ, false);
+            LogisticDeviance deviance0(reduced, nAGQ);
+            const LogisticFit fit0 = fitLogistic(deviance0, false);
             r.lrt.statistic = std::max(0.0, fit0.opt.value - fit.opt.value);
             r.lrt.df = d.conditionColumns;
             r.lrt.p = numerics::pchisq(r.lrt.statistic, r.lrt.df, false);
@@ -747,220 +536,138 @@ MixedModelResult fitLogisticMixedModel(const MixedModelData& data, int nAGQ, boo
     return r;
 }
 
-// ------------------------------------------------------------------------------ linear
-
 namespace {
 
-/// Profiled (RE)ML deviance of y = X beta + b[participant] + e with b ~ N(0, theta^2 sigma^2),
-/// e ~ N(0, sigma^2), through per-participant sums (V = I + theta^2 Z Z', Woodbury).
-// Source: Bates, Maechler, Bolker & Walker (2015), lme4, J. Stat. Softw. 67(1), eqs. 34, 41.
-class LinearProfile {
-  public:
-    explicit LinearProfile(const Design& d) : d_(d) {
-        const auto p = d.X.cols();
-        xtx_ = d.X.transpose() * d.X;
-        xty_ = d.X.transpose() * d.y;
-        yty_ = d.y.squaredNorm();
-        for (const auto& members : d.members) {
-            VectorXd s = VectorXd::Zero(p);
-            double t = 0;
-            for (int i : members) s += d.X.row(i).transpose(), t += d.y(i);
-            sums_.push_back(s);
-            ysums_.push_back(t);
-            sizes_.push_back(dbl(members.size()));
-        }
-    }
-
-    struct Eval {
-        double ldL2 = 0, ldRX2 = 0, pwrss = 0;
-        MatrixXd xvx; ///< X' V^-1 X
-        VectorXd beta;
-        bool ok = true;
-    };
-
-    Eval evaluate(double theta) const {
-        Eval e;
-        const double t2 = theta * theta;
-        e.xvx = xtx_;
-        VectorXd xvy = xty_;
-        double yvy = yty_;
-        for (std::size_t g = 0; g < sums_.size(); ++g) {
-            const double c = t2 / (1.0 + sizes_[g] * t2);
-            e.xvx.noalias() -= c * sums_[g] * sums_[g].transpose();
-            xvy -= c * ysums_[g] * sums_[g];
-            yvy -= c * ysums_[g] * ysums_[g];
-            e.ldL2 += std::log1p(sizes_[g] * t2);
-        }
-        Eigen::LLT<MatrixXd> llt(e.xvx);
-        if (llt.info() != Eigen::Success) {
-            e.ok = false;
-            return e;
-        }
-        e.beta = llt.solve(xvy);
-        e.pwrss = std::max(yvy - e.beta.dot(xvy), 0.0);
-        e.ldRX2 = 0;
-        const MatrixXd l = llt.matrixL();
-        for (Eigen::Index i = 0; i < l.rows(); ++i) e.ldRX2 += 2.0 * std::log(l(i, i));
-        return e;
-    }
-
-    double n() const { return dbl(d_.y.size()); }
-    double p() const { return dbl(d_.X.cols()); }
-
-    /// Profiled deviance (REML criterion when reml).
-    double deviance(double theta, bool reml) const {
-        const Eval e = evaluate(theta);
-        if (!e.ok) return numerics::kInf;
-        const double dof = reml ? n() - p() : n();
-        const double twoPi = 2.0 * std::numbers::pi;
-        return e.ldL2 + (reml ? e.ldRX2 : 0.0) + dof * (1.0 + std::log(twoPi * e.pwrss / dof));
-    }
-
-    /// REML deviance with sigma not profiled (lmerTest's devfun_vp).
-    double devianceVp(double theta, double sigma) const {
-        const Eval e = evaluate(theta);
-        const double s2 = sigma * sigma;
-        return e.ldL2 + e.ldRX2 + (n() - p()) * std::log(2.0 * std::numbers::pi * s2) +
-               e.pwrss / s2;
-    }
-
-  private:
-    const Design& d_;
-    MatrixXd xtx_;
-    VectorXd xty_;
-    double yty_ = 0;
-    std::vector<VectorXd> sums_;
-    std::vector<double> ysums_, sizes_;
+/// The distinct fixed-effects rows of `~ condition (+ surface)` (treatment contrasts, columns
+/// in the span of earlier ones dropped as buildDesign does) over the (condition, surface) pairs
+/// present, and the cells per participant on them.
+struct CellDesign {
+    MatrixXd patterns;
+    std::vector<std::vector<std::array<double, 3>>> cells; ///< per participant
+    int conditionColumns = 0;
 };
 
-/// Minimises the profiled deviance over theta >= 0: a log-spaced scan, then Brent's method
-/// (Boost.Math) in the best bracket.
-double optimiseTheta(const LinearProfile& profile, bool reml) {
-    std::vector<double> grid{0.0};
-    for (double t = 1e-3; t < 2e3; t *= 1.25) grid.push_back(t);
-    std::size_t best = 0;
-    double bestValue = numerics::kInf;
-    for (std::size_t i = 0; i < grid.size(); ++i) {
-        const double v = profile.deviance(grid[i], reml);
-        if (v < bestValue) bestValue = v, best = i;
+CellDesign cellDesign(const std::vector<BinomialCell>& cells, bool withCondition,
+                      const std::vector<int>& conditions, const std::vector<int>& surfaces,
+                      int participants) {
+    CellDesign d;
+    std::vector<std::pair<int, int>> keys; // (condition, surface) of each distinct row
+    std::vector<int> patternOf;
+    for (const auto& c : cells) {
+        const std::pair<int, int> key{withCondition ? c.condition : 0, c.surface};
+        auto it = std::find(keys.begin(), keys.end(), key);
+        patternOf.push_back(static_cast<int>(it - keys.begin()));
+        if (it == keys.end()) keys.push_back(key);
     }
-    const double lo = best == 0 ? 0.0 : grid[best - 1];
-    const double hi = best + 1 < grid.size() ? grid[best + 1] : grid[best] * 2;
-    boost::uintmax_t iterations = 500;
-    const auto [theta, value] = boost::math::tools::brent_find_minima(
-        [&](double t) { return profile.deviance(t, reml); }, lo, hi, 50, iterations);
-    if (best == 0 && profile.deviance(0.0, reml) <= value) return 0.0;
-    return theta;
-}
-
-/// Second derivative data of a smooth function of two variables by central differences with
-/// one Richardson extrapolation step (accurate to about 1e-9 relative here).
-double richardson(const std::function<double(double)>& f, double h) {
-    const double d1 = (f(h) - f(-h)) / (2 * h);
-    const double d2 = (f(h / 2) - f(-h / 2)) / h;
-    return (4 * d2 - d1) / 3;
+    std::vector<VectorXd> columns;
+    std::vector<bool> isCondition;
+    const auto k = static_cast<Eigen::Index>(keys.size());
+    columns.emplace_back(VectorXd::Ones(k));
+    isCondition.push_back(false);
+    auto addFactor = [&](const std::vector<int>& levels, bool condition) {
+        for (std::size_t l = 1; l < levels.size(); ++l) {
+            VectorXd col = VectorXd::Zero(k);
+            for (Eigen::Index i = 0; i < k; ++i) {
+                const auto& key = keys[static_cast<std::size_t>(i)];
+                col(i) = (condition ? key.first : key.second) == levels[l] ? 1.0 : 0.0;
+            }
+            columns.push_back(col);
+            isCondition.push_back(condition);
+        }
+    };
+    if (withCondition) addFactor(conditions, true);
+    addFactor(surfaces, false);
+    std::vector<VectorXd> basis, kept;
+    for (std::size_t c = 0; c < columns.size(); ++c) {
+        VectorXd r = columns[c];
+        const double norm0 = r.norm();
+        for (int pass = 0; pass < 2; ++pass)
+            for (const auto& q : basis) r -= q * q.dot(r);
+        if (norm0 > 0 && r.norm() > 1e-7 * norm0) {
+            basis.push_back(r / r.norm());
+            kept.push_back(columns[c]);
+            if (isCondition[c]) ++d.conditionColumns;
+        }
+    }
+    d.patterns.resize(k, static_cast<Eigen::Index>(kept.size()));
+    for (std::size_t c = 0; c < kept.size(); ++c)
+        d.patterns.col(static_cast<Eigen::Index>(c)) = kept[c];
+    d.cells.resize(static_cast<std::size_t>(participants));
+    for (std::size_t i = 0; i < cells.size(); ++i)
+        d.cells[static_cast<std::size_t>(cells[i].participant)].push_back(
+            {static_cast<double>(patternOf[i]), cells[i].trials, cells[i].successes});
+    return d;
 }
 
 } // namespace
 
-MixedModelResult fitLinearMixedModel(const MixedModelData& data) {
-    MixedModelResult r;
-    r.statisticName = "t";
-    r.formula = std::string("y ~ condition") + (data.surface.empty() ? "" : " + surface") +
-                " + (1 | participant)";
-    r.method = "Linear mixed model fit by REML. t-tests use Satterthwaite's method "
-               "[lmerModLmerTest]";
-    Design d = buildDesign(data, true);
-    if (!describeDesign(d, r)) return r;
-    if (d.nGroups >= d.y.size()) {
-        r.error = "number of levels of each grouping factor must be < number of observations "
-                  "(problems: participant)";
-        return r;
+LogisticLrt logisticLikelihoodRatio(const std::vector<BinomialCell>& cells, int nAGQ) {
+    LogisticLrt out;
+    if (nAGQ < 1 || nAGQ > 25) {
+        out.error = "nAGQ must be between 1 and 25";
+        return out;
     }
-    if (d.y.minCoeff() == d.y.maxCoeff()) {
-        r.error = "the response is constant: no variance to estimate (R's lmer stops with \"not "
-                  "a positive definite matrix\")";
-        return r;
-    }
-    r.warnings = d.warnings;
-    const LinearProfile profile(d);
-    const double theta = optimiseTheta(profile, true);
-    const auto e = profile.evaluate(theta);
-    const double n = profile.n(), p = profile.p();
-    const double sigma2 = e.pwrss / (n - p);
-    const double sigma = std::sqrt(sigma2);
-    r.residualVariance = sigma2;
-    r.randomVariance = theta * theta * sigma2;
-    r.deviance = profile.deviance(theta, true);
-    r.logLik = -0.5 * r.deviance;
-    r.aic = r.deviance + 2.0 * (p + 2.0);
-    const MatrixXd unscaled = e.xvx.inverse();
-    // Satterthwaite df as lmerTest (Kuznetsova, Brockhoff & Christensen 2017, J. Stat. Softw.
-    // 82(13); Satterthwaite 1946): df = 2 (L'CL)^2 / (g' A g), A = 2 H^-1 of the REML deviance
-    // in (theta, sigma), g = gradient of L'CL in (theta, sigma).
-    const double hT = 1e-4 * std::max(theta, 1e-2), hS = 1e-4 * sigma;
-    auto dev = [&](double t, double s) { return profile.devianceVp(t, s); };
-    MatrixXd h(2, 2);
-    h(0, 0) = richardson(
-        [&](double a) {
-            return (dev(theta + a + hT, sigma) - dev(theta + a - hT, sigma)) / (2 * hT);
-        },
-        hT);
-    h(1, 1) = richardson(
-        [&](double a) {
-            return (dev(theta, sigma + a + hS) - dev(theta, sigma + a - hS)) / (2 * hS);
-        },
-        hS);
-    h(0, 1) = h(1, 0) = richardson(
-        [&](double a) {
-            return (dev(theta + a, sigma + hS) - dev(theta + a, sigma - hS)) / (2 * hS);
-        },
-        hT);
-    // pseudo-inverse as lmerTest (eigenvalues below tolerance dropped)
-    Eigen::SelfAdjointEigenSolver<MatrixXd> eig(h);
-    MatrixXd a = MatrixXd::Zero(2, 2);
-    const double tol = 1e-8 * std::max(1.0, eig.eigenvalues().cwiseAbs().maxCoeff());
-    int negative = 0;
-    for (int k = 0; k < 2; ++k) {
-        const double ev = eig.eigenvalues()(k);
-        if (ev < -tol) ++negative;
-        if (ev > tol) a += eig.eigenvectors().col(k) * eig.eigenvectors().col(k).transpose() / ev;
-    }
-    a *= 2.0;
-    if (negative > 0)
-        r.warnings.push_back(fmt::format(
-            "Model failed to converge with {} negative eigenvalue{}: Satterthwaite df are "
-            "unreliable",
-            negative, negative == 1 ? "" : "s"));
-    for (Eigen::Index j = 0; j < d.X.cols(); ++j) {
-        FixedEffect f;
-        f.name = d.names[static_cast<std::size_t>(j)];
-        f.estimate = e.beta(j);
-        const double var = sigma2 * unscaled(j, j);
-        f.se = std::sqrt(var);
-        f.statistic = f.estimate / f.se;
-        auto cjj = [&](double t) { return profile.evaluate(t).xvx.inverse()(j, j); };
-        VectorXd g(2);
-        g(0) = sigma2 * richardson([&](double a2) { return cjj(theta + a2); }, hT);
-        g(1) = 2.0 * sigma * unscaled(j, j);
-        const double denom = g.dot(a * g);
-        f.df = 2.0 * var * var / denom;
-        f.p = 2.0 * numerics::pt(-std::fabs(f.statistic), f.df);
-        r.fixed.push_back(f);
-    }
-    if (theta < 1e-4) r.warnings.emplace_back("boundary (singular) fit: see help('isSingular')");
-    if (d.conditionColumns > 0) { // anova(): both refitted by ML
-        Design reduced = buildDesign(data, false);
-        if (reduced.error.empty()) {
-            const LinearProfile profile0(reduced);
-            const double dev1 = profile.deviance(optimiseTheta(profile, false), false);
-            const double dev0 = profile0.deviance(optimiseTheta(profile0, false), false);
-            r.lrt.statistic = std::max(0.0, dev0 - dev1);
-            r.lrt.df = d.conditionColumns;
-            r.lrt.p = numerics::pchisq(r.lrt.statistic, r.lrt.df, false);
+    std::vector<int> conditions, surfaces, people;
+    double trials = 0, successes = 0;
+    for (const auto& c : cells) {
+        if (c.participant < 0 || c.condition < 0 || !(c.trials >= 0) ||
+            !(c.successes >= 0 && c.successes <= c.trials)) {
+            out.error = "a cell has a negative code or successes outside 0..trials";
+            return out;
         }
+        if (c.trials == 0) continue;
+        conditions.push_back(c.condition);
+        surfaces.push_back(c.surface);
+        people.push_back(c.participant);
+        trials += c.trials;
+        successes += c.successes;
     }
-    return r;
+    auto unique = [](std::vector<int>& v) {
+        std::sort(v.begin(), v.end());
+        v.erase(std::unique(v.begin(), v.end()), v.end());
+    };
+    unique(conditions), unique(surfaces), unique(people);
+    if (conditions.size() < 2) {
+        out.error = "contrasts can be applied only to factors with 2 or more levels (condition "
+                    "has one level)";
+        return out;
+    }
+    if (people.size() < 2) {
+        out.error = "grouping factors must have > 1 sampled level (participant has one level)";
+        return out;
+    }
+    if (successes == 0 || successes == trials) {
+        out.error = "Response is constant";
+        return out;
+    }
+    // participants renumbered 0..n-1 in code order (empty cells left out)
+    std::vector<BinomialCell> used;
+    for (const auto& c : cells)
+        if (c.trials > 0) {
+            BinomialCell u = c;
+            u.participant = static_cast<int>(
+                std::lower_bound(people.begin(), people.end(), c.participant) - people.begin());
+            used.push_back(u);
+        }
+    const int n = static_cast<int>(people.size());
+    auto fit = [&](bool withCondition, int& conditionColumns) {
+        CellDesign d = cellDesign(used, withCondition, conditions, surfaces, n);
+        conditionColumns = d.conditionColumns;
+        LogisticDeviance deviance(std::move(d.patterns), std::move(d.cells), nAGQ);
+        return fitLogistic(deviance, false).opt;
+    };
+    int columns = 0, unused = 0;
+    const Optimum full = fit(true, columns);
+    const Optimum reduced = fit(false, unused);
+    out.randomVariance = full.x[0] * full.x[0];
+    if (columns == 0) {
+        out.error = "the condition is aliased with the surfaces (no condition column is estimable)";
+        return out;
+    }
+    out.statistic = std::max(0.0, reduced.value - full.value);
+    out.df = columns;
+    out.p = numerics::pchisq(out.statistic, out.df, false);
+    return out;
 }
 
 } // namespace underfoot::analysis

@@ -71,6 +71,29 @@ struct MixedModelResult {
 MixedModelResult fitLogisticMixedModel(const MixedModelData& data, int nAGQ = 1,
                                        bool standardErrors = true);
 
+/// One cell of a logistic mixed model given by integer codes (power simulations): the trials
+/// and successes of one participant in one condition (and surface).
+struct BinomialCell {
+    int participant = 0; ///< 0-based codes; levels are ordered by their codes
+    int condition = 0;
+    int surface = -1; ///< -1: no surface factor
+    double trials = 0;
+    double successes = 0;
+};
+
+/// The likelihood-ratio test of the condition (R's anova(m0, m1)) of glmer(y ~ condition
+/// (+ surface) + (1 | participant), binomial, nAGQ) fitted on cells: the optimum
+/// fitLogisticMixedModel reaches on the same answers given one by one (levels ordered by their
+/// codes), without strings, standard errors or warnings. Used by the power simulations.
+struct LogisticLrt {
+    double statistic = std::numeric_limits<double>::quiet_NaN();
+    double df = std::numeric_limits<double>::quiet_NaN();
+    double p = std::numeric_limits<double>::quiet_NaN();
+    double randomVariance = std::numeric_limits<double>::quiet_NaN();
+    std::string error; ///< non-empty where R would stop
+};
+LogisticLrt logisticLikelihoodRatio(const std::vector<BinomialCell>& cells, int nAGQ = 1);
+
 /// Linear mixed model by REML, lmerTest::lmer(y ~ condition (+ surface) + (1 | participant));
 /// the LRT refits both models by ML as R's anova() does.
 MixedModelResult fitLinearMixedModel(const MixedModelData& data);

@@ -130,7 +130,7 @@ double phiCoefficient(const CountTable& table);
 /// Cramér's V of an r x c table (uncorrected chi-square).
 double cramersV(const CountTable& table);
 
-// ---------------------------------------------------------------- issue #15 "holes" (stats2)
+// ---------------------------------------------------------------- the further tests of R
 
 /// Largest table total and number of tables with the observed margins that fisherTestRxC
 /// enumerates; beyond them it refuses with a message (as R reports FEXACT's workspace limit).

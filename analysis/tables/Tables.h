@@ -97,15 +97,17 @@ struct ComparisonRow {
     double pHolm = std::numeric_limits<double>::quiet_NaN(); ///< Holm across surfaces
 };
 
-/// The mixed model beside a between-group comparison (issue #15): the participant as a random
+/// The mixed model beside a between-group comparison: the participant as a random
 /// intercept, groupB's coefficient against groupA (log-odds ratio for correct answers, mean
-/// difference for ratings). Filled by addMixedModelComparisons (report/MixedModelReport.h).
+/// difference for lmer, log-odds ratio of a higher rating for clmm). Filled by
+/// addMixedModelComparisons (report/MixedModelReport.h).
 struct MixedComparisonRow {
     Measure measure = Measure::Correct;
     std::string surfaceId; ///< empty = all surfaces, surface as a fixed factor
     std::string groupA, groupB;
     double observations = 0, participants = 0;
-    std::string model; ///< "glmer (Laplace)" / "lmer (REML, Satterthwaite)"
+    std::string
+        model; ///< "glmer (Laplace)" / "lmer (REML, Satterthwaite)" / "clmm (Laplace, logit)"
     double estimate = std::numeric_limits<double>::quiet_NaN();
     double se = std::numeric_limits<double>::quiet_NaN();
     double statistic = std::numeric_limits<double>::quiet_NaN(); ///< Wald z or t
@@ -115,6 +117,8 @@ struct MixedComparisonRow {
     double lrtP = std::numeric_limits<double>::quiet_NaN();
     double randomVariance = std::numeric_limits<double>::quiet_NaN();
     double classicP = std::numeric_limits<double>::quiet_NaN(); ///< the matching chi-square / t p
+    /// Ratings: Mann-Whitney (wilcox.test) p of the pooled ratings of the two groups.
+    double nonparametricP = std::numeric_limits<double>::quiet_NaN();
     std::vector<std::string> warnings;
     std::string error;
 };

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // `underfoot devices`: the audio devices RtAudio sees, their channels and rates; --save writes
-// an audio settings file (docs/live.md) for the chosen device with a default channel map.
+// an audio settings file (docs/reference/settings.md) for the chosen device with a default channel
+// map.
 //   devices [--api jack]
 //   devices --save settings.toml [--api jack] [--device system] [--rate 48000] [--block 64]
 #include "app/cli/CommandRegistry.h"

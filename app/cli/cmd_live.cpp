@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// `underfoot live`: plays a surface live on the audio device (docs/live.md) and prints the
-// meters, xruns and callback load at the end.
+// `underfoot live`: plays a surface live on the audio device (docs/explanation/live-audio.md) and
+// prints the meters, xruns and callback load at the end.
 //   live --surface wood [--walker cadence=100 | --mics | --grf FILE] [--seconds 10]
 //        [--reverb hall] [--soundscape forest] [--haptics audio|haptic|both] [--pairs both]
 //        [--settings settings.toml] [--api jack] [--device system] [--seed 1]
@@ -71,7 +71,7 @@ int runLive(const LiveArgs& a) {
     }
     if (d.modality != eng::OutputModality::Audio && !settings.channels.hasHaptics())
         throw UserError("live --haptics: the audio settings map no actuator channels; add "
-                        "[channels.haptic] to the settings file (docs/live.md)");
+                        "[channels.haptic] to the settings file (docs/reference/settings.md)");
 
     eng::LiveEngine engine;
     try {

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// `underfoot sensors`: the live inputs (docs/sensors.md).
+// `underfoot sensors`: the live inputs (docs/reference/sensors.md).
 //   sensors ports                                           serial ports (libserialport)
 //   sensors monitor --serial PATH [--baud N] [--thresholds F] [--seconds S] [--log F] [--frames]
 //   sensors monitor --osc PORT [--seconds S] [--log F]      gyroscopes over OSC/UDP

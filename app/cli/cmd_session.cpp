@@ -8,6 +8,7 @@
 #include "app/wiring/Adapters.h"
 #include "app/wiring/ClipPlayer.h"
 #include "app/wiring/Players.h"
+#include "base/Version.h"
 #include "engine/control/StepCalibration.h"
 #include "engine/control/StepGrfPlayer.h"
 #include "engine/control/StepInput.h"
@@ -287,8 +288,8 @@ int runInteractive(const Options& o) {
                                         : silent;
     Session session(store, o.participant, player,
                     {o.experimenter, o.live ? o.audio : "none (data entry, no sound)",
-                     o.clips.empty() ? o.sensor : "clips " + o.clips, UNDERFOOT_VERSION, o.live,
-                     o.takeOver});
+                     o.clips.empty() ? o.sensor : "clips " + o.clips, underfoot::base::version(),
+                     o.live, o.takeOver});
     const Questions& q = p.questions;
     fmt::print("{} — participant {} (group {}), session {}{}\n", p.title, o.participant,
                session.participant().groupId, session.sessionNumber(),

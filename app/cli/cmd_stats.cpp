@@ -43,8 +43,11 @@ const cli::CommandRegistrar registrar("stats", [](CLI::App& app, int& exitCode) 
         "  echo '{\"y\": [1,0,1,1,0,1,1,1], \"condition\": "
         "[\"a\",\"a\",\"b\",\"b\",\"a\",\"a\",\"b\",\"b\"], "
         "\"participant\": [1,1,2,2,3,3,4,4], \"nAGQ\": 10}' | underfoot stats glmm\n"
-        "  (glmm / lmm: mixed models with a random intercept per participant, as lme4::glmer / "
-        "lmerTest::lmer; see analysis/io/StatsJsonMixed.h)");
+        "  echo '{\"y\": [2,5,3,6,1,4,3,7], \"condition\": "
+        "[\"a\",\"b\",\"a\",\"b\",\"a\",\"b\",\"a\",\"b\"], "
+        "\"participant\": [1,1,2,2,3,3,4,4], \"levels\": [1,2,3,4,5,6,7]}' | underfoot stats clmm\n"
+        "  (glmm / lmm / clmm: mixed models with a random intercept per participant, as "
+        "lme4::glmer / lmerTest::lmer / ordinal::clmm; see docs/reference/statistics.md)");
     cmd->callback([&exitCode, test] { exitCode = runStats(*test); });
 });
 

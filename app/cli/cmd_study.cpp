@@ -2,6 +2,7 @@
 // `underfoot study ...`: create a study file, register / drop participants, exclude trials,
 // inspect a study, its journal and what replay needs for a trial.
 #include "app/cli/CommandRegistry.h"
+#include "base/Version.h"
 #include "experiment/Export.h"
 #include "experiment/Invitations.h"
 #include "experiment/Protocol.h"
@@ -68,8 +69,8 @@ const underfoot::cli::CommandRegistrar registrar{
         create->callback([&exitCode, &o] {
             guarded([&] {
                 const Protocol p = loadProtocol(o.protocol);
-                StudyStore store =
-                    StudyStore::create(o.study, p, {o.code, o.site, o.seed, UNDERFOOT_VERSION});
+                StudyStore store = StudyStore::create(
+                    o.study, p, {o.code, o.site, o.seed, underfoot::base::version()});
                 fmt::print("created {} (study {}, protocol {} sha256 {})\n", o.study, o.code, p.id,
                            p.hash);
             });

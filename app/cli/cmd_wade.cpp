@@ -158,7 +158,7 @@ int runLive(const WadeArgs& a, const eng::WadingOptions& o, double seconds) {
     if (receiver) {
         receiver->start();
         fmt::print("gyroscopes: OSC on UDP port {} (/underfoot/gyro/<left|right>_<thigh|shank> "
-                   ",f deg/s [,i sequence]; docs/sensors.md)\n",
+                   ",f deg/s [,i sequence]; docs/reference/sensors.md)\n",
                    receiver->port());
     }
     try {

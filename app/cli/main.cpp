@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The `underfoot` command line: subcommands register themselves (CommandRegistry.h).
 #include "app/cli/CommandRegistry.h"
+#include "base/Version.h"
 #include "engine/dsp/Simd.h"
 
 #include <fmt/core.h>
@@ -16,7 +17,7 @@ int main(int argc, char** argv) {
         return 2;
     }
     CLI::App app{"Underfoot: physically based footsteps and perception experiments"};
-    app.set_version_flag("--version", std::string("underfoot ") + UNDERFOOT_VERSION);
+    app.set_version_flag("--version", std::string("underfoot ") + underfoot::base::versionLine());
     app.require_subcommand(1);
     int exitCode = 0;
     for (auto& entry : underfoot::cli::commandRegistry()) entry.install(app, exitCode);

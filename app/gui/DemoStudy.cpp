@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "app/gui/DemoStudy.h"
+#include "base/Version.h"
 
+#include "base/DataDir.h"
 #include "experiment/Simulation.h"
 #include "experiment/Store.h"
 
@@ -13,7 +15,7 @@ namespace underfoot::gui {
 namespace exp = underfoot::experiment;
 
 QString bundledDataDir() {
-    return QStringLiteral(UNDERFOOT_GUI_DATA_DIR);
+    return QString::fromStdString(base::dataDirectory(base::DataKind::GuiDemo));
 }
 
 QString userDataDir(const QString& overrideDir) {
@@ -44,7 +46,7 @@ QString ensureDemoStudy(const QString& dataDir, int simulated) {
             settings.code = "demo";
             settings.site = "underfoot-gui demo";
             settings.seed = 20111;
-            settings.appVersion = UNDERFOOT_VERSION;
+            settings.appVersion = underfoot::base::version();
             auto store = exp::StudyStore::create(partial.toStdString(), protocol, settings);
             if (simulated > 0) {
                 exp::MatrixByGroup matrices;

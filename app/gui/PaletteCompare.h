@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
-/// The sound palette's "compare with a recording" panel (issue #13): the current settings'
+/// The sound palette's "compare with a recording" panel: the current settings'
 /// render beside chosen reference recordings — a typical step's spectrogram of each (same colour
 /// scale), their band energies, the realism distance of realism/Distance.h with its top
 /// contributing descriptors — recomputed on a worker thread (debounced, stale results dropped)

@@ -49,7 +49,7 @@ QString parameterLabel(const std::string& path) {
         {"hp", "high-pass"},   {"lp", "low-pass"},
         {"bw", "bandwidth"},   {"min", "minimum"},
         {"max", "maximum"},    {"rms", "RMS"},
-        {"lfo", "LFO"}};
+        {"lfo", "LFO"},        {"kn", "kN"}};
     static const char* unitSuffixes[] = {"_hz", "_s",  "_ms", "_kg", "_db",    "_m",
                                          "_n",  "_pa", "_mm", "_cm", "_per_s", "_percent"};
     QStringList parts;

@@ -3,7 +3,9 @@
 #include "app/gui/QtText.h"
 
 #include "analysis/io/TrialCsv.h"
+#include "analysis/ratings/RatingAnalysis.h"
 #include "analysis/report/Export.h"
+#include "analysis/report/MixedModelReport.h"
 #include "app/gui/AudioOutput.h"
 #include "app/gui/Figures.h"
 #include "app/gui/HeatMap.h"
@@ -77,9 +79,29 @@ an::AnalysisReport analyzeStudy(const exp::StudyStore& store) {
             {std::string(an::kDontKnowId), an::labelFor(an::kDontKnowId)});
     }
     auto report = an::analyzeTrials(trials, options);
+    an::addMixedModelComparisons(report, trials, options); // glmer; lmer and clmm for ratings
     report.title = p.title;
     report.source = store.path();
     return report;
+}
+
+an::RatingStudyAnalysis analyzeRatingStudy(const exp::StudyStore& store) {
+    const exp::Protocol& p = store.protocol();
+    an::RatingData data;
+    data.title = p.title;
+    for (const auto& sc : p.questions.scales)
+        data.scales.push_back(
+            {sc.id, sc.prompt, static_cast<double>(sc.min), static_cast<double>(sc.max), {}});
+    for (const auto& st : p.stimuli) data.stimulusOrder.push_back(st.id);
+    for (const auto& person : store.participants())
+        for (const auto& t : store.trials(person.code)) {
+            if (!t.answered || t.excluded || t.practice) continue;
+            for (const auto& [scale, value] : t.answer.ratings)
+                data.ratings.push_back(
+                    {person.code, t.stimulus.id, t.stimulus.factors, scale, double(value)});
+        }
+    if (data.ratings.empty()) return {};
+    return an::analyzeRatingStudy(data);
 }
 
 QString exportStudy(const QString& studyPath, const QString& folder,
@@ -177,7 +199,20 @@ ResultsView::ResultsView(StudyContext& context, QWidget* parent)
                                        tr("Value B"), tr("Result"), tr("Test"), tr("Statistic"),
                                        tr("df"), tr("p"), tr("p (Holm)")});
     tests_->setAccessibleName(tr("Between-group tests"));
-    for (auto* t : {summary_, tests_}) {
+    models_ = new QTableWidget(0, 10, this);
+    models_->setHorizontalHeaderLabels(
+        {tr("Measure / scale"), tr("Surface"), tr("Compared"), tr("Model"), tr("Estimate (SE)"),
+         tr("p (Wald)"), tr("p (LRT)"), tr("Classic p"), tr("Mann-Whitney p"), tr("Warnings")});
+    models_->setAccessibleName(tr("Mixed models and which test to cite"));
+    modelAdvice_ = new QLabel(this);
+    modelAdvice_->setWordWrap(true);
+    modelAdvice_->setTextInteractionFlags(Qt::TextSelectableByMouse);
+    modelAdvice_->setAccessibleName(tr("Which test to cite"));
+    auto* modelsPage = new QWidget(this);
+    auto* ml = new QVBoxLayout(modelsPage);
+    ml->addWidget(modelAdvice_);
+    ml->addWidget(models_, 1);
+    for (auto* t : {summary_, tests_, models_}) {
         t->setEditTriggers(QAbstractItemView::NoEditTriggers);
         t->verticalHeader()->setVisible(false);
         t->horizontalHeader()->setStretchLastSection(true);
@@ -222,6 +257,7 @@ ResultsView::ResultsView(StudyContext& context, QWidget* parent)
     auto* lower = new QTabWidget(this);
     lower->addTab(summary_, tr("Summary"));
     lower->addTab(tests_, tr("Between-group tests"));
+    lower->addTab(modelsPage, tr("Models (which to cite)"));
     lower->addTab(replay, tr("Replay"));
 
     auto* split = new QSplitter(Qt::Vertical, this);
@@ -261,6 +297,10 @@ ResultsView::ResultsView(StudyContext& context, QWidget* parent)
     refresh();
 }
 
+QString ResultsView::modelAdvice() const {
+    return modelAdvice_->text();
+}
+
 QString ResultsView::statusText() const {
     return status_->text();
 }
@@ -273,6 +313,8 @@ void ResultsView::refresh() {
     report_ = {};
     summary_->setRowCount(0);
     tests_->setRowCount(0);
+    models_->setRowCount(0);
+    modelAdvice_->clear();
     const QString previous = group_->currentText();
     group_->blockSignals(true);
     group_->clear();
@@ -340,6 +382,7 @@ void ResultsView::refresh() {
             tests_->setItem(static_cast<int>(i), col, new QTableWidgetItem(cells[col]));
     }
     tests_->resizeColumnsToContents();
+    fillModels();
     showMatrix();
     const QString previousScale = scale_->currentData().toString();
     scale_->blockSignals(true);
@@ -351,6 +394,61 @@ void ResultsView::refresh() {
     scale_->blockSignals(false);
     showRatings();
     fillReplayParticipants();
+}
+
+void ResultsView::fillModels() {
+    const auto warningsText = [](const std::vector<std::string>& warnings) {
+        QStringList w;
+        for (const auto& x : warnings) w << q(x.substr(0, x.find('\n')));
+        return w.join("; ");
+    };
+    const auto addRow = [this](const QStringList& cells) {
+        const int r = models_->rowCount();
+        models_->insertRow(r);
+        for (int c = 0; c < cells.size(); ++c)
+            models_->setItem(r, c, new QTableWidgetItem(cells[c]));
+    };
+    const auto groupLabel = [this](const std::string& id) {
+        return groupLabelOf(context_.store().protocol(), id);
+    };
+    for (const auto& m : report_.mixedModels)
+        addRow({q(an::measureName(m.measure)),
+                m.surfaceId.empty() ? tr("(all)") : surfaceLabel(m.surfaceId),
+                groupLabel(m.groupA) + " vs " + groupLabel(m.groupB), q(m.model),
+                m.error.empty() ? num(m.estimate, 3) + " (" + num(m.se, 3) + ")" : q(m.error),
+                pval(m.p), pval(m.lrtP), pval(m.classicP), pval(m.nonparametricP),
+                warningsText(m.warnings)});
+    QStringList advice;
+    if (!report_.mixedModelAdvice.empty()) advice << q(report_.mixedModelAdvice);
+    if (!context_.store().protocol().questions.asksSurface()) {
+        an::RatingStudyAnalysis ratings;
+        try {
+            ratings = analyzeRatingStudy(context_.store());
+        } catch (const std::exception& e) {
+            advice << q(e.what());
+        }
+        for (const auto& s : ratings.scales) {
+            if (!s.models.fitted) continue;
+            const QString scale = q(s.scale.id);
+            addRow({scale, tr("(all)"), tr("stimuli"),
+                    s.omnibus.conditions.size() >= 3 ? tr("Friedman (cell means)")
+                                                     : tr("Wilcoxon signed-rank (cell means)"),
+                    "", "", pval(s.omnibus.result.p), "", "", q(s.omnibus.result.error)});
+            const auto model = [&](const QString& name, const an::MixedModelResult& r) {
+                addRow({scale, tr("(all)"), tr("stimuli"), name, r.ok() ? QString() : q(r.error),
+                        "", pval(r.lrt.p), "", "", warningsText(r.warnings)});
+            };
+            model(tr("lmer (REML; LRT by ML)"), s.models.lmm);
+            if (s.models.clmmSkipped.empty())
+                model(tr("clmm (Laplace, logit)"), s.models.clmm);
+            else
+                addRow({scale, tr("(all)"), tr("stimuli"), tr("clmm"), "", "", "", "", "",
+                        q(s.models.clmmSkipped)});
+            advice << scale + ": " + q(s.models.advice);
+        }
+    }
+    modelAdvice_->setText(advice.join("\n"));
+    models_->resizeColumnsToContents();
 }
 
 void ResultsView::showMatrix() {

@@ -4,6 +4,7 @@
 /// every committed answer), the per-stimulus summary, the between-group tests, replay of any
 /// trial to a WAV file, and export of every table (CSV, ratings, codebook, report in tidy CSV,
 /// Markdown, HTML, LaTeX) on a worker thread with a progress bar.
+#include "analysis/ratings/RatingAnalysis.h"
 #include "analysis/tables/Tables.h"
 #include "experiment/Store.h"
 
@@ -28,6 +29,10 @@ class AudioOutput;
 /// The analysis of a study's answered trials (the protocol's answer order; by group for
 /// between-subject designs), as `underfoot analyze --study` computes it.
 analysis::AnalysisReport analyzeStudy(const experiment::StudyStore& store);
+
+/// A rating study (no surface question) analysed as `underfoot analyze --form ratings` does,
+/// with the mixed models of every scale; empty without ratings.
+analysis::RatingStudyAnalysis analyzeRatingStudy(const experiment::StudyStore& store);
 
 /// Writes every export of the study at `studyPath` into `folder`; `progress(done, total)` is
 /// called after each file. Returns an empty string or what went wrong.
@@ -63,6 +68,10 @@ class ResultsView : public QWidget {
     void showFigure(int index);
     QTableWidget* summaryTable() const { return summary_; }
     QTableWidget* testsTable() const { return tests_; }
+    /// The mixed models (glmer; lmer and clmm for ratings) and the nonparametric tests beside
+    /// them, one row each, and the sentence on which to cite.
+    QTableWidget* modelsTable() const { return models_; }
+    QString modelAdvice() const;
     QComboBox* groupBox() const { return group_; }
     const analysis::AnalysisReport& report() const { return report_; }
     QString statusText() const;
@@ -73,6 +82,7 @@ class ResultsView : public QWidget {
 
   private:
     void showMatrix();
+    void fillModels();
     void showRatings();
     void chooseFigureFile();
     void chooseExport();
@@ -90,6 +100,8 @@ class ResultsView : public QWidget {
     QTabWidget* figures_;
     QTableWidget* summary_;
     QTableWidget* tests_;
+    QTableWidget* models_;
+    QLabel* modelAdvice_;
     QComboBox* replayParticipant_;
     QSpinBox* replayTrial_;
     QPushButton* exportButton_;

@@ -2,6 +2,7 @@
 #include "app/gui/RunView.h"
 #include "app/gui/Figures.h"
 #include "app/gui/QtText.h"
+#include "base/Version.h"
 
 #include "app/gui/ConsolePlayer.h"
 
@@ -666,7 +667,7 @@ bool RunView::startSession(const QString& code) {
                                .toStdString()
                          : std::string("underfoot-gui without audio output (walker meters only)");
     settings.sensorConfig = console_->sensorConfig();
-    settings.appVersion = UNDERFOOT_VERSION;
+    settings.appVersion = underfoot::base::version();
     try {
         session_ = std::make_unique<exp::Session>(context_.store(), code.toStdString(), *console_,
                                                   settings);

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "app/gui/StudyView.h"
 #include "app/gui/QtText.h"
+#include "base/Version.h"
 
 #include "app/gui/DemoStudy.h"
 #include "app/gui/StudyContext.h"
@@ -263,7 +264,7 @@ bool StudyView::createFromForm() {
     if (settings.code.empty()) settings.code = QFileInfo(file).completeBaseName().toStdString();
     settings.site = site_->text().trimmed().toStdString();
     settings.seed = static_cast<std::uint64_t>(seed_->value());
-    settings.appVersion = UNDERFOOT_VERSION;
+    settings.appVersion = underfoot::base::version();
     const QString error = context_.createStudy(file, protocol, settings);
     if (!error.isEmpty()) {
         showMessage(error, true);

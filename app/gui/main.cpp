@@ -1,14 +1,32 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // underfoot-gui: the experimenter's console.
 #include "app/gui/MainWindow.h"
+#include "base/Version.h"
 #include "engine/dsp/Simd.h"
 
 #include <QApplication>
 #include <QCommandLineParser>
 
 #include <cstdio>
+#include <string_view>
+
+namespace {
+/// --help or --version only print text: they must work without a display (over ssh, in a
+/// package's build, for the man page), so they run on Qt's offscreen platform.
+bool onlyPrintsText(int argc, char** argv) {
+    for (int i = 1; i < argc; ++i) {
+        const std::string_view a = argv[i];
+        if (a == "-h" || a == "--help" || a == "--help-all" || a == "-?" || a == "-v" ||
+            a == "--version")
+            return true;
+    }
+    return false;
+}
+} // namespace
 
 int main(int argc, char** argv) {
+    if (onlyPrintsText(argc, argv) && qEnvironmentVariableIsEmpty("QT_QPA_PLATFORM"))
+        qputenv("QT_QPA_PLATFORM", "offscreen");
     if (!underfoot::engine::simdEnvironmentValid()) {
         std::fprintf(stderr, "underfoot-gui: the environment variable UNDERFOOT_SIMD is set to an "
                              "unknown value; expected sse2 or avx (or unset: the CPU's best)\n");
@@ -17,7 +35,7 @@ int main(int argc, char** argv) {
     QApplication app(argc, argv);
     QApplication::setApplicationName("underfoot");
     QApplication::setOrganizationName("underfoot");
-    QApplication::setApplicationVersion(UNDERFOOT_VERSION);
+    QApplication::setApplicationVersion(underfoot::base::versionLine());
     QCommandLineParser parser;
     parser.setApplicationDescription("Underfoot — the experimenter's console");
     parser.addHelpOption();

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "app/web/WebStudy.h"
+#include "base/Version.h"
 
 #include <fmt/format.h>
 
@@ -182,7 +183,7 @@ Session* WebStudy::session(const Invitation& inv) {
     settings.experimenter = "online";
     settings.audioConfig = "browser";
     settings.sensorConfig = "none";
-    settings.appVersion = UNDERFOOT_VERSION;
+    settings.appVersion = underfoot::base::version();
     std::unique_ptr<Session> s;
     try {
         s = std::make_unique<Session>(store_, code, player_, settings);

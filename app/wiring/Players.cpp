@@ -344,7 +344,8 @@ void LivePlayer::stop() {
     const auto writeMeters = [&](const std::string& recording) {
         std::ofstream side(recording + ".meters.toml");
         side << fmt::format(
-            "# Measured by the live engine while this trial played (docs/live.md)\n"
+            "# Measured by the live engine while this trial played "
+            "(docs/explanation/live-audio.md)\n"
             "scene = \"{}\"\nsample_rate = {}\nblock_size = {}\nframes = {}\nxruns = {}\n"
             "average_load_percent = {:.3f}\n"
             "max_load_percent = {:.3f}\nmax_block_ms = {:.4f}\ndropped_grf_frames = {}\n",

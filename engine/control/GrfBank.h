@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
-/// A bank of heel and toe GRFs for sensor-triggered playback (haptic shoes, STUDIES.md §3: when a
-/// heel or toe pressure sensor fires, one of five recorded heel or toe GRFs is played).
+/// A bank of heel and toe GRFs for sensor-triggered playback (the haptic shoes of Turchet et al.
+/// 2010: when a heel or toe pressure sensor fires, one of five recorded heel or toe GRFs is
+/// played).
 ///
 /// Made from single stances of the VirtualWalker: the vertical force of a stance is split between
 /// heel and forefoot by the progression of the centre of pressure, w_heel(s) = 1 up to 30 % of

@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 /// Reusable control blocks for gyroscope (angular-velocity) data, after the wading chain of the
-/// gait sonification paper (STUDIES.md §4, seed 004, §3.3 and §6.1). Each block processes one
-/// control sample at a time at the sensor frame rate (100 Hz in the paper); all are noexcept and
-/// allocation-free after prepare().
+/// gait sonification paper (the wading study, §3.3 and §6.1; docs/explanation/studies.md). Each
+/// block processes one control sample at a time at the sensor frame rate (100 Hz in the paper); all
+/// are noexcept and allocation-free after prepare().
 ///
 ///  - GyroLowpass: 2nd-order Butterworth low-pass (RBJ biquad, Q = 1/sqrt(2); the paper quotes
 ///    "Q-factor of 0.7") at 5 Hz or 0.8 Hz, with an optional make-up gain (the 0.8 Hz variant

@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
-/// Angular-velocity readings of the legs (STUDIES.md §4): the common currency between the
-/// gyroscope inputs (OSC receiver, recorded gait files, the virtual gait) and the controls that
-/// use them (the wading simulation). Sagittal-plane angular velocity in degrees per second,
-/// positive when the limb swings forward.
+/// Angular-velocity readings of the legs (the wading study; docs/explanation/studies.md): the
+/// common currency between the gyroscope inputs (OSC receiver, recorded gait files, the virtual
+/// gait) and the controls that use them (the wading simulation). Sagittal-plane angular velocity in
+/// degrees per second, positive when the limb swings forward.
 #include <array>
 #include <cstddef>
 #include <cstdint>

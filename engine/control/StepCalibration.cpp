@@ -158,7 +158,7 @@ void saveStepThresholds(const std::string& path, const StepThresholds& t,
     }
     std::ofstream out(path);
     if (!out) throw std::runtime_error(fmt::format("{}: cannot open for writing", path));
-    out << "# Step-detection thresholds (underfoot sensors calibrate; docs/sensors.md)\n"
+    out << "# Step-detection thresholds (underfoot sensors calibrate; docs/reference/sensors.md)\n"
         << "# levels in raw ADC units 0..1023, derivatives in units per second\n"
         << root << "\n";
     if (!out) throw std::runtime_error(fmt::format("{}: write failed", path));

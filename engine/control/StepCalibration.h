@@ -1,10 +1,10 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
-/// Per-participant calibration of the step detector (STUDIES.md §3: "thresholds are calibrated
-/// per participant weight"). From a short recording of the participant walking (and standing),
-/// each heel/toe sensor's rest level, step peak level, derivative noise at rest and the
+/// Per-participant calibration of the step detector (Turchet et al. 2010: "thresholds are
+/// calibrated per participant weight"). From a short recording of the participant walking (and
+/// standing), each heel/toe sensor's rest level, step peak level, derivative noise at rest and the
 /// derivative peaks of its foot strikes are measured, and thresholds are proposed
-/// (docs/sensors.md, "Calibration"):
+/// (docs/reference/sensors.md, "Step thresholds file"):
 ///   rest  = 5th percentile of the pressure, peak = 99th percentile, range = peak - rest
 ///   strikes = rises from below rest + 0.2 range to above rest + 0.5 range; each strike's
 ///             derivative peak is taken over the rise

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
-/// Step detection from the FSR shoes (STUDIES.md §3; Turchet et al. 2010, "Audio-haptic
+/// Step detection from the FSR shoes (Turchet et al. 2010, "Audio-haptic
 /// physically based simulation of walking on different grounds", §V): the first time-derivative
 /// of each heel/toe pressure is watched and, when it rises above a calibrated threshold
 /// (positive changes only: foot strike, not lift-off), a step event fires for that sensor.

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "engine/control/StepGrfPlayer.h"
 
+#include "base/DataDir.h"
 #include "engine/io/AudioFile.h"
 
 #include <fmt/core.h>
@@ -73,7 +74,7 @@ GrfBank StepGrfPlayer::loadBank(const std::string& directory, double sampleRateH
 }
 
 GrfBank StepGrfPlayer::loadDefaultBank(double sampleRateHz) {
-    return loadBank(std::string(UNDERFOOT_ENGINE_DATA_DIR) + "/grf", sampleRateHz);
+    return loadBank(base::dataDirectory(base::DataKind::GrfBank), sampleRateHz);
 }
 
 bool StepGrfPlayer::pushStep(const StepEvent& step) noexcept {

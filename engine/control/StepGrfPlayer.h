@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
-/// Plays a random heel or toe GRF from a bank at each detected step (STUDIES.md §3: five heel
+/// Plays a random heel or toe GRF from a bank at each detected step (Turchet et al. 2010: five heel
 /// and five toe GRFs, picked at random per step, 25 combinations): the control source of a live
 /// scene driven by the FSR shoes.
 ///

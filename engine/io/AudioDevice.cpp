@@ -277,7 +277,7 @@ AudioSettings loadAudioSettings(const std::string& path) {
     const std::string text = ss.str();
     AudioSettings settings = parseAudioSettings(text, path);
     // An empty or truncated file is refused rather than silently read as the defaults
-    // (issue #16): the file `underfoot devices --save` writes always has an [audio] table.
+    //: the file `underfoot devices --save` writes always has an [audio] table.
     const toml::table root = toml::parse(text, path);
     const toml::table* audio = root["audio"].as_table();
     if (!audio || audio->empty())
@@ -299,7 +299,8 @@ std::string audioSettingsToToml(const AudioSettings& s) {
         }
         return out + "\"";
     };
-    std::string t = "# Underfoot audio settings (docs/live.md). Channel numbers start at 1.\n";
+    std::string t =
+        "# Underfoot audio settings (docs/reference/settings.md). Channel numbers start at 1.\n";
     t += "[audio]\n";
     t += fmt::format("api = {}\n", q(s.api));
     t += fmt::format("device = {}\n", q(s.device));

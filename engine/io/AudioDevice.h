@@ -4,9 +4,9 @@
 /// audio settings: API, device, rate, block size and the channel map that routes headphones,
 /// haptic actuators (per shoe, heel / toe) and microphones to device channels.
 ///
-/// Settings file (TOML, written by `underfoot devices --save`, documented in docs/live.md).
-/// Channel numbers in the file are 1-based, as printed on sound cards and in `underfoot devices`;
-/// in AudioSettings they are 0-based.
+/// Settings file (TOML, written by `underfoot devices --save`, documented in
+/// docs/reference/settings.md). Channel numbers in the file are 1-based, as printed on sound cards
+/// and in `underfoot devices`; in AudioSettings they are 0-based.
 ///
 ///     [audio]
 ///     api = "jack"            # jack, alsa, pulse, oss, dummy, or "" (first that works)

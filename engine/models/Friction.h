@@ -17,7 +17,7 @@
 /// bristle state is integrated with backward Euler (alpha taken at z_n), which is unconditionally
 /// stable — the forward Euler of the Sound Design Toolkit blows up for sigma0 above ~5e7. The
 /// relative velocity at n+1 follows in closed form once the plastic rate p = alpha v / z_ss is
-/// fixed (a "plain pass"); the solution is the fixed point of p. Shipped (issue #18, perf5):
+/// fixed (a "plain pass"); the solution is the fixed point of p. Shipped :
 /// safeguarded Newton on p with the analytic derivatives of the Stribeck curve and the raised
 /// sine, warm-started from the last three samples' p and kept in a bracket (bisection or a plain
 /// pass when a step leaves it); it stops when a step moved v and z by at most
@@ -64,7 +64,7 @@ struct FrictionParams {
     /// of the step squared, so the solution returned (the pass at the new p) is far closer than
     /// the step: on the creak, a step of at most 1e-3 leaves a plain-pass residual of at most
     /// 3e-7 (a few float ulps of the output) and the creak within 0.001 dB of the 50-pass
-    /// reference, in 1.08 evaluations a sample instead of 1.99 (issue #18). 0: stop only on
+    /// reference, in 1.08 evaluations a sample instead of 1.99. 0: stop only on
     /// `tolerance` (the tight solve; residual < 1e-15 on the creak).
     double newtonStepTolerance = 1e-3;
     /// true: the first trial is the previous sample's relative velocity; false: the prediction
@@ -86,7 +86,7 @@ struct FrictionParams {
     bool libmFunctions = false;
 };
 
-// Bounded-error replacements of the two libm calls of the fixed point (issue #18: ~200
+// Bounded-error replacements of the two libm calls of the fixed point (~200
 // instructions a sample in libm). Plain double arithmetic without FMA: the same values on every
 // x86-64 machine. Errors measured by test FrictionFunctions.ErrorsStayWithinTheirStatedBounds.
 

@@ -3,8 +3,9 @@
 /// Hunt–Crossley impact between an inertial exciter (the sole, a point mass) and a modal
 /// resonator (the floor).
 ///
-/// Physics (Hunt & Crossley 1975; Avanzini & Rocchesso, DAFx 2001; MODELS.md): with compression
-/// c = x_exciter - x_floor (positive when the bodies interpenetrate) and its rate c',
+/// Physics (Hunt & Crossley 1975; Avanzini & Rocchesso, DAFx 2001; docs/explanation/models.md):
+/// with compression c = x_exciter - x_floor (positive when the bodies interpenetrate) and its
+/// rate c',
 ///     F = k c^alpha (1 + mu c')   for c > 0,   else 0,
 /// clamped at F >= 0 (the contact never pulls, Marhefka & Orin 1999). mu = lambda / k is the
 /// dissipation in s/m: restitution for a rigid floor is e ~ 1 - (2/3)... falls with mu v_in.
@@ -42,7 +43,7 @@ struct ImpactParams {
     /// 1, 2, 4, 8 or 16: a sample in which the bodies touch is computed as this many sub-steps
     /// (the exact modal discretisation at the finer step, the force linear in each sub-step);
     /// samples of free flight stay single steps. A contact lasts ~10-20 samples per strike, so
-    /// this costs ~1 % while matching the 8x oversampled reference (issue #18): with 4, the
+    /// this costs ~1 % while matching the 8x oversampled reference: with 4, the
     /// bench strike's restitution is 0.5585 against the reference's 0.5583 and its spectrum is
     /// 0.02 dB from it (8 sub-steps: 0.5583, 0.01 dB, at twice the cost of a strike's samples).
     int contactSubsteps = 4;

@@ -2,8 +2,8 @@
 #pragma once
 /// Modal resonator: a bank of damped oscillators seen through "pickup" points.
 ///
-/// Physics (MODELS.md; Adrien 1991; Avanzini & Rocchesso, DAFx 2001): mode i has modal
-/// coordinate q_i obeying  m_i (q_i'' + 2 s_i q_i' + w0_i^2 q_i) = sum_p g[p][i] F_p,  where
+/// Physics (docs/explanation/models.md; Adrien 1991; Avanzini & Rocchesso, DAFx 2001): mode i has
+/// modal coordinate q_i obeying  m_i (q_i'' + 2 s_i q_i' + w0_i^2 q_i) = sum_p g[p][i] F_p,  where
 /// s_i = ln(1000) / T60_i and w0_i^2 = (2 pi f_i)^2 + s_i^2, so that the free response is
 /// exp(-s_i t) sin(2 pi f_i t): it rings at exactly f_i and decays by 60 dB in exactly T60_i.
 /// The displacement at pickup p is x_p = sum_i g[p][i] q_i.

@@ -310,7 +310,7 @@ ImpactParams scenarioImpact() {
     return p;
 }
 
-// Metal preset (engine/data/surfaces/metal.toml at the time of issue #18): 14 modes.
+// Metal preset (engine/data/surfaces/metal.toml when the cost table was measured): 14 modes.
 const std::vector<Mode>& metalModes() {
     static const std::vector<Mode> m = {
         {187, 0.235173, 8.0},   {467, 0.205776, 4.0},   {748, 0.17638, 3.0},
@@ -413,7 +413,7 @@ const std::vector<std::string>& scenarioIds() {
 }
 
 void configureCreakScenario(ElastoPlasticFriction& f, FrictionParams p) {
-    // The creaking-wood friction layer as it was when issue #18 was measured
+    // The creaking-wood friction layer as it was when the cost table was measured
     // (engine/data/surfaces/creaking_wood.toml before its creak was re-voiced on 28 Nov 2026:
     // sigma3 0.05, top modes 1130/1870/2650 Hz). A fixed benchmark of the solver: it stays as it
     // is so that its figures stay comparable with the Sound Design Toolkit's.

@@ -64,7 +64,7 @@ double spectralDistanceDb(const std::vector<float>& a, const std::vector<float>&
 /// 50-pass reference.
 std::vector<KnobMeasurement> measureKnobs(double seconds = 4.0);
 
-/// The six model scenarios of issue #18, each the model alone at 48 kHz in 64-sample blocks
+/// The six model scenarios of the cost table, each the model alone at 48 kHz in 64-sample blocks
 /// (parameters in docs/performance.md, mapped there onto the Sound Design Toolkit's API):
 ///   impact-strikes  3 modes (the bench impact), a 0.5 m/s strike every 0.25 s;
 ///   impact-pressed  the same with 300 N pressing the sole: the contact never opens;
@@ -95,7 +95,7 @@ struct ScenarioMeasurement {
 /// std::invalid_argument for an unknown id.
 ScenarioMeasurement measureScenario(const std::string& id, double seconds, int repeats = 5);
 
-/// How the cost grows (issue #18): ns per output sample against simultaneous impact voices
+/// How the cost grows: ns per output sample against simultaneous impact voices
 /// (1..256, the impact-strikes voice, strikes staggered), modes per voice (3..64, one voice) and
 /// grain events per second (250..16000, the aggregate-gravel layer). `perUnit` divides by the
 /// voices, the modes or the thousands of events per second.

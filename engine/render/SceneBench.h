@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 /// One way of timing the footstep scenes, used by `underfoot bench --only surfaces|scenes` and by
-/// tests/bench/bench_reverb (issue #18), so that the two report the same figures.
+/// tests/bench/bench_reverb, so that the two report the same figures.
 ///
 /// Method: the same deterministic input runs `repeats` times, the scene reset to the same seed
 /// before each repeat (voices AND reverb: every block does the same work in every repeat), in
@@ -12,7 +12,7 @@
 ///    (steady clock around each block): a shared machine only ever slows a block down, so the
 ///    minimum is the block's own cost. Their mean ("per-block minima") is reported too: it is a
 ///    lower bound of the cost (it keeps, for every block, its luckiest repeat) and must not be
-///    read as the real-time factor (issue #18: that was the 2x between the two harnesses).
+///    read as the real-time factor (that was the 2x between the two harnesses).
 #include "engine/control/GrfFile.h"
 #include "engine/render/FootstepScene.h"
 
@@ -83,7 +83,7 @@ SceneBenchResult measureScene(const SceneBenchSpec& spec);
 
 /// The scene of `spec` with its walker input, built and prepared at 48 kHz / 64 frames: the work
 /// measureScene times, one 64-frame block at a time. `underfoot bench --only scene-instructions`
-/// runs it block by block under callgrind to count each block's instructions (issue #18).
+/// runs it block by block under callgrind to count each block's instructions.
 class SceneBlocks {
   public:
     /// Throws as FootstepScene::build does, std::invalid_argument for voices outside 1..2.

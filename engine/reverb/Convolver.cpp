@@ -599,7 +599,7 @@ struct Convolver::Stage {
     void schedule() {
         const int slices = slack ? P / kTick : 1;
         // Estimated cost in ns, fitted to every item timed alone on this machine's AMD EPYC (Zen
-        // 3, AVX; FFTW_ESTIMATE plans; issue #18, 28 Nov 2026): e.g. on the hall, 2048 stage, a
+        // 3, AVX; FFTW_ESTIMATE plans): e.g. on the hall, 2048 stage, a
         // run of the 49 older partitions over 96 bins ~3.4 us, the newest partition over all bins
         // ~3.5 us (a run of one partition pays the accumulators' load and store per bin), a group
         // of 8 strided 64-point DFTs 0.7-1.0 us. Only the relative costs matter: they decide

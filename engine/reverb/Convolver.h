@@ -19,7 +19,7 @@
 ///    the whole next period. It is cut into P / 64 slices (a schedule fixed in prepare() by
 ///    estimated cost; order: the products of the older spectra, the forward FFT, the newest
 ///    product, the inverse FFTs), and one slice runs every 64 input samples.
-///  - In stages with P >= 1024 no piece of that work is large against a slice (issue #18: worst
+///  - In stages with P >= 1024 no piece of that work is large against a slice (worst
 ///    64-frame block <= 2x the median on short IRs too): the 2P-point FFTs are complex
 ///    "four-step" FFTs (Bailey 1990: 2P / 64 DFTs of 64 points, twiddles, 64 DFTs of 2P / 64
 ///    points; FFTW plans of a few DFTs each, run one group per piece), both output channels share
@@ -28,7 +28,7 @@
 ///  - The spectra are stored in records of 8 bins (per record: a partition's or input slot's 8
 ///    real parts, then 8 imaginary parts), so that a product over all of a stage's older
 ///    partitions reads its bins contiguously and keeps its sums in registers; its work is cut by
-///    bin ranges (issue #18: hall 789 -> 672 instructions a sample, the same output).
+///    bin ranges (hall 789 -> 672 instructions a sample, the same output).
 /// Work is tied to the count of input samples only (a "tick" every 64 samples), never to the
 /// host block: the output is bit-identical for every block size (replay relies on it).
 /// FFTs: FFTW single precision, FFTW_ESTIMATE plans (deterministic; planned under a lock).

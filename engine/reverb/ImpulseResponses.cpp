@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "engine/reverb/ImpulseResponses.h"
 
+#include "base/DataDir.h"
 #include "engine/io/AudioFile.h"
 
 #include <fmt/format.h>
@@ -13,7 +14,7 @@ namespace underfoot::engine {
 namespace fs = std::filesystem;
 
 std::string impulseResponseDirectory() {
-    return std::string(UNDERFOOT_ENGINE_DATA_DIR) + "/ir";
+    return base::dataDirectory(base::DataKind::ImpulseResponses);
 }
 
 std::vector<std::string> availableImpulseResponses() {

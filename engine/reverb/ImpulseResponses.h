@@ -6,7 +6,7 @@
 
 namespace underfoot::engine {
 
-/// Folder of the shipped IRs: UNDERFOOT_ENGINE_DATA_DIR "/ir".
+/// Folder of the shipped IRs ($UNDERFOOT_IR_DIR, else as base::dataDirectory finds it).
 std::string impulseResponseDirectory();
 
 /// Names (file stems) of the .wav files in the IR folder, sorted.

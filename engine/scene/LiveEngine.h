@@ -3,7 +3,7 @@
 /// The live engine: owns the audio stream (RtAudio, duplex, planar float) and runs the current
 /// LiveScene in its callback.
 ///
-/// Threads (docs/live.md):
+/// Threads (docs/explanation/live-audio.md):
 ///  - main thread: open / start / stop, builds scenes (LiveScene::create) and submit()s them,
 ///    reads meters(), releases retired scenes (collectRetired(), also done by submit and stop);
 ///  - audio thread: the callback. It takes commands from an SPSC queue (scene swaps, fade-outs,

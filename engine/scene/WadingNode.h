@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
-/// The live scene's wading node (STUDIES.md §4, docs/wading.md "Live"): a WadingScene fed by a
+/// The live scene's wading node (the wading study; docs/wading.md "Live"): a WadingScene fed by a
 /// gait source on the audio thread. It replaces the GRF control and the surface voices when a
 /// stimulus walks through water (surface "water").
 ///
@@ -18,7 +18,7 @@
 /// thread writes with writeGaitCsv() after the trial, so that `underfoot wade --gait` re-renders
 /// it. Each frame is also recorded with the sample (counted from the node's reset) at which it
 /// took effect; writeArrivals() saves those as a gait arrivals file from which
-/// renderWadingArrivals() reproduces the node's output exactly (issue #17, `underfoot replay`).
+/// renderWadingArrivals() reproduces the node's output exactly (`underfoot replay`).
 #include "engine/dsp/ProcessSpec.h"
 #include "engine/io/AudioFile.h"
 #include "engine/render/SafetyLimiter.h"

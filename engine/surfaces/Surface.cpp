@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "engine/surfaces/Surface.h"
 
+#include "base/DataDir.h"
 #include "engine/dsp/Random.h"
 
 #include <fmt/core.h>
@@ -26,8 +27,7 @@ const char* toString(SurfaceCategory c) noexcept {
 }
 
 std::string surfacesDirectory() {
-    if (const char* env = std::getenv("UNDERFOOT_SURFACES_DIR")) return env;
-    return std::string(UNDERFOOT_ENGINE_DATA_DIR) + "/surfaces";
+    return base::dataDirectory(base::DataKind::Surfaces);
 }
 
 namespace {

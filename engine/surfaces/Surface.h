@@ -75,7 +75,8 @@ class Surface {
     std::vector<ParamInfo> params_;
 };
 
-/// Folder holding the bundled surface presets.
+/// Folder holding the bundled surface presets ($UNDERFOOT_SURFACES_DIR, else as
+/// base::dataDirectory finds it).
 std::string surfacesDirectory();
 /// All bundled surfaces, sorted by id (loads each preset's header; throws on a broken preset).
 std::vector<SurfaceInfo> listSurfaces();

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "engine/wading/WadingScene.h"
 
+#include "base/DataDir.h"
 #include "engine/dsp/Denormals.h"
 #include "engine/dsp/ProcessSpec.h"
 #include "engine/io/AudioFile.h"
@@ -27,8 +28,7 @@ constexpr int kChunk = WadingScene::kChunkSamples; // control/EQ update granular
 // Presets
 
 std::string wadingPresetDirectory() {
-    if (const char* env = std::getenv("UNDERFOOT_WADING_DIR")) return env;
-    return std::string(UNDERFOOT_ENGINE_DATA_DIR) + "/wading";
+    return base::dataDirectory(base::DataKind::WadingPresets);
 }
 
 WadingPreset parseWadingPreset(const std::string& text, const std::string& file) {

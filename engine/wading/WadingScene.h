@@ -77,8 +77,8 @@ struct WadingPreset {
     std::vector<ParamInfo> params; ///< every parameter read, with unit and range
 };
 
-/// Folder of the shipped depth presets: UNDERFOOT_ENGINE_DATA_DIR "/wading" (or
-/// $UNDERFOOT_WADING_DIR).
+/// Folder of the shipped depth presets ($UNDERFOOT_WADING_DIR, else as base::dataDirectory
+/// finds it).
 std::string wadingPresetDirectory();
 /// Loads "shallow", "deep" (from the folder) or a path to a .toml file. Throws PresetError
 /// naming file:line:column and what was expected.

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// `underfoot analyze` with the mixed models beside the between-group comparisons (issue #15):
+// `underfoot analyze` with the mixed models beside the between-group comparisons:
 // the rows are the models of MixedModels.h (checked against R in MixedModelsTest.cpp) fitted on
 // the trials the tables use, and every export format carries them with the advice sentence.
 #include "analysis/report/MixedModelReport.h"
@@ -62,8 +62,13 @@ TEST(MixedModelReport, OneModelBesideEveryComparisonPlusThePooledOne) {
     AnalysisOptions o;
     const auto report = analysed(ts, o);
     ASSERT_FALSE(report.mixedModels.empty());
-    std::size_t perSurface = 0, pooled = 0;
+    std::size_t perSurface = 0, pooled = 0, ordinal = 0;
     for (const auto& m : report.mixedModels) {
+        if (m.model.rfind("clmm", 0) == 0) { // beside each lmer row of a rating
+            ++ordinal;
+            EXPECT_NE(m.measure, Measure::Correct);
+            EXPECT_FALSE(std::isnan(m.nonparametricP)); // the Mann-Whitney p beside it
+        }
         EXPECT_TRUE(m.error.empty()) << m.error;
         EXPECT_EQ(m.groupA, "none");
         EXPECT_EQ(m.groupB, "coherent");
@@ -75,11 +80,17 @@ TEST(MixedModelReport, OneModelBesideEveryComparisonPlusThePooledOne) {
         }
         EXPECT_FALSE(std::isnan(m.lrtP));
     }
-    std::size_t classic = 0;
-    for (const auto& c : report.comparisons)
+    std::size_t classic = 0, ratings = 0;
+    for (const auto& c : report.comparisons) {
         if (c.measure != Measure::DontKnow) ++classic;
-    EXPECT_EQ(perSurface, classic);
-    EXPECT_EQ(pooled, 3u); // correct, realism, quality over all surfaces
+        if (c.measure == Measure::Realism || c.measure == Measure::Quality) ++ratings;
+    }
+    // one glmer row per identification comparison, an lmer and a clmm row per rating one
+    EXPECT_EQ(perSurface, classic + ratings);
+    EXPECT_EQ(pooled, 5u); // correct; realism and quality by lmer and clmm, over all surfaces
+    EXPECT_EQ(ordinal, ratings + 2);
+    EXPECT_NE(report.mixedModelAdvice.find("cite the cumulative link mixed model"),
+              std::string::npos);
     EXPECT_NE(report.mixedModelAdvice.find("Which test to cite: the mixed models"),
               std::string::npos);
     EXPECT_NE(report.mixedModelAdvice.find("up to 2 answers per surface"), std::string::npos);

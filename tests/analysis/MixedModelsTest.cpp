@@ -5,7 +5,7 @@
 //   Rscript tests/analysis/data/mixed_models_reference.R >
 //   tests/analysis/data/mixed_models_reference.json
 // (R 4.2.2, lme4 and lmerTest from Debian 12; versions recorded in the file).
-// Tolerances (issue #15): relative 1e-4 on estimates, standard errors, variances, log-likelihoods
+// Tolerances: relative 1e-4 on estimates, standard errors, variances, log-likelihoods
 // and statistics; relative 1e-3 on p-values and Satterthwaite df.
 #include "analysis/stats/MixedModels.h"
 #include "analysis/io/StatsJsonMixed.h"

@@ -136,6 +136,7 @@ TEST(Power, RatingPowerReducesToThePairedTTest) {
     o.simulations = 1500;
     o.seed = 11;
     o.confLevel = 0.999;
+    o.ordinalModel = false; // continuous ratings: no categories for the clmm
     o.participantsPerGroup.clear();
     for (const auto& [n, exact] : cases) o.participantsPerGroup.push_back(n);
     const auto curve = simulateRatingPower(pairedRatings(0.6, 1.0, 1.0, 1), o);
@@ -164,4 +165,50 @@ TEST(Power, RatingPowerOfRepeatedRatingsGrowsWithParticipants) {
     EXPECT_LT(curve.points[1].mixed.power, curve.points[0].mixed.power);
     EXPECT_GT(curve.points[0].mixed.power, 0.8);
     EXPECT_EQ(curve.smallestMixed, 30);
+}
+
+namespace {
+
+/// Ratings 1..7 of a latent logistic variable (participant intercept SD 1) cut at 1.5, 2.5,
+/// ..., 6.5 around 4: a proportional-odds model with log odds ratio `logOr` for condition 1.
+RatingStudySimulator ordinalRatings(double logOr, int ratings) {
+    return [=](int participants, std::uint64_t seed) {
+        std::mt19937_64 rng(seed);
+        std::normal_distribution<double> normal;
+        std::uniform_real_distribution<double> uniform(1e-12, 1.0 - 1e-12);
+        std::vector<SimulatedRating> out;
+        for (int i = 0; i < participants; ++i) {
+            const double bias = normal(rng);
+            for (int c = 0; c < 2; ++c)
+                for (int k = 0; k < ratings; ++k) {
+                    const double u = uniform(rng);
+                    const double latent =
+                        4.0 + bias + (c == 1 ? logOr : 0.0) + std::log(u / (1 - u));
+                    out.push_back({i, c, std::clamp(std::round(latent), 1.0, 7.0)});
+                }
+        }
+        return out;
+    };
+}
+
+} // namespace
+
+TEST(Power, OrdinalRatingPowerHoldsItsLevelAndGrowsWithParticipants) {
+    PowerOptions o;
+    o.participantsPerGroup = {24};
+    o.simulations = 300;
+    o.seed = 7;
+    o.confLevel = 0.999;
+    const auto null = simulateRatingPower(ordinalRatings(0.0, 3), o);
+    ASSERT_TRUE(null.ordinal);
+    // no effect: the clmm's LRT rejects at its level (Monte-Carlo interval covers 0.05)
+    EXPECT_LE(null.points[0].ordinal.clopperPearson.lower, 0.05);
+    EXPECT_GE(null.points[0].ordinal.clopperPearson.upper, 0.05);
+    EXPECT_EQ(null.points[0].ordinalFailures, 0);
+    o.participantsPerGroup = {6, 24};
+    o.simulations = 150;
+    const auto curve = simulateRatingPower(ordinalRatings(1.0, 3), o);
+    EXPECT_LT(curve.points[0].ordinal.power, curve.points[1].ordinal.power);
+    EXPECT_GT(curve.points[1].ordinal.power, 0.8);
+    EXPECT_EQ(curve.smallestOrdinal, 24);
 }

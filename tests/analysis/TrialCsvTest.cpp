@@ -77,7 +77,7 @@ TEST(TrialCsv, ReadsTheExportFormatByHeaderName) {
     EXPECT_FALSE(u.recordedSoundscapeCorrect.has_value());
     EXPECT_TRUE(u.excluded);
     EXPECT_EQ(u.exclusionReason, "noise");
-    EXPECT_TRUE(t.simulated); // the `simulated` column (issue #17)
+    EXPECT_TRUE(t.simulated); // the `simulated` column
     EXPECT_FALSE(u.simulated);
 }
 

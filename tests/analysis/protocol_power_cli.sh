@@ -29,6 +29,41 @@ for protocol in "$src"/protocols/*.toml; do
 done
 [ "$count" -ge 6 ] || { echo "FAIL: only $count protocols found in $src/protocols"; fail=1; }
 
+# rating protocols: the clmm's power beside the t-test's and lmer's
+out=$(timeout 300 "$underfoot" protocol power "$src/protocols/wading_listening.toml" --participants 6,12 \
+      --simulations 6 --seed 3 --threads 1 --difference 1.5 2>/dev/null)
+if ! echo "$out" | grep -q '^ordinal: clmm' || ! echo "$out" | grep -q '; ordinal model ' ||
+   ! echo "$out" | grep -q 'effect: 1.5 points'; then
+    echo "FAIL: wading_listening --difference: no clmm column or effect line"; echo "$out"; fail=1
+else
+    echo "ok rating power with the clmm"
+fi
+out=$(timeout 300 "$underfoot" protocol power "$src/protocols/wading_realism.toml" --participants 6 \
+      --simulations 4 --seed 3 --threads 1 --odds-ratio 3 2>/dev/null)
+if ! echo "$out" | grep -q 'effect: odds ratio 3 of a higher rating = 0.787 points'; then
+    echo "FAIL: wading_realism --odds-ratio: no effect line"; echo "$out"; fail=1
+else
+    echo "ok rating power with an odds ratio"
+fi
+# the effect of a within-participant factor on identification, as an odds ratio
+coherence="$src/tests/analysis/data/coherence_within.toml"
+out=$(timeout 300 "$underfoot" protocol power "$coherence" --factor coherence --odds-ratio 0.5 \
+      --baseline-correct 0.7 --participants 6,12 --simulations 6 --seed 3 --threads 1 2>/dev/null)
+rows=$(echo "$out" | grep -cE '^ +(6|12)  +[01]\.[0-9]{3} ')
+if [ "$rows" != 2 ] || ! echo "$out" | grep -q 'coherence coherent vs incoherent within'; then
+    echo "FAIL: coherence odds ratio: expected 2 power rows"; echo "$out"; fail=1
+else
+    echo "ok coherence odds ratio"
+fi
+# the published matrices: found where the protocol names them, or in --published-dir
+out=$(timeout 300 "$underfoot" protocol power "$src/protocols/tvcg2011_exp2.toml" --participants 6 \
+      --simulations 4 --threads 1 --published-dir "$src/protocols/data" 2>/dev/null)
+if ! echo "$out" | grep -qE '^ +6  +[01]\.[0-9]{3} '; then
+    echo "FAIL: --published-dir"; echo "$out"; fail=1
+else
+    echo "ok --published-dir"
+fi
+
 # refusals: a clear message, non-zero status, no crash
 expect_error() {
     local pattern=$1; shift
@@ -47,4 +82,9 @@ expect_error "not a scale of protocol wading_listening" "$src/protocols/wading_l
 expect_error "no stimulus has this factor" "$src/protocols/wading_realism.toml" --factor depth
 expect_error "within-subject" "$src/protocols/tvcg2011_exp1.toml" --groups a,b
 expect_error "rates within participants" "$src/protocols/wading_interactive.toml" --groups order1
+expect_error "as an odds ratio" "$src/tests/analysis/data/coherence_within.toml"
+expect_error "not a level of coherence" "$src/tests/analysis/data/coherence_within.toml" --factor coherence --levels coherent,neutral --odds-ratio 2
+expect_error "no stimulus of protocol" "$src/tests/analysis/data/coherence_within.toml" --factor depth --odds-ratio 2
+expect_error "give the effect on identification as --odds-ratio" "$src/protocols/tvcg2011_exp1.toml" --difference 1
+expect_error "cannot open\|No such\|not found\|cannot read" "$src/protocols/tvcg2011_exp2.toml" --published-dir /nonexistent
 exit $fail

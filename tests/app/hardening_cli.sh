@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue #16 regressions through the `underfoot` program: each input used to crash, hang or
+# Regressions through the `underfoot` program: each input used to crash, hang or
 # allocate without bound; each must now end normally or be refused with a message naming the
 # input. Usage: hardening_cli.sh <underfoot> <source dir> <work dir>
 set -uo pipefail

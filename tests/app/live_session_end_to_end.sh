@@ -89,7 +89,7 @@ test "$(echo "$row" | cut -d, -f18)" = "1"
 log=$(echo "$row" | cut -d, -f17)
 test -n "$log" && test -s "$log"
 
-# 3. `clips --live` plays the listening-test clips through the device (issue #17).
+# 3. `clips --live` plays the listening-test clips through the device.
 printf '[protocol]\nid = "cl"\nversion = 1\ntitle = "c"\n[design]\ntype = "within"\n[input]\ntype = "walker"\n[clips]\nseconds = 0.5\n[[stimuli]]\nid = "GL"\nsurface = "gravel"\n[[stimuli]]\nid = "WD"\nsurface = "wood"\n[[questions.scales]]\nid = "realism"\nprompt = "R"\nmin = 1\nmax = 7\n' > cl.toml
 "$underfoot" clips --protocol cl.toml -o clips --live --settings audio.toml > clips.txt 2>&1 ||
   { cat clips.txt; exit 1; }

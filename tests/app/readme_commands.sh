@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
-# Runs every command shown in a fenced ```sh block of README.md, docs/*.md and protocols/README.md
-# on the bundled data, in order, one scratch folder per document (so a document's commands see
-# each other's files). Under the sanitizer build this makes every documented command a memory
-# check (issue #16). Commands that need hardware, a server or a placeholder filled in are
+# Runs every command shown in a fenced ```sh block of README.md, every page of docs/ (but the
+# decision records of docs/decisions/, which keep history) and protocols/README.md on the bundled
+# data, in order, one scratch folder per document (so a document's commands see each other's
+# files). Under the sanitizer build this makes every documented command a memory
+# check. Commands that need hardware, a server or a placeholder filled in are
 # skipped with the reason printed; a crash, a sanitizer report, a timeout or a non-zero exit of
 # any other command fails the test.
 #   readme_commands.sh <underfoot> <source dir> <work dir>
@@ -19,8 +20,12 @@ export UBSAN_OPTIONS="${UBSAN_OPTIONS:-print_stacktrace=1}:halt_on_error=1:abort
 skip_reason() {
     local c="$1"
     case "$c" in
-    *scripts/setup.sh* | *scripts/test.sh*) echo "builds or tests the project (this test runs inside that)" ;;
+    *scripts/setup.sh* | *scripts/test.sh* | *scripts/package.sh* | cmake* | ninja* | .ci/run* | *"git clone"*) echo "builds or tests the project (this test runs inside that)" ;;
+    *fetch-recordings.sh*) echo "downloads recorded footsteps from Debian's archive (setup.sh does; the realism tests use them)" ;;
     jackd* | *"export JACK_"*) echo "starts a JACK server (the live tests do this with their own server)" ;;
+    socat*) echo "starts a pseudo-terminal pair that runs until stopped (tests/live do this with their own)" ;;
+    arduino-cli*) echo "flashes the shoes' Arduino (needs the board and arduino-cli)" ;;
+    *"apt-get install"* | *"dpkg -i"*) echo "installs packages on this machine (tests/package install them in a clean root)" ;;
     *"underfoot devices"* | *"underfoot live"* | *" --live"*) echo "needs an audio device (JACK server)" ;;
     *"--serial /dev/"* | *"underfoot sensors"*) echo "needs the FSR shoes on a serial port" ;;
     *"--osc "*) echo "needs gyroscopes sending OSC" ;;
@@ -74,9 +79,14 @@ commands_of() {
 }
 
 fail=0 ran=0 skipped=0
-for doc in "$src/README.md" "$src"/docs/*.md "$src/protocols/README.md"; do
+docs=("$src/README.md")
+while IFS= read -r d; do docs+=("$d"); done < <(find "$src/docs" -name '*.md' -not -path '*/decisions/*' | sort)
+docs+=("$src/protocols/README.md")
+for doc in "${docs[@]}"; do
     [ -f "$doc" ] || continue
-    name="$(basename "$(dirname "$doc")")_$(basename "$doc" .md)"
+    rel="${doc#$src/}"
+    name="${rel%.md}"
+    name="${name//\//_}"
     dir="$work/$name"
     mkdir -p "$dir" && prepare "$dir"
     n=0

@@ -41,7 +41,7 @@ grep -q "beach_summer" t*.txt
 
 # A microphone-driven protocol (TVCG 2011 exp. 1). A simulated participant's feet are the
 # virtual walker for the protocol's trial time (50 s), recorded as the trial's control stream:
-# its trials replay, identical to `underfoot render` with the stored seed (issue #17).
+# its trials replay, identical to `underfoot render` with the stored seed.
 "$underfoot" study create --study mic.db --protocol "$src/protocols/tvcg2011_exp1.toml" --code M --site ci --seed 1 > /dev/null
 "$underfoot" study register --study mic.db --participant P1 > /dev/null
 "$underfoot" session --study mic.db --simulate --participants 1 > /dev/null

@@ -24,7 +24,7 @@
 //    them so that the protocol can start, and its first rendered clip is compared.
 // The JACK server runs synchronously (-S) so that the ears client never reads a period the
 // engine has not finished; a capture period still missing or damaged after an overrun is
-// skipped, counted and bounded (docs/live.md).
+// skipped, counted and bounded (docs/decisions/jack-synchronous-tests.md).
 // Skipped when jackd or socat is missing.
 #include "app/wiring/Adapters.h"
 #include "app/wiring/ClipPlayer.h"

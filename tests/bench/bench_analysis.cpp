@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Speed of the analysis: a full study (200 participants x 26 trials = 5,200 trials, two groups)
 // from CSV text to every table, test and export, and the exact tests at their largest exact n;
-// the logistic mixed model (60 participants x 16 trials, nAGQ = 10) and a power curve (issue #15).
+// the logistic mixed model (60 participants x 16 trials, nAGQ = 10) and power curves: an
+// analysis-only one and the tvcg2011_exp2 curve of `underfoot protocol power` (its simulator).
 //   build-analysis/tests/bench/bench_analysis
 #include "analysis/io/TrialCsv.h"
 #include "analysis/power/Power.h"
@@ -9,6 +10,7 @@
 #include "analysis/stats/MixedModels.h"
 #include "analysis/stats/Tests.h"
 #include "analysis/tables/Tables.h"
+#include "app/cli/PowerSimulators.h"
 #include "engine/dsp/Random.h"
 
 #include <benchmark/benchmark.h>
@@ -200,6 +202,33 @@ void powerCurve6x2000(benchmark::State& state) {
     }
 }
 BENCHMARK(powerCurve6x2000)->Unit(benchmark::kSecond)->Iterations(1);
+
+/// The curve `underfoot protocol power protocols/tvcg2011_exp2.toml --threads 2` computes:
+/// 6 group sizes (10..60) x 2,000 studies of the three groups, each participant's plan and
+/// answers by the experiment layer's synthetic participant from the protocol's [simulation]
+/// matrices (participant SD 0.8), chi-square and glmer (Laplace) LRT; two worker threads.
+void powerCurveTvcg2011Exp2x2000(benchmark::State& state) {
+    using experiment::Group;
+    const experiment::Protocol p = experiment::loadProtocol(std::string(UNDERFOOT_SOURCE_DIR) +
+                                                            "/protocols/tvcg2011_exp2.toml");
+    const experiment::MatrixByGroup matrices = experiment::defaultMatrices(p);
+    std::vector<const Group*> groups;
+    std::vector<const experiment::ConfusionMatrix*> byGroup;
+    for (const auto& g : p.groups) {
+        groups.push_back(&g);
+        byGroup.push_back(&matrices.at(g.id));
+    }
+    const auto sim = cli::power::betweenGroupsSimulator(p, groups, byGroup, 0.8);
+    PowerOptions o;
+    o.simulations = 2000;
+    o.threads = 2;
+    for (auto _ : state) {
+        const auto curve = simulatePower(sim, 3, o);
+        state.counters["smallest_mixed"] = curve.smallestMixed;
+        state.counters["power_mixed_10"] = curve.points[0].mixed.power;
+    }
+}
+BENCHMARK(powerCurveTvcg2011Exp2x2000)->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
 
 } // namespace
 

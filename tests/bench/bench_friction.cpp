@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Time of the friction's per-sample kernel (ElastoPlasticFriction::processSample) on the inputs
-// the creaking_wood preset's friction layer gives it along a walk (issue #18): ns per solved
+// the creaking_wood preset's friction layer gives it along a walk: ns per solved
 // sample. The kernel's cost in time is set by its chain of dependent operations (each sample's
 // solve starts from the last one's state), which instruction counts do not show; this measures
 // it. The steady drag of `underfoot bench --only friction-creak` mostly slides fully; along a walk

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Cost of the zero-latency convolution reverb (engine/reverb/Convolver), issue #18:
+// Cost of the zero-latency convolution reverb (engine/reverb/Convolver):
 //   - per shipped IR: median, p99 and worst 64-frame block of the Convolver alone, and the same
 //     for zita-convolver used as its author intends (one Convproc, quantum 64, partitions
 //     64..8192, its worker threads, 64 samples of latency, process(true) so that every block

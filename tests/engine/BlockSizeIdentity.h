@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
-// Helpers of the block-size identity tests (issue #18): tests/engine/test_block_size_identity.cpp
+// Helpers of the block-size identity tests: tests/engine/test_block_size_identity.cpp
 // (default run, label engine) and tests/soak/test_block_size_identity_soak.cpp (label soak).
 #include "engine/control/VirtualWalker.h"
 #include "engine/render/FootstepScene.h"

@@ -67,7 +67,7 @@ TEST(GrfBank, HeelShareHandsOverFromHeelToToe) {
 
 TEST(GrfBank, ShippedBankLoadsAsGrfFiles) {
     // engine/data/grf/README.md documents the command that made these files.
-    const std::string dir = UNDERFOOT_ENGINE_DATA_DIR "/grf";
+    const std::string dir = UNDERFOOT_SOURCE_DIR "/engine/data/grf";
     for (const char* kind : {"heel", "toe"})
         for (int i = 1; i <= 5; ++i) {
             const auto path = dir + "/" + kind + "_" + std::to_string(i) + ".wav";

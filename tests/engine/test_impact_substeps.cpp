@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Impact with contact sub-steps (the shipped default since issue #18): the samples in contact are
+// Impact with contact sub-steps (the shipped default): the samples in contact are
 // computed as ImpactParams::contactSubsteps exact sub-steps, free flight as single steps.
 // Accuracy against the 8x oversampled reference, the stability matrix, passivity, determinism,
 // block-size independence and no allocation on the audio path.
@@ -187,7 +187,7 @@ TEST(ImpactContactSubsteps, RejectsUnsupportedSubstepCounts) {
 }
 
 TEST(ModalResonatorFastPath, FreeRingingEqualsTheGeneralRecursion) {
-    // predict()/commit() skip the force terms and swap buffers when no force acts (issue #18);
+    // predict()/commit() skip the force terms and swap buffers when no force acts;
     // the result must equal the general recursion s[n+1] = A s[n] + B0 u[n] + B1 u[n+1] computed
     // here independently, for a force that switches on and off (bit-exact up to rounding order,
     // which is the same: tolerance 1e-15 relative).
@@ -330,7 +330,7 @@ TEST(ImpactFreeRuns, RunsGiveTheSampleBySampleSamples) {
 // A strike's first sample finds the sole on the floor, so its free-run try fails and the next
 // samples would step without trying (HuntCrossleyImpactT::kFreeRetrySamples). That wait must not
 // outlast the contact: once the sole leaves, the samples after it run free at once (right after a
-// contact, the run tested sample by sample; issue #18: a wood strike's block stepped eight more
+// contact, the run tested sample by sample: a wood strike's block stepped eight more
 // samples one by one).
 TEST(ImpactFreeRuns, RunsStartRightAfterAContact) {
     HuntCrossleyImpact impact;

@@ -126,7 +126,7 @@ TEST(ElastoPlasticFriction, StickSlipUnderASteadyDragMakesAPeriodicCreak) {
     EXPECT_LT(slips, 2000);
 }
 
-// issue #18: the fixed point's Stribeck exp and raised sine (and the Newton step's cosine, its
+// The fixed point's Stribeck exp and raised sine (and the Newton step's cosine, its
 // derivative) are polynomials with stated error bounds instead of libm calls.
 TEST(FrictionFunctions, ErrorsStayWithinTheirStatedBounds) {
     double worstExp = 0.0, worstSin = 0.0, worstCos = 0.0;
@@ -214,7 +214,7 @@ TEST(ElastoPlasticFriction, PolynomialFunctionsKeepTheCreakSpectrumLevelAndEvent
     EXPECT_LE(std::fabs(fast.slips - ref.slips), 0.05 * ref.slips);
 }
 
-// perf5 (issue #18): the solve is Newton on the plastic rate (see Friction.cpp). With the tight
+// The solve is Newton on the plastic rate (see Friction.cpp). With the tight
 // stop (newtonStepTolerance 0) its output meets the fixed-point passes' own criterion: one plain
 // pass from the returned solution moves v and z by at most the tolerance (relative), on every
 // sample of the creak, with no sample at the cap, in about two evaluations of the Stribeck /
@@ -262,7 +262,7 @@ TEST(ElastoPlasticFriction, NewtonAgreesWithTheFixedPointPassesSampleBySample) {
     EXPECT_LE(worst, 1e-5 * peak);
 }
 
-// friction5 (issue #18): the shipped solve must be the solution of its equations, not an
+// The shipped solve must be the solution of its equations, not an
 // artefact of an iteration cap. Reference: the same equations solved with libm and 50 passes
 // started from the prediction without friction, no extrapolation (the colleague's converged
 // reference), stopping only when a pass changes nothing. The shipped solver (Newton, warm start,
@@ -289,7 +289,7 @@ TEST(ElastoPlasticFriction, ShippedSolveEqualsTheFiftyPassReferenceOnTheCreak) {
                 distance, perSample, shipped.stats.maxPassesInOneSample,
                 static_cast<unsigned long long>(shipped.stats.capHits),
                 static_cast<unsigned long long>(shipped.stats.samples));
-    // The reference's accuracy at the default cost (issue #18): within 0.1 dB, as the default
+    // The reference's accuracy at the default cost: within 0.1 dB, as the default
     // impact (measured with the shipped Newton stop: 0.001 dB, the same slips).
     EXPECT_LE(distance, 0.1);
     EXPECT_LE(std::fabs(shipped.rmsDb - ref.rmsDb), 0.1);

@@ -146,7 +146,7 @@ void configureBank(ModalResonatorT<Real>& r, int n) {
 }
 } // namespace
 
-// issue #18: commit() updates the pickup sums as prediction + force x instantaneous response,
+// commit() updates the pickup sums as prediction + force x instantaneous response,
 // and with energy tracking energy()/energyIfCommitted() come from a quadratic in the force;
 // both must agree with the sums over the modes, for odd and even mode counts (the bank is padded
 // to a multiple of four modes), at both rates and in float as in double.
@@ -197,7 +197,7 @@ TEST(ModalResonatorFastPath, ConstantTimeSumsAndEnergiesEqualTheSumsOverTheModes
     checkO1SumsAgainstModeSums<float>(1e-4);
 }
 
-// issue #18: commit() defers its per-mode update into the next predict(); every reader of the
+// commit() defers its per-mode update into the next predict(); every reader of the
 // modes (another pickup's position or velocity, energy, flushing, the peak velocity) completes it
 // first. A bank read through pickup 1 after every commit (so the update happens in commit's
 // sample) and a bank never read (so it happens inside the next predict) give the same samples,
@@ -235,7 +235,7 @@ TEST(ModalResonatorFastPath, DeferredCommitEqualsTheImmediateUpdate) {
     }
 }
 
-// issue #18: the per-mode loops run four modes per step, as one AVX vector where the CPU has it
+// the per-mode loops run four modes per step, as one AVX vector where the CPU has it
 // or as two SSE2 pairs. Both kernels must give the same samples bit for bit (a replay on another
 // machine depends on it), for mode counts below, at and across multiples of four, through force
 // changes, held-force scales, free ringing and rate switches, with and without energy tracking.
@@ -279,7 +279,7 @@ TEST(ModalResonatorFastPath, AvxAndSse2KernelsGiveTheSameSamples) {
     RecordProperty("avx_kernel_used", probe.usesAvx() ? "yes" : "no (this CPU has no AVX)");
 }
 
-// issue #18: ringFreeUntilContact runs free ringing sample by sample while a body at soleX[t]
+// ringFreeUntilContact runs free ringing sample by sample while a body at soleX[t]
 // stays clear of the contact point, and must stop exactly where predict() / commit(0, 0) pairs
 // would first find soleX[t] - predictedPosition(0) > 0, with the same samples and state, in both
 // kernels (AVX and SSE2), for mode counts below, at and across multiples of four; runs of any

@@ -108,6 +108,19 @@ class ResultsTest : public QObject {
         }
         QVERIFY2(chi > 0, "the demo study's between-group chi-square tests");
 
+        // The mixed models beside them: glmer, and lmer and clmm for every rating comparison,
+        // with the sentence on which to cite.
+        auto* models = results->modelsTable();
+        int glmer = 0, clmm = 0;
+        for (int r = 0; r < models->rowCount(); ++r) {
+            const QString model = models->item(r, 3)->text();
+            glmer += model.startsWith("glmer") ? 1 : 0;
+            clmm += model.startsWith("clmm") ? 1 : 0;
+        }
+        QVERIFY2(glmer > 0 && clmm > 0,
+                 qPrintable(QString("glmer %1, clmm %2").arg(glmer).arg(clmm)));
+        QVERIFY(results->modelAdvice().contains("cite the cumulative link mixed model"));
+
         // Ratings per condition: mean and 95 % t interval of the stored answers.
         QVERIFY(results->scaleBox()->count() >= 1);
         results->scaleBox()->setCurrentIndex(0);

@@ -162,7 +162,7 @@ TEST(SoundscapeLibrary, ShipsTheFiveEnvironmentsOfTheStudy) {
 }
 
 TEST(SoundscapeLibrary, ForestIsDenserInNaturalEventsThanThePark) {
-    // Issue 6: the forest is "denser in natural sounds than the park" (fewer birds in the park).
+    // The study's forest is "denser in natural sounds than the park" (fewer birds in the park).
     auto birdRate = [](const SoundscapeDefinition& d) {
         double r = 0;
         for (const auto& l : d.layers)
@@ -189,7 +189,7 @@ TEST(Coherence, AnswersTheCoherentPairsOfTheStudy) {
 }
 
 TEST(Coherence, AnswersTheIncoherentPairsOfGroupThree) {
-    // STUDIES.md §2, group 3: beach sand with forest and ski slope; snow with forest and beach;
+    // TVCG 2011 experiment 2, group 3: beach sand with forest and ski slope; snow with forest and beach;
     // forest underbrush with beach and ski slope.
     const auto& t = CoherenceTable::builtin();
     EXPECT_EQ(t.incoherentSoundscapesFor("beach_sand"),

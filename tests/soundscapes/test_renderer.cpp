@@ -104,7 +104,8 @@ TEST(SoundscapeRenderer, EveryEnvironmentIsDeterministicFiniteAndAtItsTargetLeve
         const Stereo a = render(r, 60.0, 512);
         ASSERT_TRUE(a.finite());
         // Calibrated to the definition's target (mean channel power of the mix); the tolerance
-        // covers the randomness of a one-minute render (measured spread: see docs/soundscapes.md).
+        // covers the randomness of a one-minute render (measured spread: see
+        // docs/reference/soundscapes.md).
         EXPECT_NEAR(a.levelDb(), r.definition().targetLevelDbfs, 2.0);
         EXPECT_LT(a.peak(), 0.9) << "headroom below full scale";
         r.reset(1);

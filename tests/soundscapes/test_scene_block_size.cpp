@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Issue #18: a whole shipped scene (gravel under both feet + the farm courtyard soundscape,
+// A whole shipped scene (gravel under both feet + the farm courtyard soundscape,
 // mixed as the live headphone mix adds the ambience) renders the same bits for every host block
 // size: 1, 37, 64, 256, 1000 and a size that changes at every call. The walk pauses twice, so the
 // grains layers fall asleep and wake while the soundscape plays on. (Surfaces and wading alone:

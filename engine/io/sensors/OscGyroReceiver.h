@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
-/// Gyroscopes over OSC/UDP (STUDIES.md §4; docs/sensors.md, "OSC scheme"): one message per limb
-/// per sample at 100 Hz,
+/// Gyroscopes over OSC/UDP (the wading study; docs/reference/sensors.md, "Gyroscopes: OSC
+/// messages"): one message per limb per sample at 100 Hz,
 ///
 ///     /underfoot/gyro/left_thigh   ,f   <deg/s>
 ///     /underfoot/gyro/left_thigh   ,fi  <deg/s> <sequence>

@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 /// The sensor log of a live trial: raw shoe frames, step events (with the GRF the player chose)
-/// and gyroscope samples, one CSV file a trial references (docs/sensors.md, "Sensor log").
+/// and gyroscope samples, one CSV file a trial references (docs/reference/sensors.md, "Sensor
+/// log").
 /// Written by the one consumer of the sources' SPSC queues (in a live session the live player's
 /// sensor-log thread, app/wiring/Players.cpp), never on the audio thread. Long format, one row per
 /// record, time on the sensor clock relative to the log's start:

@@ -5,9 +5,9 @@
 ///
 /// A FaultMonitor is fed by one sensor thread (accepted frames, rejected lines, lost frames,
 /// disconnects) and re-evaluated by that thread at least every 20 ms, so that every fault is
-/// reported well within one second (docs/sensors.md, "Fault states"). Any thread may read a
-/// snapshot (status()) or the state alone (state(), lock-free); a callback runs on the sensor
-/// thread at each state change (and on the stopping thread for the final Stopped).
+/// reported well within one second (docs/reference/sensors.md, "Sensor states"). Any thread may
+/// read a snapshot (status()) or the state alone (state(), lock-free); a callback runs on the
+/// sensor thread at each state change (and on the stopping thread for the final Stopped).
 #include <atomic>
 #include <cstdint>
 #include <functional>

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
-/// The FSR shoes over a serial port (docs/sensors.md).
+/// The FSR shoes over a serial port (docs/reference/sensors.md).
 ///
 /// Real ports (USB CDC /dev/ttyACM*, FTDI /dev/ttyUSB*, ...) are looked up, opened and configured
 /// (baud, 8N1, no flow control) through libserialport; pseudo-terminals (/dev/pts/*, e.g. socat
@@ -33,7 +33,7 @@ enum class SerialBackend : std::uint8_t {
 /// Settings of a SerialSource.
 struct SerialConfig {
     std::string path;  ///< e.g. /dev/ttyACM0 or a socat pty link
-    int baud = 500000; ///< the sketch's rate (docs/sensors.md explains 500000)
+    int baud = 500000; ///< the sketch's rate (docs/reference/sensors.md explains 500000)
     SerialBackend backend = SerialBackend::Auto;
     std::size_t queueCapacity = 8192; ///< frames buffered for the consumer (8 s at 1 kHz)
     FaultThresholds faults{};

@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
-/// Readings of the FSR shoes (STUDIES.md §3): two force-sensing resistors per sandal (heel, toe),
-/// digitised by an Arduino at 1 kHz and streamed over serial (docs/sensors.md, "Line protocol").
+/// Readings of the FSR shoes (Turchet et al. 2010): two force-sensing resistors per sandal (heel,
+/// toe), digitised by an Arduino at 1 kHz and streamed over serial (docs/reference/sensors.md,
+/// "Shoes: the serial line protocol").
 #include <array>
 #include <cstddef>
 #include <cstdint>

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
-/// The line protocol of the FSR shoes (docs/sensors.md, "Line protocol"), version 1:
+/// The line protocol of the FSR shoes (docs/reference/sensors.md, "Shoes: the serial line
+/// protocol"), version 1:
 ///
 ///     # underfoot-shoes 1 rate_hz=1000 adc_bits=10
 ///     123456,12,8,640,702

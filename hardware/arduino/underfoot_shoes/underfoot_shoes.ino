@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Underfoot FSR shoes: four force-sensing resistors (left heel, left toe, right heel, right toe)
 // sampled at 1 kHz and streamed over USB serial in the Underfoot line protocol v1
-// (docs/sensors.md, "Line protocol"):
+// (docs/reference/sensors.md, "Shoes: the serial line protocol"):
 //
 //   # underfoot-shoes 1 rate_hz=1000 adc_bits=10\r\n                (once, at start-up)
 //   <t_ms>,<lh>,<lt>,<rh>,<rt>\r\n                                   (every 1 ms)

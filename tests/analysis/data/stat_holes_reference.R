@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
-# Reference values of tests/analysis/StatHolesTest.cpp (issue #15 holes), R 4.2.2 (Debian 12):
+# Reference values of tests/analysis/StatHolesTest.cpp, R 4.2.2 (Debian 12):
 #   Rscript tests/analysis/data/stat_holes_reference.R
 # --- fisher.test on r x c tables
 p <- function(label, v) cat(label, paste(sprintf("%.15g", v), collapse=", "), "\n")
