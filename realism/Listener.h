@@ -11,7 +11,7 @@
 /// category follows from the material. It is evaluated leave-one-source-out: trained on every
 /// source but one, tested on the held-out source's files.
 ///
-/// ListenerOptions (defaults = the configuration docs/realism.md reports): each source's files
+/// ListenerOptions (defaults = the configuration docs/explanation/realism.md reports): each source's files
 /// are first centred on that source's own per-feature median (a source's microphone, room and
 /// processing shift all its files alike; the held-out source, and the renders as a source of
 /// their own, are centred on their own median, which needs no labels), only the scalar

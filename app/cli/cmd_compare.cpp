@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// `underfoot compare`: how close a surface's footsteps are to recorded ones (docs/realism.md).
+// `underfoot compare`: how close a surface's footsteps are to recorded ones (docs/explanation/realism.md).
 //   compare --surface gravel [--real FILES_OR_DIRS...] [-o report.html]
 //   compare --all [-o report.html]          every surface with recordings of its material
 //   compare --listener [-o report.html]     the listener's real baseline and its verdicts
@@ -122,7 +122,7 @@ fs::path figureDir(const std::string& output) {
 std::string definitionHtml() {
     return "<p>Distance: for every descriptor, z = |synthetic median − recorded median| / "
            "max(recorded IQR / 1.349, floor), on octaves for frequencies, rates and times and on "
-           "dB otherwise; the distance is the mean z over the descriptors (docs/realism.md).</p>\n";
+           "dB otherwise; the distance is the mean z over the descriptors (docs/explanation/realism.md).</p>\n";
 }
 
 int runOne(const CompareArgs& a) {
@@ -491,7 +491,7 @@ CommandRegistrar reg("compare", [](CLI::App& app, int& exitCode) {
     auto args = std::make_shared<CompareArgs>();
     auto* cmd = app.add_subcommand(
         "compare", "Compare a surface's footsteps with recorded footsteps (descriptors, distance, "
-                   "listener; see docs/realism.md)");
+                   "listener; see docs/explanation/realism.md)");
     cmd->add_option("-s,--surface", args->surface, "surface id or preset .toml");
     cmd->add_option("--real", args->real,
                     "recorded footsteps: audio files or folders (default: the recordings cache, "
