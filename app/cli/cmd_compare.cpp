@@ -292,10 +292,10 @@ void printLoso(const rl::LosoResult& loso, std::size_t recordings, const std::st
 // The verdict on every surface's render (heard[i] is the material heard in infos[i]'s render).
 void printVerdicts(const std::vector<eng::SurfaceInfo>& infos,
                    const std::vector<std::string>& heard, std::string& body) {
-    fmt::print("\n{:<22} {:<9} {:<9} {:<9} {:<9} {}\n", "surface", "category", "heard cat",
+    fmt::print("\nseen sources (the listener trained on every recording, the presets' fit data "
+               "among them):\n");
+    fmt::print("{:<22} {:<9} {:<9} {:<9} {:<9} {}\n", "surface", "category", "heard cat",
                "material", "heard", "verdict");
-    fmt::print("seen sources (the listener trained on every recording, the presets' fit data "
-               "among them):");
     body += "<h2>Seen sources: verdict on every surface (listener trained on all recordings, "
             "those the presets were fitted to among them)</h2><table><tr><th>"
             "surface</th><th>category</th><th>heard category</th><th>material</th><th>heard as</th>"
