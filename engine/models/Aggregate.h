@@ -52,7 +52,7 @@
 ///    noise, rescaled to unit variance, before the envelope: the bursts keep their sharp start),
 ///    then the layer's tone filters. The energy bound uses the bursts' amplitudes,
 ///    S(t) = sum_i sqrt(E_i) exp(-(t - t_i) / tau), as for resonant grains. The noise has its own
-///    random stream, so the events' draws are the same as with resonances.
+///    random stream (one draw per sample while a burst sounds).
 ///  - Voices: a pool allocated in prepare(); a voice frees itself when its slowest resonance has
 ///    decayed 80 dB below the loudest possible event (computed at spawn, so no per-sample test);
 ///    when the pool is full the quietest voice is replaced. process() never allocates.
