@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "realism/Descriptors.h"
 
+#include "engine/dsp/Random.h"
 #include "engine/dsp/RealFft.h"
 
 #include <fmt/core.h>
@@ -120,7 +121,20 @@ std::vector<float> analysisSignal(const engine::AudioBuffer& audio, const Analys
     }
     if (std::fabs(audio.sampleRateHz - o.analysisRateHz) > 1e-6)
         mono = engine::resample(mono, o.analysisRateHz);
+    addNoiseFloor(mono.samples, o.analysisRateHz, o);
     return mono.samples;
+}
+
+double addNoiseFloor(std::vector<float>& x, double fs, const AnalysisOptions& o) {
+    if (!(o.noiseFloorDb > 0) || x.empty()) return 0.0;
+    const auto hop = static_cast<std::size_t>(std::max(1.0, std::round(0.001 * fs)));
+    const auto env = envelope(x, 0, x.size(), 2 * hop, hop); // mean square of 2 ms, 1 ms apart
+    const double loudest = *std::max_element(env.begin(), env.end());
+    if (!(loudest > 0)) return 0.0;
+    const double rms = std::sqrt(loudest) * std::pow(10.0, -o.noiseFloorDb / 20.0);
+    engine::Random noise(o.noiseSeed);
+    for (float& v : x) v = static_cast<float>(double(v) + rms * noise.gaussian());
+    return rms;
 }
 
 std::vector<StepSpan> segmentSteps(const std::vector<float>& x, double fs,

@@ -12,6 +12,7 @@
 
 #include <array>
 #include <cstddef>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -25,6 +26,10 @@ struct AnalysisOptions {
                                    ///< many dB of the loudest point of the file
     double minStepGapS = 0.25;     ///< two onsets closer than this are one step
     double maxStepS = 0.8;         ///< a step is cut after this long (or at the next onset)
+    /// White noise this many dB below the loudest 2 ms (mean square over 2 ms windows, 1 ms
+    /// apart) of the signal is added before analysis (see above); 0: none.
+    double noiseFloorDb = 60;
+    std::uint64_t noiseSeed = 1; ///< seed of the floor's noise (the same for every file)
 };
 
 /// The scalar descriptors, in this order. Their values are in the units named by
@@ -70,8 +75,14 @@ struct StepDescriptors {
 /// Third-octave centre frequencies (50 Hz upwards) whose upper edge lies below maxHz.
 std::vector<double> thirdOctaveCentres(double maxHz);
 
-/// Mono mix of an audio buffer, resampled to the analysis rate when needed.
+/// Mono mix of an audio buffer, resampled to the analysis rate when needed, with the noise floor
+/// added (addNoiseFloor).
 std::vector<float> analysisSignal(const engine::AudioBuffer& audio, const AnalysisOptions& o);
+
+/// Adds the noise floor of `o` to a mono signal at rate fs: Gaussian white noise of RMS
+/// 10^(-noiseFloorDb / 20) x the RMS of the signal's loudest 2 ms, drawn from noiseSeed.
+/// Returns that RMS (0 when noiseFloorDb is 0 or the signal is silent: nothing is added).
+double addNoiseFloor(std::vector<float>& x, double fs, const AnalysisOptions& o);
 
 /// Steps of a mono signal at rate fs (onset detection on a 5 ms energy envelope).
 std::vector<StepSpan> segmentSteps(const std::vector<float>& x, double fs,

@@ -2,7 +2,7 @@
 #pragma once
 /// The realism distance between synthetic steps and recorded steps.
 ///
-/// Definition (documented in docs/realism.md): for every scalar descriptor d, take the median
+/// Definition (documented in docs/explanation/realism.md): for every scalar descriptor d, take the median
 /// of the synthetic steps, m_s, and the median m_r and interquartile range IQR_r of the recorded
 /// steps, all on the descriptor's comparison scale (log2 for frequencies, rates and times, i.e.
 /// octaves; dB as they are). Its robust z-score is

@@ -76,6 +76,20 @@ void eachGrainEventLayer(toml::table& root, const std::function<void(toml::table
     }
 }
 
+// Calls f(layer, index) for every grains layer of noise bursts (excitation = "noise").
+void eachNoiseLayer(toml::table& root, const std::function<void(toml::table&, int)>& f) {
+    auto* layers = root["layer"].as_array();
+    if (!layers) return;
+    int i = 0;
+    for (auto& node : *layers) {
+        auto* t = node.as_table();
+        if (t && t->get("type") && t->get("type")->value<std::string>() == "grains" &&
+            (*t)["excitation"].value<std::string>() == "noise")
+            f(*t, i);
+        ++i;
+    }
+}
+
 // A grains layer that only makes the heel's onset event (onset_energy > 0, no event rates).
 bool isThudLayer(const toml::table& t) {
     if (!t.get("type") || t.get("type")->value<std::string>() != "grains") return false;
@@ -226,6 +240,38 @@ std::vector<Knob> knobsFor(const toml::table& root) {
                 {{"heel_energy", "heel burst's energy scale (heel_energy) x 2^k", -3, 3, 0, 0},
                  [mul2](toml::table& r, double x, const Ranges& rg) {
                      eachLayerKey(r, "grains", "heel_energy", rg, mul2(x));
+                 }});
+        }
+        // Noise-burst grains (excitation = "noise", GranularLayers.h): their decay and colour.
+        bool noiseLayers = false;
+        if (const auto* layers = root["layer"].as_array())
+            for (const auto& node : *layers)
+                if (const auto* t = node.as_table())
+                    noiseLayers = noiseLayers || (*t)["excitation"].value<std::string>() == "noise";
+        if (noiseLayers) {
+            k.push_back({{"noise_decay", "noise bursts' decay (noise_decay_ms) x 2^k", -2, 2, 0, 0},
+                         [](toml::table& r, double x, const Ranges& rg) {
+                             eachNoiseLayer(r, [&](toml::table& t, int i) {
+                                 if (auto v = t["noise_decay_ms"].value<double>())
+                                     t.insert_or_assign(
+                                         "noise_decay_ms",
+                                         clampTo(rg, fmt::format("layer[{}].noise_decay_ms", i),
+                                                 *v * std::exp2(x)));
+                             });
+                         }});
+            k.push_back(
+                {{"noise_band",
+                  "noise bursts' colour: noise_corner_hz and the tone filters (highpass_hz, "
+                  "lowpass_hz) x 2^k",
+                  -2, 2, 0, 0},
+                 [](toml::table& r, double x, const Ranges& rg) {
+                     eachNoiseLayer(r, [&](toml::table& t, int i) {
+                         for (const char* key : {"noise_corner_hz", "highpass_hz", "lowpass_hz"})
+                             if (auto v = t[key].value<double>(); v && *v > 0)
+                                 t.insert_or_assign(key,
+                                                    clampTo(rg, fmt::format("layer[{}].{}", i, key),
+                                                            *v * std::exp2(x)));
+                     });
                  }});
         }
         if (grainLayers > 1)

@@ -161,4 +161,31 @@ LosoResult leaveOneSourceOut(const std::vector<Example>& input, ListenerOptions 
     return r;
 }
 
+std::map<std::string, std::vector<std::string>>
+heardWithoutEachSource(const std::vector<Example>& recordings, const std::vector<Example>& renders,
+                       ListenerOptions o) {
+    if (renders.empty()) throw std::invalid_argument("heardWithoutEachSource: no render to judge");
+    std::vector<Example> ex = recordings, synth = renders;
+    if (o.centrePerSource) {
+        centreBySource(ex);
+        centreBySource(synth);
+    }
+    std::set<std::string> sources;
+    for (const auto& e : ex) sources.insert(e.source);
+    if (sources.size() < 2)
+        throw std::invalid_argument("heardWithoutEachSource needs recordings from two sources or "
+                                    "more");
+    std::map<std::string, std::vector<std::string>> heard;
+    for (const auto& held : sources) {
+        std::vector<Example> train;
+        for (const auto& e : ex)
+            if (e.source != held) train.push_back(e);
+        Listener l(o);
+        l.train(train);
+        auto& h = heard[held];
+        for (const auto& r : synth) h.push_back(l.classify(r.features));
+    }
+    return heard;
+}
+
 } // namespace underfoot::realism

@@ -11,10 +11,10 @@
 /// category follows from the material. It is evaluated leave-one-source-out: trained on every
 /// source but one, tested on the held-out source's files.
 ///
-/// ListenerOptions (defaults = the configuration docs/realism.md reports): each source's files
-/// are first centred on that source's own per-feature median (a source's microphone, room and
-/// processing shift all its files alike; the held-out source, and the renders as a source of
-/// their own, are centred on their own median, which needs no labels), only the scalar
+/// ListenerOptions (defaults = the configuration docs/explanation/realism.md reports): each
+/// source's files are first centred on that source's own per-feature median (a source's microphone,
+/// room and processing shift all its files alike; the held-out source, and the renders as a source
+/// of their own, are centred on their own median, which needs no labels), only the scalar
 /// descriptors are used, and there is one centroid per (source, material) rather than per
 /// material, so two sources that recorded a material differently each keep their own.
 #include "realism/Descriptors.h"
@@ -79,5 +79,15 @@ struct LosoResult {
 /// Leave-one-source-out evaluation over labelled examples of two or more sources (centred by
 /// source first when the options say so).
 LosoResult leaveOneSourceOut(const std::vector<Example>& examples, ListenerOptions o = {});
+
+/// The renders judged by listeners that never heard a source: for every source S of the
+/// labelled `recordings` (two or more sources), a listener trained on the other sources only
+/// (centred by source when the options say so) classifies every render of `renders` (one
+/// unlabelled source, centred on its own median when the options say so). heard[S][i] is the
+/// material heard in renders[i] without S. Throws std::invalid_argument with fewer than two
+/// sources or no render.
+std::map<std::string, std::vector<std::string>>
+heardWithoutEachSource(const std::vector<Example>& recordings, const std::vector<Example>& renders,
+                       ListenerOptions o = {});
 
 } // namespace underfoot::realism

@@ -154,6 +154,7 @@ std::vector<Mode> matrixPencilModes(const std::vector<double>& input, double fs,
 
 std::vector<Mode> modesOfRecording(const std::string& path, const ModalOptions& o) {
     AnalysisOptions ao;
+    ao.noiseFloorDb = 0; // the matrix pencil sees the recording as it is
     const auto x = analysisSignal(engine::readAudioFile(path), ao);
     const auto steps = segmentSteps(x, ao.analysisRateHz, ao);
     if (steps.empty()) throw std::invalid_argument(fmt::format("{}: no step found", path));

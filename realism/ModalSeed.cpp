@@ -16,6 +16,7 @@ namespace underfoot::realism {
 std::vector<std::vector<Mode>> modesOfStrongestSteps(const std::string& path, int steps,
                                                      const ModalOptions& o, bool preEmphasis) {
     AnalysisOptions ao;
+    ao.noiseFloorDb = 0; // the matrix pencil sees the recording as it is
     const auto audio = engine::readAudioFile(path);
     const auto x = analysisSignal(audio, ao);
     const auto spans = segmentSteps(x, ao.analysisRateHz, ao);

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 /// Listener-only features of a footstep measured on fixed windows after its contact transient
-/// (docs/realism.md, "The listener"). They do not enter `underfoot compare`'s distance.
+/// (docs/explanation/realism.md, "The listener"). They do not enter `underfoot compare`'s distance.
 ///
 /// The game libraries differ in what a "footstep file" is (a heel strike alone, a whole step
 /// with its scuff, trimmed or with tails); the descriptors of realism/Descriptors.h see the

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
-/// The listener on onset features (docs/realism.md, "The listener"): trained on recorded
+/// The listener on onset features (docs/explanation/realism.md, "The listener"): trained on recorded
 /// footsteps only, meant to name the material and category of a file from a source it never
 /// saw (another library, a lab, the renders).
 ///

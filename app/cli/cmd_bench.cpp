@@ -110,7 +110,7 @@ eng::SceneBenchSpec sceneSpec(const SceneRow& row, const BenchArgs& a,
 /// load. Each scene runs once on the timed benchmark's input and seed (scene and background
 /// reset as before its first repeat); after each block callgrind's counts are dumped (and so
 /// zeroed) with the label "<scene id> <block>": a dump's total is that block's instructions.
-/// scripts/scene_block_instructions.py runs this under callgrind and reads the dumps. Outside
+/// tools/perf/scene_block_instructions.py runs this under callgrind and reads the dumps. Outside
 /// valgrind the client requests do nothing: refused (exit code 2).
 int runSceneInstructions(const BenchArgs& a) {
     const auto all = shippedScenes();
@@ -141,7 +141,7 @@ int runSceneInstructions(const BenchArgs& a) {
             "callgrind's client requests, which do nothing outside valgrind" +
             std::string(UNDERFOOT_HAVE_CALLGRIND ? ""
                                                  : " (and this build has no valgrind headers)") +
-            ": run python3 scripts/scene_block_instructions.py (or this command under valgrind "
+            ": run python3 tools/perf/scene_block_instructions.py (or this command under valgrind "
             "--tool=callgrind --combine-dumps=yes --instr-atstart=no)");
 #if UNDERFOOT_HAVE_CALLGRIND
     for (const auto& row : rows) {
@@ -316,7 +316,7 @@ CommandRegistrar reg("bench", [](CLI::App& app, int& exitCode) {
     cmd->add_option("--only", args->only,
                     "all, impact, knobs, surfaces, scenes, scenarios, scaling (not in all), "
                     "impact-default (for callgrind), scene-instructions (instructions per block "
-                    "of the shipped scenes; under callgrind: scripts/scene_block_instructions.py), "
+                    "of the shipped scenes; under callgrind: tools/perf/scene_block_instructions.py), "
                     "or one scenario: impact-strikes, "
                     "impact-pressed, impact-metal, friction-creak, aggregate-gravel, bubbles, "
                     "aggregate-gravel-1voice")

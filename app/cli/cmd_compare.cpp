@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// `underfoot compare`: how close a surface's footsteps are to recorded ones (docs/realism.md).
+// `underfoot compare`: how close a surface's footsteps are to recorded ones
+// (docs/explanation/realism.md).
 //   compare --surface gravel [--real FILES_OR_DIRS...] [-o report.html]
 //   compare --all [-o report.html]          every surface with recordings of its material
 //   compare --listener [-o report.html]     the listener's real baseline and its verdicts
@@ -15,6 +16,7 @@
 
 #include <fmt/core.h>
 
+#include <array>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -122,7 +124,8 @@ fs::path figureDir(const std::string& output) {
 std::string definitionHtml() {
     return "<p>Distance: for every descriptor, z = |synthetic median − recorded median| / "
            "max(recorded IQR / 1.349, floor), on octaves for frequencies, rates and times and on "
-           "dB otherwise; the distance is the mean z over the descriptors (docs/realism.md).</p>\n";
+           "dB otherwise; the distance is the mean z over the descriptors "
+           "(docs/explanation/realism.md).</p>\n";
 }
 
 int runOne(const CompareArgs& a) {
@@ -289,9 +292,12 @@ void printLoso(const rl::LosoResult& loso, std::size_t recordings, const std::st
 // The verdict on every surface's render (heard[i] is the material heard in infos[i]'s render).
 void printVerdicts(const std::vector<eng::SurfaceInfo>& infos,
                    const std::vector<std::string>& heard, std::string& body) {
-    fmt::print("\n{:<22} {:<9} {:<9} {:<9} {:<9} {}\n", "surface", "category", "heard cat",
+    fmt::print("\nseen sources (the listener trained on every recording, the presets' fit data "
+               "among them):\n");
+    fmt::print("{:<22} {:<9} {:<9} {:<9} {:<9} {}\n", "surface", "category", "heard cat",
                "material", "heard", "verdict");
-    body += "<h2>Verdict on every surface (listener trained on all recordings)</h2><table><tr><th>"
+    body += "<h2>Seen sources: verdict on every surface (listener trained on all recordings, "
+            "those the presets were fitted to among them)</h2><table><tr><th>"
             "surface</th><th>category</th><th>heard category</th><th>material</th><th>heard as</th>"
             "</tr>\n";
     int catOk = 0, matOk = 0, matN = 0, n = 0;
@@ -313,11 +319,69 @@ void printVerdicts(const std::vector<eng::SurfaceInfo>& infos,
         body += fmt::format("<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>\n",
                             info.id, cat, heardCat, mat.empty() ? "-" : mat, heard[i]);
     }
-    fmt::print("synthetic: category right for {}/{}, material right for {}/{} surfaces with a "
+    fmt::print("seen sources: category right for {}/{}, material right for {}/{} surfaces with a "
                "recorded material\n",
                catOk, n, matOk, matN);
     body += fmt::format("</table><p>Category right for {}/{}; material right for {}/{}.</p>", catOk,
                         n, matOk, matN);
+}
+
+// The renders judged by listeners that never heard a source (heardWithoutEachSource): per
+// held-out source, the surfaces of a material that source recorded (their category and material
+// right or not) and every surface's category; then per surface over those sources.
+void printNested(const std::vector<eng::SurfaceInfo>& infos, const std::vector<rl::Example>& recs,
+                 const std::vector<rl::Example>& synth, const rl::ListenerOptions& lo,
+                 std::string& body) {
+    const auto heard = rl::heardWithoutEachSource(recs, synth, lo);
+    std::map<std::string, std::set<std::string>> recorded; // source -> materials
+    for (const auto& e : recs) recorded[e.source].insert(e.material);
+    fmt::print("\nnested (listener trained without the held-out source; the presets are NOT "
+               "refitted without it):\n{:<14} {:>14} {:>22}\n",
+               "held out", "category (all)", "its materials: cat / mat");
+    body += "<h2>Nested: listener trained without each source</h2><p>The presets are not refitted "
+            "without the held-out source.</p><table><tr><th>held out</th><th>category, every "
+            "surface</th><th>category, surfaces of a material it recorded</th><th>material</th>"
+            "</tr>\n";
+    std::map<std::string, std::array<int, 3>> perSurface; // id -> (sources, cat ok, mat ok)
+    for (const auto& [src, h] : heard) {
+        int catAll = 0, n = 0, catOwn = 0, matOwn = 0;
+        for (std::size_t i = 0; i < infos.size(); ++i) {
+            const auto cat = std::string(eng::toString(infos[i].category));
+            const bool catOk = rl::categoryOfMaterial(h[i]) == cat;
+            catAll += catOk;
+            const auto mat = rl::materialOfSurface(infos[i].id);
+            if (mat.empty() || !recorded[src].count(mat)) continue;
+            ++n;
+            catOwn += catOk;
+            matOwn += h[i] == mat;
+            auto& ps = perSurface[infos[i].id];
+            ++ps[0];
+            ps[1] += catOk;
+            ps[2] += h[i] == mat;
+        }
+        fmt::print("{:<14} {:>11}/{:<2} {:>15}/{:<2} {:>2}/{:<2}\n", src, catAll, infos.size(),
+                   catOwn, n, matOwn, n);
+        body += fmt::format("<tr><td>{}</td><td>{}/{}</td><td>{}/{}</td><td>{}/{}</td></tr>\n", src,
+                            catAll, infos.size(), catOwn, n, matOwn, n);
+    }
+    body += "</table><table><tr><th>surface</th><th>held-out sources that recorded its "
+            "material</th><th>category right</th><th>material right</th><th>heard (by held-out "
+            "source)</th></tr>\n";
+    fmt::print("{:<22} {:>7} {:>8} {:>8}  heard without each source\n", "surface", "sources",
+               "category", "material");
+    for (std::size_t i = 0; i < infos.size(); ++i) {
+        std::string list;
+        for (const auto& [src, h] : heard)
+            list += fmt::format("{}{}:{}", list.empty() ? "" : " ", src, h[i]);
+        const auto it = perSurface.find(infos[i].id);
+        const std::array<int, 3> ps =
+            it == perSurface.end() ? std::array<int, 3>{0, 0, 0} : it->second;
+        fmt::print("{:<22} {:>7} {:>6}/{:<1} {:>6}/{:<1}  {}\n", infos[i].id, ps[0], ps[1], ps[0],
+                   ps[2], ps[0], list);
+        body += fmt::format("<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>\n",
+                            infos[i].id, ps[0], ps[1], ps[2], list);
+    }
+    body += "</table>";
 }
 
 // The onset listener (realism/OnsetListener.h): its configuration chosen from a fixed grid by
@@ -456,10 +520,13 @@ int runListener(const CompareArgs& a) {
         infos.push_back(info);
         if (csv.is_open()) csv << featureLine(synth.back());
     }
+    const auto synthUncentred = synth;
     if (lo.centrePerSource) rl::centreBySource(synth);
     std::vector<std::string> heard;
     for (const auto& e : synth) heard.push_back(l.classify(e.features));
     printVerdicts(infos, heard, body);
+    // centreBySource above changed synth: heardWithoutEachSource centres its own copies.
+    printNested(infos, ex, synthUncentred, lo, body);
     if (!a.output.empty()) writeHtml(a.output, "Underfoot listener", body);
     return 0;
 }
@@ -491,7 +558,7 @@ CommandRegistrar reg("compare", [](CLI::App& app, int& exitCode) {
     auto args = std::make_shared<CompareArgs>();
     auto* cmd = app.add_subcommand(
         "compare", "Compare a surface's footsteps with recorded footsteps (descriptors, distance, "
-                   "listener; see docs/realism.md)");
+                   "listener; see docs/explanation/realism.md)");
     cmd->add_option("-s,--surface", args->surface, "surface id or preset .toml");
     cmd->add_option("--real", args->real,
                     "recorded footsteps: audio files or folders (default: the recordings cache, "

@@ -154,7 +154,7 @@ int runFit(FitArgs& a) {
     std::ofstream out(a.output);
     if (!out) throw UserError(fmt::format("-o {}: cannot write this file", a.output));
     out << "# Fitted by `underfoot fit` to " << real.size()
-        << " recording(s); see [provenance] at the end and docs/realism.md.\n"
+        << " recording(s); see [provenance] at the end and docs/explanation/realism.md.\n"
         << r.presetText;
     out.close();
     // The result must load as a normal preset.
@@ -202,7 +202,7 @@ CommandRegistrar reg("fit", [](CLI::App& app, int& exitCode) {
     auto args = std::make_shared<FitArgs>();
     auto* cmd = app.add_subcommand(
         "fit",
-        "Fit a surface preset to recorded footsteps (analysis by synthesis; docs/realism.md)");
+        "Fit a surface preset to recorded footsteps (analysis by synthesis; docs/explanation/realism.md)");
     cmd->add_option("-s,--surface", args->surface, "surface id or preset .toml");
     cmd->add_option("--real", args->real,
                     "recorded footsteps: files or folders (default: the recordings cache, "

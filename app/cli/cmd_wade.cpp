@@ -1,9 +1,11 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// `underfoot wade`: the wading simulation (STUDIES.md §4), offline.
+// `underfoot wade`: wading through water driven by leg gyroscopes (docs/explanation/wading.md),
+// offline.
 //   wade --depth deep --algo v2 --cadence 63 --seconds 20 -o wade.wav   virtual gait
 //   wade --gait recording.csv -o wade.wav                                recorded gait
 //   wade --write-gait gait.csv --cadence 63 --seconds 20                 virtual gait as CSV
 //   wade --latency [--algo v1] [--filter ...]                            measured latencies
+//   wade --depth-table [--seeds 1-10] [--seconds 12]    deep against shallow, every cadence
 //   wade --live [--osc 9000] [--settings audio.toml] --depth deep --algo v2 --seconds 60
 //        [--record-gait live.csv] [-o live.wav]       live on the audio device: OSC gyroscopes
 //                                                     (--osc) or the virtual gait (--cadence)
@@ -23,6 +25,7 @@
 
 #include <fmt/core.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -47,6 +50,8 @@ struct WadeArgs {
     std::string format = "pcm24";
     std::string block = "256";
     bool latency = false;
+    bool depthTable = false;
+    std::string seeds = "1-10";
     bool report = false;
     bool live = false;
     std::string osc; ///< UDP port of the gyroscopes ("" = virtual gait)
@@ -209,6 +214,70 @@ int runLive(const WadeArgs& a, const eng::WadingOptions& o, double seconds) {
     return 0;
 }
 
+// Seeds given as "A-B" or "A,B,C".
+std::vector<std::uint64_t> seedList(const std::string& text) {
+    std::vector<std::uint64_t> out;
+    const auto dash = text.find('-');
+    auto one = [&](const std::string& t) {
+        return static_cast<std::uint64_t>(
+            number("--seeds", t, 0, 1e9, "seeds as A-B or A,B,C (integers in [0, 1e9])"));
+    };
+    if (dash != std::string::npos) {
+        const auto lo = one(text.substr(0, dash)), hi = one(text.substr(dash + 1));
+        if (hi < lo || hi - lo > 1000)
+            throw UserError("--seeds \"" + text +
+                            "\": expected A-B with A <= B, at most 1001 seeds");
+        for (auto s = lo; s <= hi; ++s) out.push_back(s);
+        return out;
+    }
+    std::size_t start = 0;
+    while (start <= text.size()) {
+        const auto comma = text.find(',', start);
+        out.push_back(one(text.substr(start, comma - start)));
+        if (comma == std::string::npos) break;
+        start = comma + 1;
+    }
+    return out;
+}
+
+/// `wade --depth-table`: deep against shallow water at the studies' three cadences, both
+/// algorithms, every seed; prints the Markdown table of docs/explanation/wading.md.
+int runDepthTable(const WadeArgs& a, eng::WadingOptions o, double seconds) {
+    const auto seeds = seedList(a.seeds);
+    fmt::print("Deep against shallow water, {} s of virtual gait, seeds {} ({} each); level = RMS "
+               "over the whole render (Leq, dBFS), median over the seeds\n\n",
+               seconds, a.seeds, seeds.size());
+    fmt::print("| algorithm | cadence (steps/min) | shallow Leq | deep Leq | deep - shallow: min / "
+               "median / max (dB) | shallow centroid | deep centroid |\n");
+    fmt::print("|---|---:|---:|---:|---|---:|---:|\n");
+    auto median = [](std::vector<double> v) {
+        std::sort(v.begin(), v.end());
+        const auto n = v.size();
+        return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+    };
+    for (const char* algo : {"v1", "v2"})
+        for (double cadence : {eng::kSlowCadence, eng::kNormalCadence, eng::kFastCadence}) {
+            std::vector<double> sh, dp, diff, shc, dpc;
+            for (auto seed : seeds) {
+                o.algorithm = algo;
+                o.cadenceStepsPerMin = cadence;
+                o.seed = seed;
+                const auto c = eng::measureDepthContrast(o, seconds);
+                sh.push_back(c.shallow.leqDb);
+                dp.push_back(c.deep.leqDb);
+                diff.push_back(c.contrastDb());
+                shc.push_back(c.shallow.centroidHz);
+                dpc.push_back(c.deep.centroidHz);
+            }
+            fmt::print("| {} | {:.0f} | {:.1f} | {:.1f} | {:.1f} / {:.1f} / {:.1f} | {:.0f} Hz | "
+                       "{:.0f} Hz |\n",
+                       algo, cadence, median(sh), median(dp),
+                       *std::min_element(diff.begin(), diff.end()), median(diff),
+                       *std::max_element(diff.begin(), diff.end()), median(shc), median(dpc));
+        }
+    return 0;
+}
+
 int runWade(const WadeArgs& a) {
     const eng::WadingOptions o = options(a);
     const double seconds =
@@ -222,6 +291,7 @@ int runWade(const WadeArgs& a) {
                                 "options (use --osc PORT for live gyroscopes)");
             return runLive(a, o, seconds);
         }
+        if (a.depthTable) return runDepthTable(a, o, seconds);
         if (a.latency) {
             const int block = static_cast<int>(
                 number("--block", a.block, 1, 8192, "an audio block size in [1, 8192] samples"));
@@ -293,9 +363,10 @@ int runWade(const WadeArgs& a) {
                    o.filter, o.seed, source);
         if (a.report) {
             const auto f = eng::computeFeatures(audio);
-            fmt::print("  peak {:.1f} dBFS, RMS {:.1f} dBFS (active frames), centroid {:.0f} Hz, "
+            fmt::print("  peak {:.1f} dBFS, Leq {:.1f} dBFS, RMS {:.1f} dBFS (active frames), "
+                       "centroid {:.0f} Hz, "
                        "low share {:.2f}, high share {:.2f}; {:.1f}x real time ({:.3f} s CPU)\n",
-                       f.peakDb, f.rmsDb, f.centroidHz, f.lowShare, f.highShare,
+                       f.peakDb, f.leqDb, f.rmsDb, f.centroidHz, f.lowShare, f.highShare,
                        cpu > 0 ? audio.durationSeconds() / cpu : 0.0, cpu);
         }
     } catch (const eng::WadingOptionError& e) {
@@ -335,6 +406,11 @@ const CommandRegistrar registrar{
         cmd->add_option("--format", a.format, "pcm24 (default), pcm16 or float");
         cmd->add_option("--write-gait", a.writeGait, "write the virtual gait as CSV");
         cmd->add_flag("--latency", a.latency, "measure the latency from a gyroscope frame");
+        cmd->add_flag("--depth-table", a.depthTable,
+                      "deep against shallow water at 27, 63 and 118 steps/min, v1 and v2, over "
+                      "--seeds (a Markdown table; --seconds sets the render length)");
+        cmd->add_option("--seeds", a.seeds,
+                        "with --depth-table: seeds A-B or A,B,C (default 1-10)");
         cmd->add_option("--block", a.block, "audio block size for --latency (default 256)");
         cmd->add_flag("--report", a.report, "print level, spectral centroid and CPU cost");
         cmd->add_flag("--live", a.live,

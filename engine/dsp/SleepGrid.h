@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
-/// Block-size independence of sleep decisions (docs/performance.md "Block-size
+/// Block-size independence of sleep decisions (docs/explanation/performance.md "Block-size
 /// independence").
 ///
 /// A layer that stops computing when it has rung out ("falls asleep") must take that decision

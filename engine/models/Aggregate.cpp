@@ -127,6 +127,10 @@ void AggregateParameters::validate() const {
     require(finite(maxRateHz) && maxRateHz > 0, "maxRateHz", "a positive rate", maxRateHz);
     require(finite(amplitudeCap) && amplitudeCap >= 0, "amplitudeCap",
             "a non-negative amplitude (0: no bound)", amplitudeCap);
+    require(finite(noiseDecayMs) && noiseDecayMs > 0, "noiseDecayMs", "a positive time",
+            noiseDecayMs);
+    require(finite(noiseCornerHz) && noiseCornerHz >= 0, "noiseCornerHz",
+            "a frequency >= 0 (0: white)", noiseCornerHz);
 }
 
 void AggregateModel::configure(const AggregateParameters& parameters) {
@@ -155,6 +159,15 @@ void AggregateModel::prepare(double sampleRateHz, int maxEventsPerSecond) {
     logDecay_.assign(v, 0.0);
     startSample_.assign(v, 0);
     laneSums_.assign(static_cast<std::size_t>(kRunMax * kLanes), 0.0f);
+    noise_ = params_.excitation == AggregateParameters::Excitation::Noise;
+    noiseLogDecay_ = -1.0 / (params_.noiseDecayMs * 1e-3 * sampleRateHz_);
+    noisePowerDecay_ = std::exp(2.0 * noiseLogDecay_);
+    // y += (1 - a) (x - y) with a = exp(-2 pi fc / fs); its output variance is (1 - a) / (1 + a).
+    noiseColour_ = params_.noiseCornerHz > 0
+                       ? std::exp(-kTwoPi * std::min(params_.noiseCornerHz, 0.45 * sampleRateHz_) /
+                                  sampleRateHz_)
+                       : 0.0;
+    noiseColourGain_ = std::sqrt((1.0 + noiseColour_) / (1.0 - noiseColour_));
     allowAvx(avxAllowed_);
     reset(0);
 }
@@ -216,7 +229,27 @@ void AggregateModel::ringAvx(AggregateModel& m, float* out, int n) noexcept {
     m.ringBody<true>(out, n);
 }
 
+void AggregateModel::ringNoise(float* out, int n) noexcept {
+    if (noisePower_ == 0.0) return;
+    const double floor = silenceAmplitude_ * silenceAmplitude_;
+    const double unitVariance = std::sqrt(3.0) * noiseColourGain_; // uniform: variance 1/3
+    const double a = noiseColour_;
+    for (int t = 0; t < n; ++t) {
+        noiseState_ += (1.0 - a) * (noiseRandom_.bipolar() - noiseState_);
+        out[t] += static_cast<float>(std::sqrt(noisePower_) * unitVariance * noiseState_);
+        noisePower_ *= noisePowerDecay_;
+        if (noisePower_ < floor) { // 80 dB below the largest burst: silent
+            noisePower_ = 0.0;
+            return;
+        }
+    }
+}
+
 void AggregateModel::ring(float* out, int n) noexcept {
+    if (noise_) {
+        ringNoise(out, n);
+        return;
+    }
     for (int done = 0; done < n; done += kRunMax)
         ring_(*this, out + done, std::min(kRunMax, n - done));
 }
@@ -239,6 +272,11 @@ void AggregateModel::reset(std::uint64_t seed) noexcept {
     stolen_ = 0;
     capped_ = 0;
     peakSummed_ = 0.0;
+    noisePower_ = 0.0;
+    noiseState_ = 0.0;
+    noiseAmplitude_ = 0.0;
+    noiseAmplitudeAt_ = 0;
+    noiseRandom_.setSeed(Random::deriveSeed(seed, 0x6e6f697365)); // "noise"
 }
 
 void AggregateModel::trigger(double energy) noexcept {
@@ -250,6 +288,10 @@ void AggregateModel::spawn(double energy, bool burst) noexcept {
     if (observer_) observer_(observerUser_, {sample_, energy, burst});
     double amplitude = std::sqrt(energy);
     if (!(amplitude > silenceAmplitude_) || c1_.empty()) return; // inaudible: no voice
+    if (noise_) {
+        spawnNoise(amplitude);
+        return;
+    }
     // Current envelope of every ringing voice: their sum (for the energy bound) and the quietest
     // (replaced when the pool is full). The loop runs only when one of them is needed.
     const bool full = activeVoices_ >= params_.voices;
@@ -335,6 +377,30 @@ void AggregateModel::spawn(double energy, bool burst) noexcept {
     logDecay_[u] = slowest;
     startSample_[u] = sample_;
     nextDeath_ = std::min(nextDeath_, deathSample_[u]);
+}
+
+void AggregateModel::spawnNoise(double amplitude) noexcept {
+    const double cap = params_.amplitudeCap;
+    if (cap > 0) {
+        // The bursts' summed amplitude now: exact, from its value at the last burst.
+        const double summed =
+            noiseAmplitude_ *
+            std::exp(noiseLogDecay_ * static_cast<double>(sample_ - noiseAmplitudeAt_));
+        noiseAmplitude_ = summed;
+        noiseAmplitudeAt_ = sample_;
+        const double room = cap - summed;
+        if (amplitude > room) {
+            ++capped_;
+            amplitude = room;
+            if (!(amplitude > silenceAmplitude_)) {
+                peakSummed_ = std::max(peakSummed_, summed);
+                return; // the bed is at its bound
+            }
+        }
+        noiseAmplitude_ += amplitude;
+        peakSummed_ = std::max(peakSummed_, noiseAmplitude_);
+    }
+    noisePower_ += amplitude * amplitude;
 }
 
 void AggregateModel::freeVoice(int v) noexcept {

@@ -40,6 +40,19 @@
 ///    sqrt(resonances) x cap: the bound holds for any load, cadence and seed. S is evaluated at
 ///    each event from the voices' own decays (exact, no extra per-sample work), so it is
 ///    deterministic and independent of the block size. Below the cap nothing changes.
+///  - Noise excitation (Excitation::Noise): instead of ringing resonances, each event is a
+///    burst of white noise of RMS amplitude sqrt(E) at its start, decaying as
+///    exp(-(t - t_i) / tau), tau = noiseDecayMs (Cook 1997's shaker: a collision is a noise burst
+///    whose energy decays exponentially; friction and fracture of grains too small to ring).
+///    Independent white bursts sum to white noise whose power is the sum of their powers, so
+///    the layer draws one noise, scaled by sqrt(P(t)) with P(t) = sum_i E_i exp(-2 (t - t_i) /
+///    tau): one multiply, one square root and one draw per sample however many bursts overlap
+///    (the noise is uniform with unit variance: the same power and spectrum as Gaussian bursts).
+///    Its colour: above noiseCornerHz it falls 6 dB per octave (a one-pole low-pass of the unit
+///    noise, rescaled to unit variance, before the envelope: the bursts keep their sharp start),
+///    then the layer's tone filters. The energy bound uses the bursts' amplitudes,
+///    S(t) = sum_i sqrt(E_i) exp(-(t - t_i) / tau), as for resonant grains. The noise has its own
+///    random stream (one draw per sample while a burst sounds).
 ///  - Voices: a pool allocated in prepare(); a voice frees itself when its slowest resonance has
 ///    decayed 80 dB below the loudest possible event (computed at spawn, so no per-sample test);
 ///    when the pool is full the quietest voice is replaced. process() never allocates.
@@ -55,6 +68,10 @@ namespace underfoot::engine {
 
 /// Parameters of one stochastic aggregate process (ranges in the grains layer, GranularLayers).
 struct AggregateParameters {
+    enum class Excitation { Resonant, Noise };
+    Excitation excitation = Excitation::Resonant; ///< ringing grains or noise bursts (above)
+    double noiseDecayMs = 5.0; ///< Noise: decay time constant of each burst's amplitude
+    double noiseCornerHz = 0;  ///< Noise: -6 dB/octave above this (0: white)
     double gamma = -1.5;       ///< exponent of p(E) ~ E^gamma
     double energyMin = 1e-3;   ///< smallest event energy (relative; the largest is energyMax)
     double energyMax = 1.0;    ///< largest event energy (peak amplitude sqrt(E))
@@ -131,9 +148,10 @@ class AggregateModel {
     /// Starts one event of energy `energy` (already scaled) at the next processed sample.
     void trigger(double energy) noexcept;
 
-    /// True when no voice rings and no burst is pending.
+    /// True when no voice rings (no noise burst sounds) and no burst is pending.
     bool idle() const noexcept {
-        return activeVoices_ == 0 && burstRemaining_ == 0 && pendingTrigger_ <= 0.0;
+        return activeVoices_ == 0 && noisePower_ == 0.0 && burstRemaining_ == 0 &&
+               pendingTrigger_ <= 0.0;
     }
     int activeVoices() const noexcept { return activeVoices_; }
     int voiceCapacity() const noexcept { return params_.voices; }
@@ -169,7 +187,9 @@ class AggregateModel {
     template <bool Avx>
     void ringBody(float* out, int n) noexcept;
     void ring(float* out, int n) noexcept;
+    void ringNoise(float* out, int n) noexcept;
     void spawn(double energy, bool burst) noexcept;
+    void spawnNoise(double amplitude) noexcept;
     void freeVoice(int v) noexcept;
     void retireDeadVoices() noexcept;
 
@@ -204,6 +224,15 @@ class AggregateModel {
     std::uint64_t eventCount_ = 0;
     std::uint64_t stolen_ = 0;
     std::uint64_t capped_ = 0;
+    // Noise excitation: the summed power of the sounding bursts (at the next sample), its decay
+    // per sample, the summed amplitude (for the bound) at sample noiseAmplitudeAt_, and the
+    // noise's own random stream.
+    bool noise_ = false;
+    double noisePower_ = 0.0, noisePowerDecay_ = 1.0, noiseLogDecay_ = 0.0;
+    double noiseColour_ = 0.0, noiseColourGain_ = 1.0, noiseState_ = 0.0; // one-pole, unit var.
+    double noiseAmplitude_ = 0.0;
+    std::int64_t noiseAmplitudeAt_ = 0;
+    Random noiseRandom_;
     double peakSummed_ = 0.0;
     EventObserver observer_ = nullptr;
     void* observerUser_ = nullptr;

@@ -52,6 +52,9 @@ AudioFeatures computeFeatures(const AudioBuffer& audio) {
     double peak = 0;
     for (float v : audio.samples) peak = std::max(peak, double(std::fabs(v)));
     f.peakDb = peak > 0 ? 20 * std::log10(peak) : -999;
+    double squares = 0;
+    for (float v : x) squares += double(v) * double(v);
+    if (squares > 0) f.leqDb = 10 * std::log10(squares / double(x.size()));
     // 10 ms frame energies.
     const auto frameLen = static_cast<std::size_t>(std::max(1.0, 0.01 * fs));
     std::vector<double> energy;

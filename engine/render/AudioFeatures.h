@@ -11,6 +11,7 @@ namespace underfoot::engine {
 struct AudioFeatures {
     double peakDb = -999;       ///< sample peak, dBFS (all channels)
     double rmsDb = -999;        ///< RMS over the active frames, dBFS
+    double leqDb = -999;        ///< RMS over the whole buffer (equivalent level), dBFS
     double centroidHz = 0;      ///< energy-weighted spectral centroid of the active frames
     double rolloff85Hz = 0;     ///< frequency below which 85 % of the energy lies
     double lowShare = 0;        ///< energy share below 500 Hz

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
-/// The live scene's wading node (the wading study; docs/wading.md "Live"): a WadingScene fed by a
+/// The live scene's wading node (the wading study; docs/explanation/wading.md "Live"): a WadingScene fed by a
 /// gait source on the audio thread. It replaces the GRF control and the surface voices when a
 /// stimulus walks through water (surface "water").
 ///

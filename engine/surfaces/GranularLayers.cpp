@@ -264,15 +264,31 @@ std::unique_ptr<SurfaceLayer> makeGrainsLayer(PresetReader& r, const AccuracyOpt
                              "energy of one event when the heel loads (0: none)");
     c.onsetForceN = r.number("onset_force_n", 200.0, 1.0, 2000.0, "N",
                              "load at which the onset event fires", true);
-    m.resonances = r.integer("resonances", 2, 1, 4, "damped resonances per event");
-    std::tie(m.freqMinHz, m.freqMaxHz) =
-        orderedPair(r.number("freq_min_hz", 1000.0, 20.0, 20000.0, "Hz",
-                             "lowest resonance frequency of a grain", true),
-                    r.number("freq_max_hz", 4000.0, 20.0, 20000.0, "Hz",
-                             "highest resonance frequency of a grain", true));
-    std::tie(m.qMin, m.qMax) = orderedPair(
-        r.number("q_min", 5.0, 0.5, 200.0, "", "lowest quality factor (decay Q / (pi f))", true),
-        r.number("q_max", 20.0, 0.5, 200.0, "", "highest quality factor", true));
+    const bool noise = r.string("excitation", "resonant", {"resonant", "noise"}) == "noise";
+    if (noise) { // noise bursts: no resonances to read (a stray freq_* or q_* is refused)
+        m.excitation = AggregateParameters::Excitation::Noise;
+        m.resonances = 1;
+        m.noiseDecayMs = r.number(
+            "noise_decay_ms", 5.0, 0.1, 200.0, "ms",
+            "excitation = \"noise\": each event is a burst of white noise (the layer's tone "
+            "filters colour it) whose amplitude decays as exp(-t / noise_decay_ms): the friction "
+            "and fracture of grains too small to ring",
+            true);
+        m.noiseCornerHz = r.number("noise_corner_hz", 0.0, 0.0, 20000.0, "Hz",
+                                   "excitation = \"noise\": the bursts' spectrum falls 6 dB per "
+                                   "octave above this frequency (0: white)");
+    } else {
+        m.resonances = r.integer("resonances", 2, 1, 4, "damped resonances per event");
+        std::tie(m.freqMinHz, m.freqMaxHz) =
+            orderedPair(r.number("freq_min_hz", 1000.0, 20.0, 20000.0, "Hz",
+                                 "lowest resonance frequency of a grain", true),
+                        r.number("freq_max_hz", 4000.0, 20.0, 20000.0, "Hz",
+                                 "highest resonance frequency of a grain", true));
+        std::tie(m.qMin, m.qMax) =
+            orderedPair(r.number("q_min", 5.0, 0.5, 200.0, "",
+                                 "lowest quality factor (decay Q / (pi f))", true),
+                        r.number("q_max", 20.0, 0.5, 200.0, "", "highest quality factor", true));
+    }
     m.burstEvents = r.number("burst_events", 0.0, 0.0, 32.0, "events",
                              "mean number of micro-events following each event (a crunch)");
     m.burstMs = r.number("burst_ms", 2.0, 0.1, 100.0, "ms",

@@ -23,7 +23,7 @@
 /// walker makes more and stronger breaks, but the bed under the sole releases only so much
 /// energy at a time, so the layer's output stays below sqrt(resonances) x cap x gain for any
 /// load. 0 (the default): no bound.
-/// Heel burst (heel_rate_hz > 0; docs/realism.md "Heel-driven grains and several starts"): the
+/// Heel burst (heel_rate_hz > 0; docs/explanation/realism.md "Heel-driven grains and several starts"): the
 /// heel's first impact crushes the most grains. The sole lands at its highest speed and stops
 /// within tens of ms, before the load has built up, so a bed of sand or dirt crushes and
 /// shifts most in the first 20-30 ms of the contact (recorded sand and dirt steps peak there)
@@ -42,6 +42,9 @@
 /// acoustic emission; R is its Felicity ratio: 1 = strict, < 1 = it re-breaks a little before the
 /// old maximum). The memory is cleared when the foot leaves (F <= contact_threshold_n). 0 (the
 /// default): every load rise counts.
+/// Excitation: "resonant" (the default: each event rings at random resonances) or "noise" (each
+/// event is a burst of white noise decaying with noise_decay_ms, Aggregate.h: grains too small
+/// to ring, heard as the hiss of sand or the crunch of snow rather than as pitched ticks).
 /// The sum of the voices goes through an optional 2nd-order Butterworth high-pass and low-pass
 /// (tone) and the layer gain.
 #include "engine/dsp/Biquad.h"

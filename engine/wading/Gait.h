@@ -6,7 +6,7 @@
 ///  - recorded gait CSV files (time, left/right thigh/shank) read and written;
 ///  - GaitFrameAssembler: live GyroSamples (one OSC packet per limb) into 100 Hz frames.
 ///
-/// Virtual gait model (documented choices; sources in docs/wading.md):
+/// Virtual gait model (documented choices; sources in docs/explanation/wading.md):
 ///  - steps alternate left/right, each lasting 60 / cadence s (x a seeded jitter); a limb's
 ///    stride runs from its heel strike to its next one; its swing is the last Tsw of the stride,
 ///    Tsw = min(0.4 T, 0.25 s + 0.15 T) for stride time T (swing ~40 % of the cycle at normal

@@ -177,4 +177,13 @@ AudioBuffer renderWading(const WadingOptions& options, const std::vector<GaitFra
                         limiter);
 }
 
+WadingDepthContrast measureDepthContrast(WadingOptions options, double seconds) {
+    WadingDepthContrast c;
+    options.depth = "shallow";
+    c.shallow = computeFeatures(renderWading(options, seconds));
+    options.depth = "deep";
+    c.deep = computeFeatures(renderWading(options, seconds));
+    return c;
+}
+
 } // namespace underfoot::engine

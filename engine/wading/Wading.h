@@ -6,6 +6,7 @@
 /// byte-identical audio.
 #include "engine/control/GyroFrame.h"
 #include "engine/io/AudioFile.h"
+#include "engine/render/AudioFeatures.h"
 #include "engine/render/SafetyLimiter.h"
 
 #include <cstdint>
@@ -55,5 +56,14 @@ AudioBuffer renderWading(const WadingOptions& options, double seconds,
 /// length is that of the recording. Cadence and stride of the options are not used.
 AudioBuffer renderWading(const WadingOptions& options, const std::vector<GaitFrame>& gait,
                          LimiterReport* limiter = nullptr);
+
+/// Deep against shallow water for one gait: both depths rendered with the same options (the
+/// virtual gait at `cadence`, algorithm, seed), with their features. The depth cue is the
+/// difference of the equivalent levels (RMS over the whole render, AudioFeatures::leqDb).
+struct WadingDepthContrast {
+    AudioFeatures shallow, deep;
+    double contrastDb() const { return deep.leqDb - shallow.leqDb; }
+};
+WadingDepthContrast measureDepthContrast(WadingOptions options, double seconds);
 
 } // namespace underfoot::engine

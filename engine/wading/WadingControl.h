@@ -34,7 +34,7 @@ enum class GyroFilter { Butterworth5Hz, Butterworth0_8Hz, Asymmetric };
 /// Make-up gain after the 0.8 Hz filter (the paper's unstated "gain factor to compensate for the
 /// resulting amplitude decrease"): the ratio of the peak of the 5 Hz-filtered thigh swing to the
 /// 0.8 Hz-filtered one for the virtual gait at 63 steps/min (1.673 measured, see
-/// tests/wading/engine/test_wading_control.cpp and docs/wading.md).
+/// tests/wading/engine/test_wading_control.cpp and docs/explanation/wading.md).
 inline constexpr double kSlowFilterMakeUpGain = 1.67;
 
 /// Parameters of the mapping (defaults: the paper's values).

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""scripts/scene_block_instructions.py (issue #18): reading callgrind's per-block dumps, the
+"""tools/perf/scene_block_instructions.py: reading callgrind's per-block dumps, the
 block figures, and (when valgrind is installed and the build is not sanitized) one short scene
 through `underfoot bench --only scene-instructions` under callgrind.
 
@@ -14,7 +14,7 @@ import tempfile
 import unittest
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-SCRIPT_DIR = os.path.join(HERE, "..", "..", "scripts")
+SCRIPT_DIR = os.path.join(HERE, "..", "..", "tools", "perf")
 sys.path.insert(0, SCRIPT_DIR)
 import scene_block_instructions as sbi  # noqa: E402
 
@@ -212,7 +212,7 @@ class TheModeOutsideValgrind(unittest.TestCase):
                            capture_output=True, text=True)
         self.assertEqual(r.returncode, 2, r.stdout + r.stderr)
         self.assertIn("valgrind", r.stderr)
-        self.assertIn("scripts/scene_block_instructions.py", r.stderr)
+        self.assertIn("tools/perf/scene_block_instructions.py", r.stderr)
         self.assertEqual(r.stdout, "")
 
     def test_lists_the_shipped_scenes_and_refuses_an_unknown_one(self):

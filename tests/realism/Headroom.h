@@ -59,7 +59,7 @@ inline std::map<std::string, WorstPeak> worstPeaks(const std::vector<std::string
 
 // Every surface has the same limit: 1 dB below the limiter's ceiling. The aggregates' grains are
 // held there for heavy walkers by their energy bound (energy_saturation, amplitude_cap:
-// engine/surfaces/GranularLayers.h, docs/realism.md "Levels"), not by exceptions.
+// engine/surfaces/GranularLayers.h, docs/explanation/realism.md "Levels"), not by exceptions.
 inline double peakLimitDb(const std::string&) {
     return kLimitDb;
 }

@@ -118,6 +118,47 @@ TEST(RealismDescriptors, BandwidthAwareComparisonIgnoresWhatOneSideCannotHold) {
     EXPECT_EQ(a.thirdOctaveDb.size(), b.thirdOctaveDb.size());
 }
 
+TEST(RealismDescriptors, TheNoiseFloorSitsSixtyDbBelowTheLoudestTwoMilliseconds) {
+    // A ping followed by digital silence, as a render ends: the floor added by analysisSignal
+    // is white noise of RMS 1e-3 x the RMS of the loudest 2 ms, the same on every call, and it
+    // follows the signal's level (so the descriptors stay level-invariant).
+    auto ping = decayingSine(1200, 0.05, 0.3);
+    double loudest = 0;
+    for (std::size_t s = 0; s + 96 <= ping.size(); s += 48) {
+        double e = 0;
+        for (std::size_t i = s; i < s + 96; ++i) e += double(ping[i]) * ping[i];
+        loudest = std::max(loudest, e / 96);
+    }
+    auto floored = ping;
+    const AnalysisOptions o;
+    const double rms = addNoiseFloor(floored, kFs, o);
+    EXPECT_NEAR(rms, std::sqrt(loudest) * 1e-3, 1e-9);
+    double added = 0;
+    for (std::size_t i = 0; i < ping.size(); ++i)
+        added += std::pow(double(floored[i]) - double(ping[i]), 2);
+    EXPECT_NEAR(std::sqrt(added / double(ping.size())), rms, 0.03 * rms);
+    auto again = ping;
+    addNoiseFloor(again, kFs, o);
+    EXPECT_EQ(again, floored);
+    AnalysisOptions none;
+    none.noiseFloorDb = 0;
+    auto untouched = ping;
+    EXPECT_EQ(addNoiseFloor(untouched, kFs, none), 0.0);
+    EXPECT_EQ(untouched, ping);
+    // Without a floor the silent tail leaves most of the band empty: flatness far below any
+    // recording's; with it the flatness is that of a tone over a floor 60 dB down.
+    const auto bare = whole(ping), withFloor = whole(floored);
+    EXPECT_LT(bare.value[kFlatness], withFloor.value[kFlatness] - 10.0);
+    auto quiet = ping;
+    for (auto& v : quiet) v *= 0.01f;
+    addNoiseFloor(quiet, kFs, o);
+    const auto quietD = whole(quiet);
+    for (int k = 0; k < kDescriptorCount; ++k)
+        EXPECT_NEAR(withFloor.value[std::size_t(k)], quietD.value[std::size_t(k)],
+                    1e-3 * std::max(1.0, std::fabs(withFloor.value[std::size_t(k)])))
+            << descriptorInfo(k).key;
+}
+
 TEST(RealismDescriptors, GrainRateCountsClicks) {
     // 40 clicks (decaying 6 kHz bursts of 1 ms) per second over 0.5 s, on a faint noise floor.
     auto x = whiteNoise(0.5, 2, 1e-4);

@@ -98,6 +98,39 @@ TEST(RealismListener, NearestCentroidAndLeaveOneSourceOut) {
     EXPECT_THROW(leaveOneSourceOut(one), std::invalid_argument);
 }
 
+TEST(RealismListener, RendersAreJudgedByListenersThatNeverHeardASource) {
+    // Sources a and b hear gravel at 4; source c alone recorded gravel at 1, next to metal (0).
+    // A render at 1.2 (with a metal render at 0 and a water render at 8 beside it, so the renders'
+    // own median is 1.2 and centring leaves them in place relative to the recordings' median)
+    // is heard as gravel by the listener that knows c, as metal by the one trained without c.
+    std::mt19937 g(5);
+    std::vector<Example> rec;
+    for (const char* src : {"a", "b", "c"})
+        for (int i = 0; i < 3; ++i) {
+            rec.push_back(example(src, "metal", 0.0, g));
+            rec.push_back(example(src, "water", 8.0, g));
+        }
+    for (int i = 0; i < 3; ++i) rec.push_back(example("c", "gravel", 1.0, g));
+    const auto n = static_cast<std::size_t>(kDescriptorCount + 4);
+    const std::vector<Example> renders = {{"m", "synthetic", "", std::vector<double>(n, 0.0)},
+                                          {"g", "synthetic", "", std::vector<double>(n, 1.2)},
+                                          {"w", "synthetic", "", std::vector<double>(n, 8.0)}};
+    const ListenerOptions plain{false, true, true};
+    const auto heard = heardWithoutEachSource(rec, renders, plain);
+    ASSERT_EQ(heard.size(), 3u);
+    EXPECT_EQ(heard.at("a")[1], "gravel");
+    EXPECT_EQ(heard.at("b")[1], "gravel");
+    EXPECT_EQ(heard.at("c")[1], "metal") << "without c no source has gravel";
+    for (const auto& [src, h] : heard) {
+        EXPECT_EQ(h[0], "metal") << src;
+        EXPECT_EQ(h[2], "water") << src;
+    }
+    EXPECT_EQ(heardWithoutEachSource(rec, renders), heardWithoutEachSource(rec, renders));
+    EXPECT_THROW(heardWithoutEachSource(rec, {}), std::invalid_argument);
+    std::vector<Example> one = {example("a", "metal", 0, g)};
+    EXPECT_THROW(heardWithoutEachSource(one, renders), std::invalid_argument);
+}
+
 TEST(RealismRecordings, ManifestErrorsNameTheFileAndLine) {
     const auto dir = scratch("manifest");
     EXPECT_THROW(loadManifest(dir.string()), std::runtime_error); // missing

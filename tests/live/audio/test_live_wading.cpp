@@ -365,7 +365,7 @@ TEST(LiveWading, VirtualGaitStandsSilentWalksLouderWhenFasterAndDrivesTheShoes) 
     for (const auto& ch : still)
         for (float v : ch) ASSERT_EQ(v, 0.0f);
     // The virtual gait is audible, and faster walking (118 steps/min) is louder than slow (27),
-    // as offline (docs/wading.md, measured figures).
+    // as offline (docs/explanation/wading.md, measured figures).
     const auto slow = runVirtualWater(27, 6.0, eng::OutputModality::Audio);
     const auto fast = runVirtualWater(118, 6.0, eng::OutputModality::Audio);
     const double slowRms = rms(slow[0]) + rms(slow[1]), fastRms = rms(fast[0]) + rms(fast[1]);

@@ -1,10 +1,10 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""Why the listener hears a render in another category (docs/realism.md, "Heard in their
+"""Why the listener hears a render in another category (docs/explanation/realism.md, "Heard in their
 category: liquids, snows, leaves and underbrush").
 
     underfoot compare --listener --features features.csv
-    python3 realism/category_why.py features.csv [--all] [--surface ID ...]
+    python3 tools/research/category_why.py features.csv [--all] [--surface ID ...]
 
 Reads the per-file listener features written by `compare --features` and rebuilds the default
 listener of realism/Listener.cpp exactly (every source, the renders as source "synthetic"

@@ -1,9 +1,9 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""How the listener's configuration was chosen (docs/realism.md, "The listener").
+"""How the listener's configuration was chosen (docs/explanation/realism.md, "The listener").
 
     underfoot compare --listener --features features.csv
-    python3 realism/listener_grid.py features.csv [--by-category]
+    python3 tools/research/listener_grid.py features.csv [--by-category]
 
 Reads the per-file listener features written by `compare --features` and evaluates, leave-one-
 source-out on the recordings only, a small fixed grid: feature set (all, scalar descriptors

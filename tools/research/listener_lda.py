@@ -1,10 +1,10 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""A check that was not shipped (docs/realism.md, "The listener"): does a trained linear
+"""A check that was not shipped (docs/explanation/realism.md, "The listener"): does a trained linear
 classifier beat the nearest-centroid listeners on unseen sources?
 
     underfoot compare --listener --onset-listener --features steps.csv
-    python3 realism/listener_lda.py steps.csv
+    python3 tools/research/listener_lda.py steps.csv
 
 Reads every step's features (the 14 scalar descriptors, then the onset features), takes each
 file's per-feature median, centres every source on its own median (as the listeners do) and

@@ -4,13 +4,13 @@
 one panel per axis (voices, modes per voice, grain events/s), ns per output sample against the
 axis value on linear scales, the measured points joined by lines.
 
-    underfoot bench --only scaling | python3 scripts/plot_scaling.py > docs/scaling.svg
+    underfoot bench --only scaling | python3 tools/perf/plot_scaling.py > docs/scaling.svg
 
 With --pareto it reads `underfoot bench --only impact` instead and plots every impact setting's
 spectral distance to the reference against its ns per sample, the Pareto front (no other setting
 both cheaper and more accurate) joined by a line:
 
-    underfoot bench --only impact | python3 scripts/plot_scaling.py --pareto > docs/pareto.svg
+    underfoot bench --only impact | python3 tools/perf/plot_scaling.py --pareto > docs/pareto.svg
 """
 import math
 import sys

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""Coefficients of frictionCosHalfPi (engine/models/Friction.h), issue #18.
+"""Coefficients of frictionCosHalfPi (engine/models/Friction.h).
 
 cos(pi t / 2) for |t| <= 1 as Q(t^2): Q is the degree-8 Chebyshev interpolant of
 cos(pi sqrt(u) / 2) on [0, 1], computed in 60-digit decimal arithmetic and rounded to double.
@@ -8,7 +8,7 @@ Prints the coefficients of u^0 .. u^8 and the largest error of the double evalua
 scheme, exactly as in Friction.h; Python floats are IEEE doubles without FMA) against the decimal
 cosine on 8001 points of [-1, 1]. Python standard library only.
 
-    python3 scripts/friction_cos_fit.py
+    python3 tools/perf/friction_cos_fit.py
 """
 from decimal import Decimal, getcontext
 from math import comb

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""Instructions per 64-frame block of the shipped scenes (issue #18), counted by callgrind.
+"""Instructions per 64-frame block of the shipped scenes, counted by callgrind.
 
 The timed scene benchmark (`underfoot bench --only scenes`) moves by about +-0.3 in worst /
 median between runs on a shared machine; instruction counts do not move. This script runs
@@ -16,8 +16,8 @@ that what the reverb adds to a block is seen apart from the surfaces' strikes an
 per scene, what the worst block spends its instructions on beside a median block (inclusive and
 self instructions per function, from callgrind's call graph).
 
-    python3 scripts/scene_block_instructions.py             # every shipped scene, --seconds 5
-    python3 scripts/scene_block_instructions.py --scene wood_reverb --seconds 1 --top 12
+    python3 tools/perf/scene_block_instructions.py             # every shipped scene, --seconds 5
+    python3 tools/perf/scene_block_instructions.py --scene wood_reverb --seconds 1 --top 12
 
 It prints each valgrind command it runs (stderr), e.g.
 
@@ -43,7 +43,7 @@ import tempfile
 import time
 from concurrent.futures import ThreadPoolExecutor
 
-REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 VALGRIND_OPTIONS = [
     "--tool=callgrind",
     "--combine-dumps=yes",  # one file per scene, one part per block
@@ -450,7 +450,7 @@ def main(argv=None):
 
     print(f"### Instructions per 64-frame block (callgrind), walks of {2 * args.seconds:g} s\n")
     scene_args = "".join(f" --scene {s}" for s in args.scene)
-    print(f"`python3 scripts/scene_block_instructions.py --seconds {args.seconds:g}{scene_args}`"
+    print(f"`python3 tools/perf/scene_block_instructions.py --seconds {args.seconds:g}{scene_args}`"
           f" ({os.path.relpath(underfoot, REPO)}): {wall:.0f} s wall clock, "
           f"{min(max(1, args.jobs), len(scenes))} valgrind process(es) at a time.\n")
     print("| scene | reverb taps | blocks | median | p99 | worst | p99 / median | worst / median "
