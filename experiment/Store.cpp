@@ -155,7 +155,7 @@ void StudyStore::configure() {
                                      "this version reads up to {}",
                                      path_, version, kSchemaVersion));
     // A damaged or foreign file can carry any 32-bit user_version; only 0..kSchemaVersion are
-    // ours (a negative one used to index the migrations at -1, issue #16).
+    // ours (a negative one used to index the migrations at -1).
     if (version < 0)
         throw StoreError(fmt::format("{}: schema version {} is not one Underfoot ever wrote "
                                      "(expected 1 to {}); the file is damaged or not a study",
@@ -220,7 +220,7 @@ StudyStore StudyStore::open(const std::string& path, Clock clock, const Catalogu
                                      "`underfoot study create`",
                                      path));
     // Say plainly when this user may not write the study (SQLite would open it read-only, or
-    // fail to create its -wal/-shm files, with a misleading message; issue #16).
+    // fail to create its -wal/-shm files, with a misleading message).
     const std::string folder = std::filesystem::absolute(path).parent_path().string();
     if (::access(path.c_str(), R_OK) != 0)
         throw StoreError(
@@ -242,7 +242,7 @@ StudyStore StudyStore::open(const std::string& path, Clock clock, const Catalogu
     } catch (const SQLite::Exception& e) {
         throw StoreError(fmt::format("{}: not a readable study file ({})", path, e.what()));
     }
-    // A damaged file is refused before anything is written to it (issue #16).
+    // A damaged file is refused before anything is written to it.
     if (const std::string problems = quickCheck(*db, std::chrono::seconds(10)); !problems.empty())
         throw StoreError(fmt::format("{}: the study file is damaged (SQLite integrity check: {}); "
                                      "{}",

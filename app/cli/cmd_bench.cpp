@@ -105,7 +105,7 @@ eng::SceneBenchSpec sceneSpec(const SceneRow& row, const BenchArgs& a,
     return spec;
 }
 
-/// `--only scene-instructions` (issue #18): the instructions of every 64-frame block of the
+/// `--only scene-instructions`: the instructions of every 64-frame block of the
 /// shipped scenes, counted by callgrind, so that worst / median does not depend on the machine's
 /// load. Each scene runs once on the timed benchmark's input and seed (scene and background
 /// reset as before its first repeat); after each block callgrind's counts are dumped (and so
@@ -201,7 +201,7 @@ int runBench(const BenchArgs& a) {
         return 0;
     }
     if (a.only == "all" || a.only == "scenarios" || isScenario(a.only)) {
-        fmt::print("### Model scenarios (issue #18), 48 kHz, 64-frame blocks, per-block minimum "
+        fmt::print("### Model scenarios, 48 kHz, 64-frame blocks, per-block minimum "
                    "of {} runs\n\n",
                    a.repeats);
         fmt::print("| scenario | ns/sample | median block | p99 block | worst block | worst block "
@@ -216,7 +216,7 @@ int runBench(const BenchArgs& a) {
         fmt::print("\n");
     }
     if (a.only == "scaling") {
-        fmt::print("### Scaling (issue #18): ns per output sample, 48 kHz, 64-frame blocks, "
+        fmt::print("### Scaling: ns per output sample, 48 kHz, 64-frame blocks, "
                    "per-block minimum of {} runs of {:.1f} s\n\n",
                    a.repeats, a.seconds);
         fmt::print("| axis | value | ns/sample | per unit |\n|---|---:|---:|---:|\n");

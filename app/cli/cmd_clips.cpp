@@ -32,7 +32,7 @@ struct ClipsArgs {
 };
 
 /// --live: plays the clip folder's clips in protocol order through the configured device, each
-/// to its end; refuses with the reason when the device cannot be opened (issue #17: an option
+/// to its end; refuses with the reason when the device cannot be opened (an option
 /// that promises sound plays it or says why not).
 void playClips(const ClipsArgs& a, const std::vector<exp::ClipJob>& jobs) {
     eng::AudioSettings settings;

@@ -186,7 +186,7 @@ CommandRegistrar regSurfaces("surfaces", [](CLI::App& app, int& exitCode) {
             if (*verbose) {
                 for (const auto& l : s.layerPurposes) fmt::print("    layer {}\n", l);
                 // Keep the surface alive while iterating: a range-for over a member of a
-                // temporary reads freed memory (issue #16).
+                // temporary reads freed memory.
                 const auto surface = eng::Surface::load(s.file);
                 for (const auto& p : surface->parameters())
                     fmt::print("      {:<36} {:>12g} {:<14} [{:g}, {:g}]  {}\n", p.path, p.value,

@@ -124,7 +124,7 @@ ReplayRender renderTrialReplay(const ReplayRequest& q) {
     std::optional<fs::path> recording;
     LiveMeters live;
     // A simulated participant's sensor trial: its feet were a virtual walker whose parameters
-    // the trial stores as text (issue #17).
+    // the trial stores as text.
     std::optional<exp::SimulatedWalker> simulatedWalker;
     if (info.grfRecording) {
         try {
@@ -162,7 +162,7 @@ ReplayRender renderTrialReplay(const ReplayRequest& q) {
                 recording ? fs::path(recording->string() + ".arrivals.csv") : fs::path();
             if (recording && fs::exists(arrivals)) {
                 // Each frame at the sample where the live node applied it, at the live block
-                // size: the samples the node rendered (issue #17).
+                // size: the samples the node rendered.
                 out.audio = eng::renderWadingArrivals(
                     options, eng::readGaitArrivals(arrivals.string()), out.blockSize);
                 source = fmt::format("recorded gait arrivals {} (block {})", arrivals.string(),

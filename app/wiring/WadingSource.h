@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
-/// Wading stimuli (`surface = "water"`, STUDIES.md §4) for the live scene: the wading node a
-/// stimulus asks for, fed by the live gyroscopes (a stimulus whose input is the gyro sensor) or
-/// by the virtual gait at the stimulus's cadence (`wading = { cadence = ... }`).
+/// Wading stimuli (`surface = "water"`; the wading study, docs/explanation/studies.md) for the live
+/// scene: the wading node a stimulus asks for, fed by the live gyroscopes (a stimulus whose input
+/// is the gyro sensor) or by the virtual gait at the stimulus's cadence
+/// (`wading = { cadence = ... }`).
 ///
 /// LivePlayer use (describeStimulus): when isWadingStimulus(s), set
 /// `description.wading = makeWadingNode(s, seed, receiver)` instead of a GRF control, record no

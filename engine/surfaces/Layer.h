@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
-/// A surface is a sum of layers (MODELS.md "Surfaces"): impact and friction layers for solid
+/// A surface is a sum of layers (docs/explanation/models.md): impact and friction layers for solid
 /// floors, stochastic granular layers for aggregates, bubble layers for liquids. Every layer is
 /// driven by the same control signal, the vertical ground reaction force in newtons, sample by
 /// sample, and adds its sound into a mono buffer.

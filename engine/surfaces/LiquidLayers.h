@@ -15,7 +15,7 @@
 ///  - wake: when the foot leaves (the load falls below contact_threshold_n) a motion envelope
 ///    starts at the speed of the release (|dF/dt| / 10 kN/s, clamped to [0.25, 2]) and decays with
 ///    time constant wake_ms: bubbles at wake_bubbles_hz x envelope (drips from the shoe in a
-///    puddle; the leg swinging through the water when wading, STUDIES.md §4);
+///    puddle; the leg swinging through the water when wading, the wading study);
 ///  - slosh: low band-pass noise (slosh_hz) following the motion (|dF/dt| / 10 kN/s, smoothed, plus
 ///    the wake envelope): the mass of water being displaced.
 /// A load appearing from no contact by more than 100 N within one sample (a GRF starting

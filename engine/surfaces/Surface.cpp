@@ -139,7 +139,7 @@ std::unique_ptr<Surface> Surface::loadById(const std::string& idOrPath,
         return load(idOrPath, options);
     const std::string file = surfacesDirectory() + "/" + idOrPath + ".toml";
     if (!fs::exists(file)) {
-        // Sorted, with the closest id suggested (issue #17).
+        // Sorted, with the closest id suggested.
         std::vector<std::string> names;
         for (const auto& e : fs::directory_iterator(surfacesDirectory()))
             if (e.path().extension() == ".toml") names.push_back(e.path().stem().string());

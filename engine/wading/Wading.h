@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
-/// Public rendering API of the wading simulation (STUDIES.md §4, gait sonification paper 004):
+/// Public rendering API of the wading simulation (the wading study, docs/explanation/studies.md):
 /// what the studies (experiment/, the listening-test mode) and the CLI call. Everything here runs
 /// the same WadingScene as the live path, block by block; the same options and seed give
 /// byte-identical audio.

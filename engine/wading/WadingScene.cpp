@@ -356,8 +356,8 @@ void WadingScene::process(const TimedGaitFrame* frames, int frameCount, float* l
         int end = n;
         if (fi < frameCount) end = std::min(n, std::max(pos + 1, frames[fi].offset));
         // The chunk controls are decided on a fixed grid of kChunk samples counted from reset,
-        // never where a host block starts, so the output does not depend on the block size
-        // (issue #18); a frame still takes effect at its own sample (the per-sample ramps).
+        // never where a host block starts, so the output does not depend on the block size;
+        // a frame still takes effect at its own sample (the per-sample ramps).
         const int phase = static_cast<int>((sample_ + pos) % kChunk);
         if (phase == 0) chunkControls();
         const int len = std::min(end - pos, kChunk - phase);

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
-/// The wading scene: gait frames in, stereo water out (STUDIES.md §4, gait sonification paper).
+/// The wading scene: gait frames in, stereo water out (the wading study,
+/// docs/explanation/studies.md).
 ///
 ///   GaitFrame (100 Hz) -> WadingControl (v1 | v2) -> per-layer, per-side gains, EQ gain, rate
 ///     -> ControlRamp (linear over one frame period, from the sample where the frame arrives)

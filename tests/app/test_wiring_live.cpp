@@ -252,7 +252,7 @@ TEST(Wiring, WaterStimulusPlaysTheWadingNodeAndRecordsItsGait) {
     double swing = 0;
     for (const auto& f : gait) swing = std::max(swing, f[eng::Limb::LeftThigh]);
     EXPECT_GT(swing, 50.0) << "the recorded virtual gait swings";
-    // Beside it, what reproduces the node exactly (issue #17): the same frames with the samples
+    // Beside it, what reproduces the node exactly: the same frames with the samples
     // at which they took effect, and the live block size for the replay.
     const auto recording = (study / *start.grfRecording).string();
     const auto arrivals = eng::readGaitArrivals(recording + ".arrivals.csv");

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The grains' energy bound (issue #13, docs/explanation/realism.md "Levels"): the summed amplitude of the
+// The grains' energy bound (docs/explanation/realism.md "Levels"): the summed amplitude of the
 // grains ringing at once never exceeds amplitude_cap, a grain's energy scale saturates softly at
 // energy_saturation, nothing changes below them, the bound is block-size independent and
 // deterministic, and process() still does not allocate.

@@ -271,7 +271,7 @@ TEST(GranularSurfaces, SurfacesAreDistinctByTheNumbers) {
     // impacts (measured 589 vs 1177 events per step).
     EXPECT_LT(at("deep_snow").eventsPerStep, 0.6 * at("gravel").eventsPerStep);
     // Recorded sand steps are lower, sparser and shorter than recorded snow steps (`underfoot
-    // compare` medians: centroid 329 vs 558 Hz, 38 vs 61 grains/s; issue #13, docs/explanation/realism.md
+    // compare` medians: centroid 329 vs 558 Hz, 38 vs 61 grains/s; docs/explanation/realism.md
     // "Heel-driven grains and several starts"): sand's grains now come from the heel's impact
     // alone, below deep snow (measured 371 vs 440 Hz, 59 vs 589 events per step, 0.00 vs 0.72
     // of the step's energy after 0.2 s). Before, sand was the brighter, denser one (1073 vs

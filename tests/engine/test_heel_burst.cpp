@@ -147,7 +147,7 @@ TEST(HeelBurst, EventsFollowTheEnvelopeFromTheContact) {
         const auto ev = observe(layer, grf);
         for (std::size_t k = 0; k < ev.times.size(); ++k) {
             // The model runs from the contact (the layer sleeps before it and wakes at its first
-            // sample in contact, whatever the block: issue #18), so its times count from there.
+            // sample in contact, whatever the block), so its times count from there.
             const double t = ev.times[k]; // since the contact
             ASSERT_GE(t, 0.0) << "an event before the contact";
             ASSERT_LE(t, T + 10 * D + 1e-3) << "an event after the burst's end";

@@ -20,7 +20,8 @@
 using namespace underfoot::engine;
 
 namespace {
-// Every surface of the studies' answer lists (STUDIES.md) plus the reverb variants.
+// Every surface of the studies' answer lists (docs/explanation/studies.md) plus the reverb
+// variants.
 const std::vector<std::string> kAnswerListSurfaces = {"beach_sand",
                                                       "gravel",
                                                       "dirt_pebbles",

@@ -166,7 +166,7 @@ TEST(ExperimentCrash, SigkillAtRandomPointsLosesNoAcknowledgedAnswer) {
     for (const auto& [code, index] : acknowledged) EXPECT_TRUE(after.trial(code, index).answered);
 }
 
-// The SIGKILL soak of issue #16 (label soak; run by ctest -L soak, not in the default run):
+// The SIGKILL soak (label soak; run by ctest -L soak, not in the default run):
 // hundreds of kills at random moments (start-up, registration, inside commits, mid-session),
 // then every acknowledged answer must be present once and as typed: answered exactly once in
 // the journal (no "answer_changed"), the stored answer equal to the journaled one.

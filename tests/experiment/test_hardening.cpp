@@ -44,7 +44,7 @@ TEST(StoreHardening, UnknownSchemaVersionsAreRefusedWithTheFileName) {
     EXPECT_EQ(openError(path), "");
 }
 
-// ---- Store faults (issue #16): each counts the acknowledged answers before and after. ----------
+// ---- Store faults: each counts the acknowledged answers before and after. ----------
 
 #include <fmt/format.h>
 
@@ -386,7 +386,7 @@ TEST(StoreFaults, ReadOnlyFileAndFolderNameTheFileAndTheCause) {
     EXPECT_EQ(answersOf(s, "P1"), expectedAnswers(2));
 }
 
-// ---- Read-only open mode (issue #16): an archived study still exports and analyzes. ---------
+// ---- Read-only open mode: an archived study still exports and analyzes. ---------
 
 #include "experiment/Export.h"
 

@@ -134,7 +134,7 @@ TEST(Honest, ExportFlagsSimulatedRowsAndNumbersTrialsFromOne) {
     std::ostringstream participants;
     EXPECT_EQ(writeParticipantsCsv(store, participants, SimulatedRows::Exclude), 1);
     {
-        // participants.csv and ratings.csv carry the flag too (issue #17).
+        // participants.csv and ratings.csv carry the flag too.
         std::ostringstream everyone;
         EXPECT_EQ(writeParticipantsCsv(store, everyone, SimulatedRows::Include), 2);
         const auto p = csvRows(everyone.str());

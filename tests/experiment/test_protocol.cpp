@@ -56,7 +56,7 @@ TEST(ExperimentProtocol, Tvcg2011Exp2GroupsAndPairsFollowStudies) {
     EXPECT_EQ(generatePlan(p, "none", 1, 0).size(), 10u);
     EXPECT_EQ(generatePlan(p, "coherent", 1, 0).size(), 10u);
     EXPECT_EQ(generatePlan(p, "incoherent", 1, 0).size(), 12u);
-    // Coherent pairs (STUDIES.md §2).
+    // Coherent pairs (Nordahl et al. 2011, exp. 2).
     const std::vector<std::pair<std::string, std::string>> coherent = {
         {"beach_sand", "beach_summer"},
         {"gravel", "farm_courtyard"},
@@ -81,7 +81,7 @@ TEST(ExperimentProtocol, Tvcg2011Exp2GroupsAndPairsFollowStudies) {
         EXPECT_EQ(s->soundscape, incoherent[i].second);
     }
     for (const auto& sid : p.groups[0].stimuli) EXPECT_FALSE(p.stimulus(sid)->soundscape);
-    // Answer letters a..p as in STUDIES.md §2.
+    // Answer letters a..p as in Nordahl et al. 2011, exp. 2.
     const auto& o = p.questions.surfaceOptions;
     ASSERT_EQ(o.size(), 16u);
     EXPECT_EQ(o[0].letter, 'a');

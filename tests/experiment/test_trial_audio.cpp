@@ -61,10 +61,10 @@ void downgrade(const std::string& path, int version) {
          {"clip_file", "clip_seconds", "clip_frames", "clip_sample_rate_hz", "clip_sha256"})
         db.exec(std::string("ALTER TABLE trials DROP COLUMN ") + column);
     db.exec("DROP TABLE IF EXISTS session_leases"); // version 6's
-    db.exec("DROP TABLE IF EXISTS online_answers"); // version 5's (issue #14)
+    db.exec("DROP TABLE IF EXISTS online_answers"); // version 5's
     db.exec("DROP TABLE IF EXISTS online_sessions");
     db.exec("DROP TABLE IF EXISTS online_invitations");
-    db.exec("ALTER TABLE participants DROP COLUMN simulated"); // version 4's (issue #17)
+    db.exec("ALTER TABLE participants DROP COLUMN simulated"); // version 4's
     db.exec("ALTER TABLE sessions DROP COLUMN sound_played");
     for (const char* column :
          {"audio_sample_rate_hz", "audio_block_size", "audio_frames", "audio_xruns",
