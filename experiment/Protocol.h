@@ -2,9 +2,10 @@
 #pragma once
 /// Experiment protocols: what is presented, to whom, in which order, and what is asked.
 ///
-/// A protocol is a TOML file (protocols/*.toml; the format is documented in docs/reference/protocol.md).
-/// Loading validates everything against a catalogue of known surface / soundscape ids and reports
-/// every problem found, each with file:line:column and what was expected.
+/// A protocol is a TOML file (protocols/*.toml; the format is documented in
+/// docs/reference/protocol.md). Loading validates everything against a catalogue of known surface /
+/// soundscape ids and reports every problem found, each with file:line:column and what was
+/// expected.
 #include "experiment/Catalogue.h"
 
 #include <cstdint>

@@ -3,8 +3,8 @@
 /// How simulated participants rate stimuli on scales: for each scale a base value, an effect
 /// per factor level, per stimulus and per participant-field answer, a participant bias and a
 /// trial noise (all in scale points), rounded and clamped to the scale. Read from a TOML file
-/// (format in docs/reference/protocol.md, "Rating models"), so that simulated studies show the effects
-/// a lab expects and the analysis can be checked against them.
+/// (format in docs/reference/protocol.md, "Rating models"), so that simulated studies show the
+/// effects a lab expects and the analysis can be checked against them.
 #include "experiment/Protocol.h"
 
 #include <map>

@@ -2,10 +2,10 @@
 #pragma once
 /// The realism distance between synthetic steps and recorded steps.
 ///
-/// Definition (documented in docs/explanation/realism.md): for every scalar descriptor d, take the median
-/// of the synthetic steps, m_s, and the median m_r and interquartile range IQR_r of the recorded
-/// steps, all on the descriptor's comparison scale (log2 for frequencies, rates and times, i.e.
-/// octaves; dB as they are). Its robust z-score is
+/// Definition (documented in docs/explanation/realism.md): for every scalar descriptor d, take the
+/// median of the synthetic steps, m_s, and the median m_r and interquartile range IQR_r of the
+/// recorded steps, all on the descriptor's comparison scale (log2 for frequencies, rates and times,
+/// i.e. octaves; dB as they are). Its robust z-score is
 ///     z_d = |m_s - m_r| / clamp(IQR_r / 1.349, s_d, 2 s_d)
 /// (IQR / 1.349 is the standard deviation of a normal distribution with that IQR). The scale
 /// s_d is a tolerance a listener would grant (0.5 octave for frequencies, rates and times, 3 dB

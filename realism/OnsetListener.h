@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
-/// The listener on onset features (docs/explanation/realism.md, "The listener"): trained on recorded
-/// footsteps only, meant to name the material and category of a file from a source it never
-/// saw (another library, a lab, the renders).
+/// The listener on onset features (docs/explanation/realism.md, "The listener"): trained on
+/// recorded footsteps only, meant to name the material and category of a file from a source it
+/// never saw (another library, a lab, the renders).
 ///
 /// Every step of a file is described by the 14 scalar descriptors (realism/Descriptors.h, on
 /// their comparison scale) and the onset features (realism/OnsetFeatures.h); a file's vector is

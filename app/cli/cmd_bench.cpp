@@ -313,13 +313,14 @@ CommandRegistrar reg("bench", [](CLI::App& app, int& exitCode) {
                                         "surfaces",  "scenes",  "impact-default",
                                         "scenarios", "scaling", "scene-instructions"};
     for (const auto& id : eng::scenarioIds()) choices.push_back(id);
-    cmd->add_option("--only", args->only,
-                    "all, impact, knobs, surfaces, scenes, scenarios, scaling (not in all), "
-                    "impact-default (for callgrind), scene-instructions (instructions per block "
-                    "of the shipped scenes; under callgrind: tools/perf/scene_block_instructions.py), "
-                    "or one scenario: impact-strikes, "
-                    "impact-pressed, impact-metal, friction-creak, aggregate-gravel, bubbles, "
-                    "aggregate-gravel-1voice")
+    cmd->add_option(
+           "--only", args->only,
+           "all, impact, knobs, surfaces, scenes, scenarios, scaling (not in all), "
+           "impact-default (for callgrind), scene-instructions (instructions per block "
+           "of the shipped scenes; under callgrind: tools/perf/scene_block_instructions.py), "
+           "or one scenario: impact-strikes, "
+           "impact-pressed, impact-metal, friction-creak, aggregate-gravel, bubbles, "
+           "aggregate-gravel-1voice")
         ->check(CLI::IsMember(choices))
         ->capture_default_str();
     cmd->add_option("--repeats", args->repeats,

@@ -200,9 +200,8 @@ int runFit(FitArgs& a) {
 
 CommandRegistrar reg("fit", [](CLI::App& app, int& exitCode) {
     auto args = std::make_shared<FitArgs>();
-    auto* cmd = app.add_subcommand(
-        "fit",
-        "Fit a surface preset to recorded footsteps (analysis by synthesis; docs/explanation/realism.md)");
+    auto* cmd = app.add_subcommand("fit", "Fit a surface preset to recorded footsteps (analysis by "
+                                          "synthesis; docs/explanation/realism.md)");
     cmd->add_option("-s,--surface", args->surface, "surface id or preset .toml");
     cmd->add_option("--real", args->real,
                     "recorded footsteps: files or folders (default: the recordings cache, "

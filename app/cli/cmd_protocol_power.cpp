@@ -240,10 +240,11 @@ int runRatingPower(const PowerArgs& a, const Protocol& p) {
     std::string modelFile = a.ratingModel;
     if (modelFile.empty()) {
         if (p.simulation.ratingModel.empty())
-            throw underfoot::cli::UserError(fmt::format(
-                "{}: protocol {} asks no surface question and names no rating model in "
-                "[simulation]; give --rating-model FILE (docs/reference/protocol.md, \"Rating models\")",
-                a.file, p.id));
+            throw underfoot::cli::UserError(
+                fmt::format("{}: protocol {} asks no surface question and names no rating model in "
+                            "[simulation]; give --rating-model FILE (docs/reference/protocol.md, "
+                            "\"Rating models\")",
+                            a.file, p.id));
         try {
             modelFile = findProtocolFile(p, p.simulation.ratingModel, a.file);
         } catch (const std::runtime_error& e) {

@@ -135,9 +135,10 @@ extern const double kFrictionExp2Table[256];
 /// cos(pi t / 2) for |t| <= 1, absolute error < 1e-15. Deterministic (no FMA, no libm).
 [[gnu::always_inline]] inline double frictionCosHalfPi(double t) noexcept {
     // Q(t^2), Q the degree-8 Chebyshev interpolant of cos(pi sqrt(u) / 2) on [0, 1] (nodes and
-    // coefficients in 60-digit decimal arithmetic, rounded to double: tools/perf/friction_cos_fit.py).
-    // Evaluated as here, 3.1e-16 at most against libm over the test's 2,000,001 points.
-    // Estrin's scheme, as frictionSinHalfPi: both can run side by side from the same u.
+    // coefficients in 60-digit decimal arithmetic, rounded to double:
+    // tools/perf/friction_cos_fit.py). Evaluated as here, 3.1e-16 at most against libm over the
+    // test's 2,000,001 points. Estrin's scheme, as frictionSinHalfPi: both can run side by side
+    // from the same u.
     const double u = t * t, u2 = u * u, u4 = u2 * u2;
     const double q01 = 1.0 - 1.233700550136169 * u;
     const double q23 = 0.25366950790103104 - 0.02086348076317886 * u;

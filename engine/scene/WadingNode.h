@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
-/// The live scene's wading node (the wading study; docs/explanation/wading.md "Live"): a WadingScene fed by a
-/// gait source on the audio thread. It replaces the GRF control and the surface voices when a
-/// stimulus walks through water (surface "water").
+/// The live scene's wading node (the wading study; docs/explanation/wading.md "Live"): a
+/// WadingScene fed by a gait source on the audio thread. It replaces the GRF control and the
+/// surface voices when a stimulus walks through water (surface "water").
 ///
 /// Gait sources (all pulled once per audio block, allocation-free):
 ///  - LiveGyroGaitSource: GyroSamples popped from an OscGyroReceiver's SPSC queue, folded into

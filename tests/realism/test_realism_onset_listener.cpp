@@ -212,8 +212,8 @@ struct NestedFloor {
     int heldOut, material, category; ///< the nested estimate as measured
     const char* chosen;              ///< the grid's choice on all the sources
 };
-// Counts measured without the analysis noise floor (docs/explanation/realism.md, "The listener"); the
-// seven-source choice is the one made with the floor 60 dB below the loudest 2 ms
+// Counts measured without the analysis noise floor (docs/explanation/realism.md, "The listener");
+// the seven-source choice is the one made with the floor 60 dB below the loudest 2 ms
 // (AnalysisOptions::noiseFloorDb), which this test runs with: `underfoot compare --listener
 // --onset-listener` prints it as "chosen on all sources".
 constexpr NestedFloor kNestedFloors[] = {{90, 4, 83, 22, 53, "scalars/centred/step-vote"},
