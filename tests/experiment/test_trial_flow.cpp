@@ -318,3 +318,61 @@ TEST(TrialFlow, ExperimenterPauseHoldsEverythingAndIsJournaled) {
     EXPECT_EQ(paused, 1);
     EXPECT_EQ(resumed, 1);
 }
+
+// The protocol's rules are the trial core's: the answer the store would take as it is (see
+// ExperimentStore.KeepsOnlyTheSchemaNotTheProtocol) is refused here, with every reason, and
+// nothing is stored.
+TEST(TrialFlow, ProtocolRulesAreTheTrialCoresNotTheStores) {
+    TempDir dir;
+    StudyStore store = StudyStore::create(
+        dir.file("p.db"), loadProtocol(shipped("tvcg2011_exp2.toml")), {"P", "lab", 3, "t"});
+    NewParticipant np{"P01", {}, "", "", "", {}, ""};
+    np.groupOverride = "coherent";
+    np.overrideReason = "test";
+    store.registerParticipant(np);
+    FakePlayer player;
+    Session session(store, "P01", player, {});
+    TrialFlow flow(store, session);
+    session.finishBriefing();
+    flow.reset();
+    ASSERT_TRUE(flow.start());
+    TrialAnswer bad;
+    bad.answer = "lava";
+    bad.ratings["realism"] = 8;
+    const int index = session.current().index;
+    const FlowResult r = flow.submit(bad);
+    EXPECT_EQ(r.refusal, Refusal::Incomplete);
+    for (const char* why :
+         {"'lava' is not an option of the answer list", "rating 'realism' is 8; expected 1 to 7",
+          "the rating 'quality' is missing", "the soundscape answer is missing"})
+        EXPECT_NE(r.message.find(why), std::string::npos) << why << " in: " << r.message;
+    EXPECT_FALSE(store.trial("P01", index).answered);
+    EXPECT_TRUE(session.playing()) << "the trial stays current";
+}
+
+// The lock rule holds across sessions: once a later trial started (then the session was
+// interrupted), the earlier answer is neither offered for a change nor stored as one.
+TEST(TrialFlow, LockRuleCountsTrialsStartedInAnEarlierSession) {
+    TempDir dir;
+    StudyStore store = makeStudy(dir, "next_trial");
+    FakePlayer player;
+    {
+        Session session(store, "P1", player, {});
+        TrialFlow flow(store, session);
+        session.finishBriefing();
+        flow.reset();
+        ASSERT_TRUE(flow.start());
+        flow.chooseLetter('a');
+        flow.typeDigit(2);
+        flow.typeDigit(5);
+        ASSERT_TRUE(flow.commit());
+        ASSERT_TRUE(flow.start()); // the next trial's stimulus starts, then the session stops
+        session.interrupt();
+    }
+    Session again(store, "P1", player, {});
+    TrialFlow flow(store, again);
+    ASSERT_TRUE(again.resumed());
+    const FlowResult r = flow.revisePrevious();
+    EXPECT_EQ(r.refusal, Refusal::Locked);
+    EXPECT_NE(r.message.find("lock = \"next_trial\""), std::string::npos) << r.message;
+}
