@@ -222,6 +222,29 @@ class TrialFlow {
     /// Whether the current lap is a silent baseline lap being walked.
     bool silentLapNow() const;
 
+    // A text front end (the terminal): what it prints and asks, and how a typed line is read
+    // (TrialFlowText.cpp). The terminal prints these and forwards the lines typed.
+
+    /// "Press Enter to play the clip. " / "Press Enter to start the stimulus. " while the current
+    /// trial's stimulus has not started; "" otherwise.
+    std::string startPrompt() const;
+    /// "Lap 2 of 6 (silent baseline). Press Enter when it is walked. " while a lap of the current
+    /// condition is being walked; "" when none is (no laps, not started, every lap walked).
+    std::string lapPrompt() const;
+    /// The lines printed before section `index` is asked: an answer list's prompt and options
+    /// ("  a. Wood"); none for a scale (its prompt is the input prompt).
+    std::vector<std::string> sectionLines(int index) const;
+    /// The input prompt of section `index` ("Realism [1 not at all .. 7 completely]> ",
+    /// "letter> ", "letter (r: listen again)> ").
+    std::string sectionInputPrompt(int index) const;
+    /// One typed line for section `index`: a letter of its answer list, a whole number on its
+    /// scale, or "r" to hear a listening-test clip again. Refused with what was expected.
+    FlowResult typeLine(int index, const std::string& line);
+    /// Whether section `index` of the draft has its answer.
+    bool sectionAnswered(int index) const;
+    /// "comment (Enter for none)> " when the protocol takes a comment, else "".
+    std::string commentPrompt() const;
+
     /// What the participant's screen shows now.
     ParticipantScreen participantScreen() const;
     /// The briefing for the participant, made from the protocol's questions and ordering.
