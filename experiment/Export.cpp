@@ -81,7 +81,11 @@ int writeTrialsCsv(const StudyStore& store, std::ostream& out, ExportScope scope
                            t.startedAt,
                            t.answeredAt,
                            std::to_string(t.index + 1),
-                           p.simulated ? "1" : "0"});
+                           p.simulated ? "1" : "0",
+                           t.clip ? t.clip->file : "",
+                           t.clip ? std::to_string(t.clip->frames) : "",
+                           t.clip ? fmt::format("{}", t.clip->sampleRateHz) : "",
+                           t.clip ? t.clip->samplesSha256 : ""});
             ++rows;
         }
     }
@@ -270,7 +274,15 @@ void writeCodebook(const StudyStore& store, std::ostream& out) {
          "in the session, `underfoot replay --trial 3`)"},
         {"simulated", "0/1",
          "1 for a synthetic participant of `underfoot session --simulate` (not a person; left "
-         "out of `underfoot analyze` unless --include-simulated)"}};
+         "out of `underfoot analyze` unless --include-simulated)"},
+        {"clip_file", "text",
+         "the clip a listening-test trial played, relative to the clip folder (empty for live "
+         "and booth trials without a clip); its seed is `render_seed`"},
+        {"clip_frames", "integer", "frames of the clip file"},
+        {"clip_rate", "Hz", "sample rate of the clip file"},
+        {"clip_sha256", "hex text",
+         "SHA-256 of the clip's float32 samples (`underfoot replay` renders the trial again and "
+         "compares)"}};
     for (const auto& r : rows) out << fmt::format("| `{}` | {} | {} |\n", r[0], r[1], r[2]);
     out << "\n## ratings.csv — one row per rating\n\n"
            "Columns: study, participant, group, trial_index, stimulus_id, practice, excluded, "

@@ -14,7 +14,7 @@
 namespace underfoot::experiment {
 
 /// The columns of the long-format trials CSV, in order.
-inline constexpr std::array<std::string_view, 32> kTrialColumns = {"study",
+inline constexpr std::array<std::string_view, 36> kTrialColumns = {"study",
                                                                    "site",
                                                                    "protocol_id",
                                                                    "protocol_hash",
@@ -45,7 +45,11 @@ inline constexpr std::array<std::string_view, 32> kTrialColumns = {"study",
                                                                    "started_at",
                                                                    "answered_at",
                                                                    "trial",
-                                                                   "simulated"};
+                                                                   "simulated",
+                                                                   "clip_file",
+                                                                   "clip_frames",
+                                                                   "clip_rate",
+                                                                   "clip_sha256"};
 
 /// Which trials are written.
 enum class ExportScope { Answered, All };

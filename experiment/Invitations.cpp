@@ -121,7 +121,7 @@ std::vector<NewInvitation> Invitations::create(StudyStore& store, int count,
         out.push_back(std::move(inv));
     }
     tx.commit();
-    store.journal("online_invited", "", std::nullopt,
+    store.journal(JournalEvent::OnlineInvited, "", std::nullopt,
                   jsonObject({{"count", std::to_string(count)},
                               {"first", out.front().participantCode},
                               {"last", out.back().participantCode},

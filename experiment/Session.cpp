@@ -49,7 +49,7 @@ Session::Session(StudyStore& store, std::string participantCode, StimulusPlayer&
     position_ = static_cast<std::size_t>(*first);
     resumed_ = *first > 0;
     if (resumed_) {
-        store_.journal("session_resumed", participantCode, *first,
+        store_.journal(JournalEvent::SessionResumed, participantCode, *first,
                        jsonObject({{"session", std::to_string(sessionNumber_)}}));
         phase_ = trials_[position_].practice ? SessionPhase::Practice : SessionPhase::Trial;
     }
@@ -74,7 +74,7 @@ int Session::answeredCount() const {
 void Session::finishBriefing() {
     if (phase_ != SessionPhase::Briefing)
         throw std::logic_error(fmt::format("finishBriefing() in phase {}", toString(phase_)));
-    store_.journal("briefing_done", participant_.code, std::nullopt,
+    store_.journal(JournalEvent::BriefingDone, participant_.code, std::nullopt,
                    jsonObject({{"session", std::to_string(sessionNumber_)}}));
     phase_ = trials_[position_].practice ? SessionPhase::Practice : SessionPhase::Trial;
 }
@@ -133,7 +133,6 @@ void Session::answer(const TrialAnswer& answer) {
         trials_[position_].answered = true;
         trials_[position_].answer = answer;
         trials_[position_].responseTimeS = rt;
-        pending_.clear();
         advance();
     };
     try {
@@ -157,7 +156,8 @@ void Session::advance() {
     }
     if (breakNow) {
         phase_ = SessionPhase::Break;
-        store_.journal("break_started", participant_.code, trials_[position_ - 1].index, "{}");
+        store_.journal(JournalEvent::BreakStarted, participant_.code, trials_[position_ - 1].index,
+                       "{}");
         return;
     }
     phase_ = trials_[position_].practice ? SessionPhase::Practice : SessionPhase::Trial;
@@ -166,7 +166,7 @@ void Session::advance() {
 void Session::finishBreak() {
     if (phase_ != SessionPhase::Break)
         throw std::logic_error(fmt::format("finishBreak() in phase {}", toString(phase_)));
-    store_.journal("break_ended", participant_.code, std::nullopt, "{}");
+    store_.journal(JournalEvent::BreakEnded, participant_.code, std::nullopt, "{}");
     phase_ = trials_[position_].practice ? SessionPhase::Practice : SessionPhase::Trial;
 }
 
@@ -197,10 +197,9 @@ void Session::sensorFault(const std::string& reason) {
         ++trials_[position_].interruptions;
         trials_[position_].interruptionReason = pauseReason_;
     } else {
-        store_.journal("sensor_fault", participant_.code, t.index,
+        store_.journal(JournalEvent::SensorFault, participant_.code, t.index,
                        jsonObject({{"reason", pauseReason_}}));
     }
-    pending_.clear();
 }
 
 bool Session::checkSensors() {
@@ -213,7 +212,7 @@ void Session::resumeAfterFault() {
     if (!paused_) return;
     if (const auto fault = player_.sensorFault())
         throw std::logic_error(fmt::format("the sensor still fails: {}", *fault));
-    store_.journal("sensor_restored", participant_.code, trials_[position_].index,
+    store_.journal(JournalEvent::SensorRestored, participant_.code, trials_[position_].index,
                    jsonObject({{"fault", pauseReason_}}));
     paused_ = false;
     pauseReason_.clear();
@@ -254,38 +253,6 @@ void Session::presentClip() {
 
 int Session::replayCount() const {
     return current().replays;
-}
-
-void Session::rate(const std::string& scaleId, int value) {
-    const TrialRecord& t = current();
-    if (!playing_)
-        throw std::logic_error(
-            fmt::format("rate() for trial {} before its clip was presented", t.index + 1));
-    for (const Scale* s : askedScales()) {
-        if (s->id != scaleId) continue;
-        if (!ratingInRange(*s, value)) // the trial core's rule (TrialFlow.h)
-            throw StoreError(fmt::format("participant '{}' trial {}: rating '{}': {}",
-                                         participant_.code, t.index + 1, scaleId,
-                                         ratingRangeProblem(*s, value)));
-        pending_[scaleId] = value;
-        return;
-    }
-    throw StoreError(fmt::format("participant '{}' trial {}: scale '{}' is not asked in this "
-                                 "trial",
-                                 participant_.code, t.index + 1, scaleId));
-}
-
-bool Session::ratingsComplete() const {
-    for (const Scale* s : askedScales())
-        if (!pending_.count(s->id)) return false;
-    return true;
-}
-
-void Session::submitRatings(const std::string& comment) {
-    TrialAnswer a;
-    a.ratings = pending_;
-    a.comment = comment;
-    answer(a);
 }
 
 int Session::lapCount() const {

@@ -92,8 +92,10 @@ class Session {
     /// Starts the current trial's stimulus and stores the start (the player reports the render
     /// seed and recording it used); if storing fails the stimulus is stopped and the error thrown.
     void play();
-    /// Commits the answer (durably), stops the stimulus and advances. Throws StoreError for an
-    /// invalid answer; the trial then stays current and keeps playing. When the answer was
+    /// Commits the answer (durably), stops the stimulus and advances. It does not check the
+    /// answer against the protocol: TrialFlow::commit() does, before it calls this (every front
+    /// end and the simulation answer through TrialFlow). Throws StoreError when the store
+    /// refuses the write; the trial then stays current and keeps playing. When the answer was
     /// stored but the checkpoint after it failed, it advances first and then throws
     /// AnswerSavedButNotCopied, so that the view shows the warning and never asks again.
     void answer(const TrialAnswer& answer);
@@ -124,19 +126,11 @@ class Session {
     /// The scales asked after the current trial (one per block with per-scale blocks).
     std::vector<const Scale*> askedScales() const;
     /// Presents the current trial's clip: the first call starts it (as play()); every later call
-    /// replays it from the start, counted and journaled (refused when [clips] replay = false).
+    /// replays it from the start, counted and journaled (whether the protocol allows replays is
+    /// TrialFlow::replay()'s rule).
     void presentClip();
     /// Replays of the current trial's clip so far.
     int replayCount() const;
-    /// Sets one rating of the current trial (kept until submitRatings(); may be changed).
-    /// Throws StoreError for a scale not asked in this trial or a value outside its range.
-    void rate(const std::string& scaleId, int value);
-    /// Ratings given so far for the current trial.
-    const std::map<std::string, int>& pendingRatings() const { return pending_; }
-    /// Whether every asked scale has a rating.
-    bool ratingsComplete() const;
-    /// Commits the pending ratings (and a comment) as the current trial's answer, like answer().
-    void submitRatings(const std::string& comment = {});
 
     // Interactive tests with laps ([laps]): silent baseline laps, then laps with sound.
 
@@ -168,7 +162,6 @@ class Session {
     bool paused_ = false;
     std::string pauseReason_;
     double startedAtS_ = 0.0;
-    std::map<std::string, int> pending_;
 };
 
 } // namespace underfoot::experiment

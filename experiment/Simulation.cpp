@@ -275,6 +275,7 @@ double SimulatedParticipant::responseTimeS() {
 } // namespace underfoot::experiment
 
 #include "experiment/Session.h"
+#include "experiment/TrialFlow.h"
 
 namespace underfoot::experiment {
 
@@ -358,41 +359,47 @@ int runSimulatedSession(StudyStore& store, const std::string& code, const Confus
                     SessionSettings{"simulation", "none (simulated)", "none (simulated)",
                                     underfoot::base::version(), false},
                     [&] { return simulatedTimeS; });
+    // The simulated participant answers through the trial core like a person (TrialFlow: its
+    // checks against the protocol before anything is stored).
+    TrialFlow flow(store, session);
+    const auto check = [&](const FlowResult& r) {
+        if (!r)
+            throw StoreError(
+                fmt::format("{}: simulated participant '{}': {}", store.path(), code, r.message));
+    };
     int committed = 0;
     while (session.phase() != SessionPhase::Finished) {
         switch (session.phase()) {
         case SessionPhase::Briefing:
             session.finishBriefing();
+            flow.reset();
             break;
         case SessionPhase::Break:
             session.finishBreak();
+            flow.reset();
             break;
         case SessionPhase::Practice:
         case SessionPhase::Trial: {
             const TrialRecord trial = session.current();
+            check(flow.start());
             if (protocol.clips.enabled) {
-                // Listening-test mode: the clip on demand, replays counted, scale by scale.
-                session.presentClip();
+                // Listening-test mode: the clip on demand, replays counted.
                 for (int n = 0;
                      protocol.clips.replay && n < 5 && listening.uniform() < replayProbability;
                      ++n) {
                     simulatedTimeS += protocol.clips.seconds;
-                    session.presentClip();
+                    check(flow.replay());
                 }
-                const TrialAnswer a = answerer.answer(trial);
-                simulatedTimeS += answerer.responseTimeS();
-                session.answer(a); // every question of the trial: surface, scales, soundscape
             } else {
-                session.play();
                 // A resumed trial continues from the laps already walked.
                 for (int lap = session.lapsDone(); lap < session.lapCount(); ++lap) {
                     simulatedTimeS += 30.0 * std::exp(0.1 * listening.gaussian());
-                    session.completeLap();
+                    check(flow.completeLap());
                 }
-                const TrialAnswer a = answerer.answer(trial);
-                simulatedTimeS += answerer.responseTimeS();
-                session.answer(a);
             }
+            const TrialAnswer a = answerer.answer(trial);
+            simulatedTimeS += answerer.responseTimeS();
+            check(flow.submit(a)); // every question of the trial: surface, scales, soundscape
             ++committed;
             if (onCommitted) onCommitted(code, trial.index);
             break;

@@ -165,7 +165,7 @@ void StudyStore::configure() {
         db_->exec(migration(v));
         db_->exec(fmt::format("PRAGMA user_version = {}", v + 1));
         if (version > 0) // a real migration of an existing study is journaled
-            appendEvent("schema_migrated", std::nullopt, std::nullopt,
+            appendEvent(JournalEvent::SchemaMigrated, std::nullopt, std::nullopt,
                         jsonObject({{"from", std::to_string(v)}, {"to", std::to_string(v + 1)}}));
         tx.commit();
     }
@@ -203,7 +203,7 @@ StudyStore StudyStore::create(const std::string& path, const Protocol& protocol,
     proto.bind(5, protocol.hash);
     proto.bind(6, at);
     proto.exec();
-    store.appendEvent("study_created", std::nullopt, std::nullopt,
+    store.appendEvent(JournalEvent::StudyCreated, std::nullopt, std::nullopt,
                       jsonObject({{"code", settings.code},
                                   {"site", settings.site},
                                   {"seed", std::to_string(settings.seed)},

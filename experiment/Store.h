@@ -6,6 +6,7 @@
 /// before the call returns, so an acknowledged answer survives a crash or a power loss. The event
 /// journal is append-only (triggers refuse UPDATE and DELETE). The protocol's full text and
 /// SHA-256 are stored; a different protocol text is refused for an existing study.
+#include "experiment/JournalEvent.h"
 #include "experiment/Plan.h"
 #include "experiment/Protocol.h"
 
@@ -254,6 +255,8 @@ struct ReplayInfo {
 struct Event {
     std::int64_t id = 0;
     std::string at;
+    JournalEvent event = JournalEvent::StudyCreated;
+    /// The stored name of `event` (journalEventName).
     std::string kind;
     std::string participant;
     std::optional<int> trialIndex;
@@ -353,23 +356,33 @@ class StudyStore {
     /// (counted, reason kept, journaled as "trial_interrupted"); the trial stays unanswered so
     /// the participant resumes at it. Throws StoreError for an answered or unknown trial.
     void markTrialInterrupted(const std::string& code, int trialIndex, const std::string& reason);
-    /// Validates and commits an answer in its own durable transaction.
+    /// Commits an answer in its own durable transaction. The store checks only what its schema
+    /// and record order say: the participant and trial exist, the trial's stimulus started,
+    /// the response time is a finite number >= 0, ratings name a scale, the participant's lease
+    /// is this store's; a second commit replaces the answer (journaled "answer_changed"). It
+    /// does NOT check the answer against the protocol (answer list, scales and their ranges,
+    /// laps, lock rule): that is the trial core's (TrialFlow), which every front end and the
+    /// simulation go through first.
     /// Throws AnswerSavedButNotCopied (a StoreError) when the answer was stored but the
     /// checkpoint after it failed.
     void commitAnswer(const std::string& code, int trialIndex, const TrialAnswer& answer,
                       std::optional<double> responseTimeS);
     /// Counts one more replay of a started, unanswered trial's clip; journaled. Throws StoreError
-    /// when the trial has not started, is answered, or the protocol forbids replays.
+    /// when the trial has not started or is answered (whether the protocol allows replays is
+    /// TrialFlow's rule).
     void recordReplay(const std::string& code, int trialIndex);
     /// Records that lap `lap` (1-based) of a started trial was completed (silent or with sound);
-    /// journaled. Laps must be completed in order.
+    /// journaled. Laps are counted in order (lap = laps done + 1); how many the protocol walks
+    /// is TrialFlow's rule.
     void recordLap(const std::string& code, int trialIndex, int lap);
     /// Excludes (or re-includes with an empty reason) a trial from analysis; journaled.
     void setExcluded(const std::string& code, int trialIndex, bool excluded,
                      const std::string& reason);
-    /// Appends a free event to the journal.
-    void journal(const std::string& kind, const std::string& code, std::optional<int> trialIndex,
+    /// Appends an event to the journal (`detail`: a JSON object with the event's fields).
+    void journal(JournalEvent event, const std::string& code, std::optional<int> trialIndex,
                  const std::string& detail);
+    /// The journal, in order. Throws StoreError naming the file and the row for a stored name
+    /// that is not a JournalEvent (docs/decisions/journal-event-enum.md).
     std::vector<Event> events() const;
 
     /// Answered and planned trial counts per participant code (one aggregate query).
@@ -377,15 +390,6 @@ class StudyStore {
 
     /// What replay needs for one trial (throws StoreError if the trial never started).
     ReplayInfo trialForReplay(const std::string& code, int trialIndex) const;
-
-    /// Validation of an answer against the protocol (the trial core's answerProblems, in
-    /// TrialFlow.h); returns the problems (empty: valid).
-    std::vector<std::string> checkAnswer(const std::string& groupId,
-                                         const TrialAnswer& answer) const;
-    /// Validation of an answer to one trial: only the scales asked after that stimulus in that
-    /// block (per-scale blocks, scales restricted to some stimuli) are expected.
-    std::vector<std::string> checkAnswer(const std::string& groupId, const TrialAnswer& answer,
-                                         const Stimulus& stimulus, int block) const;
 
   private:
     StudyStore(std::string path, std::unique_ptr<SQLite::Database> db, Clock clock);
@@ -404,7 +408,7 @@ class StudyStore {
     [[noreturn]] void writeFailed(const std::string& what, const std::exception& e) const;
     /// Copies the WAL into the main file so that nothing acknowledged lives only in -wal.
     void checkpoint();
-    void appendEvent(const std::string& kind, std::optional<std::int64_t> participantId,
+    void appendEvent(JournalEvent event, std::optional<std::int64_t> participantId,
                      std::optional<int> trialIndex, const std::string& detail);
     std::string now() const;
 

@@ -2,7 +2,6 @@
 // Participants: registration with balanced group assignment and plan, fields, dropouts.
 #include "experiment/Store.h"
 #include "experiment/StoreInternal.h"
-#include "experiment/TrialFlow.h"
 
 #include <SQLiteCpp/SQLiteCpp.h>
 #include <fmt/format.h>
@@ -140,18 +139,6 @@ std::string StudyStore::nextGroup(int participantIndex) const {
     return counts[best[static_cast<std::size_t>(rng.below(best.size()))]].groupId;
 }
 
-// The trial core's rule (TrialFlow.h), called by the store as its last check before a write.
-std::vector<std::string> StudyStore::checkAnswer(const std::string& groupId,
-                                                 const TrialAnswer& answer) const {
-    return answerProblems(*protocol_, groupId, answer);
-}
-
-std::vector<std::string> StudyStore::checkAnswer(const std::string& groupId,
-                                                 const TrialAnswer& answer,
-                                                 const Stimulus& stimulus, int block) const {
-    return answerProblems(*protocol_, groupId, answer, stimulus, block);
-}
-
 ParticipantInfo StudyStore::registerParticipant(const NewParticipant& np) {
     return registerParticipant(np, {});
 }
@@ -244,7 +231,7 @@ ParticipantInfo StudyStore::registerParticipant(const NewParticipant& np,
         trial.exec();
     }
     appendEvent(
-        "participant_registered", pid, std::nullopt,
+        JournalEvent::ParticipantRegistered, pid, std::nullopt,
         jsonObject({{"code", np.code},
                     {"index", std::to_string(index)},
                     {"group", groupId},
@@ -264,7 +251,8 @@ void StudyStore::dropParticipant(const std::string& code, const std::string& rea
     SQLite::Statement q(*db_, "UPDATE participants SET status = 'dropped' WHERE id = ?");
     q.bind(1, pid);
     q.exec();
-    appendEvent("participant_dropped", pid, std::nullopt, jsonObject({{"reason", reason}}));
+    appendEvent(JournalEvent::ParticipantDropped, pid, std::nullopt,
+                jsonObject({{"reason", reason}}));
     tx.commit();
 }
 

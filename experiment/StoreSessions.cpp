@@ -73,8 +73,9 @@ int StudyStore::startSession(const std::string& code, const SessionSettings& set
                     if (state == HolderState::Live) throw LeaseHeld(what + hint);
                     throw StoreError(what + hint);
                 }
-                appendEvent(recoverable ? "lease_recovered" : "lease_taken_over", p.id,
-                            std::nullopt,
+                appendEvent(recoverable ? JournalEvent::LeaseRecovered
+                                        : JournalEvent::LeaseTakenOver,
+                            p.id, std::nullopt,
                             jsonObject({{"pid", std::to_string(holder.pid)},
                                         {"host", holder.host},
                                         {"holder", toString(state)},
@@ -115,7 +116,7 @@ int StudyStore::startSession(const std::string& code, const SessionSettings& set
         SQLite::Statement st(*db_, "UPDATE participants SET status = 'active' WHERE id = ?");
         st.bind(1, p.id);
         st.exec();
-        appendEvent("session_started", p.id, std::nullopt,
+        appendEvent(JournalEvent::SessionStarted, p.id, std::nullopt,
                     jsonObject({{"session", std::to_string(number)},
                                 {"experimenter", settings.experimenter},
                                 {"audio", settings.audioConfig},
@@ -173,7 +174,7 @@ void StudyStore::endSession(const std::string& code, int sessionNumber, bool com
     release.bind(1, pid);
     release.bind(2, leaseToken_);
     release.exec();
-    appendEvent("session_ended", pid, std::nullopt,
+    appendEvent(JournalEvent::SessionEnded, pid, std::nullopt,
                 jsonObject({{"session", std::to_string(sessionNumber)},
                             {"outcome", completed ? "completed" : "interrupted"}}));
     tx.commit();
@@ -190,7 +191,7 @@ void StudyStore::markCompleted(const std::string& code) {
     SQLite::Statement st(*db_, "UPDATE participants SET status = 'completed' WHERE id = ?");
     st.bind(1, p.id);
     st.exec();
-    appendEvent("participant_completed", p.id, std::nullopt,
+    appendEvent(JournalEvent::ParticipantCompleted, p.id, std::nullopt,
                 jsonObject({{"note", "every trial answered; the session had not been closed"}}));
     tx.commit();
 }

@@ -2,7 +2,6 @@
 // Trials: starts, answers (durable), replays, laps, audio figures, interruptions, exclusions.
 #include "experiment/Store.h"
 #include "experiment/StoreInternal.h"
-#include "experiment/TrialFlow.h"
 
 #include <SQLiteCpp/SQLiteCpp.h>
 #include <fmt/format.h>
@@ -162,7 +161,8 @@ void StudyStore::markTrialStarted(const std::string& code, int trialIndex, int s
         q.bind(10, pid);
         q.bind(11, trialIndex);
         q.exec();
-        appendEvent(restarted ? "trial_restarted" : "trial_started", pid, trialIndex,
+        appendEvent(restarted ? JournalEvent::TrialRestarted : JournalEvent::TrialStarted, pid,
+                    trialIndex,
                     jsonObject({{"session", std::to_string(sessionNumber)},
                                 {"render_seed", std::to_string(renderSeed)},
                                 {"grf", grfRecording.value_or("")},
@@ -186,38 +186,22 @@ void StudyStore::commitAnswer(const std::string& code, int trialIndex, const Tri
         SQLite::Transaction tx(*db_, SQLite::TransactionBehavior::IMMEDIATE);
         const ParticipantInfo p = participant(code);
         checkLease(p.id, code);
-        SQLite::Statement cur = selectTrial(
-            p.id, code, trialIndex, "id, started_at, answered_at, stimulus, block, laps_done");
-        const Stimulus trialStimulus = stimulusFromToml(cur.getColumn(3).getString());
-        if (const auto problems =
-                checkAnswer(p.groupId, answer, trialStimulus, cur.getColumn(4).getInt());
-            !problems.empty()) {
-            std::string all;
-            for (const auto& s : problems) all += (all.empty() ? "" : "; ") + s;
-            throw StoreError(
-                fmt::format("participant '{}' trial {}: {}", code, trialIndex + 1, all));
-        }
-        if (const int laps = protocol_->laps.total();
-            laps > 0 && !cur.getColumn(1).isNull() && cur.getColumn(5).getInt() < laps)
-            throw StoreError(
-                fmt::format("participant '{}' trial {}: {} of {} laps walked; expected "
-                            "every lap (baseline and feedback) before the questions",
-                            code, trialIndex + 1, cur.getColumn(5).getInt(), laps));
+        // Only what the schema and the record's order say: the trial exists, its stimulus was
+        // presented, one answer row per trial (a second commit replaces it, journaled as a
+        // change). The protocol's rules (answer list, scales and ranges, laps, lock) are the
+        // trial core's (TrialFlow), which every writer goes through first.
+        SQLite::Statement cur = selectTrial(p.id, code, trialIndex, "id, started_at, answered_at");
         const std::int64_t trialId = cur.getColumn(0).getInt64();
         if (cur.getColumn(1).isNull())
             throw StoreError(fmt::format("participant '{}' trial {} has not started; expected its "
                                          "stimulus to be played first",
                                          code, trialIndex + 1));
         const bool changing = !cur.getColumn(2).isNull();
-        if (changing) { // the trial core's lock rule (TrialFlow.h)
-            SQLite::Statement later(*db_, "SELECT 1 FROM trials WHERE participant_id = ? AND "
-                                          "trial_index > ? AND started_at IS NOT NULL");
-            later.bind(1, p.id);
-            later.bind(2, trialIndex);
-            if (const std::string why = lockRefusal(*protocol_, later.executeStep()); !why.empty())
-                throw StoreError(
-                    fmt::format("participant '{}' trial {}: {}", code, trialIndex + 1, why));
-        }
+        for (const auto& [scale, value] : answer.ratings)
+            if (scale.empty())
+                throw StoreError(fmt::format("participant '{}' trial {}: a rating without a "
+                                             "scale id (value {})",
+                                             code, trialIndex + 1, value));
         SQLite::Statement q(*db_,
                             "UPDATE trials SET answered_at = ?, response_time_s = ?, answer = ?, "
                             "soundscape_answer = ?, comment = ? WHERE id = ?");
@@ -242,7 +226,8 @@ void StudyStore::commitAnswer(const std::string& code, int trialIndex, const Tri
             rate.exec();
             ratingsText += fmt::format("{}{}={}", ratingsText.empty() ? "" : " ", scale, value);
         }
-        appendEvent(changing ? "answer_changed" : "answered", p.id, trialIndex,
+        appendEvent(changing ? JournalEvent::AnswerChanged : JournalEvent::Answered, p.id,
+                    trialIndex,
                     jsonObject({{"answer", answer.answer},
                                 {"ratings", ratingsText},
                                 {"soundscape", answer.soundscapeAnswer},
@@ -268,10 +253,6 @@ void StudyStore::commitAnswer(const std::string& code, int trialIndex, const Tri
 }
 
 void StudyStore::recordReplay(const std::string& code, int trialIndex) {
-    if (!protocol_->clips.replay)
-        throw StoreError(fmt::format("participant '{}' trial {}: the protocol does not allow "
-                                     "replays ([clips] replay = false)",
-                                     code, trialIndex + 1));
     SQLite::Transaction tx(*db_, SQLite::TransactionBehavior::IMMEDIATE);
     const std::int64_t pid = participantId(code);
     SQLite::Statement cur = selectTrial(pid, code, trialIndex, "started_at, answered_at, replays");
@@ -289,16 +270,18 @@ void StudyStore::recordReplay(const std::string& code, int trialIndex) {
     q.bind(2, pid);
     q.bind(3, trialIndex);
     q.exec();
-    appendEvent("clip_replayed", pid, trialIndex,
+    appendEvent(JournalEvent::ClipReplayed, pid, trialIndex,
                 jsonObject({{"replays", std::to_string(replays)}}));
     tx.commit();
 }
 
 void StudyStore::recordLap(const std::string& code, int trialIndex, int lap) {
+    // The count of laps walked goes up by one (the protocol's number of laps is TrialFlow's).
     const Laps& laps = protocol_->laps;
-    if (lap < 1 || lap > laps.total())
-        throw StoreError(fmt::format("participant '{}' trial {}: lap {} is outside 1 to {}", code,
-                                     trialIndex + 1, lap, laps.total()));
+    if (lap < 1)
+        throw StoreError(fmt::format("participant '{}' trial {}: lap {}; expected a lap number "
+                                     ">= 1",
+                                     code, trialIndex + 1, lap));
     SQLite::Transaction tx(*db_, SQLite::TransactionBehavior::IMMEDIATE);
     const std::int64_t pid = participantId(code);
     SQLite::Statement cur =
@@ -318,7 +301,7 @@ void StudyStore::recordLap(const std::string& code, int trialIndex, int lap) {
     q.bind(2, pid);
     q.bind(3, trialIndex);
     q.exec();
-    appendEvent("lap_completed", pid, trialIndex,
+    appendEvent(JournalEvent::LapCompleted, pid, trialIndex,
                 jsonObject({{"lap", std::to_string(lap)},
                             {"sound", laps.silent(lap) ? "silent baseline" : "feedback"}}));
     tx.commit();
@@ -380,7 +363,7 @@ void StudyStore::markTrialInterrupted(const std::string& code, int trialIndex,
     if (q.exec() != 1)
         throw StoreError(fmt::format("{}: participant '{}' has no unanswered trial {}", path_, code,
                                      trialIndex + 1));
-    appendEvent("trial_interrupted", pid, trialIndex, jsonObject({{"reason", reason}}));
+    appendEvent(JournalEvent::TrialInterrupted, pid, trialIndex, jsonObject({{"reason", reason}}));
     tx.commit();
 }
 
@@ -397,8 +380,8 @@ void StudyStore::setExcluded(const std::string& code, int trialIndex, bool exclu
     q.bind(3, pid);
     q.bind(4, trialIndex);
     if (q.exec() != 1) noSuchTrial(code, trialIndex);
-    appendEvent(excluded ? "trial_excluded" : "trial_included", pid, trialIndex,
-                jsonObject({{"reason", reason}}));
+    appendEvent(excluded ? JournalEvent::TrialExcluded : JournalEvent::TrialIncluded, pid,
+                trialIndex, jsonObject({{"reason", reason}}));
     tx.commit();
 }
 

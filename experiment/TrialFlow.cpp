@@ -298,7 +298,8 @@ FlowResult TrialFlow::pause() {
     if (held_) return {Refusal::NotAllowed, "the session is paused already"};
     held_ = true; // held even when the journal cannot be written
     try {
-        store_.journal("paused", session_.participant().code, session_.current().index, "{}");
+        store_.journal(JournalEvent::Paused, session_.participant().code, session_.current().index,
+                       "{}");
     } catch (const std::exception& e) {
         return {Refusal::Failed, std::string("paused, but not journaled: ") + e.what()};
     }
@@ -309,7 +310,7 @@ FlowResult TrialFlow::resume() {
     if (!held_) return {Refusal::NotAllowed, "the session is not paused"};
     held_ = false;
     try {
-        store_.journal("resumed", session_.participant().code,
+        store_.journal(JournalEvent::Resumed, session_.participant().code,
                        inTrial() ? std::optional<int>(session_.current().index) : std::nullopt,
                        "{}");
     } catch (const std::exception& e) {
@@ -397,6 +398,21 @@ FlowResult TrialFlow::commit() {
     return {};
 }
 
+FlowResult TrialFlow::submit(const TrialAnswer& answer) {
+    if (revising_)
+        return {Refusal::Locked, "store or cancel the change of the previous answer first"};
+    draft_ = answer;
+    pendingDigit_ = -1;
+    return commit();
+}
+
+bool TrialFlow::laterTrialStarted(int index) const {
+    if (session_.playing()) return true;
+    for (const auto& t : store_.trials(session_.participant().code))
+        if (t.index > index && !t.startedAt.empty()) return true; // this session's or earlier
+    return false;
+}
+
 FlowResult TrialFlow::revisePrevious() {
     if (!inTrial()) return {Refusal::NotInTrial, "no trial is current"};
     if (const FlowResult hold = holdRefusal(); !hold) return hold;
@@ -408,6 +424,9 @@ FlowResult TrialFlow::revisePrevious() {
         if (t.answered && t.index < current && (!previous || t.index > previous->index))
             previous = std::move(t);
     if (!previous) return {Refusal::NoPrevious, "No earlier answer in this session to change."};
+    if (const std::string why = lockRefusal(protocol(), laterTrialStarted(previous->index));
+        !why.empty())
+        return {Refusal::Locked, why};
     draft_ = previous->answer;
     pendingDigit_ = -1;
     revising_ = previous->index;
@@ -419,8 +438,15 @@ FlowResult TrialFlow::revisePrevious() {
 
 FlowResult TrialFlow::commitRevision() {
     if (!revising_) return {Refusal::NotAllowed, "no answer is being changed"};
-    if (const std::string why = lockRefusal(protocol(), session_.playing()); !why.empty())
+    if (const FlowResult hold = holdRefusal(); !hold) return hold;
+    if (const std::string why = lockRefusal(protocol(), laterTrialStarted(*revising_));
+        !why.empty())
         return {Refusal::Locked, why};
+    if (const auto missing = problems(); !missing.empty()) {
+        std::string list;
+        for (const auto& p : missing) list += (list.empty() ? "" : "; ") + p;
+        return {Refusal::Incomplete, list};
+    }
     try {
         store_.commitAnswer(session_.participant().code, *revising_, draft_,
                             revisedTrial_->responseTimeS);

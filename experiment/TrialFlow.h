@@ -6,8 +6,10 @@
 /// - the answer being entered for the current trial: its sections (surface question, the scales
 ///   asked in this trial's block, soundscape question), the active section, letters, digits
 ///   (two-digit values on 0–10 scales), Left/Right adjustments;
-/// - its validation before commit (stimulus started, every lap walked, the store's per-trial
-///   checkAnswer) and the commit itself;
+/// - its validation before commit (stimulus started, every lap walked, answerProblems) and the
+///   commit itself: the only check of an answer against the protocol (the store checks only its
+///   schema), which every writer of answers goes through (terminal, console, participant window,
+///   web API, simulated participants);
 /// - the lock rule (changing the previous answer only under lock = "next_trial" and before the
 ///   next stimulus starts), replay counts of listening-test clips and laps;
 /// - what the participant may see (ParticipantScreen: a neutral briefing made from the
@@ -47,7 +49,7 @@ enum class Refusal {
     NotStarted,     ///< the stimulus has not started
     AlreadyStarted, ///< the stimulus is already playing
     LapsPending,    ///< laps still to walk before the questions
-    Incomplete,     ///< the answer is missing something (checkAnswer's problems)
+    Incomplete,     ///< the answer is missing something (answerProblems)
     Locked,         ///< the protocol's lock rule forbids the change
     NoPrevious,     ///< no earlier answer to change
     NotAllowed,     ///< the protocol does not allow it (replay = false, no laps, no such letter)
@@ -61,8 +63,8 @@ struct FlowResult {
     explicit operator bool() const { return refusal == Refusal::None; }
 };
 
-// The trial core's rules, as free functions for every front end and for the store's last check
-// before it writes (one copy each).
+// The trial core's rules, as free functions for every front end (one copy each). The store does
+// not call them: it keeps only its schema's constraints.
 
 /// What is wrong with `answer` to a trial of `stimulus` in `block` for a participant of
 /// `groupId` (empty: valid): the surface answer from the answer list, exactly the scales asked
@@ -83,7 +85,7 @@ std::string ratingRangeProblem(const Scale& scale, int value);
 std::string personSessionRefusal(const ParticipantInfo& participant);
 /// The lock rule: why an answer already given may not be changed now ("" when it may). Under
 /// lock = "answer" never; under lock = "next_trial" until a later trial's stimulus starts.
-/// The store asks it before it overwrites an answer, TrialFlow before it offers the change.
+/// TrialFlow asks it before it offers the change and again before it stores it.
 std::string lockRefusal(const Protocol& protocol, bool laterTrialStarted);
 /// "12 of 40 trials answered" (the progress line of every front end).
 std::string progressText(int answered, int total);
@@ -194,6 +196,9 @@ class TrialFlow {
     FlowResult completeLap();
     /// Validates and commits the draft (durably) and moves on; a fresh draft follows.
     FlowResult commit();
+    /// Takes `answer` as the whole draft and commits it like commit() (the same checks): the
+    /// path of answerers that give every question at once (simulated participants).
+    FlowResult submit(const TrialAnswer& answer);
 
     // Changing the previous answer (lock rule).
 
@@ -217,6 +222,29 @@ class TrialFlow {
     /// Whether the current lap is a silent baseline lap being walked.
     bool silentLapNow() const;
 
+    // A text front end (the terminal): what it prints and asks, and how a typed line is read
+    // (TrialFlowText.cpp). The terminal prints these and forwards the lines typed.
+
+    /// "Press Enter to play the clip. " / "Press Enter to start the stimulus. " while the current
+    /// trial's stimulus has not started; "" otherwise.
+    std::string startPrompt() const;
+    /// "Lap 2 of 6 (silent baseline). Press Enter when it is walked. " while a lap of the current
+    /// condition is being walked; "" when none is (no laps, not started, every lap walked).
+    std::string lapPrompt() const;
+    /// The lines printed before section `index` is asked: an answer list's prompt and options
+    /// ("  a. Wood"); none for a scale (its prompt is the input prompt).
+    std::vector<std::string> sectionLines(int index) const;
+    /// The input prompt of section `index` ("Realism [1 not at all .. 7 completely]> ",
+    /// "letter> ", "letter (r: listen again)> ").
+    std::string sectionInputPrompt(int index) const;
+    /// One typed line for section `index`: a letter of its answer list, a whole number on its
+    /// scale, or "r" to hear a listening-test clip again. Refused with what was expected.
+    FlowResult typeLine(int index, const std::string& line);
+    /// Whether section `index` of the draft has its answer.
+    bool sectionAnswered(int index) const;
+    /// "comment (Enter for none)> " when the protocol takes a comment, else "".
+    std::string commentPrompt() const;
+
     /// What the participant's screen shows now.
     ParticipantScreen participantScreen() const;
     /// The briefing for the participant, made from the protocol's questions and ordering.
@@ -228,6 +256,9 @@ class TrialFlow {
     FlowResult holdRefusal() const;
     void buildSections(const TrialRecord& trial);
     int firstSection(SectionKind kind) const;
+    /// Whether a trial after stored index `index` has started (the lock rule's "next trial"):
+    /// the current stimulus, or any later trial started in this or an earlier session.
+    bool laterTrialStarted(int index) const;
 
     StudyStore& store_;
     Session& session_;

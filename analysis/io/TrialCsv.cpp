@@ -46,7 +46,11 @@ const std::vector<std::string>& trialCsvColumns() {
                                                   "started_at",
                                                   "answered_at",
                                                   "trial",
-                                                  "simulated"};
+                                                  "simulated",
+                                                  "clip_file",
+                                                  "clip_frames",
+                                                  "clip_rate",
+                                                  "clip_sha256"};
     return columns;
 }
 
@@ -228,7 +232,11 @@ std::string formatTrialCsv(const std::vector<TrialRecord>& records) {
                                               "",
                                               "",
                                               std::to_string(t.trialIndex + 1),
-                                              t.simulated ? "1" : "0"};
+                                              t.simulated ? "1" : "0",
+                                              "", // clip_file .. clip_sha256: not read back
+                                              "",
+                                              "",
+                                              ""};
         out += csv::joinLine(fields) + "\n";
     }
     return out;

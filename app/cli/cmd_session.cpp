@@ -144,64 +144,20 @@ std::string askLine(const std::string& prompt) {
     return line;
 }
 
-std::string anchorsText(const Scale& s) {
-    std::string out;
-    for (const auto& text : anchorTexts(s)) out += (out.empty() ? "" : ", ") + text;
-    return out;
-}
-
-/// Asks one question of the trial flow until the flow takes the answer. 'r' replays the clip of a
-/// listening test (counted); 'quit' interrupts.
-void askSection(TrialFlow& flow, const AnswerSection& section, bool clips) {
-    while (true) {
-        if (section.kind == SectionKind::Scale) {
-            const Scale& s = *section.scale;
-            const std::string line =
-                askLine(s.anchors.empty() ? fmt::format("{} [{} {} .. {} {}]> ", s.prompt, s.min,
-                                                        s.minLabel, s.max, s.maxLabel)
-                                          : fmt::format("{} [{} .. {}; {}]> ", s.prompt, s.min,
-                                                        s.max, anchorsText(s)));
-            if (clips && line == "r") {
-                if (const auto r = flow.replay(); !r) fmt::print("{}\n", r.message);
-                continue;
-            }
-            int v = 0;
-            std::size_t used = 0;
-            try {
-                v = std::stoi(line, &used);
-            } catch (const std::exception&) {
-                used = 0;
-            }
-            if (used == 0 || used != line.size()) {
-                fmt::print("expected a whole number from {} to {}\n", s.min, s.max);
-                continue;
-            }
-            const auto r = flow.setRating(s.id, v);
-            if (r) return;
+/// Asks one question of the trial flow until the flow has its answer: prints the flow's lines
+/// and prompt and forwards each typed line (the flow reads it: a letter, a number, 'r' to hear
+/// a clip again); 'quit' interrupts.
+void askSection(TrialFlow& flow, int index) {
+    while (!flow.sectionAnswered(index)) {
+        for (const auto& line : flow.sectionLines(index)) fmt::print("{}\n", line);
+        if (const auto r = flow.typeLine(index, askLine(flow.sectionInputPrompt(index))); !r)
             fmt::print("{}\n", r.message);
-            continue;
-        }
-        fmt::print("{}\n", section.prompt);
-        for (const auto& option : section.options)
-            fmt::print("  {}. {}\n", option.letter, option.label);
-        const std::string line = askLine(clips ? "letter (r: listen again)> " : "letter> ");
-        if (clips && line == "r") {
-            if (const auto r = flow.replay(); !r) fmt::print("{}\n", r.message);
-            continue;
-        }
-        if (line.size() == 1) {
-            const auto r = flow.choose(section.kind, line[0]);
-            if (r) return;
-            fmt::print("{}\n", r.message);
-            continue;
-        }
-        fmt::print("expected one of the letters {}-{} (or 'quit' to interrupt)\n",
-                   section.options.front().letter, section.options.back().letter);
     }
 }
 
 /// The terminal's session: a thin adapter of experiment::TrialFlow. It prints the participant's
-/// screen model (heading, text, questions) and forwards what is typed; the experimenter's lines
+/// screen model (heading, text, questions) and the flow's prompts, and forwards what is typed
+/// (the flow reads it); the experimenter's lines
 /// (stimulus, group, clip file) appear only with --show-stimulus and are marked as such.
 int runInteractive(const Options& o) {
     StudyStore store = StudyStore::open(o.study);
@@ -290,9 +246,8 @@ int runInteractive(const Options& o) {
                 shownPart = screen.part;
                 fmt::print("\n{}\n", screen.part);
             }
-            if (!session.playing()) {
-                askLine(p.clips.enabled ? "Press Enter to play the clip. "
-                                        : "Press Enter to start the stimulus. ");
+            if (const std::string prompt = flow.startPrompt(); !prompt.empty()) {
+                askLine(prompt);
                 if (const auto r = flow.start(); !r) {
                     fmt::print("not started: {}\n", r.message);
                     if (session.paused()) waitOutSensorFault(session);
@@ -301,10 +256,8 @@ int runInteractive(const Options& o) {
                 }
             }
             bool faulted = false;
-            while (session.lapsDone() < session.lapCount()) {
-                askLine(fmt::format("Lap {} of {} ({}). Press Enter when it is walked. ",
-                                    session.lapsDone() + 1, session.lapCount(),
-                                    session.currentLapSilent() ? "silent baseline" : "with sound"));
+            for (std::string lap; !(lap = flow.lapPrompt()).empty();) {
+                askLine(lap);
                 if ((faulted = session.checkSensors())) break;
                 if (const auto r = flow.completeLap(); !r) fmt::print("{}\n", r.message);
             }
@@ -313,9 +266,9 @@ int runInteractive(const Options& o) {
                 flow.reset();
                 continue; // the same trial again, from the start
             }
-            for (const AnswerSection& section : flow.sections())
-                askSection(flow, section, p.clips.enabled);
-            if (p.questions.comment) flow.setComment(askLine("comment (Enter for none)> "));
+            for (int i = 0; i < static_cast<int>(flow.sections().size()); ++i) askSection(flow, i);
+            if (const std::string prompt = flow.commentPrompt(); !prompt.empty())
+                flow.setComment(askLine(prompt));
             if (session.checkSensors()) { // nothing stored: the trial comes again
                 waitOutSensorFault(session);
                 flow.reset();
@@ -323,10 +276,8 @@ int runInteractive(const Options& o) {
             }
             if (const auto r = flow.commit(); !r) {
                 fmt::print("not stored: {}\n", r.message);
-                if (session.paused()) {
-                    waitOutSensorFault(session);
-                    flow.reset();
-                }
+                if (session.paused()) waitOutSensorFault(session);
+                flow.reset();
                 continue; // the same trial: its questions again
             }
             if (o.ack) fmt::print("ack {} {}\n", o.participant, t.index + 1);

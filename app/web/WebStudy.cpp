@@ -169,9 +169,9 @@ void WebStudy::refuse(const Invitation& inv, std::optional<int> trial, const std
                                            {"reason", reason}});
     try {
         try {
-            store_.journal("online_refused", inv.participantCode, trial, detail);
+            store_.journal(JournalEvent::OnlineRefused, inv.participantCode, trial, detail);
         } catch (const StoreError&) {
-            store_.journal("online_refused", "", trial, detail); // not registered yet
+            store_.journal(JournalEvent::OnlineRefused, "", trial, detail); // not registered yet
         }
     } catch (const std::exception&) {
         // A journal failure must not turn a refusal into an acceptance.
@@ -209,7 +209,7 @@ Session* WebStudy::session(const Invitation& inv) {
         // lease holder, a busy or failing store) is retryable and never shows the end page.
         if (!store_.firstUnanswered(code)) return nullptr; // marked completed by the session
         try {
-            store_.journal("online_unavailable", code, std::nullopt,
+            store_.journal(JournalEvent::OnlineUnavailable, code, std::nullopt,
                            jsonObject({{"participant", code}, {"reason", e.what()}}));
         } catch (const std::exception&) {
         }
@@ -440,7 +440,8 @@ json WebStudy::screening(const std::string& token, const json& body) {
                                      {"passMark", screeningPassMark(*total)}})
                                    .dump();
     invitations_->recordScreening(inv.id, passed, detail);
-    store_.journal(passed ? "online_screening_passed" : "online_screening_failed",
+    store_.journal(passed ? JournalEvent::OnlineScreeningPassed
+                          : JournalEvent::OnlineScreeningFailed,
                    inv.participantCode, std::nullopt, detail);
     if (!passed && options_.screeningFailure == ScreeningFailure::End) {
         s->interrupt();

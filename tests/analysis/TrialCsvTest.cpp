@@ -54,9 +54,9 @@ TEST(TrialCsv, ReadsTheExportFormatByHeaderName) {
     const std::string text =
         header() + ",extra_column\n" +
         "exp2,lab,p2,abc,P01,2_coherent,1,3,main,0,gravel_farm,gravel,farm_courtyard,audio,0,1,42,"
-        "gravel,Gravel,1,5,4.5,farm_courtyard,1,3.25,0,,\"note, with comma\",t0,t1,4,1,x\n" +
+        "gravel,Gravel,1,5,4.5,farm_courtyard,1,3.25,0,,\"note, with comma\",t0,t1,4,1,,,,,x\n" +
         "exp2,lab,p2,abc,P01,2_coherent,1,4,main,0,snow,deep_snow,,audio,0,2,43,dont_know,"
-        "\"I don't know\",0,,,,,,1,noise,,t0,t1,5,0,y\n";
+        "\"I don't know\",0,,,,,,1,noise,,t0,t1,5,0,,,,,y\n";
     const auto trials = parseTrialCsv(text, "trials.csv");
     ASSERT_EQ(trials.size(), 2u);
     const auto& t = trials[0];
@@ -89,15 +89,15 @@ TEST(TrialCsv, MissingRequiredColumnsAreNamedWithFileAndLine) {
 }
 
 TEST(TrialCsv, MalformedCellsNameLineColumnAndExpectation) {
-    std::string row = "s,,,,P1,A,,1,,2,st,gravel,,,,,,gravel,,,5,5,,,,0,,,,,,";
+    std::string row = "s,,,,P1,A,,1,,2,st,gravel,,,,,,gravel,,,5,5,,,,0,,,,,,,,,,";
     std::string msg = expectError(header() + "\n" + row + "\n");
     EXPECT_NE(msg.find("trials.csv:2: column 10 ('practice')"), std::string::npos) << msg;
-    row = "s,,,,P1,A,,1,,0,st,gravel,,,,,,gravel,,,NaN,5,,,,0,,,,,,";
+    row = "s,,,,P1,A,,1,,0,st,gravel,,,,,,gravel,,,NaN,5,,,,0,,,,,,,,,,";
     msg = expectError(header() + "\n" + row + "\n");
     EXPECT_NE(msg.find("'realism'"), std::string::npos) << msg;
     EXPECT_NE(msg.find("finite number"), std::string::npos) << msg;
     msg = expectError(header() + "\ns,P1\n");
-    EXPECT_NE(msg.find("trials.csv:2: 2 fields, expected 32"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("trials.csv:2: 2 fields, expected 36"), std::string::npos) << msg;
 }
 
 TEST(TrialCsv, FormattedRecordsReadBackUnchanged) {

@@ -7,6 +7,7 @@
 #include "app/wiring/ClipPlayer.h"
 #include "experiment/Protocol.h"
 #include "experiment/Store.h"
+#include "experiment/TrialFlow.h"
 #include "tests/common/ScratchDir.h"
 #include "tests/experiment/support/ParticipantScreens.h"
 
@@ -19,6 +20,8 @@
 #include <fstream>
 #include <regex>
 #include <sstream>
+
+#include <sys/wait.h>
 
 namespace xp = underfoot::experiment;
 namespace xt = underfoot::experiment::test;
@@ -40,6 +43,7 @@ std::vector<std::string> fixedWording(const xp::Protocol& p) {
     // The terminal's own prompts too ("Enter for none" is not the group "none").
     std::vector<std::string> out{p.questions.surfacePrompt, p.questions.soundscapePrompt,
                                  p.briefing, "comment (Enter for none)> "};
+    // (the comment prompt is the trial core's: TrialFlow.TextPromptsAndTypedLinesAreTheCores)
     for (const auto& o : p.questions.surfaceOptions) out.push_back(o.label);
     for (const auto& o : p.questions.soundscapeOptions) out.push_back(o.label);
     for (const auto& s : p.questions.scales) {
@@ -177,4 +181,86 @@ TEST(TerminalParticipantLines, ExperimenterLinesAreFound) {
     }
     EXPECT_TRUE(stimulus);
     EXPECT_TRUE(group);
+}
+
+// The terminal prints the trial core's prompts and forwards what is typed. With the laps of the
+// protocol changed (1 silent baseline lap and 2 with sound instead of 3 + 3), `underfoot session`
+// asks exactly the lap prompts that the core's TrialFlow gives for that protocol; the lines the
+// protocol refuses (a rating off its scale, a word) are refused with the core's messages and
+// never stored.
+TEST(TerminalParticipantLines, LapPromptsAndTypedLinesComeFromTheTrialCore) {
+    const fs::path dir = underfoot::test::scratchDir("terminal_core_prompts");
+    std::string text = readFile(fs::path(xp::shippedProtocolDir()) / "wading_interactive.toml");
+    const auto at = text.find("baseline = 3\nfeedback = 3");
+    ASSERT_NE(at, std::string::npos);
+    text.replace(at, 25, "baseline = 1\nfeedback = 2");
+    const xp::Protocol p = xp::parseProtocol(text, "laps.toml");
+    const std::string study = (dir / "study.db").string();
+    const std::string copy = (dir / "core.db").string();
+    {
+        xp::StudyStore store = xp::StudyStore::create(study, p, {"L", "lab", 3, "t"});
+        store.registerParticipant({"P1", {}, "", "", "", {}, ""});
+    }
+    fs::copy_file(study, copy, fs::copy_options::overwrite_existing);
+    // The core's prompts for P1's first trial, from a session on a copy of the study.
+    std::vector<std::string> corePrompts;
+    std::string rangeMessage;
+    std::size_t scales = 0;
+    {
+        xp::StudyStore store = xp::StudyStore::open(copy);
+        xp::SilentPlayer silent;
+        xp::Session session(store, "P1", silent, {});
+        xp::TrialFlow flow(store, session);
+        session.finishBriefing();
+        flow.reset();
+        corePrompts.push_back(flow.startPrompt());
+        ASSERT_TRUE(flow.start());
+        for (std::string lap; !(lap = flow.lapPrompt()).empty();) {
+            corePrompts.push_back(lap);
+            ASSERT_TRUE(flow.completeLap());
+        }
+        scales = flow.sections().size();
+        for (int i = 0; i < static_cast<int>(scales); ++i) {
+            ASSERT_EQ(flow.sections()[static_cast<std::size_t>(i)].kind, xp::SectionKind::Scale);
+            corePrompts.push_back(flow.sectionInputPrompt(i));
+        }
+        corePrompts.push_back(flow.commentPrompt());
+        rangeMessage = xp::ratingRangeProblem(*flow.sections().front().scale, 99);
+        session.interrupt();
+    }
+    ASSERT_GE(scales, 1u);
+    ASSERT_EQ(corePrompts.size(), 1u + 3u + scales + 1u); // start, 3 laps, the scales, comment
+    EXPECT_NE(corePrompts[1].find("Lap 1 of 3 (silent baseline)"), std::string::npos);
+    {
+        std::ofstream in(dir / "input.txt");
+        in << "\n\n\n\n\n";    // briefing, start, three laps
+        in << "99\nfour\n4\n"; // first scale: off the scale, a word, then 4
+        for (std::size_t i = 1; i < scales; ++i) in << "4\n";
+        in << "\nquit\n"; // no comment; stop at the next trial
+    }
+    const fs::path out = dir / "out.txt";
+    const std::string command =
+        fmt::format("'{}' session --study '{}' --participant P1 < '{}' > '{}' 2>&1", UNDERFOOT_CLI,
+                    study, (dir / "input.txt").string(), out.string());
+    const int status = std::system(command.c_str());
+    const std::string printed = readFile(out);
+    EXPECT_EQ(WEXITSTATUS(status), 3) << "interrupted by 'quit'\n" << printed;
+    std::size_t from = 0;
+    for (const auto& prompt : corePrompts) {
+        const auto found = printed.find(prompt, from);
+        EXPECT_NE(found, std::string::npos) << "the core's prompt '" << prompt << "' in order in:\n"
+                                            << printed;
+        if (found != std::string::npos) from = found + prompt.size();
+    }
+    EXPECT_NE(printed.find(rangeMessage), std::string::npos) << printed;
+    EXPECT_NE(printed.find("expected a whole number from 1 to 7"), std::string::npos) << printed;
+    const xp::StudyStore store = xp::StudyStore::openForReading(study);
+    int answered = 0;
+    for (const auto& t : store.trials("P1")) {
+        if (!t.answered) continue;
+        ++answered;
+        EXPECT_EQ(t.lapsDone, 3);
+        for (const auto& [scale, value] : t.answer.ratings) EXPECT_EQ(value, 4) << scale;
+    }
+    EXPECT_EQ(answered, 1);
 }

@@ -21,7 +21,7 @@ grep -q "incoherent .* 12 " check.txt
 
 # 15 x 10 + 15 x 10 + 13 x 12 = 456 trials, plus the header.
 test "$(wc -l < out/trials.csv)" -eq 457
-head -1 out/trials.csv | tr -d '\r' | grep -qx "study,site,protocol_id,protocol_hash,participant,group,session,trial_index,block,practice,stimulus_id,surface,soundscape,modalities,reverb,repetition,render_seed,answer,answer_label,correct,realism,quality,soundscape_answer,soundscape_correct,response_time_s,excluded,exclusion_reason,comment,started_at,answered_at,trial,simulated"
+head -1 out/trials.csv | tr -d '\r' | grep -qx "study,site,protocol_id,protocol_hash,participant,group,session,trial_index,block,practice,stimulus_id,surface,soundscape,modalities,reverb,repetition,render_seed,answer,answer_label,correct,realism,quality,soundscape_answer,soundscape_correct,response_time_s,excluded,exclusion_reason,comment,started_at,answered_at,trial,simulated,clip_file,clip_frames,clip_rate,clip_sha256"
 for g in none coherent incoherent; do
   n=$(cut -d, -f5,6 out/trials.csv | grep ",$g\$" | sort -u | wc -l)
   case $g in none|coherent) test "$n" -eq 15 ;; incoherent) test "$n" -eq 13 ;; esac

@@ -1,11 +1,15 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "TestSupport.h"
+#include "experiment/Clips.h"
 #include "experiment/Export.h"
 #include "experiment/Session.h"
 #include "experiment/Simulation.h"
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
 #include <map>
 #include <sstream>
 
@@ -49,7 +53,8 @@ TEST(ExperimentExport, HeaderIsTheAnalysisContract) {
         "study,site,protocol_id,protocol_hash,participant,group,session,trial_index,block,"
         "practice,stimulus_id,surface,soundscape,modalities,reverb,repetition,render_seed,answer,"
         "answer_label,correct,realism,quality,soundscape_answer,soundscape_correct,"
-        "response_time_s,excluded,exclusion_reason,comment,started_at,answered_at,trial,simulated";
+        "response_time_s,excluded,exclusion_reason,comment,started_at,answered_at,trial,simulated,"
+        "clip_file,clip_frames,clip_rate,clip_sha256";
     std::string joined;
     for (auto c : kTrialColumns) joined += (joined.empty() ? "" : ",") + std::string(c);
     EXPECT_EQ(joined, expected);
@@ -238,4 +243,87 @@ TEST(Export, AFormulaInAParticipantCommentIsExportedInert) {
     writeParticipantsCsv(store, out, SimulatedRows::Include);
     EXPECT_NE(out.str().find(",'=cmd|' /C calc'!A0,"), std::string::npos) << out.str();
     EXPECT_EQ(out.str().find(",=cmd"), std::string::npos) << out.str();
+}
+
+// The clip columns of trials.csv are the clip each trial stored (schema 7): a listening test run
+// by simulated participants from a clip folder, exported and read back. The clip files are
+// stand-in bytes (experiment/ renders nothing); the manifest names one of them with quotes (the
+// manifest takes no comma), so that its cell must come back through RFC 4180 quoting.
+TEST(ExperimentExport, ClipColumnsEqualTheClipsStoredWithEachTrial) {
+    TempDir dir;
+    const Protocol p = loadProtocol(shipped("tvcg2011_exp2_clips.toml"));
+    const std::string clipDir = dir.file("clips");
+    std::filesystem::create_directories(clipDir);
+    std::vector<ClipRecord> records;
+    for (const ClipJob& job : clipJobs(p, clipDir)) {
+        std::ofstream(job.path, std::ios::binary) << "stand-in clip " << job.stimulus.id;
+        ClipRecord r;
+        r.stimulusId = job.stimulus.id;
+        r.file = records.empty() ? "take \"quiet\".wav" : job.stimulus.id + ".wav";
+        r.source = job.source;
+        r.seed = job.seed;
+        r.sampleRateHz = records.empty() ? 44100.0 : 48000.0;
+        r.frames = 1000 + records.size();
+        r.seconds = static_cast<double>(r.frames) / r.sampleRateHz;
+        r.sha256 = fileSha256(job.path);
+        r.samplesSha256 =
+            fileSha256(job.path).substr(0, 60) + fmt::format("{:04x}", records.size());
+        records.push_back(r);
+    }
+    ASSERT_GE(records.size(), 2u);
+    writeClipManifest(clipDir, records);
+    StudyStore store = StudyStore::create(dir.file("c.db"), p, {"CLIP", "lab", 7, "t"});
+    SimulationSettings settings;
+    settings.clipDir = clipDir;
+    const MatrixByGroup m = defaultMatrices(p, shipped("tvcg2011_exp2_clips.toml"));
+    ASSERT_GT(simulateStudy(store, m, 2, settings), 0);
+
+    std::ostringstream out;
+    const int written = writeTrialsCsv(store, out);
+    const auto rows = readCsv(out.str());
+    ASSERT_EQ(rows.size(), static_cast<std::size_t>(written) + 1);
+    std::map<std::string, std::size_t> col;
+    for (std::size_t i = 0; i < rows[0].size(); ++i) col[rows[0][i]] = i;
+    int withClip = 0;
+    bool quotedSeen = false;
+    for (std::size_t r = 1; r < rows.size(); ++r) {
+        const auto& row = rows[r];
+        ASSERT_EQ(row.size(), kTrialColumns.size());
+        const TrialRecord t =
+            store.trial(row[col["participant"]], std::stoi(row[col["trial_index"]]));
+        ASSERT_TRUE(t.clip) << "every answered trial of a listening test stored its clip";
+        ++withClip;
+        EXPECT_EQ(row[col["clip_file"]], t.clip->file);
+        EXPECT_EQ(row[col["clip_frames"]], std::to_string(t.clip->frames));
+        EXPECT_EQ(std::stod(row[col["clip_rate"]]), t.clip->sampleRateHz);
+        EXPECT_EQ(row[col["clip_sha256"]], t.clip->samplesSha256);
+        EXPECT_EQ(row[col["render_seed"]], std::to_string(clipSeed(p, t.stimulus)))
+            << "the clip's seed is the render_seed column";
+        const auto rec = std::find_if(records.begin(), records.end(), [&](const ClipRecord& c) {
+            return c.stimulusId == t.stimulus.id;
+        });
+        ASSERT_NE(rec, records.end());
+        EXPECT_EQ(t.clip->file, rec->file);
+        EXPECT_EQ(t.clip->samplesSha256, rec->samplesSha256);
+        quotedSeen = quotedSeen || t.clip->file == records.front().file;
+    }
+    EXPECT_GT(withClip, 0);
+    EXPECT_TRUE(quotedSeen) << "the clip named with quotes was played";
+    EXPECT_NE(out.str().find("\"take \"\"quiet\"\".wav\""), std::string::npos);
+}
+
+// A trial without a clip (booth / live footsteps) leaves the four clip cells empty.
+TEST(ExperimentExport, ClipColumnsAreEmptyWithoutAClip) {
+    TempDir dir;
+    StudyStore store = StudyStore::create(dir.file("n.db"), parseProtocol(miniProtocol(), "m.toml"),
+                                          {"NC", "lab", 5, "t"});
+    store.registerParticipant({"P1", 30, "", "", "", {}, ""});
+    std::ostringstream out;
+    writeTrialsCsv(store, out, ExportScope::All);
+    const auto rows = readCsv(out.str());
+    ASSERT_GE(rows.size(), 2u);
+    std::map<std::string, std::size_t> col;
+    for (std::size_t i = 0; i < rows[0].size(); ++i) col[rows[0][i]] = i;
+    for (const char* c : {"clip_file", "clip_frames", "clip_rate", "clip_sha256"})
+        EXPECT_EQ(rows[1].at(col.at(c)), "") << c;
 }

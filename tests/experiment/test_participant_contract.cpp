@@ -150,11 +150,9 @@ TEST(TrialCoreRules, PartRangeLockAndPersonSession) {
     EXPECT_NE(personSessionRefusal(person).find("simulated participant"), std::string::npos);
     EXPECT_EQ(progressText(12, 40), "12 of 40 trials answered");
 
-    // answerProblems is the store's rule too: the same problems, one implementation.
+    // answerProblems is the trial core's rule (the store keeps only its schema).
     const TrialRecord t = store.trials("P1").front();
     TrialAnswer a;
     a.ratings[depth.id] = depth.max + 1;
-    EXPECT_EQ(answerProblems(p, "all", a, t.stimulus, t.block),
-              store.checkAnswer("all", a, t.stimulus, t.block));
     EXPECT_FALSE(answerProblems(p, "all", a, t.stimulus, t.block).empty());
 }

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "TestSupport.h"
 #include "experiment/Session.h"
+#include "experiment/TrialFlow.h"
 
 #include <gtest/gtest.h>
 
@@ -92,8 +93,9 @@ TEST(ExperimentSession, RunsBriefingPracticeTrialsBreaksEnd) {
         EXPECT_TRUE(player.playing);
         now += 2.0;
         TrialAnswer bad;
-        bad.answer = "lava";
-        EXPECT_THROW(session.answer(bad), StoreError);
+        bad.ratings["quality"] = 4; // the surface answer is missing
+        TrialFlow flow(store, session);
+        EXPECT_EQ(flow.submit(bad).refusal, Refusal::Incomplete);
         EXPECT_TRUE(player.playing) << "an invalid answer keeps the stimulus running";
         session.answer(answerFor(t));
         EXPECT_FALSE(player.playing);

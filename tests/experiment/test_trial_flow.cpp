@@ -6,6 +6,9 @@
 
 #include <gtest/gtest.h>
 
+#include <fstream>
+#include <sstream>
+
 using namespace underfoot::experiment;
 using namespace underfoot::experiment::test;
 
@@ -317,4 +320,137 @@ TEST(TrialFlow, ExperimenterPauseHoldsEverythingAndIsJournaled) {
     }
     EXPECT_EQ(paused, 1);
     EXPECT_EQ(resumed, 1);
+}
+
+// The protocol's rules are the trial core's: the answer the store would take as it is (see
+// ExperimentStore.KeepsOnlyTheSchemaNotTheProtocol) is refused here, with every reason, and
+// nothing is stored.
+TEST(TrialFlow, ProtocolRulesAreTheTrialCoresNotTheStores) {
+    TempDir dir;
+    StudyStore store = StudyStore::create(
+        dir.file("p.db"), loadProtocol(shipped("tvcg2011_exp2.toml")), {"P", "lab", 3, "t"});
+    NewParticipant np{"P01", {}, "", "", "", {}, ""};
+    np.groupOverride = "coherent";
+    np.overrideReason = "test";
+    store.registerParticipant(np);
+    FakePlayer player;
+    Session session(store, "P01", player, {});
+    TrialFlow flow(store, session);
+    session.finishBriefing();
+    flow.reset();
+    ASSERT_TRUE(flow.start());
+    TrialAnswer bad;
+    bad.answer = "lava";
+    bad.ratings["realism"] = 8;
+    const int index = session.current().index;
+    const FlowResult r = flow.submit(bad);
+    EXPECT_EQ(r.refusal, Refusal::Incomplete);
+    for (const char* why :
+         {"'lava' is not an option of the answer list", "rating 'realism' is 8; expected 1 to 7",
+          "the rating 'quality' is missing", "the soundscape answer is missing"})
+        EXPECT_NE(r.message.find(why), std::string::npos) << why << " in: " << r.message;
+    EXPECT_FALSE(store.trial("P01", index).answered);
+    EXPECT_TRUE(session.playing()) << "the trial stays current";
+}
+
+// The lock rule holds across sessions: once a later trial started (then the session was
+// interrupted), the earlier answer is neither offered for a change nor stored as one.
+TEST(TrialFlow, LockRuleCountsTrialsStartedInAnEarlierSession) {
+    TempDir dir;
+    StudyStore store = makeStudy(dir, "next_trial");
+    FakePlayer player;
+    {
+        Session session(store, "P1", player, {});
+        TrialFlow flow(store, session);
+        session.finishBriefing();
+        flow.reset();
+        ASSERT_TRUE(flow.start());
+        flow.chooseLetter('a');
+        flow.typeDigit(2);
+        flow.typeDigit(5);
+        ASSERT_TRUE(flow.commit());
+        ASSERT_TRUE(flow.start()); // the next trial's stimulus starts, then the session stops
+        session.interrupt();
+    }
+    Session again(store, "P1", player, {});
+    TrialFlow flow(store, again);
+    ASSERT_TRUE(again.resumed());
+    const FlowResult r = flow.revisePrevious();
+    EXPECT_EQ(r.refusal, Refusal::Locked);
+    EXPECT_NE(r.message.find("lock = \"next_trial\""), std::string::npos) << r.message;
+}
+
+// The text front end's model: the terminal prints these prompts and forwards typed lines, which
+// the flow reads (a letter, a whole number on the scale) and refuses with what was expected.
+TEST(TrialFlow, TextPromptsAndTypedLinesAreTheCores) {
+    TempDir dir;
+    StudyStore store = makeStudy(dir, "next_trial");
+    FakePlayer player;
+    Session session(store, "P1", player, {});
+    TrialFlow flow(store, session);
+    EXPECT_EQ(flow.startPrompt(), "") << "no trial during the briefing";
+    session.finishBriefing();
+    flow.reset();
+    EXPECT_EQ(flow.startPrompt(), "Press Enter to start the stimulus. ");
+    EXPECT_EQ(flow.lapPrompt(), "") << "a protocol without laps";
+    ASSERT_TRUE(flow.start());
+    EXPECT_EQ(flow.startPrompt(), "");
+    const auto lines = flow.sectionLines(0);
+    ASSERT_GE(lines.size(), 3u);
+    EXPECT_EQ(lines[0], store.protocol().questions.surfacePrompt);
+    EXPECT_EQ(lines[2], "  b. " + store.protocol().questions.surfaceOptions[1].label);
+    EXPECT_EQ(flow.sectionInputPrompt(0), "letter> ");
+    EXPECT_TRUE(flow.sectionLines(1).empty()) << "a scale's prompt is its input prompt";
+    EXPECT_EQ(flow.sectionInputPrompt(2), "Quality [0 .. 10; 0 = bad, 10 = excellent]> ");
+
+    EXPECT_NE(flow.typeLine(0, "wood").message.find("expected one of the letters a-"),
+              std::string::npos);
+    EXPECT_EQ(flow.typeLine(0, "z").refusal, Refusal::NotAllowed);
+    EXPECT_FALSE(flow.sectionAnswered(0));
+    ASSERT_TRUE(flow.typeLine(0, "b"));
+    EXPECT_TRUE(flow.sectionAnswered(0));
+    EXPECT_EQ(flow.draft().answer, "gravel");
+    EXPECT_EQ(flow.typeLine(1, "5x").message, "expected a whole number from 1 to 7");
+    EXPECT_EQ(flow.typeLine(1, "9").refusal, Refusal::OutOfRange);
+    EXPECT_FALSE(flow.sectionAnswered(1));
+    ASSERT_TRUE(flow.typeLine(1, "5"));
+    ASSERT_TRUE(flow.typeLine(2, "10"));
+    EXPECT_EQ(flow.draft().ratings.at("quality"), 10);
+    EXPECT_EQ(flow.typeLine(2, "r").refusal, Refusal::NotAllowed) << "'r' only in listening tests";
+    ASSERT_TRUE(flow.commit());
+}
+
+// The lap prompt follows the protocol's laps: 1 silent baseline lap and 2 with sound.
+TEST(TrialFlow, LapPromptFollowsTheProtocolsLaps) {
+    TempDir dir;
+    std::string text;
+    {
+        std::ifstream in(shipped("wading_interactive.toml"));
+        std::ostringstream s;
+        s << in.rdbuf();
+        text = s.str();
+    }
+    const auto at = text.find("baseline = 3\nfeedback = 3");
+    ASSERT_NE(at, std::string::npos);
+    text.replace(at, 25, "baseline = 1\nfeedback = 2");
+    StudyStore store = StudyStore::create(dir.file("l.db"), parseProtocol(text, "laps.toml"),
+                                          {"L", "lab", 3, "t"});
+    store.registerParticipant({"P1", {}, "", "", "", {}, ""});
+    FakePlayer player;
+    Session session(store, "P1", player, {});
+    TrialFlow flow(store, session);
+    session.finishBriefing();
+    flow.reset();
+    EXPECT_EQ(flow.lapPrompt(), "") << "not started";
+    ASSERT_TRUE(flow.start());
+    std::vector<std::string> prompts;
+    for (std::string p; !(p = flow.lapPrompt()).empty();) {
+        prompts.push_back(p);
+        ASSERT_TRUE(flow.completeLap());
+    }
+    EXPECT_EQ(prompts, (std::vector<std::string>{
+                           "Lap 1 of 3 (silent baseline). Press Enter when it is walked. ",
+                           "Lap 2 of 3 (with sound). Press Enter when it is walked. ",
+                           "Lap 3 of 3 (with sound). Press Enter when it is walked. "}));
+    EXPECT_EQ(flow.commentPrompt(), "comment (Enter for none)> ");
 }

@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // A study file (experiment/Store.h: StudyStore::open, then every table `underfoot export`
-// writes). Refusal: StoreError naming the file; SQLite's own errors on a damaged file
-// (SQLite::Exception) are tolerated as refusals here.
+// writes, and the journal, whose event names are read back strictly). Refusal: StoreError naming
+// the file; SQLite's own errors on a damaged file (SQLite::Exception) are tolerated as refusals
+// here.
 #include "FuzzSupport.h"
 #include "experiment/Export.h"
 #include "experiment/Store.h"
@@ -28,6 +29,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         (void)experiment::writeScalesCsv(store, out);
         (void)experiment::writeAudioCsv(store, out, experiment::ExportScope::All);
         experiment::writeCodebook(store, out);
+        (void)store.events();
     } catch (const experiment::StoreError& e) {
         fuzz::expectNamed(e, path);
     } catch (const SQLite::Exception&) {

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The runner's listening-test and lap modes (Session presentClip / rate / submitRatings /
+// The runner's listening-test and lap modes (TrialFlow start / replay / setRating / commit /
 // completeLap), participant fields, clip rendering through engine/wading and the clip manifest,
 // and the migration of version-1 study files.
 #include "StudySupport.h"
@@ -7,6 +7,7 @@
 #include "engine/wading/Wading.h"
 #include "experiment/Clips.h"
 #include "experiment/Session.h"
+#include "experiment/TrialFlow.h"
 
 #include <SQLiteCpp/SQLiteCpp.h>
 #include <gtest/gtest.h>
@@ -145,24 +146,27 @@ TEST(WadingListeningMode, ClipsArePlayedOnDemandReplaysCountedAndRatedScaleBySca
     ClipPlayer player(store.protocol(), dir,
                       [&](const std::string& path) { played.push_back(path); });
     Session session(store, "P1", player, {"exp", "headphones", "", "t"});
+    TrialFlow flow(store, session);
     session.finishBriefing();
+    flow.reset();
     const TrialRecord first = session.current();
     ASSERT_EQ(session.askedScales().size(), 1u);
     EXPECT_EQ(session.askedScales()[0]->id, "depth");
-    EXPECT_THROW(session.rate("depth", 5), std::logic_error) << "rating before the clip played";
-    session.presentClip();
-    session.presentClip();
-    session.presentClip();
+    EXPECT_EQ(flow.commit().refusal, Refusal::NotStarted) << "an answer before the clip played";
+    ASSERT_TRUE(flow.start());
+    ASSERT_TRUE(flow.replay());
+    ASSERT_TRUE(flow.start()); // a second start of a clip replays it
     EXPECT_EQ(session.replayCount(), 2);
     ASSERT_EQ(played.size(), 3u);
     EXPECT_EQ(played[0], dir + "/" + first.stimulus.id + ".wav");
-    EXPECT_THROW(session.rate("depth", 11), StoreError);
-    EXPECT_THROW(session.rate("speed", 3), StoreError) << "speed is the next block's scale";
-    EXPECT_FALSE(session.ratingsComplete());
-    session.rate("depth", 4);
-    session.rate("depth", 6); // changed before submitting
-    EXPECT_TRUE(session.ratingsComplete());
-    session.submitRatings();
+    EXPECT_EQ(flow.setRating("depth", 11).refusal, Refusal::OutOfRange);
+    EXPECT_EQ(flow.setRating("speed", 3).refusal, Refusal::NotAllowed)
+        << "speed is the next block's scale";
+    EXPECT_FALSE(flow.problems().empty());
+    ASSERT_TRUE(flow.setRating("depth", 4));
+    ASSERT_TRUE(flow.setRating("depth", 6)); // changed before submitting
+    EXPECT_TRUE(flow.problems().empty());
+    ASSERT_TRUE(flow.commit());
     const TrialRecord stored = store.trial("P1", first.index);
     EXPECT_EQ(stored.replays, 2);
     EXPECT_EQ(stored.answer.ratings.at("depth"), 6);
@@ -171,9 +175,10 @@ TEST(WadingListeningMode, ClipsArePlayedOnDemandReplaysCountedAndRatedScaleBySca
     int replayEvents = 0;
     for (const auto& e : store.events()) replayEvents += e.kind == "clip_replayed" ? 1 : 0;
     EXPECT_EQ(replayEvents, 2);
-    // A missing rating is refused by the store, whoever calls it.
-    session.presentClip();
-    EXPECT_THROW(session.submitRatings(), StoreError);
+    // A missing rating is refused by the trial core before anything is stored.
+    ASSERT_TRUE(flow.start());
+    EXPECT_EQ(flow.commit().refusal, Refusal::Incomplete);
+    EXPECT_FALSE(store.trial("P1", session.current().index).answered);
 }
 
 TEST(WadingListeningMode, LapsAreWalkedSilentThenWithSoundBeforeTheQuestions) {
@@ -183,7 +188,9 @@ TEST(WadingListeningMode, LapsAreWalkedSilentThenWithSoundBeforeTheQuestions) {
     store.registerParticipant({"P1", std::nullopt, "", "", "", {}, ""});
     RecordingPlayer player;
     Session session(store, "P1", player, {"exp", "", "gyro", "t"});
+    TrialFlow flow(store, session);
     session.finishBriefing();
+    flow.reset();
     EXPECT_EQ(session.lapCount(), 6);
     EXPECT_THROW(session.completeLap(), std::logic_error) << "the condition has not started";
     session.play();
@@ -191,14 +198,15 @@ TEST(WadingListeningMode, LapsAreWalkedSilentThenWithSoundBeforeTheQuestions) {
     EXPECT_TRUE(session.currentLapSilent());
     TrialAnswer a;
     for (const Scale* s : session.askedScales()) a.ratings[s->id] = 4;
-    EXPECT_THROW(session.answer(a), StoreError) << "questions before the laps are walked";
+    EXPECT_EQ(flow.submit(a).refusal, Refusal::LapsPending)
+        << "questions before the laps are walked";
     for (int lap = 1; lap <= 6; ++lap) {
         EXPECT_EQ(session.currentLapSilent(), lap <= 3);
         session.completeLap();
     }
     EXPECT_THROW(session.completeLap(), std::logic_error);
     EXPECT_EQ(std::count(player.log.begin(), player.log.end(), "unmute"), 1);
-    session.answer(a);
+    ASSERT_TRUE(flow.submit(a));
     const auto t = store.trial("P1", 0);
     EXPECT_EQ(t.lapsDone, 6);
     std::vector<std::string> laps;
