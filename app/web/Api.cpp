@@ -290,6 +290,8 @@ struct WebApi::Impl {
         });
         const std::string clipIndex =
             suffix(p, "/api/clip/", 6, [](unsigned char c) { return std::isdigit(c) != 0; });
+        const std::string toneIndex = suffix(p, "/api/screening/tones/", 2,
+                                             [](unsigned char c) { return std::isdigit(c) != 0; });
         if (get && p == "/") {
             res.contentType = "text/plain; charset=utf-8";
             res.body = "Underfoot online study. Please open the personal link you received.\n";
@@ -313,6 +315,19 @@ struct WebApi::Impl {
         } else if (post && p == "/api/screening") {
             api(req, res,
                 [this](const std::string& t, const json& b) { return study.screening(t, b); });
+        } else if (post && p == "/api/screening/start") {
+            api(req, res,
+                [this](const std::string& t, const json& b) { return study.screeningStart(t, b); });
+        } else if (get && !toneIndex.empty()) {
+            // A triplet of the headphone check by its index only: nothing in the path, the
+            // headers or a file name says which interval is the quiet one.
+            std::string wav;
+            if (!guarded(req, res,
+                         [&] { wav = study.screeningTones(bearer(req), std::stoi(toneIndex)); }))
+                return;
+            res.headers.emplace_back("Cache-Control", "private, no-store");
+            res.contentType = "audio/wav";
+            res.body = std::move(wav);
         } else if (post && p == "/api/present") {
             api(req, res,
                 [this](const std::string& t, const json& b) { return study.present(t, b); });
