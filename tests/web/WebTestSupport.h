@@ -326,10 +326,15 @@ inline Reply doScreening(const ApiClient& c, Listener who = Listener::Headphones
     return r;
 }
 
+/// The consent of a participant of webProtocol() (its one required field answered).
+inline Reply consent(const ApiClient& c) {
+    return c.post("/api/consent",
+                  {{"consent", true}, {"fields", {{"listening_device", "headphones"}}}});
+}
+
 /// Consent + screening; returns the state of the first trial.
 inline json startParticipant(const ApiClient& c) {
-    Reply r = c.post("/api/consent",
-                     {{"consent", true}, {"fields", {{"listening_device", "headphones"}}}});
+    Reply r = consent(c);
     EXPECT_EQ(r.status, 200) << r.raw;
     EXPECT_EQ(r.body["phase"], "screening");
     r = c.post("/api/client", {{"sampleRate", 48000}});

@@ -277,10 +277,7 @@ TEST(WebApi, FailedScreeningEndsTheSessionWhenAskedTo) {
     wo.screeningFailure = ScreeningFailure::End;
     InProcessServer s(f, {}, wo);
     ApiClient c(s.port, f.links[0].token);
-    ASSERT_EQ(c.post("/api/consent",
-                     {{"consent", true}, {"fields", {{"listening_device", "headphones"}}}})
-                  .status,
-              200);
+    ASSERT_EQ(consent(c).status, 200);
     const Reply r = doScreening(c, Listener::Loudspeakers);
     ASSERT_EQ(r.status, 200) << r.raw;
     EXPECT_EQ(r.body["phase"], "ended");
@@ -296,10 +293,7 @@ TEST(WebApi, FailedScreeningIsFlaggedByDefault) {
     StudyFixture f(1);
     InProcessServer s(f);
     ApiClient c(s.port, f.links[0].token);
-    ASSERT_EQ(c.post("/api/consent",
-                     {{"consent", true}, {"fields", {{"listening_device", "headphones"}}}})
-                  .status,
-              200);
+    ASSERT_EQ(consent(c).status, 200);
     const Reply r = doScreening(c, Listener::Loudspeakers);
     EXPECT_EQ(r.body["phase"], "practice");
     EXPECT_EQ(r.body["screening"]["passed"], false);

@@ -16,12 +16,6 @@ namespace {
 using experiment::HeadphoneCheck;
 using experiment::StudyStore;
 
-void consent(const ApiClient& c) {
-    const Reply r = c.post("/api/consent",
-                           {{"consent", true}, {"fields", {{"listening_device", "headphones"}}}});
-    ASSERT_EQ(r.status, 200) << r.raw;
-}
-
 json storedDetail(const StudyFixture& f, int link = 0) {
     StudyStore store = StudyStore::open(f.study);
     const std::string d =
@@ -33,7 +27,7 @@ TEST(WebScreening, AForgedScoreIsRefused) {
     StudyFixture f(1);
     InProcessServer s(f);
     ApiClient c(s.port, f.links[0].token);
-    consent(c);
+    ASSERT_EQ(consent(c).status, 200);
     // The old page's score, before and after the check started: refused, nothing stored.
     EXPECT_EQ(c.post("/api/screening", {{"correct", 6}, {"total", 6}}).status, 400);
     EXPECT_EQ(c.post("/api/screening", {{"triplet", 0}, {"choice", 1}}).status, 409);
@@ -60,8 +54,8 @@ TEST(WebScreening, HeadphonesPassLoudspeakersFail) {
     InProcessServer s(f);
     ApiClient ears(s.port, f.links[0].token);
     ApiClient room(s.port, f.links[1].token);
-    consent(ears);
-    consent(room);
+    ASSERT_EQ(consent(ears).status, 200);
+    ASSERT_EQ(consent(room).status, 200);
     const Reply pass = doScreening(ears, Listener::Headphones);
     ASSERT_EQ(pass.status, 200) << pass.raw;
     EXPECT_EQ(pass.body["screening"]["passed"], true);
@@ -98,7 +92,7 @@ TEST(WebScreening, FiveOfSixPassFourDoNot) {
     InProcessServer s(f);
     for (int link = 0; link < 2; ++link) {
         ApiClient c(s.port, f.links[static_cast<std::size_t>(link)].token);
-        consent(c);
+        ASSERT_EQ(consent(c).status, 200);
         Reply r = c.post("/api/screening/start", json::object());
         const int wrong = link == 0 ? 1 : 2; // participant 0: 5 of 6; participant 1: 4 of 6
         for (int k = 0; k < 6; ++k) {
@@ -120,7 +114,7 @@ TEST(WebScreening, AnAnswerBeforeTheTonesCouldEndIsRefused) {
     wo.screeningMinResponseS = 0.4;
     InProcessServer s(f, {}, wo);
     ApiClient c(s.port, f.links[0].token);
-    consent(c);
+    ASSERT_EQ(consent(c).status, 200);
     ASSERT_EQ(c.post("/api/screening/start", json::object()).status, 200);
     const Reply tones = c.get("/api/screening/tones/0");
     ASSERT_EQ(tones.status, 200);
@@ -141,7 +135,7 @@ TEST(WebScreening, TheStoredSeedReplaysTheTonesServed) {
     StudyFixture f(1);
     InProcessServer s(f);
     ApiClient c(s.port, f.links[0].token);
-    consent(c);
+    ASSERT_EQ(consent(c).status, 200);
     ASSERT_EQ(c.post("/api/screening/start", json::object()).status, 200);
     std::vector<std::string> served;
     for (int k = 0; k < 6; ++k) {
@@ -171,7 +165,7 @@ TEST(WebScreening, ARestartResumesTheCheckWithItsSeed) {
     {
         InProcessServer s(f);
         ApiClient c(s.port, f.links[0].token);
-        consent(c);
+        ASSERT_EQ(consent(c).status, 200);
         ASSERT_EQ(c.post("/api/screening/start", json::object()).status, 200);
         for (int k = 0; k < 2; ++k) {
             const Reply tones = c.get("/api/screening/tones/" + std::to_string(k));
