@@ -109,6 +109,9 @@ try {
   await waitFor(() => document.querySelector('h1')?.textContent === 'Headphone check', 'the screening');
   await shot('2-screening');
   for (let check = 0; check < 6; check++) {
+    // The previous choice is stored (and scored) by the server before Play is enabled again.
+    await waitFor(() => [...document.querySelectorAll('button')]
+      .some((b) => b.textContent.startsWith('Play the three') && !b.disabled), 'the play button');
     const before = await page.evaluate(() => window.__played.length);
     await page.keyboard.press('Space');
     await waitFor((n) => window.__played.length >= n + 1 && !document.querySelector('[data-choice]').disabled,
