@@ -30,6 +30,7 @@ struct Options {
     std::string bind = "127.0.0.1";
     int port = 8080;
     std::string screening = "flag";
+    double screeningMinResponse = underfoot::experiment::HeadphoneCheck::tripletSeconds();
     double rate = 20.0;
     std::size_t maxBody = 16 * 1024;
     std::vector<std::string> trustedProxies;
@@ -58,6 +59,7 @@ int serve(const Options& o) {
     wo.clipsDir = o.clips;
     wo.screeningFailure =
         o.screening == "end" ? web::ScreeningFailure::End : web::ScreeningFailure::Flag;
+    wo.screeningMinResponseS = o.screeningMinResponse;
     std::unique_ptr<web::WebStudy> study;
     try {
         study = std::make_unique<web::WebStudy>(o.study, wo);
@@ -135,6 +137,10 @@ const underfoot::cli::CommandRegistrar registrar{
                         "a failed headphone screening 'flag's the participant (stored, the test "
                         "goes on) or 'end's the session (participant dropped)")
             ->check(CLI::IsMember({"flag", "end"}));
+        cmd->add_option("--screening-min-response", o.screeningMinResponse,
+                        "seconds after a headphone-check triplet's tones are served before its "
+                        "answer is accepted (default: the tones' length, 4; lower only in tests)")
+            ->check(CLI::Range(0.0, 60.0));
         cmd->add_option("--rate", o.rate,
                         "API requests per second per invitation, and per client address for "
                         "requests without a real invitation's token (burst: 3x; the page and "

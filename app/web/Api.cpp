@@ -83,6 +83,13 @@ std::string suffix(const std::string& path, std::string_view prefix, std::size_t
     return std::all_of(rest.begin(), rest.end(), allowed) ? rest : std::string();
 }
 
+/// The API's POST calls that take the token and the JSON body only.
+using StudyCall = json (WebStudy::*)(const std::string& token, const json& body);
+const std::map<std::string, StudyCall> kPostCalls{
+    {"/api/consent", &WebStudy::consent},     {"/api/screening/start", &WebStudy::screeningStart},
+    {"/api/screening", &WebStudy::screening}, {"/api/present", &WebStudy::present},
+    {"/api/answer", &WebStudy::answer},       {"/api/break", &WebStudy::finishBreak}};
+
 /// A link token as `study invite` writes it: 43 characters of base64url (256 bits).
 bool plausibleToken(const std::string& t) {
     return t.size() == 43 && std::all_of(t.begin(), t.end(), [](unsigned char c) {
@@ -290,6 +297,8 @@ struct WebApi::Impl {
         });
         const std::string clipIndex =
             suffix(p, "/api/clip/", 6, [](unsigned char c) { return std::isdigit(c) != 0; });
+        const std::string toneIndex = suffix(p, "/api/screening/tones/", 2,
+                                             [](unsigned char c) { return std::isdigit(c) != 0; });
         if (get && p == "/") {
             res.contentType = "text/plain; charset=utf-8";
             res.body = "Underfoot online study. Please open the personal link you received.\n";
@@ -303,25 +312,24 @@ struct WebApi::Impl {
                 asset(assetName, res);
         } else if (get && p == "/api/state") {
             api(req, res, [this](const std::string& t, const json&) { return study.state(t); });
-        } else if (post && p == "/api/consent") {
-            api(req, res,
-                [this](const std::string& t, const json& b) { return study.consent(t, b); });
         } else if (post && p == "/api/client") {
             const std::string ua = req.header("User-Agent");
             api(req, res,
                 [&](const std::string& t, const json& b) { return study.client(t, b, ua); });
-        } else if (post && p == "/api/screening") {
+        } else if (const auto call = post ? kPostCalls.find(p) : kPostCalls.end();
+                   call != kPostCalls.end()) {
             api(req, res,
-                [this](const std::string& t, const json& b) { return study.screening(t, b); });
-        } else if (post && p == "/api/present") {
-            api(req, res,
-                [this](const std::string& t, const json& b) { return study.present(t, b); });
-        } else if (post && p == "/api/answer") {
-            api(req, res,
-                [this](const std::string& t, const json& b) { return study.answer(t, b); });
-        } else if (post && p == "/api/break") {
-            api(req, res,
-                [this](const std::string& t, const json& b) { return study.finishBreak(t, b); });
+                [&](const std::string& t, const json& b) { return (study.*(call->second))(t, b); });
+        } else if (get && !toneIndex.empty()) {
+            // A triplet of the headphone check by its index only: nothing in the path, the
+            // headers or a file name says which interval is the quiet one.
+            std::string wav;
+            if (!guarded(req, res,
+                         [&] { wav = study.screeningTones(bearer(req), std::stoi(toneIndex)); }))
+                return;
+            res.headers.emplace_back("Cache-Control", "private, no-store");
+            res.contentType = "audio/wav";
+            res.body = std::move(wav);
         } else if (get && !clipIndex.empty()) {
             // The clip of the participant's current trial, by trial index (never by file name,
             // which would tell the answer; never a path from the request).

@@ -9,6 +9,8 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <limits>
+#include <random>
 
 namespace underfoot::web {
 
@@ -17,11 +19,6 @@ using nlohmann::json;
 namespace fs = std::filesystem;
 
 namespace {
-
-/// Correct answers needed in the headphone screening (Woods et al. 2017: 5 of 6).
-int screeningPassMark(int total) {
-    return static_cast<int>(std::ceil(total * 5.0 / 6.0));
-}
 
 std::string contentTypeOf(const fs::path& p) {
     std::string ext = p.extension().string();
@@ -331,6 +328,12 @@ json WebStudy::stateOf(const Invitation& inv) {
     j["progress"] = {{"answered", s->answeredCount()}, {"total", s->trialCount()}};
     if (!inv.screeningPassed) {
         j["phase"] = "screening";
+        // Progress only: which interval is the quiet one is never sent.
+        const auto it = checks_.find(inv.participantCode);
+        const HeadphoneCheck* c = it == checks_.end() ? nullptr : it->second.check.get();
+        j["check"] = {{"triplets", HeadphoneCheck::kTriplets},
+                      {"started", c != nullptr},
+                      {"next", c ? c->next() : 0}};
         return j;
     }
     switch (s->phase()) {
@@ -420,6 +423,81 @@ json WebStudy::client(const std::string& token, const json& body, const std::str
     return stateOf(inv);
 }
 
+HeadphoneCheck* WebStudy::check(const Invitation& inv) {
+    auto& entry = checks_[inv.participantCode];
+    if (entry.check) return entry.check.get();
+    // After a restart: the last check started in the journal, with the answers given since.
+    std::optional<std::uint64_t> seed;
+    std::vector<std::pair<int, int>> answers;
+    for (const Event& e : store_.events()) {
+        if (e.participant != inv.participantCode) continue;
+        if (e.kind == "online_screening_started") {
+            const json d = json::parse(e.detail, nullptr, false);
+            if (!d.is_object() || !d.contains("seed") || !d["seed"].is_number_unsigned()) continue;
+            seed = d["seed"].get<std::uint64_t>();
+            answers.clear();
+        } else if (e.kind == "online_screening_answer" && seed) {
+            const json d = json::parse(e.detail, nullptr, false);
+            if (d.is_object() && d.value("triplet", -1) >= 0)
+                answers.emplace_back(d.value("triplet", -1), d.value("choice", 0));
+        }
+    }
+    if (!seed) {
+        checks_.erase(inv.participantCode);
+        return nullptr;
+    }
+    entry.check = std::make_unique<HeadphoneCheck>(*seed, options_.screeningMinResponseS);
+    // Replayed as stored (their timing was checked when they were given).
+    for (const auto& [triplet, choice] : answers)
+        (void)entry.check->answer(triplet, choice, std::numeric_limits<double>::infinity());
+    return entry.check.get();
+}
+
+json WebStudy::screeningStart(const std::string& token, const json&) {
+    std::lock_guard lock(mutex_);
+    const Invitation inv = invitation(token);
+    Session* s = session(inv);
+    if (!s)
+        refuse(inv, std::nullopt, "screening/start", 409, "screening/start: no running session");
+    if (inv.screeningPassed) return stateOf(inv); // screened already: the first verdict counts
+    if (!check(inv)) {
+        // 53 bits: exact in every JSON reader of the journal.
+        std::random_device rd;
+        const std::uint64_t seed =
+            ((std::uint64_t{rd()} << 32) ^ std::uint64_t{rd()}) & ((std::uint64_t{1} << 53) - 1);
+        auto& entry = checks_[inv.participantCode];
+        entry.check = std::make_unique<HeadphoneCheck>(seed, options_.screeningMinResponseS);
+        entry.served.reset();
+        store_.journal("online_screening_started", inv.participantCode, std::nullopt,
+                       json({{"test", "woods2017_antiphase"},
+                             {"seed", seed},
+                             {"triplets", HeadphoneCheck::kTriplets},
+                             {"passMark", HeadphoneCheck::kPassMark},
+                             {"minResponseS", options_.screeningMinResponseS}})
+                           .dump());
+    }
+    return stateOf(inv);
+}
+
+std::string WebStudy::screeningTones(const std::string& token, int index) {
+    std::lock_guard lock(mutex_);
+    const Invitation inv = invitation(token);
+    const std::string request = fmt::format("screening/tones/{}", index);
+    if (inv.screeningPassed)
+        refuse(inv, std::nullopt, request, 409, request + ": the headphone check is over");
+    HeadphoneCheck* c = check(inv);
+    if (!c)
+        refuse(inv, std::nullopt, request, 409,
+               request + ": the headphone check has not started (POST /api/screening/start)");
+    if (index != c->next())
+        refuse(inv, std::nullopt, request, 409,
+               fmt::format("{}: refused; the triplet waiting for an answer is {}", request,
+                           c->next()));
+    auto& served = checks_[inv.participantCode].served;
+    if (!served) served = std::chrono::steady_clock::now(); // a refetch does not restart it
+    return HeadphoneCheck::wav(c->triplets()[static_cast<std::size_t>(index)]);
+}
+
 json WebStudy::screening(const std::string& token, const json& body) {
     std::lock_guard lock(mutex_);
     const Invitation inv = invitation(token);
@@ -427,22 +505,50 @@ json WebStudy::screening(const std::string& token, const json& body) {
     if (!s) refuse(inv, std::nullopt, "screening", 409, "screening: no running session");
     if (inv.screeningPassed)
         return stateOf(inv); // already screened (a retry or a reload): the first result counts
-    const auto correct = member<int>(body, "correct", "screening");
-    const auto total = member<int>(body, "total", "screening");
-    if (!correct || !total || *total < 1 || *total > 100 || *correct < 0 || *correct > *total)
+    const auto triplet = member<int>(body, "triplet", "screening");
+    const auto choice = member<int>(body, "choice", "screening");
+    if (!triplet || !choice)
         refuse(inv, std::nullopt, "screening", 400,
-               "screening: expected integers 'correct' and 'total' with 0 <= correct <= total <= "
-               "100");
-    const bool passed = *correct >= screeningPassMark(*total);
+               "screening: expected integers 'triplet' (the check's triplet) and 'choice' (1, 2 "
+               "or 3: the quietest sound); the server scores the check");
+    HeadphoneCheck* c = check(inv);
+    if (!c)
+        refuse(inv, std::nullopt, "screening", 409,
+               "screening: the headphone check has not started (POST /api/screening/start)");
+    auto& entry = checks_[inv.participantCode];
+    std::optional<double> since;
+    if (entry.served)
+        since =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - *entry.served).count();
+    if (const auto problem = c->answer(*triplet, *choice, since))
+        refuse(inv, std::nullopt, "screening", *choice < 1 || *choice > 3 ? 400 : 409,
+               "screening: " + *problem);
+    entry.served.reset();
+    const auto k = static_cast<std::size_t>(*triplet);
+    store_.journal("online_screening_answer", inv.participantCode, std::nullopt,
+                   json({{"triplet", *triplet},
+                         {"choice", *choice},
+                         {"correct", *choice - 1 == c->triplets()[k].quiet},
+                         {"secondsSinceTones", *since}})
+                       .dump());
+    if (!c->done()) return stateOf(inv);
+    const bool passed = c->passed();
+    json layout = json::array();
+    for (const auto& t : c->triplets())
+        layout.push_back({{"quiet", t.quiet + 1}, {"antiphase", t.antiphase + 1}});
     const std::string detail = json({{"test", "woods2017_antiphase"},
-                                     {"correct", *correct},
-                                     {"total", *total},
-                                     {"passMark", screeningPassMark(*total)}})
+                                     {"seed", c->seed()},
+                                     {"layout", layout},
+                                     {"choices", c->choices()},
+                                     {"correct", c->correct()},
+                                     {"total", HeadphoneCheck::kTriplets},
+                                     {"passMark", HeadphoneCheck::kPassMark}})
                                    .dump();
     invitations_->recordScreening(inv.id, passed, detail);
     store_.journal(passed ? JournalEvent::OnlineScreeningPassed
                           : JournalEvent::OnlineScreeningFailed,
                    inv.participantCode, std::nullopt, detail);
+    checks_.erase(inv.participantCode);
     if (!passed && options_.screeningFailure == ScreeningFailure::End) {
         s->interrupt();
         close(inv.participantCode);

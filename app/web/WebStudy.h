@@ -13,6 +13,7 @@
 /// Everything is validated against the protocol before it is stored; a refused request of a
 /// known participant is journaled ("online_refused"). One mutex serialises the store.
 #include "experiment/Clips.h"
+#include "experiment/HeadphoneCheck.h"
 #include "experiment/Invitations.h"
 #include "experiment/Session.h"
 #include "experiment/Store.h"
@@ -20,6 +21,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <chrono>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -45,6 +47,9 @@ struct WebOptions {
     /// Folder of the protocol's clips (`underfoot clips -o DIR`).
     std::string clipsDir;
     ScreeningFailure screeningFailure = ScreeningFailure::Flag;
+    /// A headphone-check answer sooner than this after its tones were served is refused
+    /// (default: the tones' length, 4 s; `serve --screening-min-response`, for tests).
+    double screeningMinResponseS = experiment::HeadphoneCheck::tripletSeconds();
     /// Longest comment / answer text accepted (characters).
     std::size_t maxText = 2000;
 };
@@ -72,6 +77,14 @@ class WebStudy {
     /// The browser's audio output rate (and the user agent header).
     nlohmann::json client(const std::string& token, const nlohmann::json& body,
                           const std::string& userAgent);
+    /// Starts the headphone check (idempotent): the server draws and journals its seed, which
+    /// lays out every triplet ("online_screening_started").
+    nlohmann::json screeningStart(const std::string& token, const nlohmann::json& body);
+    /// The tones of triplet `index` of the check (a WAV file), only for the triplet waiting for
+    /// an answer; the time it is first served starts that triplet's minimum response time.
+    std::string screeningTones(const std::string& token, int index);
+    /// The participant's choice for one triplet: `{"triplet": k, "choice": 1..3}`. Scored and
+    /// journaled here ("online_screening_answer"); after the last triplet the verdict is stored.
     nlohmann::json screening(const std::string& token, const nlohmann::json& body);
     /// Presents (first time) or replays (counted) the current trial's clip.
     nlohmann::json present(const std::string& token, const nlohmann::json& body);
@@ -109,6 +122,9 @@ class WebStudy {
     nlohmann::json trialJson(const experiment::TrialFlow& flow) const;
     [[noreturn]] void refuse(const experiment::Invitation& inv, std::optional<int> trial,
                              const std::string& request, int status, const std::string& reason);
+    /// The participant's running check: in memory, else restored from the journal (the last
+    /// "online_screening_started" and its answers); null when none was started.
+    experiment::HeadphoneCheck* check(const experiment::Invitation& inv);
     int currentTrialChecked(const experiment::Invitation& inv, experiment::Session* s,
                             const nlohmann::json& body, const std::string& request);
 
@@ -122,6 +138,12 @@ class WebStudy {
     std::map<std::string, std::unique_ptr<experiment::TrialFlow>> flows_;
     /// The last play id of each participant (trial:attempt), for idempotent presentations.
     std::map<std::string, std::string> lastPresent_;
+    /// Running headphone checks and when each one's current triplet was first served.
+    struct Screening {
+        std::unique_ptr<experiment::HeadphoneCheck> check;
+        std::optional<std::chrono::steady_clock::time_point> served;
+    };
+    std::map<std::string, Screening> checks_;
 };
 
 } // namespace underfoot::web

@@ -90,8 +90,13 @@ Template& templ() {
             experiment::StudyStore store =
                 experiment::StudyStore::create(t.study, p, {"WEB", "web", 4, "fuzz"});
             experiment::Invitations inv(store);
-            for (const auto& link : inv.create(store, 2, std::nullopt))
-                t.tokens.push_back(link.token);
+            const auto links = inv.create(store, 2, std::nullopt);
+            for (const auto& link : links) t.tokens.push_back(link.token);
+            // The first participant has passed the headphone check (its layout is the server's
+            // secret, so an input could not pass it): the trials are reachable after consent.
+            // The second one takes the check (corpus failed_screening).
+            inv.recordScreening(inv.byCode(links[0].participantCode).id, true,
+                                R"({"test": "passed in the fuzz template"})");
         }
         fs::create_directories(t.clips);
         for (const auto& s : p.stimuli) {
@@ -188,6 +193,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     fuzz::copyFile(t.study, t.work);
     web::WebOptions wo;
     wo.clipsDir = t.clips;
+    wo.screeningMinResponseS = 0.0; // the check's choices are reachable without waiting
     web::ServerOptions so;
     so.maxBodyBytes = 16 * 1024;
     so.ratePerSecond = 1e9; // the rate limit is tested by tests/web, not fuzzed

@@ -29,6 +29,7 @@ class ServeProcess {
         const std::string program = other && *other ? other : UNDERFOOT_CLI;
         std::vector<std::string> args{program,   "serve", "--study", f.study,
                                       "--clips", f.clips, "--port",  std::to_string(port)};
+        args.insert(args.end(), kServeTestArgs.begin(), kServeTestArgs.end());
         args.insert(args.end(), extra.begin(), extra.end());
         std::vector<char*> argv;
         for (auto& a : args) argv.push_back(a.data());

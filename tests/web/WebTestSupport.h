@@ -17,9 +17,11 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cstdint>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -134,6 +136,16 @@ struct StudyFixture {
     }
 };
 
+/// The server's options in tests: headphone-check answers accepted at once after their tones
+/// (the default waits the tones' 4 s; WebScreening tests that rule).
+inline WebOptions testOptions() {
+    WebOptions wo;
+    wo.screeningMinResponseS = 0.0;
+    return wo;
+}
+/// The same for `underfoot serve` processes.
+inline const std::vector<std::string> kServeTestArgs{"--screening-min-response", "0"};
+
 /// WebStudy + WebServer on a free loopback port, served by a thread.
 struct InProcessServer {
     std::unique_ptr<WebStudy> study;
@@ -141,9 +153,12 @@ struct InProcessServer {
     std::thread thread;
     int port = 0;
 
-    InProcessServer(const StudyFixture& f, ServerOptions so = {}, WebOptions wo = {}) {
-        wo.clipsDir = f.clips;
-        study = std::make_unique<WebStudy>(f.study, wo);
+    InProcessServer(const StudyFixture& f, ServerOptions so = {}, WebOptions wo = testOptions())
+        : InProcessServer(f.study, f.clips, so, wo) {}
+    InProcessServer(const std::string& studyPath, const std::string& clipsDir, ServerOptions so,
+                    WebOptions wo) {
+        wo.clipsDir = clipsDir;
+        study = std::make_unique<WebStudy>(studyPath, wo);
         so.port = 0;
         server = std::make_unique<WebServer>(*study, so);
         port = server->bind();
@@ -260,16 +275,73 @@ inline std::string clientAddress(int i) {
     return "127.0." + std::to_string(1 + i / 250) + "." + std::to_string(1 + i % 250);
 }
 
+/// The interval (1, 2 or 3) a listener names the quietest in a headphone-check triplet's WAV
+/// as served (16-bit stereo PCM, three tones in equal thirds): with headphones each ear hears
+/// its own channel (the left one's peaks are compared); over loudspeakers the ears hear the
+/// sum of both channels, in which the antiphase tone cancels. Throws when it is not such a WAV.
+inline int quietestHeard(const std::string& wav, bool loudspeakers = false) {
+    if (wav.size() < 44 || wav.compare(0, 4, "RIFF") != 0 || wav.compare(36, 4, "data") != 0)
+        throw std::runtime_error("not a WAV file: " + wav.substr(0, 200));
+    const auto* pcm = reinterpret_cast<const unsigned char*>(wav.data() + 44);
+    const std::size_t frames = (wav.size() - 44) / 4;
+    auto sample = [&](std::size_t i) {
+        return static_cast<int>(static_cast<std::int16_t>(pcm[2 * i] | (pcm[2 * i + 1] << 8)));
+    };
+    int best = 0;
+    int quietest = 0;
+    for (int k = 0; k < 3; ++k) {
+        int peak = 0;
+        for (std::size_t f = k * frames / 3; f < (k + 1) * frames / 3; ++f) {
+            const int v = loudspeakers ? sample(2 * f) + sample(2 * f + 1) : sample(2 * f);
+            peak = std::max(peak, std::abs(v));
+        }
+        if (k == 0 || peak < best) {
+            best = peak;
+            quietest = k + 1;
+        }
+    }
+    return quietest;
+}
+
+/// How a simulated participant does the headphone check.
+enum class Listener { Headphones, Loudspeakers, Guess1 };
+
+/// The headphone check through the API as a listener does it: start, then per triplet its
+/// tones and the interval heard quietest (Guess1: always 1, without fetching the tones).
+/// Returns the last reply (the state after the verdict when every step was accepted).
+inline Reply doScreening(const ApiClient& c, Listener who = Listener::Headphones) {
+    // From the triplet the server waits for: a retry after a lost reply or a restart goes on.
+    Reply r = c.post("/api/screening/start", json::object());
+    for (int guard = 0; guard < 12 && r.status == 200 && r.body.value("phase", "") == "screening";
+         ++guard) {
+        const int k = r.body.at("check").at("next");
+        int choice = 1;
+        if (who != Listener::Guess1) {
+            const Reply tones = c.get("/api/screening/tones/" + std::to_string(k));
+            if (tones.status != 200) return tones;
+            choice = quietestHeard(tones.raw, who == Listener::Loudspeakers);
+        }
+        r = c.post("/api/screening", {{"triplet", k}, {"choice", choice}});
+    }
+    return r;
+}
+
+/// The consent of a participant of webProtocol() (its one required field answered).
+inline Reply consent(const ApiClient& c) {
+    return c.post("/api/consent",
+                  {{"consent", true}, {"fields", {{"listening_device", "headphones"}}}});
+}
+
 /// Consent + screening; returns the state of the first trial.
 inline json startParticipant(const ApiClient& c) {
-    Reply r = c.post("/api/consent",
-                     {{"consent", true}, {"fields", {{"listening_device", "headphones"}}}});
+    Reply r = consent(c);
     EXPECT_EQ(r.status, 200) << r.raw;
     EXPECT_EQ(r.body["phase"], "screening");
     r = c.post("/api/client", {{"sampleRate", 48000}});
     EXPECT_EQ(r.status, 200) << r.raw;
-    r = c.post("/api/screening", {{"correct", 6}, {"total", 6}});
+    r = doScreening(c);
     EXPECT_EQ(r.status, 200) << r.raw;
+    EXPECT_EQ(r.body["screening"]["passed"], true) << r.raw;
     return r.body;
 }
 
@@ -278,6 +350,7 @@ inline json validAnswer(const json& state, const std::string& attempt) {
     const json& t = state.at("trial");
     json a{{"trial", t.at("index")}, {"attempt", attempt}, {"clientMs", 1234.5}};
     if (t.contains("surface")) a["answer"] = t["surface"]["options"][0]["id"];
+    if (t.contains("soundscape")) a["soundscape"] = t["soundscape"]["options"][0]["id"];
     json ratings = json::object();
     for (const auto& s : t.at("scales")) ratings[s.at("id").get<std::string>()] = s.at("max");
     a["ratings"] = ratings;

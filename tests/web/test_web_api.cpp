@@ -24,6 +24,22 @@ Reply answerCurrent(const ApiClient& c, const json& state, const std::string& at
     return c.post("/api/answer", validAnswer(state, attempt));
 }
 
+/// One participant of a study served in process, past consent and screening: `state` is their
+/// first trial's, `t` its index.
+struct AtFirstTrial {
+    explicit AtFirstTrial(const std::string& protocol = webProtocol())
+        : f(1, protocol), s(f), c(s.port, f.links[0].token), state(startParticipant(c)),
+          t(state["trial"]["index"].get<int>()) {}
+    int replaysStored() const {
+        return StudyStore::open(f.study).trial(f.links[0].participantCode, t).replays;
+    }
+    StudyFixture f;
+    InProcessServer s;
+    ApiClient c;
+    json state;
+    int t;
+};
+
 int refusals(const std::string& study) {
     int n = 0;
     for (const auto& e : StudyStore::open(study).events()) n += e.kind == "online_refused";
@@ -207,11 +223,8 @@ TEST(WebApi, InvalidAnswersAreRefusedAndJournaled) {
 }
 
 TEST(WebApi, OutOfRangeNumbersAreRefusedNotTruncated) {
-    StudyFixture f(1);
-    InProcessServer s(f);
-    ApiClient c(s.port, f.links[0].token);
-    const json state = startParticipant(c);
-    const int t = state["trial"]["index"];
+    AtFirstTrial p;
+    auto& [f, s, c, state, t] = p;
     ASSERT_EQ(c.post("/api/present", {{"trial", t}}).status, 200);
     const json good = validAnswer(state, "g1");
     constexpr std::int64_t two32 = std::int64_t{1} << 32;
@@ -255,20 +268,17 @@ TEST(WebApi, ConsentNeedsTheProtocolsRequiredFields) {
     const json st = c.get("/api/state").body;
     EXPECT_EQ(st["phase"], "screening");
     EXPECT_EQ(c.post("/api/present", {{"trial", 0}}).status, 409);
-    EXPECT_EQ(c.post("/api/screening", {{"correct", 7}, {"total", 6}}).status, 400);
+    EXPECT_EQ(c.post("/api/screening", {{"triplet", 0}, {"choice", 1}}).status, 409);
 }
 
 TEST(WebApi, FailedScreeningEndsTheSessionWhenAskedTo) {
     StudyFixture f(2);
-    WebOptions wo;
+    WebOptions wo = testOptions();
     wo.screeningFailure = ScreeningFailure::End;
     InProcessServer s(f, {}, wo);
     ApiClient c(s.port, f.links[0].token);
-    ASSERT_EQ(c.post("/api/consent",
-                     {{"consent", true}, {"fields", {{"listening_device", "headphones"}}}})
-                  .status,
-              200);
-    const Reply r = c.post("/api/screening", {{"correct", 4}, {"total", 6}});
+    ASSERT_EQ(consent(c).status, 200);
+    const Reply r = doScreening(c, Listener::Loudspeakers);
     ASSERT_EQ(r.status, 200) << r.raw;
     EXPECT_EQ(r.body["phase"], "ended");
     EXPECT_EQ(r.body["reason"], "screening");
@@ -283,37 +293,25 @@ TEST(WebApi, FailedScreeningIsFlaggedByDefault) {
     StudyFixture f(1);
     InProcessServer s(f);
     ApiClient c(s.port, f.links[0].token);
-    ASSERT_EQ(c.post("/api/consent",
-                     {{"consent", true}, {"fields", {{"listening_device", "headphones"}}}})
-                  .status,
-              200);
-    const Reply r = c.post("/api/screening", {{"correct", 2}, {"total", 6}});
+    ASSERT_EQ(consent(c).status, 200);
+    const Reply r = doScreening(c, Listener::Loudspeakers);
     EXPECT_EQ(r.body["phase"], "practice");
     EXPECT_EQ(r.body["screening"]["passed"], false);
 }
 
 TEST(WebApi, ReplaysAreCountedOrRefusedAsTheProtocolSays) {
     {
-        StudyFixture f(1);
-        InProcessServer s(f);
-        ApiClient c(s.port, f.links[0].token);
-        const json st = startParticipant(c);
-        const int t = st["trial"]["index"];
-        EXPECT_EQ(c.post("/api/present", {{"trial", t}}).body["replays"], 0);
-        EXPECT_EQ(c.post("/api/present", {{"trial", t}}).body["replays"], 1);
-        EXPECT_EQ(c.post("/api/present", {{"trial", t}}).body["replays"], 2);
-        EXPECT_EQ(StudyStore::open(f.study).trial(f.links[0].participantCode, t).replays, 2);
+        const AtFirstTrial p;
+        for (int replays = 0; replays < 3; ++replays)
+            EXPECT_EQ(p.c.post("/api/present", {{"trial", p.t}}).body["replays"], replays);
+        EXPECT_EQ(p.replaysStored(), 2);
     }
     {
-        StudyFixture f(1, webProtocol("replay = false\n"));
-        InProcessServer s(f);
-        ApiClient c(s.port, f.links[0].token);
-        const json st = startParticipant(c);
-        EXPECT_EQ(st["trial"]["replayAllowed"], false);
-        const int t = st["trial"]["index"];
-        EXPECT_EQ(c.post("/api/present", {{"trial", t}}).status, 200);
-        EXPECT_EQ(c.post("/api/present", {{"trial", t}}).status, 409);
-        EXPECT_EQ(StudyStore::open(f.study).trial(f.links[0].participantCode, t).replays, 0);
+        const AtFirstTrial p(webProtocol("replay = false\n"));
+        EXPECT_EQ(p.state["trial"]["replayAllowed"], false);
+        EXPECT_EQ(p.c.post("/api/present", {{"trial", p.t}}).status, 200);
+        EXPECT_EQ(p.c.post("/api/present", {{"trial", p.t}}).status, 409);
+        EXPECT_EQ(p.replaysStored(), 0);
     }
 }
 
@@ -390,7 +388,7 @@ TEST(WebApi, HeadAnswersLikeGetWithoutABody) {
 
 TEST(WebApi, ATrustedProxyMustBeAnAddress) {
     StudyFixture f(1);
-    WebOptions wo;
+    WebOptions wo = testOptions();
     wo.clipsDir = f.clips;
     WebStudy study(f.study, wo);
     ServerOptions so;
@@ -428,7 +426,7 @@ TEST(WebApi, ProtocolsThatCannotRunOnlineAreRefusedClearly) {
 TEST(WebApi, MissingClipsStopTheServerBeforeItStarts) {
     StudyFixture f(1);
     fs::remove(f.clips + "/GL.wav");
-    WebOptions wo;
+    WebOptions wo = testOptions();
     wo.clipsDir = f.clips;
     try {
         WebStudy study(f.study, wo);

@@ -3,8 +3,10 @@
 // online is taken from consent to the completion code (every group), and every API reply is
 // searched for the experimenter's notes, group names, clip file names, seeds, and (outside the
 // question texts and answer lists the protocol shows in every trial alike) the current
-// stimulus's id, surface and soundscape, i.e. the correct answer. The scanner is first shown to
-// find a planted leak, so the test can fail.
+// stimulus's id, surface and soundscape, i.e. the correct answer. The headphone check is done
+// as a listener does it (tones, then a choice): no reply names its seed or which interval is
+// quiet or in antiphase, and its tones' headers are the same for every triplet. The scanner is
+// first shown to find a planted leak, so the test can fail.
 #include "WebTestSupport.h"
 
 #include <gtest/gtest.h>
@@ -43,6 +45,23 @@ json withoutQuestionTexts(json j) {
     return j;
 }
 
+/// Keys that would tell the headphone check's answer (its layout or its scoring).
+const std::set<std::string> kCheckKeys{"quiet",   "antiphase", "layout",  "correct",
+                                       "choices", "seed",      "passMark"};
+
+/// The first key of `j` (at any depth) that is one of kCheckKeys, or "".
+std::string checkKey(const json& j) {
+    if (j.is_object())
+        for (const auto& [k, v] : j.items()) {
+            if (kCheckKeys.count(k)) return k;
+            if (std::string inner = checkKey(v); !inner.empty()) return inner;
+        }
+    if (j.is_array())
+        for (const auto& v : j)
+            if (std::string inner = checkKey(v); !inner.empty()) return inner;
+    return "";
+}
+
 struct Leak {
     std::string what;
     std::string reply;
@@ -69,6 +88,10 @@ class Scanner {
                 everywhere_.emplace_back("render seed", std::to_string(*t.renderSeed));
         }
     }
+    /// The headphone check's seed (known once the verdict is stored).
+    void setCheckSeed(std::uint64_t seed) {
+        everywhere_.emplace_back("headphone check seed", std::to_string(seed));
+    }
     /// Leaks in one reply.
     std::vector<Leak> scan(const std::string& raw) const {
         std::vector<Leak> out;
@@ -79,6 +102,9 @@ class Scanner {
         const std::string body = raw.substr(0, raw.find('\n'));
         const json j = json::parse(body, nullptr, false);
         const std::string rest = j.is_discarded() ? body : withoutQuestionTexts(j).dump();
+        if (!j.is_discarded())
+            if (const std::string k = checkKey(j); !k.empty())
+                out.push_back({"headphone check key '" + k + "'", raw});
         for (const auto& [what, token] : tokens_)
             if (hasToken(rest, token)) out.push_back({what + " '" + token + "'", raw});
         if (!j.is_discarded() && j.contains("trial") && j["trial"].contains("index")) {
@@ -126,7 +152,24 @@ std::vector<std::string> runParticipant(const ApiClient& c, const Protocol& p) {
         fields[f.id] = f.options.empty() ? std::string("x") : f.options.front();
     keep(c.post("/api/consent", {{"consent", true}, {"fields", fields}}));
     keep(c.post("/api/client", {{"sampleRate", 48000}}));
-    json state = keep(c.post("/api/screening", {{"correct", 6}, {"total", 6}}));
+    // The headphone check as a listener with headphones does it. The tones' headers (but the
+    // date) must be the same for every triplet: nothing in them depends on the layout.
+    json state = keep(c.post("/api/screening/start", json::object()));
+    std::set<std::string> toneHeaders;
+    for (int n = 0; n < 12 && state.value("phase", "") == "screening"; ++n) {
+        const int k = state.at("check").at("next");
+        const Reply tones = c.get("/api/screening/tones/" + std::to_string(k));
+        EXPECT_EQ(tones.status, 200) << tones.raw.substr(0, 200);
+        std::string headers;
+        for (const auto& [name, value] : tones.headers)
+            if (name != "Date") headers += name + ": " + value + "\n";
+        toneHeaders.insert(headers);
+        replies.push_back(headers);
+        state =
+            keep(c.post("/api/screening", {{"triplet", k}, {"choice", quietestHeard(tones.raw)}}));
+    }
+    EXPECT_EQ(toneHeaders.size(), 1u);
+    EXPECT_EQ(state.at("screening").at("passed"), true);
     for (int n = 0; n < 400 && state.value("phase", "") != "finished"; ++n) {
         if (state.value("phase", "") == "break") {
             state = keep(c.post("/api/break", json::object()));
@@ -169,6 +212,10 @@ TEST(WebLeaks, ScannerFindsAPlantedLeak) {
     EXPECT_FALSE(scan.scan(R"({"trial":{"index":2,"id":"GL"}})").empty());
     EXPECT_FALSE(scan.scan(R"({"seed":1234567890123})").empty());
     EXPECT_FALSE(scan.scan(R"({"x":"Listen & identify <script>alert(1)</script>."})").empty());
+    EXPECT_TRUE(scan.scan(R"({"phase":"screening","check":{"triplets":6,"next":2}})").empty());
+    EXPECT_FALSE(scan.scan(R"({"phase":"screening","check":{"next":2,"quiet":3}})").empty());
+    scan.setCheckSeed(987654321987ULL);
+    EXPECT_FALSE(scan.scan(R"({"phase":"screening","n":987654321987})").empty());
 }
 
 TEST(WebLeaks, NoShippedProtocolShowsTheDesignToAParticipant) {
@@ -196,7 +243,13 @@ TEST(WebLeaks, NoShippedProtocolShowsTheDesignToAParticipant) {
             ++participants;
             searched += static_cast<int>(replies.size());
             Scanner scan(p, f.clips);
-            scan.setTrials(experiment::StudyStore::open(f.study).trials(link.participantCode));
+            {
+                experiment::StudyStore store = experiment::StudyStore::open(f.study);
+                scan.setTrials(store.trials(link.participantCode));
+                const json detail = json::parse(
+                    experiment::Invitations(store).byCode(link.participantCode).screeningDetail);
+                scan.setCheckSeed(detail.at("seed").get<std::uint64_t>());
+            }
             int leaks = 0;
             for (const auto& r : replies)
                 for (const auto& leak : scan.scan(r))

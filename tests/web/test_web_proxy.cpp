@@ -166,13 +166,7 @@ Start openAtOnce(const StudyFixture& f, int proxyPort, bool retry) {
                     },
                     false);
             if (ok) call([&] { return c.post("/api/client", {{"sampleRate", 48000}}); }, false);
-            if (ok)
-                state = call(
-                            [&] {
-                                return c.post("/api/screening", {{"correct", 6}, {"total", 6}});
-                            },
-                            false)
-                            .body;
+            if (ok) state = call([&] { return doScreening(c); }, false).body;
             if (ok) {
                 const int t = state["trial"]["index"];
                 call([&] { return c.get("/api/clip/" + std::to_string(t)); }, false);

@@ -64,16 +64,23 @@ std::vector<std::string> leaseEvents(const StudyFixture& f) {
     return out;
 }
 
+/// One participant of a study served by an `underfoot serve` process (`first`), past consent
+/// and screening; `state` is their first trial's.
+struct Started {
+    StudyFixture f{1};
+    std::string code = f.links[0].participantCode;
+    std::unique_ptr<ServeProcess> first = std::make_unique<ServeProcess>(f, 0);
+    ApiClient c{first->port(), f.links[0].token};
+    json state = startParticipant(c);
+};
+
 enum class Holder { Reaped, Zombie, OtherHost, OtherBoot, ReusedPid };
 
 /// Three trials (and the practice) answered, the server killed, the lease left as `holder`,
 /// a new server: the participant resumes at the next trial and finishes, nothing lost.
 void restartResumes(Holder holder, const std::string& expectedEvent) {
-    StudyFixture f(1);
-    const std::string code = f.links[0].participantCode;
-    auto first = std::make_unique<ServeProcess>(f, 0);
-    ApiClient c(first->port(), f.links[0].token);
-    json state = startParticipant(c);
+    Started p;
+    auto& [f, code, first, c, state] = p;
     int n = 0;
     int answered = 0;
     while (answered < 4) {
@@ -146,11 +153,8 @@ TEST(WebRestart, ReusedPidIsNotALiveHolder) {
 }
 
 TEST(WebRestart, LiveHolderGetsRetryableUnavailableNeverTheEndPage) {
-    StudyFixture f(1);
-    const std::string code = f.links[0].participantCode;
-    auto first = std::make_unique<ServeProcess>(f, 0);
-    ApiClient c(first->port(), f.links[0].token);
-    json state = startParticipant(c);
+    Started p;
+    auto& [f, code, first, c, state] = p;
     state = step(c, state, 0); // the practice trial
     state = step(c, state, 1);
     first->kill9();
@@ -188,11 +192,8 @@ TEST(WebRestart, LiveHolderGetsRetryableUnavailableNeverTheEndPage) {
 }
 
 TEST(WebRestart, ReplaysBeforeAKillAreKept) {
-    StudyFixture f(1);
-    const std::string code = f.links[0].participantCode;
-    auto first = std::make_unique<ServeProcess>(f, 0);
-    ApiClient c(first->port(), f.links[0].token);
-    json state = startParticipant(c);
+    Started p;
+    auto& [f, code, first, c, state] = p;
     const int index = state.at("trial").at("index").get<int>();
     for (const char* play : {"p1", "p2", "p3"}) // one presentation, two replays
         ASSERT_EQ(c.post("/api/present", {{"trial", index}, {"attempt", play}}).status, 200);

@@ -177,67 +177,64 @@
 
   // Woods, Siegel, Traer & McDermott (2017), Attention, Perception & Psychophysics 79:2064:
   // three 200 Hz tones, one 6 dB quieter; one of the two others is in antiphase between the
-  // ears, which sounds quieter over loudspeakers but not over headphones. 6 trials; 5 correct
-  // pass (the server computes the result).
+  // ears, which sounds quieter over loudspeakers but not over headphones. The server lays out
+  // each triplet, renders its tones and scores the choices: the page only plays and forwards.
   function screeningPage(s) {
-    const trials = [];
-    for (let i = 0; i < 6; i++) {
-      const b = new Uint8Array(2); crypto.getRandomValues(b);
-      const quiet = b[0] % 3;
-      const others = [0, 1, 2].filter((x) => x !== quiet);
-      trials.push({ quiet, anti: others[b[1] % 2] });
+    if (!s.check || !s.check.started) {
+      show(el('h1', { text: 'Headphone check' }), el('p', { text: 'Preparing…' }));
+      api('POST', '/api/screening/start', {}).then(render)
+        .catch((e) => show(el('h1', { text: 'Headphone check' }), el('p', { class: 'error', text: e.message })));
+      return;
     }
-    let index = 0, correct = 0;
+    const total = s.check.triplets;
+    let index = s.check.next;
     const status = el('p', { 'aria-live': 'polite' });
     const err = errorBox();
     const playBtn = el('button', { class: 'primary', type: 'button', text: 'Play the three sounds (Space)' });
     const choices = [1, 2, 3].map((n) => el('button', { type: 'button', disabled: true, 'data-choice': n },
       el('span', { class: 'key', text: String(n) }), ' Sound ' + n + ' was the quietest'));
-    function tone(ctx, antiphase, level) {
-      const rate = ctx.sampleRate, n = Math.round(rate * 1.0), ramp = Math.round(rate * 0.1);
-      const buf = ctx.createBuffer(2, n, rate);
-      const l = buf.getChannelData(0), r = buf.getChannelData(1);
-      for (let i = 0; i < n; i++) {
-        const env = Math.min(1, i / ramp, (n - 1 - i) / ramp);
-        const v = level * env * Math.sin(2 * Math.PI * 200 * i / rate);
-        l[i] = v; r[i] = antiphase ? -v : v;
-      }
-      return buf;
-    }
+    let busy = false;
     async function playTrial() {
-      const ctx = ensureAudio();
+      if (busy) return;
+      busy = true;
       playBtn.disabled = true;
       choices.forEach((c) => { c.disabled = true; });
-      const t = trials[index];
-      for (let k = 0; k < 3; k++) {
-        status.textContent = 'Sound ' + (k + 1);
-        await playBuffer(tone(ctx, k === t.anti, k === t.quiet ? 0.1 * 0.5012 : 0.1));
-        await sleep(500);
+      err.textContent = '';
+      try {
+        const data = await api('GET', '/api/screening/tones/' + index, undefined, { binary: true });
+        const buffer = await ensureAudio().decodeAudioData(data);
+        // Three 1 s tones 0.5 s apart: name each one while it plays.
+        const timers = [0, 1.5, 3].map((t, k) => setTimeout(() => { status.textContent = 'Sound ' + (k + 1); }, t * 1000));
+        await playBuffer(buffer);
+        timers.forEach(clearTimeout);
+        status.textContent = 'Which sound was the quietest? (check ' + (index + 1) + ' of ' + total + ')';
+        choices.forEach((c) => { c.disabled = false; });
+        choices[0].focus();
+      } catch (e) {
+        err.textContent = e.message;
+        playBtn.disabled = false;
       }
-      status.textContent = 'Which sound was the quietest? (check ' + (index + 1) + ' of 6)';
-      choices.forEach((c) => { c.disabled = false; });
-      choices[0].focus();
+      busy = false;
     }
     async function choose(n) {
       if (choices[0].disabled) return;
       choices.forEach((c) => { c.disabled = true; });
-      if (n - 1 === trials[index].quiet) correct++;
-      index++;
-      if (index < trials.length) {
-        status.textContent = 'Check ' + (index + 1) + ' of 6: press Play.';
-        playBtn.disabled = false;
-        playBtn.focus();
-        return;
-      }
       status.textContent = 'Saving…';
-      try { render(await api('POST', '/api/screening', { correct, total: trials.length })); }
-      catch (e) { err.textContent = e.message; }
+      let next;
+      try { next = await api('POST', '/api/screening', { triplet: index, choice: n }); }
+      catch (e) { err.textContent = e.message; playBtn.disabled = false; return; }
+      if (next.phase !== 'screening' || !next.check) { render(next); return; }
+      state = next;
+      index = next.check.next;
+      status.textContent = 'Check ' + (index + 1) + ' of ' + total + ': press Play.';
+      playBtn.disabled = false;
+      playBtn.focus();
     }
     playBtn.addEventListener('click', playTrial);
     choices.forEach((c) => c.addEventListener('click', () => choose(Number(c.dataset.choice))));
     show(el('h1', { text: 'Headphone check' }),
          el('div', { class: 'card' },
-            el('p', { text: 'Put on your headphones. Each check plays three tones; press the number of the quietest one. There are 6 checks.' }),
+            el('p', { text: 'Put on your headphones. Each check plays three tones; press the number of the quietest one. There are ' + total + ' checks.' }),
             el('div', { class: 'row' }, playBtn), status, el('div', { class: 'row' }, ...choices), err));
     playBtn.focus();
     onKeys((ev) => {

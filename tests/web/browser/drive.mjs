@@ -3,8 +3,8 @@
 // chromium, driven over the DevTools protocol by puppeteer-core), with the keyboard only:
 // consent -> headphone screening -> level -> practice -> trials (with breaks) -> completion
 // code. The screening is answered from what the page actually plays (the peak of each tone
-// buffer, read by wrapping AudioBufferSourceNode.start), so a page playing the wrong levels
-// fails the check. Screenshots of each page go to the given folder.
+// in the triplet the server rendered, read by wrapping AudioBufferSourceNode.start): the server
+// scores it, so a page or server playing the wrong levels fails the check. Screenshots of each page go to the given folder.
 //
 //   node drive.mjs LINK SCREENSHOT_DIR NAME CHROMIUM [RESULT_JSON]
 import puppeteer from 'puppeteer-core';
@@ -50,7 +50,14 @@ try {
         const d = b.getChannelData(0);
         let peak = 0;
         for (let i = 0; i < d.length; i++) peak = Math.max(peak, Math.abs(d[i]));
-        window.__played.push({ peak, seconds: b.duration, channels: b.numberOfChannels });
+        // Peaks of the left ear in three equal windows (one tone each in a headphone-check
+        // triplet), as a listener with headphones hears them.
+        const thirds = [0, 1, 2].map((k) => {
+          let p = 0;
+          for (let i = Math.floor(k * d.length / 3); i < Math.floor((k + 1) * d.length / 3); i++) p = Math.max(p, Math.abs(d[i]));
+          return p;
+        });
+        window.__played.push({ peak, thirds, seconds: b.duration, channels: b.numberOfChannels });
       }
       return start.apply(this, args);
     };
@@ -102,11 +109,14 @@ try {
   await waitFor(() => document.querySelector('h1')?.textContent === 'Headphone check', 'the screening');
   await shot('2-screening');
   for (let check = 0; check < 6; check++) {
+    // The previous choice is stored (and scored) by the server before Play is enabled again.
+    await waitFor(() => [...document.querySelectorAll('button')]
+      .some((b) => b.textContent.startsWith('Play the three') && !b.disabled), 'the play button');
     const before = await page.evaluate(() => window.__played.length);
     await page.keyboard.press('Space');
-    await waitFor((n) => window.__played.length >= n + 3 && !document.querySelector('[data-choice]').disabled,
+    await waitFor((n) => window.__played.length >= n + 1 && !document.querySelector('[data-choice]').disabled,
       'three tones', 15_000, before);
-    const peaks = await page.evaluate((n) => window.__played.slice(n, n + 3).map((p) => p.peak), before);
+    const peaks = await page.evaluate((n) => window.__played[n].thirds, before);
     const quiet = peaks.indexOf(Math.min(...peaks));
     const ratio = Math.min(...peaks) / Math.max(...peaks);
     if (Math.abs(20 * Math.log10(ratio) + 6) > 0.5) throw new Error(`the quiet tone is not 6 dB down: ${peaks}`);

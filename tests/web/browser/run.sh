@@ -76,6 +76,9 @@ PY
     || fail "$name: user agent / audio sample rate not stored"
   [ "$(q "$db" "SELECT screening_passed FROM online_invitations WHERE participant_code = 'W001'")" = 1 ] \
     || fail "$name: headphone screening not passed/stored"
+  # Scored by the server from the choices the page forwarded: the driver heard every triplet.
+  [ "$(q "$db" "SELECT json_extract(screening_detail, '\$.correct') FROM online_invitations WHERE participant_code = 'W001'")" = 6 ] \
+    || fail "$name: the server did not score 6 of 6 headphone-check choices"
   local want_replays=1; grep -q '^replay = false' "$protocol" && want_replays=0
   [ "$(q "$db" "SELECT sum(replays) FROM trials WHERE participant_id = $pid_sql")" = "$want_replays" ] \
     || fail "$name: expected $want_replays counted replay(s)"
