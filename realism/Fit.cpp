@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cctype>
 #include <chrono>
 #include <cmath>
@@ -537,8 +538,11 @@ FitResult fitSurface(const std::string& presetFile, const std::vector<Recording>
     if (realSteps.empty()) throw std::runtime_error("no footstep found in the recordings");
 
     const auto id = fs::path(presetFile).stem().string();
-    const fs::path tmp = fs::temp_directory_path() /
-                         fmt::format("underfoot-fit-{}-{}", static_cast<long>(::getpid()), id);
+    // One folder per fit: fits of the same preset may run at once (fitsWithoutEachSource).
+    static std::atomic<long> fitCount{0};
+    const fs::path tmp = fs::temp_directory_path() / fmt::format("underfoot-fit-{}-{}-{}",
+                                                                 static_cast<long>(::getpid()),
+                                                                 fitCount.fetch_add(1), id);
     fs::create_directories(tmp);
     const auto tmpFile = (tmp / (id + ".toml")).string();
 

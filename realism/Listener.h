@@ -80,6 +80,15 @@ struct LosoResult {
 /// source first when the options say so).
 LosoResult leaveOneSourceOut(const std::vector<Example>& examples, ListenerOptions o = {});
 
+/// The renders judged by a listener that never heard `heldOut`: trained on the other sources of
+/// the labelled `recordings` (centred by source when the options say so), it classifies every
+/// render of `renders` (one unlabelled source, centred on its own median when the options say
+/// so); element i is the material heard in renders[i]. Throws std::invalid_argument with fewer
+/// than two sources, no recording of `heldOut` or no render.
+std::vector<std::string> heardWithoutSource(const std::vector<Example>& recordings,
+                                            const std::vector<Example>& renders,
+                                            const std::string& heldOut, ListenerOptions o = {});
+
 /// The renders judged by listeners that never heard a source: for every source S of the
 /// labelled `recordings` (two or more sources), a listener trained on the other sources only
 /// (centred by source when the options say so) classifies every render of `renders` (one
