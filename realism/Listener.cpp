@@ -121,6 +121,22 @@ std::string Listener::classify(const std::vector<double>& f) const {
     return distances(f).front().first;
 }
 
+void LosoResult::score(const std::string& source, const std::string& material,
+                       const std::string& heard) {
+    ++confusion[material][heard];
+    ++files;
+    auto& ps = perSource[source];
+    ++ps.second;
+    if (heard == material) {
+        ++materialCorrect;
+        ++ps.first;
+    }
+    if (categoryOfMaterial(heard) == categoryOfMaterial(material)) {
+        ++categoryCorrect;
+        ++perSourceCategory[source];
+    }
+}
+
 namespace {
 // The sources of (labelled) examples; throws std::invalid_argument with fewer than two.
 std::set<std::string> twoSourcesOrMore(const std::vector<Example>& ex, const char* who) {
@@ -158,19 +174,7 @@ LosoResult leaveOneSourceOut(const std::vector<Example>& input, ListenerOptions 
                 ++r.unseenMaterialFiles;
                 continue;
             }
-            const auto p = l.classify(e.features);
-            ++r.confusion[e.material][p];
-            ++r.files;
-            auto& ps = r.perSource[held];
-            ++ps.second;
-            if (p == e.material) {
-                ++r.materialCorrect;
-                ++ps.first;
-            }
-            if (categoryOfMaterial(p) == categoryOfMaterial(e.material)) {
-                ++r.categoryCorrect;
-                ++r.perSourceCategory[held];
-            }
+            r.score(held, e.material, l.classify(e.features));
         }
     }
     return r;

@@ -74,6 +74,10 @@ struct LosoResult {
     int unseenMaterialFiles = 0; ///< held-out files of a material no other source recorded
     std::map<std::string, std::pair<int, int>> perSource; ///< source -> (material ok, files)
     std::map<std::string, int> perSourceCategory;         ///< source -> category ok
+
+    /// Counts one held-out file of `source` (true `material`, heard as `heard`) in the totals,
+    /// the confusion and the source's figures.
+    void score(const std::string& source, const std::string& material, const std::string& heard);
 };
 
 /// Leave-one-source-out evaluation over labelled examples of two or more sources (centred by
