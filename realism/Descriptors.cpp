@@ -171,6 +171,32 @@ std::vector<StepSpan> segmentSteps(const std::vector<float>& x, double fs,
     return steps;
 }
 
+int countGrainEvents(const std::vector<float>& x, std::size_t from, std::size_t to,
+                     std::size_t hop) {
+    std::vector<double> g; // energy of the first difference per frame of `hop` samples
+    for (std::size_t s = from; s < to; s += hop) {
+        double acc = 0;
+        for (std::size_t i = std::max(s, std::size_t{1}); i < std::min(to, s + hop); ++i) {
+            const double dx = double(x[i]) - double(x[i - 1]);
+            acc += dx * dx;
+        }
+        g.push_back(acc);
+    }
+    int events = 0;
+    if (g.empty()) return events;
+    const double gPeak = *std::max_element(g.begin(), g.end());
+    double trough = g[0]; // lowest envelope value since the last counted event
+    for (std::size_t i = 1; i + 1 < g.size(); ++i) {
+        trough = std::min(trough, g[i]);
+        const bool isPeak = g[i] >= g[i - 1] && g[i] > g[i + 1];
+        if (isPeak && g[i] >= gPeak * 1e-3 && g[i] >= 4.0 * trough) {
+            ++events;
+            trough = g[i];
+        }
+    }
+    return events;
+}
+
 StepDescriptors describeStep(const std::vector<float>& x, double fs, StepSpan span,
                              const AnalysisOptions& o) {
     if (span.end > x.size() || span.end <= span.begin)
@@ -270,28 +296,7 @@ StepDescriptors describeStep(const std::vector<float>& x, double fs, StepSpan sp
 
     // ---- grain events: peaks of the differentiated signal's 1 ms envelope that rise 6 dB
     // above the previous trough, within 30 dB of the step's peak (clicks, grains, bubbles) ----
-    std::vector<double> g;
-    for (std::size_t s = a0; s < a1; s += hop) {
-        double acc2 = 0;
-        for (std::size_t i = std::max(s, std::size_t{1}); i < std::min(a1, s + hop); ++i) {
-            const double dx = double(x[i]) - double(x[i - 1]);
-            acc2 += dx * dx;
-        }
-        g.push_back(acc2);
-    }
-    int events = 0;
-    if (!g.empty()) {
-        const double gPeak = *std::max_element(g.begin(), g.end());
-        double trough = g[0]; // lowest envelope value since the last counted event
-        for (std::size_t i = 1; i + 1 < g.size(); ++i) {
-            trough = std::min(trough, g[i]);
-            const bool isPeak = g[i] >= g[i - 1] && g[i] > g[i + 1];
-            if (isPeak && g[i] >= gPeak * 1e-3 && g[i] >= 4.0 * trough) {
-                ++events;
-                trough = g[i];
-            }
-        }
-    }
+    const int events = countGrainEvents(x, a0, a1, hop);
     v[kGrainRate] = std::max(double(events), 0.5) / (double(a1 - a0) / fs);
     for (double val : v)
         if (!std::isfinite(val)) throw std::invalid_argument("non-finite descriptor");
@@ -300,16 +305,9 @@ StepDescriptors describeStep(const std::vector<float>& x, double fs, StepSpan sp
 
 std::vector<StepDescriptors> describeSteps(const engine::AudioBuffer& audio,
                                            const AnalysisOptions& o) {
-    const auto x = analysisSignal(audio, o);
-    std::vector<StepDescriptors> out;
-    for (const auto& s : segmentSteps(x, o.analysisRateHz, o)) {
-        try {
-            out.push_back(describeStep(x, o.analysisRateHz, s, o));
-        } catch (const std::invalid_argument&) {
-            // a step silent inside the analysed band carries no descriptors
-        }
-    }
-    return out;
+    return forEachStep(audio, o, [&](const std::vector<float>& x, double fs, StepSpan s) {
+        return describeStep(x, fs, s, o);
+    });
 }
 
 } // namespace underfoot::realism

@@ -13,6 +13,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -88,10 +89,32 @@ double addNoiseFloor(std::vector<float>& x, double fs, const AnalysisOptions& o)
 std::vector<StepSpan> segmentSteps(const std::vector<float>& x, double fs,
                                    const AnalysisOptions& o);
 
+/// Grain events in x[from, to): peaks of the first difference's energy in frames of `hop`
+/// samples that rise 6 dB above the previous trough, within 30 dB of the loudest frame (clicks,
+/// grains, bubbles).
+int countGrainEvents(const std::vector<float>& x, std::size_t from, std::size_t to,
+                     std::size_t hop);
+
 /// Descriptors of one step of a mono signal at rate fs. Throws std::invalid_argument when the
 /// span is empty or the step is silent.
 StepDescriptors describeStep(const std::vector<float>& x, double fs, StepSpan span,
                              const AnalysisOptions& o);
+
+/// f(x, fs, span) for every step of a buffer (analysisSignal, then segmentSteps), collected in
+/// order; a step f rejects with std::invalid_argument (silent in the analysed band) is left out.
+template <class F>
+auto forEachStep(const engine::AudioBuffer& audio, const AnalysisOptions& o, F f) {
+    const auto x = analysisSignal(audio, o);
+    std::vector<decltype(f(x, o.analysisRateHz, StepSpan{}))> out;
+    for (const auto& s : segmentSteps(x, o.analysisRateHz, o)) {
+        try {
+            out.push_back(f(x, o.analysisRateHz, s));
+        } catch (const std::invalid_argument&) {
+            // a step silent inside the analysed band carries no descriptors
+        }
+    }
+    return out;
+}
 
 /// Every step of a buffer, described (segmentation + description).
 std::vector<StepDescriptors> describeSteps(const engine::AudioBuffer& audio,

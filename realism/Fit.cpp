@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cctype>
 #include <chrono>
 #include <cmath>
@@ -57,37 +58,40 @@ void eachLayerKey(toml::table& root, const std::string& type, const std::string&
     }
 }
 
-// Calls f(layer, index) for every grains layer with ongoing events (not onset-only: some
-// events_per_* > 0).
-void eachGrainEventLayer(toml::table& root, const std::function<void(toml::table&, int)>& f) {
+// Calls f(layer, index) for every grains layer that `which` accepts.
+void eachGrainsLayer(toml::table& root, const std::function<bool(const toml::table&)>& which,
+                     const std::function<void(toml::table&, int)>& f) {
     auto* layers = root["layer"].as_array();
     if (!layers) return;
     int i = 0;
     for (auto& node : *layers) {
         auto* t = node.as_table();
-        if (t && t->get("type") && t->get("type")->value<std::string>() == "grains") {
-            double rate = 0;
-            for (const char* key :
-                 {"events_per_kn_rise", "events_per_kn_fall", "events_per_s_per_kn"})
-                rate += (*t)[key].value<double>().value_or(0.0);
-            if (rate > 0) f(*t, i);
-        }
+        if (t && t->get("type") && t->get("type")->value<std::string>() == "grains" && which(*t))
+            f(*t, i);
         ++i;
     }
 }
 
+// Calls f(layer, index) for every grains layer with ongoing events (not onset-only: some
+// events_per_* > 0).
+void eachGrainEventLayer(toml::table& root, const std::function<void(toml::table&, int)>& f) {
+    eachGrainsLayer(
+        root,
+        [](const toml::table& t) {
+            double rate = 0;
+            for (const char* key :
+                 {"events_per_kn_rise", "events_per_kn_fall", "events_per_s_per_kn"})
+                rate += t[key].value<double>().value_or(0.0);
+            return rate > 0;
+        },
+        f);
+}
+
 // Calls f(layer, index) for every grains layer of noise bursts (excitation = "noise").
 void eachNoiseLayer(toml::table& root, const std::function<void(toml::table&, int)>& f) {
-    auto* layers = root["layer"].as_array();
-    if (!layers) return;
-    int i = 0;
-    for (auto& node : *layers) {
-        auto* t = node.as_table();
-        if (t && t->get("type") && t->get("type")->value<std::string>() == "grains" &&
-            (*t)["excitation"].value<std::string>() == "noise")
-            f(*t, i);
-        ++i;
-    }
+    eachGrainsLayer(
+        root, [](const toml::table& t) { return t["excitation"].value<std::string>() == "noise"; },
+        f);
 }
 
 // A grains layer that only makes the heel's onset event (onset_energy > 0, no event rates).
@@ -537,8 +541,11 @@ FitResult fitSurface(const std::string& presetFile, const std::vector<Recording>
     if (realSteps.empty()) throw std::runtime_error("no footstep found in the recordings");
 
     const auto id = fs::path(presetFile).stem().string();
-    const fs::path tmp = fs::temp_directory_path() /
-                         fmt::format("underfoot-fit-{}-{}", static_cast<long>(::getpid()), id);
+    // One folder per fit: fits of the same preset may run at once (fitsWithoutEachSource).
+    static std::atomic<long> fitCount{0};
+    const fs::path tmp = fs::temp_directory_path() / fmt::format("underfoot-fit-{}-{}-{}",
+                                                                 static_cast<long>(::getpid()),
+                                                                 fitCount.fetch_add(1), id);
     fs::create_directories(tmp);
     const auto tmpFile = (tmp / (id + ".toml")).string();
 

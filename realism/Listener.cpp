@@ -121,21 +121,52 @@ std::string Listener::classify(const std::vector<double>& f) const {
     return distances(f).front().first;
 }
 
-LosoResult leaveOneSourceOut(const std::vector<Example>& input, ListenerOptions o) {
-    std::vector<Example> ex = input;
-    if (o.centrePerSource) centreBySource(ex);
+void LosoResult::score(const std::string& source, const std::string& material,
+                       const std::string& heard) {
+    ++confusion[material][heard];
+    ++files;
+    auto& ps = perSource[source];
+    ++ps.second;
+    if (heard == material) {
+        ++materialCorrect;
+        ++ps.first;
+    }
+    if (categoryOfMaterial(heard) == categoryOfMaterial(material)) {
+        ++categoryCorrect;
+        ++perSourceCategory[source];
+    }
+}
+
+namespace {
+// The sources of (labelled) examples; throws std::invalid_argument with fewer than two.
+std::set<std::string> twoSourcesOrMore(const std::vector<Example>& ex, const char* who) {
     std::set<std::string> sources;
     for (const auto& e : ex) sources.insert(e.source);
     if (sources.size() < 2)
         throw std::invalid_argument(
-            "leave-one-source-out needs recordings from two sources or more");
+            fmt::format("{} needs recordings from two sources or more", who));
+    return sources;
+}
+
+// A listener trained on the examples (already centred when the options say so) of every source
+// but `held`.
+Listener trainedWithout(const std::vector<Example>& ex, const std::string& held,
+                        ListenerOptions o) {
+    std::vector<Example> train;
+    for (const auto& e : ex)
+        if (e.source != held) train.push_back(e);
+    Listener l(o);
+    l.train(train);
+    return l;
+}
+} // namespace
+
+LosoResult leaveOneSourceOut(const std::vector<Example>& input, ListenerOptions o) {
+    std::vector<Example> ex = input;
+    if (o.centrePerSource) centreBySource(ex);
     LosoResult r;
-    for (const auto& held : sources) {
-        std::vector<Example> train;
-        for (const auto& e : ex)
-            if (e.source != held) train.push_back(e);
-        Listener l(o);
-        l.train(train);
+    for (const auto& held : twoSourcesOrMore(ex, "leave-one-source-out")) {
+        const Listener l = trainedWithout(ex, held, o);
         const auto& mats = l.materials();
         for (const auto& e : ex) {
             if (e.source != held) continue;
@@ -143,48 +174,37 @@ LosoResult leaveOneSourceOut(const std::vector<Example>& input, ListenerOptions 
                 ++r.unseenMaterialFiles;
                 continue;
             }
-            const auto p = l.classify(e.features);
-            ++r.confusion[e.material][p];
-            ++r.files;
-            auto& ps = r.perSource[held];
-            ++ps.second;
-            if (p == e.material) {
-                ++r.materialCorrect;
-                ++ps.first;
-            }
-            if (categoryOfMaterial(p) == categoryOfMaterial(e.material)) {
-                ++r.categoryCorrect;
-                ++r.perSourceCategory[held];
-            }
+            r.score(held, e.material, l.classify(e.features));
         }
     }
     return r;
 }
 
-std::map<std::string, std::vector<std::string>>
-heardWithoutEachSource(const std::vector<Example>& recordings, const std::vector<Example>& renders,
-                       ListenerOptions o) {
-    if (renders.empty()) throw std::invalid_argument("heardWithoutEachSource: no render to judge");
+std::vector<std::string> heardWithoutSource(const std::vector<Example>& recordings,
+                                            const std::vector<Example>& renders,
+                                            const std::string& heldOut, ListenerOptions o) {
+    if (renders.empty()) throw std::invalid_argument("heardWithoutSource: no render to judge");
     std::vector<Example> ex = recordings, synth = renders;
     if (o.centrePerSource) {
         centreBySource(ex);
         centreBySource(synth);
     }
-    std::set<std::string> sources;
-    for (const auto& e : ex) sources.insert(e.source);
-    if (sources.size() < 2)
-        throw std::invalid_argument("heardWithoutEachSource needs recordings from two sources or "
-                                    "more");
+    const auto sources = twoSourcesOrMore(ex, "heardWithoutSource");
+    if (!sources.count(heldOut))
+        throw std::invalid_argument(
+            fmt::format("heardWithoutSource: no recording of source \"{}\"", heldOut));
+    const Listener l = trainedWithout(ex, heldOut, o);
+    std::vector<std::string> heard;
+    for (const auto& r : synth) heard.push_back(l.classify(r.features));
+    return heard;
+}
+
+std::map<std::string, std::vector<std::string>>
+heardWithoutEachSource(const std::vector<Example>& recordings, const std::vector<Example>& renders,
+                       ListenerOptions o) {
     std::map<std::string, std::vector<std::string>> heard;
-    for (const auto& held : sources) {
-        std::vector<Example> train;
-        for (const auto& e : ex)
-            if (e.source != held) train.push_back(e);
-        Listener l(o);
-        l.train(train);
-        auto& h = heard[held];
-        for (const auto& r : synth) h.push_back(l.classify(r.features));
-    }
+    for (const auto& held : twoSourcesOrMore(recordings, "heardWithoutEachSource"))
+        heard[held] = heardWithoutSource(recordings, renders, held, o);
     return heard;
 }
 

@@ -74,11 +74,24 @@ struct LosoResult {
     int unseenMaterialFiles = 0; ///< held-out files of a material no other source recorded
     std::map<std::string, std::pair<int, int>> perSource; ///< source -> (material ok, files)
     std::map<std::string, int> perSourceCategory;         ///< source -> category ok
+
+    /// Counts one held-out file of `source` (true `material`, heard as `heard`) in the totals,
+    /// the confusion and the source's figures.
+    void score(const std::string& source, const std::string& material, const std::string& heard);
 };
 
 /// Leave-one-source-out evaluation over labelled examples of two or more sources (centred by
 /// source first when the options say so).
 LosoResult leaveOneSourceOut(const std::vector<Example>& examples, ListenerOptions o = {});
+
+/// The renders judged by a listener that never heard `heldOut`: trained on the other sources of
+/// the labelled `recordings` (centred by source when the options say so), it classifies every
+/// render of `renders` (one unlabelled source, centred on its own median when the options say
+/// so); element i is the material heard in renders[i]. Throws std::invalid_argument with fewer
+/// than two sources, no recording of `heldOut` or no render.
+std::vector<std::string> heardWithoutSource(const std::vector<Example>& recordings,
+                                            const std::vector<Example>& renders,
+                                            const std::string& heldOut, ListenerOptions o = {});
 
 /// The renders judged by listeners that never heard a source: for every source S of the
 /// labelled `recordings` (two or more sources), a listener trained on the other sources only

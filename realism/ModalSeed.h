@@ -2,7 +2,7 @@
 #pragma once
 /// The modes of a material from its recordings: the starting point `underfoot fit` gives a
 /// solid's modal parameters before it refines them on the realism distance
-/// (docs/explanation/realism.md, "Solids, re-voiced from recorded modes").
+/// (docs/explanation/realism.md, "Fitting"; docs/decisions/realism-modal-seed.md).
 ///
 /// 1. Per recording, the matrix pencil (Modal.h) estimates `modesPerStep` modes of each of its
 ///    `stepsPerFile` strongest steps (from the step's envelope peak on, at most `maxSamples` at

@@ -166,28 +166,7 @@ std::vector<double> onsetFeatures(const std::vector<float>& x, double fs, StepSp
     const std::size_t e150 = at(0.150), e80 = at(0.080), e30 = at(0.030);
     // micro-onsets: peaks of the differentiated signal's 1 ms energy that rise 6 dB above the
     // previous trough, within 30 dB of the window's loudest (as the grain rate descriptor)
-    std::vector<double> g;
-    for (std::size_t s = t0; s < e150; s += hop) {
-        double acc = 0;
-        for (std::size_t i = std::max(s, std::size_t{1}); i < std::min(e150, s + hop); ++i) {
-            const double dx = double(x[i]) - double(x[i - 1]);
-            acc += dx * dx;
-        }
-        g.push_back(acc);
-    }
-    int events = 0;
-    if (g.size() >= 3) {
-        const double gPeak = *std::max_element(g.begin(), g.end());
-        double trough = g[0];
-        for (std::size_t i = 1; i + 1 < g.size(); ++i) {
-            trough = std::min(trough, g[i]);
-            if (g[i] >= g[i - 1] && g[i] > g[i + 1] && g[i] >= gPeak * 1e-3 &&
-                g[i] >= 4.0 * trough) {
-                ++events;
-                trough = g[i];
-            }
-        }
-    }
+    const int events = countGrainEvents(x, t0, e150, hop);
     f.push_back(std::log2(1.0 + events));
     double eAll = 0, eEarly = 0, pk = 0, sq80 = 0;
     for (std::size_t i = t0; i < e150; ++i) {
@@ -223,16 +202,9 @@ std::vector<double> onsetFeatures(const std::vector<float>& x, double fs, StepSp
 
 std::vector<std::vector<double>> onsetFeaturesOfSteps(const engine::AudioBuffer& audio,
                                                       const AnalysisOptions& o) {
-    const auto x = analysisSignal(audio, o);
-    std::vector<std::vector<double>> out;
-    for (const auto& s : segmentSteps(x, o.analysisRateHz, o)) {
-        try {
-            out.push_back(onsetFeatures(x, o.analysisRateHz, s, o));
-        } catch (const std::invalid_argument&) {
-            // silent in the analysed band: no features, as describeSteps
-        }
-    }
-    return out;
+    return forEachStep(audio, o, [&](const std::vector<float>& x, double fs, StepSpan s) {
+        return onsetFeatures(x, fs, s, o);
+    });
 }
 
 } // namespace underfoot::realism

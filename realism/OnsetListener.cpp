@@ -291,19 +291,7 @@ void scoreHeldOut(const std::vector<ListenerFile>& files, const std::string& hel
             ++r.unseenMaterialFiles;
             continue;
         }
-        const auto p = l.classify(f);
-        ++r.confusion[f.material][p];
-        ++r.files;
-        auto& ps = r.perSource[held];
-        ++ps.second;
-        if (p == f.material) {
-            ++r.materialCorrect;
-            ++ps.first;
-        }
-        if (categoryOfMaterial(p) == categoryOfMaterial(f.material)) {
-            ++r.categoryCorrect;
-            ++r.perSourceCategory[held];
-        }
+        r.score(held, f.material, l.classify(f));
     }
 }
 } // namespace

@@ -4,6 +4,8 @@
 //   compare --surface gravel [--real FILES_OR_DIRS...] [-o report.html]
 //   compare --all [-o report.html]          every surface with recordings of its material
 //   compare --listener [-o report.html]     the listener's real baseline and its verdicts
+//           [--markdown]                    tables as Markdown (docs/explanation/realism.md)
+//           [--refit [--evaluations N] [--threads T]]   nested estimate, presets refitted
 //           [--classic-listener | --onset-listener [--listener-grid]]   other listeners
 // Without --real, recordings come from the cache of scripts/fetch-recordings.sh
 // (--recordings DIR, default $UNDERFOOT_RECORDINGS or build/recordings).
@@ -12,11 +14,15 @@
 #include "engine/surfaces/Surface.h"
 #include "realism/Compare.h"
 #include "realism/Listener.h"
+#include "realism/NestedFit.h"
 #include "realism/OnsetListener.h"
 
 #include <fmt/core.h>
+#include <fmt/format.h>
 
+#include <algorithm>
 #include <array>
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -42,6 +48,10 @@ struct CompareArgs {
     bool onsetListener = false;   ///< --onset-listener: onset features, configuration grid
     bool listenerGrid = false;    ///< --listener-grid: every configuration's figures
     bool dryRecordings = false;   ///< --dry-recordings: no room on the recordings
+    bool markdown = false;        ///< --markdown: the listener's tables as Markdown
+    bool refit = false;           ///< --refit: the nested estimate with refitted presets
+    int evaluations = 80;         ///< --evaluations: renders per refit (as fit)
+    int threads = 1;              ///< --threads: refits at once
     rl::RenderSpec spec;
 };
 
@@ -243,63 +253,120 @@ int runAll(const CompareArgs& a) {
     return 0;
 }
 
-// Prints (and appends to the HTML body) a leave-one-source-out result: totals, per held-out
-// source, confusion table.
+// A table printed on the terminal (aligned, or Markdown with --markdown, to paste into the
+// docs verbatim) and appended to the HTML report.
+struct Table {
+    std::vector<std::string> head;
+    std::vector<std::vector<std::string>> rows;
+    std::size_t leftFrom = 1000; ///< columns from this one on are text, aligned left
+
+    std::string text(bool markdown) const {
+        std::vector<std::size_t> w(head.size());
+        for (std::size_t c = 0; c < head.size(); ++c) w[c] = head[c].size();
+        for (const auto& r : rows)
+            for (std::size_t c = 0; c < r.size() && c < w.size(); ++c)
+                w[c] = std::max(w[c], r[c].size());
+        auto line = [&](const std::vector<std::string>& cells) {
+            std::string out = markdown ? "|" : "";
+            for (std::size_t c = 0; c < head.size(); ++c) {
+                const auto& v = c < cells.size() ? cells[c] : std::string();
+                const auto cell =
+                    c == 0 ? fmt::format("{:<{}}", v, w[c]) : fmt::format("{:>{}}", v, w[c]);
+                out += markdown ? " " + cell + " |" : (c == 0 ? "" : "  ") + cell;
+            }
+            return out + "\n";
+        };
+        std::string out = line(head);
+        if (markdown) {
+            out += "|";
+            for (std::size_t c = 0; c < head.size(); ++c) {
+                const bool left = c == 0 || c >= leftFrom;
+                out += (left ? " :" : " ") + std::string(w[c] - 1, '-') + (left ? " |" : ": |");
+            }
+            out += "\n";
+        }
+        for (const auto& r : rows) out += line(r);
+        return out;
+    }
+    std::string html() const {
+        std::string out = "<table><tr>";
+        for (const auto& h : head) out += "<th>" + h + "</th>";
+        out += "</tr>\n";
+        for (const auto& r : rows) {
+            out += "<tr>";
+            for (const auto& v : r) out += "<td>" + v + "</td>";
+            out += "</tr>\n";
+        }
+        return out + "</table>\n";
+    }
+};
+
+// The listener's output: lines and tables on the terminal (Markdown with --markdown) and in the
+// HTML body.
+struct Out {
+    bool markdown = false;
+    std::string body;
+    void heading(const std::string& h) {
+        if (markdown)
+            fmt::print("\n#### {}\n\n", h);
+        else
+            fmt::print("\n{}:\n", h);
+        body += "<h2>" + h + "</h2>\n";
+    }
+    void line(const std::string& l) {
+        fmt::print("{}\n{}", l, markdown ? "\n" : "");
+        body += "<p>" + l + "</p>\n";
+    }
+    void table(const Table& t) {
+        fmt::print("{}", t.text(markdown));
+        if (markdown) fmt::print("\n");
+        body += t.html();
+    }
+};
+
+std::string ratio(int ok, int n) {
+    return fmt::format("{}/{}", ok, n);
+}
+std::string percent(int ok, int n) {
+    return fmt::format("{}/{} ({:.0f} %)", ok, n, 100.0 * ok / std::max(n, 1));
+}
+
+// A leave-one-source-out result: totals, per held-out source, confusion table.
 void printLoso(const rl::LosoResult& loso, std::size_t recordings, const std::string& what,
-               std::string& body) {
-    fmt::print("{}, leave-one-source-out over {} recordings: material {}/{} ({:.0f} %), "
-               "category {}/{} ({:.0f} %); {} held-out files of a material no other source has "
-               "were not scored\n",
-               what, recordings, loso.materialCorrect, loso.files,
-               100.0 * loso.materialCorrect / std::max(loso.files, 1), loso.categoryCorrect,
-               loso.files, 100.0 * loso.categoryCorrect / std::max(loso.files, 1),
-               loso.unseenMaterialFiles);
-    body += fmt::format("<p>{}, leave-one-source-out: material {}/{}, category {}/{}.</p><ul>",
-                        what, loso.materialCorrect, loso.files, loso.categoryCorrect, loso.files);
+               Out& out) {
+    out.line(fmt::format("{}, leave-one-source-out over {} recordings: material {}, category {}; "
+                         "{} held-out files of a material no other source has were not scored",
+                         what, recordings, percent(loso.materialCorrect, loso.files),
+                         percent(loso.categoryCorrect, loso.files), loso.unseenMaterialFiles));
+    Table perSource{{"held out", "material", "category"}, {}};
     for (const auto& [src, mf] : loso.perSource) {
         const auto it = loso.perSourceCategory.find(src);
         const int cat = it == loso.perSourceCategory.end() ? 0 : it->second;
-        fmt::print("  held out {:<10} material {:>2}/{:<2}  category {:>2}/{}\n", src, mf.first,
-                   mf.second, cat, mf.second);
-        body += fmt::format("<li>held out {}: material {}/{}, category {}/{}</li>", src, mf.first,
-                            mf.second, cat, mf.second);
+        perSource.rows.push_back({src, ratio(mf.first, mf.second), ratio(cat, mf.second)});
     }
-    body += "</ul><table><tr><th>true \\ heard</th>";
+    out.table(perSource);
     std::set<std::string> cols;
     for (const auto& [t, row] : loso.confusion)
         for (const auto& [p, n] : row) cols.insert(p), cols.insert(t);
-    for (const auto& c : cols) body += "<th>" + c + "</th>";
-    body += "</tr>";
-    fmt::print("confusion (rows: true material, columns: heard):\n{:<8}", "");
-    for (const auto& c : cols) fmt::print(" {:>6}", c);
-    fmt::print("\n");
+    out.line("confusion (rows: true material, columns: heard):");
+    Table confusion{{"true \\ heard"}, {}};
+    confusion.head.insert(confusion.head.end(), cols.begin(), cols.end());
     for (const auto& t : cols) {
         if (!loso.confusion.count(t)) continue;
-        fmt::print("{:<8}", t);
-        body += "<tr><th>" + t + "</th>";
-        for (const auto& c : cols) {
-            const auto& row = loso.confusion.at(t);
-            const int n = row.count(c) ? row.at(c) : 0;
-            fmt::print(" {:>6}", n);
-            body += fmt::format("<td>{}</td>", n);
-        }
-        fmt::print("\n");
-        body += "</tr>";
+        const auto& row = loso.confusion.at(t);
+        std::vector<std::string> r{t};
+        for (const auto& c : cols) r.push_back(std::to_string(row.count(c) ? row.at(c) : 0));
+        confusion.rows.push_back(std::move(r));
     }
-    body += "</table>";
+    out.table(confusion);
 }
 
 // The verdict on every surface's render (heard[i] is the material heard in infos[i]'s render).
 void printVerdicts(const std::vector<eng::SurfaceInfo>& infos,
-                   const std::vector<std::string>& heard, std::string& body) {
-    fmt::print("\nseen sources (the listener trained on every recording, the presets' fit data "
-               "among them):\n");
-    fmt::print("{:<22} {:<9} {:<9} {:<9} {:<9} {}\n", "surface", "category", "heard cat",
-               "material", "heard", "verdict");
-    body += "<h2>Seen sources: verdict on every surface (listener trained on all recordings, "
-            "those the presets were fitted to among them)</h2><table><tr><th>"
-            "surface</th><th>category</th><th>heard category</th><th>material</th><th>heard as</th>"
-            "</tr>\n";
+                   const std::vector<std::string>& heard, Out& out) {
+    out.heading("Seen sources (the listener trained on every recording, the presets' fit data "
+                "among them: not evidence)");
+    Table t{{"surface", "category", "heard cat", "material", "heard", "verdict"}, {}, 1};
     int catOk = 0, matOk = 0, matN = 0, n = 0;
     for (std::size_t i = 0; i < infos.size(); ++i) {
         const auto& info = infos[i];
@@ -312,37 +379,33 @@ void printVerdicts(const std::vector<eng::SurfaceInfo>& infos,
             ++matN;
             matOk += heard[i] == mat;
         }
-        fmt::print("{:<22} {:<9} {:<9} {:<9} {:<9} {}{}\n", info.id, cat, heardCat,
-                   mat.empty() ? "-" : mat, heard[i],
-                   heardCat == cat ? "category ok" : "WRONG category",
-                   mat.empty() ? "" : (heard[i] == mat ? ", material ok" : ", wrong material"));
-        body += fmt::format("<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>\n",
-                            info.id, cat, heardCat, mat.empty() ? "-" : mat, heard[i]);
+        t.rows.push_back(
+            {info.id, cat, heardCat, mat.empty() ? "-" : mat, heard[i],
+             std::string(heardCat == cat ? "category ok" : "WRONG category") +
+                 (mat.empty() ? "" : (heard[i] == mat ? ", material ok" : ", wrong material"))});
     }
-    fmt::print("seen sources: category right for {}/{}, material right for {}/{} surfaces with a "
-               "recorded material\n",
-               catOk, n, matOk, matN);
-    body += fmt::format("</table><p>Category right for {}/{}; material right for {}/{}.</p>", catOk,
-                        n, matOk, matN);
+    out.table(t);
+    out.line(fmt::format("seen sources: category right for {}, material right for {} surfaces "
+                         "with a recorded material",
+                         ratio(catOk, n), ratio(matOk, matN)));
 }
 
-// The renders judged by listeners that never heard a source (heardWithoutEachSource): per
-// held-out source, the surfaces of a material that source recorded (their category and material
-// right or not) and every surface's category; then per surface over those sources.
+// Renders judged by listeners that never heard a source: heard[S][i] is the material heard in
+// infos[i]'s render without S. Per held-out source: its recordings' leave-one-source-out score
+// (loso), every surface's category, and the surfaces of a material S recorded (category and
+// material right or not); then per surface over the sources that recorded its material.
 void printNested(const std::vector<eng::SurfaceInfo>& infos, const std::vector<rl::Example>& recs,
-                 const std::vector<rl::Example>& synth, const rl::ListenerOptions& lo,
-                 std::string& body) {
-    const auto heard = rl::heardWithoutEachSource(recs, synth, lo);
+                 const std::map<std::string, std::vector<std::string>>& heard,
+                 const rl::LosoResult& loso, const std::string& title, Out& out) {
     std::map<std::string, std::set<std::string>> recorded; // source -> materials
     for (const auto& e : recs) recorded[e.source].insert(e.material);
-    fmt::print("\nnested (listener trained without the held-out source; the presets are NOT "
-               "refitted without it):\n{:<14} {:>14} {:>22}\n",
-               "held out", "category (all)", "its materials: cat / mat");
-    body += "<h2>Nested: listener trained without each source</h2><p>The presets are not refitted "
-            "without the held-out source.</p><table><tr><th>held out</th><th>category, every "
-            "surface</th><th>category, surfaces of a material it recorded</th><th>material</th>"
-            "</tr>\n";
+    out.heading(title);
+    Table perSource{{"held out", "its recordings: material", "category", "renders: category (all)",
+                     "its materials: category", "material"},
+                    {}};
     std::map<std::string, std::array<int, 3>> perSurface; // id -> (sources, cat ok, mat ok)
+    int totals[4] = {0, 0, 0, 0};                         // cat all, n all, own n, own cat
+    int totalMat = 0;
     for (const auto& [src, h] : heard) {
         int catAll = 0, n = 0, catOwn = 0, matOwn = 0;
         for (std::size_t i = 0; i < infos.size(); ++i) {
@@ -359,16 +422,26 @@ void printNested(const std::vector<eng::SurfaceInfo>& infos, const std::vector<r
             ps[1] += catOk;
             ps[2] += h[i] == mat;
         }
-        fmt::print("{:<14} {:>11}/{:<2} {:>15}/{:<2} {:>2}/{:<2}\n", src, catAll, infos.size(),
-                   catOwn, n, matOwn, n);
-        body += fmt::format("<tr><td>{}</td><td>{}/{}</td><td>{}/{}</td><td>{}/{}</td></tr>\n", src,
-                            catAll, infos.size(), catOwn, n, matOwn, n);
+        totals[0] += catAll;
+        totals[1] += int(infos.size());
+        totals[2] += n;
+        totals[3] += catOwn;
+        totalMat += matOwn;
+        const auto it = loso.perSource.find(src);
+        const auto cit = loso.perSourceCategory.find(src);
+        const auto files = it == loso.perSource.end() ? std::pair<int, int>{0, 0} : it->second;
+        const int filesCat = cit == loso.perSourceCategory.end() ? 0 : cit->second;
+        perSource.rows.push_back({src, ratio(files.first, files.second),
+                                  ratio(filesCat, files.second), ratio(catAll, int(infos.size())),
+                                  ratio(catOwn, n), ratio(matOwn, n)});
     }
-    body += "</table><table><tr><th>surface</th><th>held-out sources that recorded its "
-            "material</th><th>category right</th><th>material right</th><th>heard (by held-out "
-            "source)</th></tr>\n";
-    fmt::print("{:<22} {:>7} {:>8} {:>8}  heard without each source\n", "surface", "sources",
-               "category", "material");
+    perSource.rows.push_back({"all", ratio(loso.materialCorrect, loso.files),
+                              ratio(loso.categoryCorrect, loso.files),
+                              percent(totals[0], totals[1]), percent(totals[3], totals[2]),
+                              percent(totalMat, totals[2])});
+    out.table(perSource);
+    Table perSurf{
+        {"surface", "sources", "category", "material", "heard without each source"}, {}, 4};
     for (std::size_t i = 0; i < infos.size(); ++i) {
         std::string list;
         for (const auto& [src, h] : heard)
@@ -376,12 +449,12 @@ void printNested(const std::vector<eng::SurfaceInfo>& infos, const std::vector<r
         const auto it = perSurface.find(infos[i].id);
         const std::array<int, 3> ps =
             it == perSurface.end() ? std::array<int, 3>{0, 0, 0} : it->second;
-        fmt::print("{:<22} {:>7} {:>6}/{:<1} {:>6}/{:<1}  {}\n", infos[i].id, ps[0], ps[1], ps[0],
-                   ps[2], ps[0], list);
-        body += fmt::format("<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>\n",
-                            infos[i].id, ps[0], ps[1], ps[2], list);
+        perSurf.rows.push_back(
+            {infos[i].id, std::to_string(ps[0]), ratio(ps[1], ps[0]), ratio(ps[2], ps[0]), list});
     }
-    body += "</table>";
+    out.line("per surface (sources: held-out sources that recorded its material; category and "
+             "material right without those sources):");
+    out.table(perSurf);
 }
 
 // The onset listener (realism/OnsetListener.h): its configuration chosen from a fixed grid by
@@ -416,10 +489,11 @@ int runOnsetListener(const CompareArgs& a) {
     }
     const auto grid = rl::listenerGrid();
     const auto cfg = rl::chooseConfig(files, grid);
-    std::string body = fmt::format(
-        "<p>Onset listener (realism/OnsetListener.h), configuration {} chosen among {} by "
-        "leave-one-source-out (band {:.0f}-{:.0f} Hz), trained on recordings only.</p>",
-        cfg.name(), grid.size(), o.minHz, o.maxHz);
+    Out out{a.markdown, {}};
+    out.line(
+        fmt::format("Onset listener (realism/OnsetListener.h), configuration {} chosen among {} by "
+                    "leave-one-source-out (band {:.0f}-{:.0f} Hz), trained on recordings only.",
+                    cfg.name(), grid.size(), o.minHz, o.maxHz));
     if (a.listenerGrid) {
         fmt::print("every configuration, leave-one-source-out over {} recordings (material, "
                    "category):\n",
@@ -431,8 +505,7 @@ int runOnsetListener(const CompareArgs& a) {
         }
         fmt::print("chosen on all sources: {}\n", cfg.name());
     }
-    printLoso(rl::leaveOneSourceOut(files, cfg), files.size(), "onset listener " + cfg.name(),
-              body);
+    printLoso(rl::leaveOneSourceOut(files, cfg), files.size(), "onset listener " + cfg.name(), out);
     const auto nested = rl::nestedLeaveOneSourceOut(files, grid);
     for (const auto& [src, c] : nested.chosen)
         fmt::print("nested: held out {}: chose {} on the other sources\n", src, c.name());
@@ -440,7 +513,7 @@ int runOnsetListener(const CompareArgs& a) {
               fmt::format("nested estimate (configuration chosen among {} without the held-out "
                           "source)",
                           grid.size()),
-              body);
+              out);
     auto trainSet = files;
     rl::normaliseBySource(trainSet, cfg.standardisePerSource);
     rl::OnsetListener l(cfg);
@@ -459,9 +532,53 @@ int runOnsetListener(const CompareArgs& a) {
     rl::normaliseBySource(synth, cfg.standardisePerSource); // the renders are one more source
     std::vector<std::string> heard;
     for (const auto& f : synth) heard.push_back(l.classify(f));
-    printVerdicts(infos, heard, body);
-    if (!a.output.empty()) writeHtml(a.output, "Underfoot listener", body);
+    printVerdicts(infos, heard, out);
+    if (!a.output.empty()) writeHtml(a.output, "Underfoot listener", out.body);
     return 0;
+}
+
+// The nested estimate with the presets refitted without each source (realism/NestedFit.h).
+void printRefitNested(const CompareArgs& a, const std::vector<rl::Recording>& recs,
+                      const std::vector<rl::Example>& ex, const rl::AnalysisOptions& o,
+                      const rl::ListenerOptions& lo, const rl::LosoResult& loso, Out& out) {
+    rl::NestedRefitOptions no;
+    no.fit.maxEvaluations = a.evaluations;
+    no.fit.contrast = 2.0; // `underfoot fit`'s defaults
+    no.fit.margin = 0.1;
+    no.threads = a.threads;
+    no.render = a.spec;
+    no.listener = lo;
+    no.progress = [](std::size_t done, std::size_t total, const rl::RefitJob& j,
+                     const rl::FitResult& r) {
+        fmt::print(stderr,
+                   "refit {}/{}: {} without {} ({} recordings): distance {:.3f} -> {:.3f} "
+                   "in {:.0f} s\n",
+                   done, total, j.surface, j.heldOut, j.own.size(), r.distanceBefore,
+                   r.distanceAfter, r.seconds);
+    };
+    const auto t0 = std::chrono::steady_clock::now();
+    const auto n = rl::nestedRefit(recs, ex, o, no);
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    std::map<std::string, std::vector<std::string>> refitted; // source -> surfaces
+    for (const auto& j : n.jobs) refitted[j.heldOut].push_back(j.surface);
+    std::string list;
+    for (const auto& [src, ids] : refitted)
+        list += fmt::format("{}{}: {}", list.empty() ? "" : "; ", src, fmt::join(ids, ", "));
+    std::vector<eng::SurfaceInfo> infos;
+    for (const auto& info : eng::listSurfaces())
+        if (std::find(n.surfaces.begin(), n.surfaces.end(), info.id) != n.surfaces.end())
+            infos.push_back(info);
+    printNested(infos, ex, n.heard, loso,
+                "Nested, presets refitted: listener trained and presets fitted without the "
+                "held-out source",
+                out);
+    out.line(fmt::format(
+        "{} fits ({} evaluations each at most, contrast 2, margin 0.1, {} thread(s)) in {:.0f} s. "
+        "Refitted without each source: {}. A preset of a material the held-out source did not "
+        "record, or recorded alone, keeps its shipped (all-source) fit; a preset with a base "
+        "inherits its base's refit.",
+        n.jobs.size(), a.evaluations, a.threads, seconds, list));
 }
 
 // The default listener and the first one (realism/Listener.h, --classic-listener).
@@ -491,9 +608,10 @@ int runListener(const CompareArgs& a) {
     }
     rl::ListenerOptions lo;
     if (a.classicListener) lo = {false, false, false};
-    std::string body = fmt::format(
-        "<p>Nearest-centroid listener on {} descriptors{} (band {:.0f}-{:.0f} Hz), {}, trained on "
-        "recordings only.</p>",
+    Out out{a.markdown, {}};
+    out.line(fmt::format(
+        "Nearest-centroid listener on {} descriptors{} (band {:.0f}-{:.0f} Hz), {}, trained on "
+        "recordings only.",
         int(rl::kDescriptorCount),
         lo.scalarsOnly
             ? std::string()
@@ -501,9 +619,9 @@ int runListener(const CompareArgs& a) {
         o.minHz, o.maxHz,
         lo.centrePerSource ? "every source centred on its own median, one centroid per source "
                              "and material"
-                           : "one centroid per material");
-    printLoso(rl::leaveOneSourceOut(ex, lo), ex.size(),
-              a.classicListener ? "first listener" : "listener", body);
+                           : "one centroid per material"));
+    const auto loso = rl::leaveOneSourceOut(ex, lo);
+    printLoso(loso, ex.size(), a.classicListener ? "first listener" : "listener", out);
     rl::Listener l(lo);
     auto trainSet = ex;
     if (lo.centrePerSource) rl::centreBySource(trainSet);
@@ -524,10 +642,14 @@ int runListener(const CompareArgs& a) {
     if (lo.centrePerSource) rl::centreBySource(synth);
     std::vector<std::string> heard;
     for (const auto& e : synth) heard.push_back(l.classify(e.features));
-    printVerdicts(infos, heard, body);
     // centreBySource above changed synth: heardWithoutEachSource centres its own copies.
-    printNested(infos, ex, synthUncentred, lo, body);
-    if (!a.output.empty()) writeHtml(a.output, "Underfoot listener", body);
+    printNested(infos, ex, rl::heardWithoutEachSource(ex, synthUncentred, lo), loso,
+                "Nested, presets not refitted: listener trained without the held-out source, "
+                "presets as shipped (fitted with it)",
+                out);
+    if (a.refit) printRefitNested(a, recs, ex, o, lo, loso, out);
+    printVerdicts(infos, heard, out);
+    if (!a.output.empty()) writeHtml(a.output, "Underfoot listener", out.body);
     return 0;
 }
 
@@ -541,6 +663,10 @@ int runCompare(const CompareArgs& a) {
         throw UserError("compare: --listener-grid goes with --onset-listener");
     if (!a.real.empty() && a.surface.empty())
         throw UserError("compare: --real goes with --surface");
+    if ((a.refit || a.markdown) && !a.listener)
+        throw UserError("compare: --refit and --markdown go with --listener");
+    if (a.refit && (a.onsetListener || a.classicListener))
+        throw UserError("compare: --refit goes with the default listener");
     try {
         eng::WalkerParameters::parse(a.spec.walker).validate();
     } catch (const std::invalid_argument& e) {
@@ -590,6 +716,20 @@ CommandRegistrar reg("compare", [](CLI::App& app, int& exitCode) {
     cmd->add_flag("--listener-grid", args->listenerGrid,
                   "with --onset-listener: print every configuration's leave-one-source-out "
                   "figures");
+    cmd->add_flag("--markdown", args->markdown,
+                  "with --listener: print the tables as Markdown (pasted verbatim into "
+                  "docs/explanation/realism.md)");
+    cmd->add_flag("--refit", args->refit,
+                  "with --listener: the nested estimate with the presets refitted (as `underfoot "
+                  "fit` does) without each held-out source; slow: one fit per preset and source "
+                  "that recorded its material");
+    cmd->add_option("--evaluations", args->evaluations,
+                    "with --refit: renders the optimiser may try per fit")
+        ->capture_default_str()
+        ->check(CLI::Range(5, 2000));
+    cmd->add_option("--threads", args->threads, "with --refit: fits run at once")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 64));
     cmd->add_option("--features", args->features,
                     "with --listener: write the listener's features (CSV: name, source, material, "
                     "then one column per feature; with --onset-listener every step of every "

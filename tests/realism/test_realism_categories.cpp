@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Water, deep snow, frozen snow, dry leaves and forest underbrush stay where their re-voicing put
-// them (docs/explanation/realism.md, "Heard in their category: liquids, snows, leaves and
+// them (docs/decisions/realism-revoicing.md, "Heard in their category: liquids, snows, leaves and
 // underbrush"): the descriptors that made the listener hear them as solids lie within about one
 // recorded spread of their material's recordings (leaves and underbrush, which have none, of all
 // recorded aggregates). Each check is a robust z of realism/Distance.h against the recordings of
@@ -88,13 +88,13 @@ TEST_F(HeardInTheirCategory, LeavesAndUnderbrushLieAmongTheRecordedAggregates) {
         check(s, aggregates, {{kCentroid, 1.0}, {kFlatness, 1.0}, {kBandHigh, 1.0}}, 0.85);
 }
 
-// Frozen snow (docs/explanation/realism.md, "Frozen snow: a crust that breaks"): main's was a
-// bright crunch over 1-5 kHz with glassy 5-12 kHz grains and almost nothing low, heard as ice (the
-// listener's pulls: 4-16 kHz, flatness, 250 Hz-1 kHz, decay) and nearer gravel (0.67) and water
-// than snow (1.77). Against the snow recordings: 20-250 Hz z 5.95 (-20 dB of the whole band vs a
-// recorded median of -2.2), centroid 2.66 (1997 vs 558 Hz), flatness 2.29, 1-4 kHz 2.01,
-// 4-16 kHz 1.69. Now: the low band within one recorded spread and the step closer to the snow
-// recordings than to those of gravel, water and ice (the materials it was nearest or heard as).
+// Frozen snow (docs/decisions/realism-revoicing.md, "Frozen snow: a crust that breaks"): main's was
+// a bright crunch over 1-5 kHz with glassy 5-12 kHz grains and almost nothing low, heard as ice
+// (the listener's pulls: 4-16 kHz, flatness, 250 Hz-1 kHz, decay) and nearer gravel (0.67) and
+// water than snow (1.77). Against the snow recordings: 20-250 Hz z 5.95 (-20 dB of the whole band
+// vs a recorded median of -2.2), centroid 2.66 (1997 vs 558 Hz), flatness 2.29, 1-4 kHz 2.01, 4-16
+// kHz 1.69. Now: the low band within one recorded spread and the step closer to the snow recordings
+// than to those of gravel, water and ice (the materials it was nearest or heard as).
 TEST_F(HeardInTheirCategory, FrozenSnowIsACrustBreakingOverSnowNotIce) {
     const auto c = check(
         "frozen_snow", {"snow"},

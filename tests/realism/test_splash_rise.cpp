@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The bubbles layer's splash_rise_ms (engine/surfaces/LiquidLayers.h), added for the re-voiced
-// water (docs/explanation/realism.md, "Heard in their category"): absent or 0 it changes nothing
-// (same samples as before the knob); set, the splash noise develops after the landing: its loudest
-// moment comes later, and the layer still ends in silence and sleeps.
+// water (docs/decisions/realism-revoicing.md, "Heard in their category"): absent or 0 it changes
+// nothing (same samples as before the knob); set, the splash noise develops after the landing: its
+// loudest moment comes later, and the layer still ends in silence and sleeps.
 #include "engine/control/VirtualWalker.h"
 #include "engine/surfaces/Surface.h"
 
