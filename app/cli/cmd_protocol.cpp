@@ -25,6 +25,11 @@
 namespace underfoot::cli::protocol_command {
 namespace {
 
+/// "1 repetition", "2 repetitions": `n` with the singular or the plural noun.
+std::string count(std::size_t n, std::string_view singular, std::string_view plural) {
+    return fmt::format("{} {}", n, n == 1 ? singular : plural);
+}
+
 using namespace underfoot::experiment;
 
 std::string minutes(double seconds) {
@@ -36,8 +41,9 @@ void printSummary(const Protocol& p, std::uint64_t seed, int participants) {
     fmt::print("{} — {} (version {})\n", p.id, p.title, p.version);
     if (!p.reference.empty()) fmt::print("reference: {}\n", p.reference);
     fmt::print("sha256: {}\n", p.hash);
-    fmt::print("design: {}-subject, {} stimuli, {} repetition(s), order {}{}{}\n",
-               toString(p.design), p.stimuli.size(), p.ordering.repetitions,
+    fmt::print("design: {}-subject, {}, {}, order {}{}{}\n", toString(p.design),
+               count(p.stimuli.size(), "stimulus", "stimuli"),
+               count(static_cast<std::size_t>(p.ordering.repetitions), "repetition", "repetitions"),
                p.ordering.order == OrderKind::Random ? "random per participant" : "fixed",
                p.ordering.blocks == BlockKind::Repetition ? ", one block per repetition"
                : p.ordering.blocks == BlockKind::Scale    ? ", one block per scale"
@@ -52,9 +58,10 @@ void printSummary(const Protocol& p, std::uint64_t seed, int participants) {
     if (p.clips.enabled) {
         int lab = 0;
         for (const auto& s : p.stimuli) lab += s.clip ? 1 : 0;
-        fmt::print("listening test: {} clip(s) rendered by `underfoot clips` ({:g} s, seed {}), {} "
+        fmt::print("listening test: {} rendered by `underfoot clips` ({:g} s, seed {}), {} "
                    "supplied by the lab; replay {}\n",
-                   static_cast<int>(p.stimuli.size()) - lab, p.clips.seconds, p.clips.seed, lab,
+                   count(p.stimuli.size() - static_cast<std::size_t>(lab), "clip", "clips"),
+                   p.clips.seconds, p.clips.seed, lab,
                    p.clips.replay ? "allowed (counted)" : "not allowed");
     }
     for (const auto& f : p.participantFields)
@@ -65,8 +72,9 @@ void printSummary(const Protocol& p, std::uint64_t seed, int participants) {
                p.questions.asksSurface()
                    ? fmt::format("surface ({} options)", p.questions.surfaceOptions.size())
                    : "no surface question",
-               p.questions.scales.empty() ? ""
-                                          : fmt::format(", {} scale(s)", p.questions.scales.size()),
+               p.questions.scales.empty()
+                   ? ""
+                   : ", " + count(p.questions.scales.size(), "scale", "scales"),
                p.questions.soundscapeOptions.empty() ? "" : ", soundscape",
                p.questions.comment ? ", comment" : "");
     const PlanSummary summary = summarizePlans(p, seed, participants);

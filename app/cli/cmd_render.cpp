@@ -5,9 +5,11 @@
 #include "engine/io/AudioFile.h"
 #include "engine/render/Renderer.h"
 #include "engine/surfaces/Surface.h"
+#include "engine/wading/WadingScene.h"
 
 #include <fmt/core.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <memory>
 
@@ -169,11 +171,64 @@ CommandRegistrar reg("render", [](CLI::App& app, int& exitCode) {
     cmd->callback([args, &exitCode] { exitCode = runRender(*args); });
 });
 
+/// One line per key every bundled surface and wading preset reads, tab-separated, for
+/// tools/docs/presets_reference.py (docs/reference/presets.md).
+void printKeys() {
+    std::vector<eng::KeyInfo> keys;
+    std::vector<std::pair<std::string, std::size_t>> models; // model, keys up to here
+    try {
+        for (const auto& s : eng::listSurfaces()) {
+            eng::KeyCatalog catalog(keys);
+            (void)eng::Surface::load(s.file);
+            models.emplace_back("surface", keys.size());
+        }
+        std::vector<std::string> wading;
+        for (const auto& e : std::filesystem::directory_iterator(eng::wadingPresetDirectory()))
+            if (e.path().extension() == ".toml") wading.push_back(e.path().string());
+        std::sort(wading.begin(), wading.end());
+        for (const auto& w : wading) {
+            eng::KeyCatalog catalog(keys);
+            (void)eng::loadWadingPreset(w);
+            models.emplace_back("wading", keys.size());
+        }
+    } catch (const eng::PresetError& e) {
+        throw UserError(e.what());
+    }
+    auto clean = [](std::string s) {
+        for (char& c : s)
+            if (c == '\t' || c == '\n') c = ' ';
+        return s;
+    };
+    fmt::print("model\tfile\tkey\ttype\tunit\tmin\tmax\tdefault\trequired\tvalue\tallowed\thelp\n");
+    std::size_t i = 0;
+    for (const auto& [model, end] : models) {
+        for (; i < end; ++i) {
+            const auto& k = keys[i];
+            const bool ranged = k.type == "number" || k.type == "integer";
+            fmt::print("{}\t{}\t{}\t{}\t{}\t{}\t{}\t{}\t{}\t{}\t{}\t{}\n", model,
+                       std::filesystem::path(k.file).stem().string(), k.path, k.type, clean(k.unit),
+                       ranged ? fmt::format("{:g}", k.minValue) : "",
+                       ranged ? fmt::format("{:g}", k.maxValue) : "", clean(k.defaultText),
+                       k.required ? "yes" : "no", clean(k.valueText), clean(k.allowed),
+                       clean(k.help));
+        }
+    }
+}
+
 CommandRegistrar regSurfaces("surfaces", [](CLI::App& app, int& exitCode) {
     auto verbose = std::make_shared<bool>(false);
+    auto keys = std::make_shared<bool>(false);
     auto* cmd = app.add_subcommand("surfaces", "List the bundled surfaces");
     cmd->add_flag("-v,--verbose", *verbose, "also list each surface's layers and parameters");
-    cmd->callback([verbose, &exitCode] {
+    cmd->add_flag("--keys", *keys,
+                  "print every preset key the bundled surface and wading presets read, "
+                  "tab-separated (for docs/reference/presets.md)");
+    cmd->callback([verbose, keys, &exitCode] {
+        if (*keys) {
+            printKeys();
+            exitCode = 0;
+            return;
+        }
         std::vector<eng::SurfaceInfo> list;
         try {
             list = eng::listSurfaces();

@@ -5,7 +5,7 @@
 /// driven by the stimulus's virtual walker or gait, or by a recorded GRF. Listening-test clips,
 /// trial replays, simulated participants' trials and the console's previews all render here;
 /// the live path builds the same scene from describeStimulus() (Players.h), and live trials
-/// replay to its samples (docs/architecture.md, "Determinism and seeds").
+/// replay to its samples (docs/explanation/architecture.md, "Determinism and seeds").
 ///
 /// A clip is the stimulus rendered to exactly `clip.seconds` (see docs/reference/protocol.md,
 /// [clips]): the feet walk for the length minus a ring-out tail of min(1 s, a fifth of the

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
-/// Block-size independence of sleep decisions (docs/explanation/performance.md "Block-size
-/// independence").
+/// Block-size independence of sleep decisions (docs/explanation/performance.md, "Block-size
+/// independence"; docs/decisions/sleep-grid.md).
 ///
 /// A layer that stops computing when it has rung out ("falls asleep") must take that decision
 /// at moments that do not depend on how the host cuts the signal into blocks, or the same input

@@ -65,8 +65,7 @@ double spectralDistanceDb(const std::vector<float>& a, const std::vector<float>&
 std::vector<KnobMeasurement> measureKnobs(double seconds = 4.0);
 
 /// The six model scenarios of the cost table, each the model alone at 48 kHz in 64-sample blocks
-/// (parameters in docs/explanation/performance.md, mapped there onto the Sound Design Toolkit's
-/// API):
+/// (their parameters are the presets' layers when the table was made):
 ///   impact-strikes  3 modes (the bench impact), a 0.5 m/s strike every 0.25 s;
 ///   impact-pressed  the same with 300 N pressing the sole: the contact never opens;
 ///   impact-metal    the metal preset's 14 modes, k and mu, a 0.45 m/s strike every 0.25 s;

@@ -264,7 +264,9 @@ std::unique_ptr<SurfaceLayer> makeGrainsLayer(PresetReader& r, const AccuracyOpt
                              "energy of one event when the heel loads (0: none)");
     c.onsetForceN = r.number("onset_force_n", 200.0, 1.0, 2000.0, "N",
                              "load at which the onset event fires", true);
-    const bool noise = r.string("excitation", "resonant", {"resonant", "noise"}) == "noise";
+    const bool noise =
+        r.string("excitation", "resonant", {"resonant", "noise"},
+                 "each event rings at random resonances or is a noise burst") == "noise";
     if (noise) { // noise bursts: no resonances to read (a stray freq_* or q_* is refused)
         m.excitation = AggregateParameters::Excitation::Noise;
         m.resonances = 1;

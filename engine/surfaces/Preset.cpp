@@ -13,6 +13,37 @@ std::string sourcePlace(const std::string& file, const toml::source_region& wher
     return fmt::format("{}:{}:{}", file, where.begin.line, where.begin.column);
 }
 
+namespace {
+thread_local std::vector<KeyInfo>* catalog = nullptr;
+} // namespace
+
+KeyCatalog::KeyCatalog(std::vector<KeyInfo>& sink) {
+    catalog = &sink;
+}
+
+KeyCatalog::~KeyCatalog() {
+    catalog = nullptr;
+}
+
+void PresetReader::record(KeyInfo info) const {
+    if (!catalog) return;
+    info.file = file_;
+    catalog->push_back(std::move(info));
+}
+
+void PresetReader::recordKey(std::string_view key, const char* type, std::string_view help) const {
+    if (!catalog) return;
+    KeyInfo k;
+    k.path = keyPath(key);
+    k.type = type;
+    k.help = std::string(help);
+    record(std::move(k));
+}
+
+std::string PresetReader::keyPath(std::string_view key) const {
+    return path_.empty() ? std::string(key) : path_ + "." + std::string(key);
+}
+
 PresetReader::PresetReader(std::string file, const toml::table& table, std::string path,
                            std::vector<ParamInfo>* sink)
     : file_(std::move(file)), table_(&table), path_(std::move(path)), sink_(sink) {}
@@ -58,9 +89,20 @@ double PresetReader::number(std::string_view key, double defaultValue, double mi
             fail(key, fmt::format("expected a number in {}, got {:g}", rangeText(min, max, unit),
                                   value));
     }
-    if (sink_) {
-        const std::string name = path_.empty() ? std::string(key) : path_ + "." + std::string(key);
-        sink_->push_back({name, std::string(unit), min, max, value, logScale, std::string(help)});
+    if (sink_)
+        sink_->push_back(
+            {keyPath(key), std::string(unit), min, max, value, logScale, std::string(help)});
+    if (catalog) {
+        KeyInfo k;
+        k.path = keyPath(key);
+        k.type = "number";
+        k.unit = std::string(unit);
+        k.minValue = min;
+        k.maxValue = max;
+        k.defaultText = fmt::format("{:g}", defaultValue);
+        k.valueText = node ? fmt::format("{:g}", value) : "";
+        k.help = std::string(help);
+        record(std::move(k));
     }
     return value;
 }
@@ -70,12 +112,29 @@ double PresetReader::requiredNumber(std::string_view key, double min, double max
     if (!table_->get(key))
         fail("", fmt::format("missing `{}`: expected a number in {} ({})", key,
                              rangeText(min, max, unit), help));
-    return number(key, 0.0, min, max, unit, help, logScale);
+    const double value = number(key, 0.0, min, max, unit, help, logScale);
+    if (catalog && !catalog->empty()) {
+        catalog->back().required = true;
+        catalog->back().defaultText.clear();
+    }
+    return value;
 }
 
 int PresetReader::integer(std::string_view key, int defaultValue, int min, int max,
                           std::string_view help) {
     const toml::node* node = find(key);
+    if (catalog) {
+        const auto present = node ? node->value_exact<int64_t>() : std::nullopt;
+        KeyInfo k;
+        k.path = keyPath(key);
+        k.type = "integer";
+        k.minValue = static_cast<double>(min);
+        k.maxValue = static_cast<double>(max);
+        k.defaultText = std::to_string(defaultValue);
+        k.valueText = present ? std::to_string(*present) : "";
+        k.help = std::string(help);
+        record(std::move(k));
+    }
     if (!node) return defaultValue;
     const auto v = node->value_exact<int64_t>();
     if (!v) fail(key, fmt::format("expected a whole number in [{}, {}] ({})", min, max, help));
@@ -85,24 +144,36 @@ int PresetReader::integer(std::string_view key, int defaultValue, int min, int m
 }
 
 std::string PresetReader::string(std::string_view key, std::string_view defaultValue,
-                                 const std::vector<std::string>& allowed) {
+                                 const std::vector<std::string>& allowed, std::string_view help) {
     const toml::node* node = find(key);
-    if (!node) return std::string(defaultValue);
-    const auto v = node->value<std::string>();
     auto list = [&] {
         std::string s;
         for (const auto& a : allowed) s += (s.empty() ? "" : ", ") + ("\"" + a + "\"");
         return s;
     };
+    if (catalog) {
+        const auto present = node ? node->value<std::string>() : std::nullopt;
+        KeyInfo k;
+        k.path = keyPath(key);
+        k.type = "string";
+        k.defaultText = std::string(defaultValue);
+        k.valueText = present.value_or("");
+        k.allowed = list();
+        k.help = std::string(help);
+        record(std::move(k));
+    }
+    if (!node) return std::string(defaultValue);
+    const auto v = node->value<std::string>();
     if (!v) fail(key, allowed.empty() ? "expected a string" : "expected one of " + list());
     if (!allowed.empty() && std::find(allowed.begin(), allowed.end(), *v) == allowed.end())
         fail(key, fmt::format("expected one of {}, got \"{}\"", list(), *v));
     return *v;
 }
 
-std::vector<PresetReader> PresetReader::tables(std::string_view key) {
+std::vector<PresetReader> PresetReader::tables(std::string_view key, std::string_view help) {
     std::vector<PresetReader> out;
     const toml::node* node = find(key);
+    recordKey(key, "tables", help);
     if (!node) return out;
     const auto* array = node->as_array();
     if (!array) fail(key, "expected an array of tables ([[...]] or [{...}, ...])");
@@ -120,8 +191,9 @@ std::vector<PresetReader> PresetReader::tables(std::string_view key) {
     return out;
 }
 
-std::optional<PresetReader> PresetReader::table(std::string_view key) {
+std::optional<PresetReader> PresetReader::table(std::string_view key, std::string_view help) {
     const toml::node* node = find(key);
+    recordKey(key, "table", help);
     if (!node) return std::nullopt;
     const auto* t = node->as_table();
     if (!t) fail(key, "expected a table");
@@ -129,8 +201,9 @@ std::optional<PresetReader> PresetReader::table(std::string_view key) {
                         path_.empty() ? std::string(key) : path_ + "." + std::string(key), sink_);
 }
 
-void PresetReader::allow(std::string_view key) {
+void PresetReader::allow(std::string_view key, std::string_view help) {
     used_.emplace_back(key);
+    recordKey(key, "free", help);
 }
 
 void PresetReader::finish() const {

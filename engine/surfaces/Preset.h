@@ -32,6 +32,32 @@ struct ParamInfo {
     std::string help; ///< one line: what it does
 };
 
+/// One key a reader asked for, as the layer declared it: what the generated preset reference
+/// (`underfoot surfaces --keys`, docs/reference/presets.md) lists.
+struct KeyInfo {
+    std::string file;      ///< the preset file
+    std::string path;      ///< e.g. "layer[2].stiffness"
+    std::string type;      ///< "number", "integer", "string", "table", "tables" or "free"
+    std::string unit;      ///< numbers only
+    double minValue = 0.0; ///< numbers and integers: documented range
+    double maxValue = 0.0;
+    std::string defaultText; ///< the default ("" when required or none)
+    std::string valueText;   ///< the value in the file ("" when absent)
+    std::string allowed;     ///< strings: the allowed values, comma-separated ("" = any)
+    std::string help;        ///< one line: what it does
+    bool required = false;
+};
+
+/// While alive, every PresetReader of this thread also records each key it is asked for into
+/// `sink` (loading only; never on the audio thread). Nested catalogs are not supported.
+class KeyCatalog {
+  public:
+    explicit KeyCatalog(std::vector<KeyInfo>& sink);
+    ~KeyCatalog();
+    KeyCatalog(const KeyCatalog&) = delete;
+    KeyCatalog& operator=(const KeyCatalog&) = delete;
+};
+
 /// "file:line:column" for a TOML node (or just the file when it has no source position).
 std::string sourcePlace(const std::string& file, const toml::source_region& where);
 
@@ -49,15 +75,16 @@ class PresetReader {
                           std::string_view help, bool logScale = false);
     /// An integer in [min, max].
     int integer(std::string_view key, int defaultValue, int min, int max, std::string_view help);
-    /// A string; when `allowed` is not empty it must be one of them.
+    /// A string; when `allowed` is not empty it must be one of them. `help`: one line for the
+    /// preset reference.
     std::string string(std::string_view key, std::string_view defaultValue,
-                       const std::vector<std::string>& allowed = {});
+                       const std::vector<std::string>& allowed = {}, std::string_view help = {});
     /// An array of tables (e.g. modes); empty when absent.
-    std::vector<PresetReader> tables(std::string_view key);
+    std::vector<PresetReader> tables(std::string_view key, std::string_view help = {});
     /// A sub-table; nullopt when absent.
-    std::optional<PresetReader> table(std::string_view key);
-    /// Marks a key as known without reading it (read by someone else).
-    void allow(std::string_view key);
+    std::optional<PresetReader> table(std::string_view key, std::string_view help = {});
+    /// Marks a key as known without reading it (read by someone else, or free text).
+    void allow(std::string_view key, std::string_view help = {});
     /// Throws for every key that no call above asked for (typos must not pass silently).
     void finish() const;
 
@@ -69,6 +96,9 @@ class PresetReader {
 
   private:
     const toml::node* find(std::string_view key);
+    void record(KeyInfo info) const;
+    void recordKey(std::string_view key, const char* type, std::string_view help = {}) const;
+    std::string keyPath(std::string_view key) const;
     std::string file_;
     const toml::table* table_;
     std::string path_;

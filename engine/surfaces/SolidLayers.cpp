@@ -28,7 +28,7 @@ namespace {
 /// Reads `modes = [{ freq_hz, t60_s, mass_kg, gain }, ...]` (the floor's resonances).
 void readModes(PresetReader& reader, const AccuracyOptions& options, std::vector<Mode>& modes,
                std::vector<double>& gains) {
-    auto tables = reader.tables("modes");
+    auto tables = reader.tables("modes", "the floor's modes, one table each (required)");
     if (tables.empty())
         reader.fail(
             "",

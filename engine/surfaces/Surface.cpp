@@ -47,9 +47,10 @@ void Surface::loadLayers(const std::string& file, const toml::table& root,
     const std::string prefix = depth == 0 ? "" : fs::path(file).stem().string() + ":";
     PresetReader top(file, root, prefix, &params_);
     // Header keys are read by loadSurfaceFromString() for the outermost file.
-    for (const char* k :
-         {"id", "name", "category", "description", "gain_db", "reverb", "base", "provenance"})
+    for (const char* k : {"id", "name", "category", "description", "gain_db", "reverb"})
         top.allow(k);
+    top.allow("base", "the id of another preset whose layers come first (a string)");
+    top.allow("provenance", "a free table recording where the values came from (not read)");
     if (const auto* baseNode = root.get("base")) {
         const auto base = baseNode->value<std::string>();
         if (!base) top.fail("base", "expected the id of another preset (a string)");
@@ -60,12 +61,15 @@ void Surface::loadLayers(const std::string& file, const toml::table& root,
                      fmt::format("expected the id of another preset; there is no {}", baseFile));
         loadLayers(baseFile, parseFile(baseFile), options, depth + 1);
     }
-    auto layerTables = top.tables("layer");
+    auto layerTables =
+        top.tables("layer", "the layers, one sound source each (at least one, or a `base`)");
     if (layerTables.empty() && layers_.empty())
         top.fail("", "expected at least one [[layer]] table (or a `base` preset)");
     for (auto& reader : layerTables) {
-        const std::string type = reader.string("type", "");
-        const std::string purpose = reader.string("purpose", "");
+        const std::string type = reader.string(
+            "type", "", {}, "the layer's kind, which decides its other keys (required)");
+        const std::string purpose =
+            reader.string("purpose", "", {}, "one line: what this layer is for (required)");
         if (purpose.empty())
             reader.fail("purpose", "expected a one-line `purpose`: what this layer is for");
         const auto& kinds = layerKinds();
@@ -101,12 +105,15 @@ std::unique_ptr<Surface> Surface::fromTable(const toml::table& root, const std::
     PresetReader top(file, root, "", &surface->params_);
     auto& info = surface->info_;
     info.file = file;
-    info.id = top.string("id", "");
+    info.id = top.string("id", "", {}, "the surface id; must match the file name (required)");
     if (info.id.empty()) top.fail("", "expected `id`: the surface id (e.g. \"gravel\")");
-    info.name = top.string("name", info.id);
-    info.description = top.string("description", "");
+    info.name =
+        top.string("name", info.id, {}, "the name shown to the experimenter (default: the id)");
+    info.description =
+        top.string("description", "", {}, "one line: what it sounds like (required)");
     if (info.description.empty()) top.fail("", "expected `description`: one line");
-    const std::string category = top.string("category", "", {"solid", "aggregate", "liquid"});
+    const std::string category = top.string("category", "", {"solid", "aggregate", "liquid"},
+                                            "the kind of ground (required)");
     if (category.empty())
         top.fail("", "expected `category`: \"solid\", \"aggregate\" or \"liquid\"");
     info.category = category == "solid"       ? SurfaceCategory::Solid
@@ -114,9 +121,10 @@ std::unique_ptr<Surface> Surface::fromTable(const toml::table& root, const std::
                                               : SurfaceCategory::Liquid;
     surface->gain_ = dbToGain(
         top.number("gain_db", 0.0, -60.0, 60.0, "dB", "calibration of the whole surface's level"));
-    if (auto reverb = top.table("reverb")) {
+    if (auto reverb = top.table("reverb", "optional: a room the surface is heard in")) {
         ReverbSpec spec;
-        spec.impulseResponse = reverb->string("ir", "");
+        spec.impulseResponse = reverb->string(
+            "ir", "", {}, "an impulse response of engine/data/ir or a .wav file (required)");
         if (spec.impulseResponse.empty())
             reverb->fail("",
                          "expected `ir`: an impulse response name (e.g. \"wooden_room\") or file");

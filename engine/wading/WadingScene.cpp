@@ -41,15 +41,15 @@ WadingPreset parseWadingPreset(const std::string& text, const std::string& file)
     WadingPreset p;
     p.file = file;
     PresetReader top(file, root, "", &p.params);
-    p.id = top.string("id", "");
+    p.id = top.string("id", "", {}, "the preset id (required)");
     if (p.id.empty()) top.fail("id", "expected a preset id (a string)");
-    p.name = top.string("name", p.id);
-    p.description = top.string("description", "");
+    p.name = top.string("name", p.id, {}, "the name shown (default: the id)");
+    p.description = top.string("description", "", {}, "one line: what it sounds like");
     p.outputGainDb =
         top.number("output_gain_db", 0, -60, 24, "dB", "gain of the stereo sum (calibration)");
 
     auto& m = p.mapping;
-    if (auto r = top.table("mapping")) {
+    if (auto r = top.table("mapping", "how the legs' rotation drives the three sounds")) {
         m.normaliseRangeDps = r->number("normalise_range_dps", m.normaliseRangeDps, 10, 1000,
                                         "deg/s", "forward rotation mapped to 1 (paper: 100)");
         m.thighWeight = r->number("thigh_weight", m.thighWeight, 0, 4, "",
@@ -100,12 +100,15 @@ WadingPreset parseWadingPreset(const std::string& text, const std::string& file)
     }
     const fs::path base = fs::path(file).parent_path();
     auto recording = [&](PresetReader& r) {
-        std::string path = r.string("recording", "");
+        std::string path =
+            r.string("recording", "", {},
+                     "a .wav file (relative to the preset) played instead of synthesis");
         if (!path.empty() && fs::path(path).is_relative()) path = (base / path).string();
         return path;
     };
     auto& f = p.flowing;
-    if (auto r = top.table("flowing")) {
+    if (auto r =
+            top.table("flowing", "noise and small bubbles of the water moving past the legs")) {
         f.levelDb = r->number("level_db", f.levelDb, -80, 12, "dB", "level at fader 0 dB");
         f.noiseLowHz =
             r->number("noise_low_hz", f.noiseLowHz, 20, 5000, "Hz", "noise band low", true);
@@ -129,7 +132,7 @@ WadingPreset parseWadingPreset(const std::string& text, const std::string& file)
             r->fail("radius_max_mm", "expected radius_max_mm above radius_min_mm");
     }
     auto& b = p.bubbling;
-    if (auto r = top.table("bubbling")) {
+    if (auto r = top.table("bubbling", "the steady bubble stream around the legs")) {
         b.levelDb = r->number("level_db", b.levelDb, -80, 12, "dB", "level at fader 0 dB");
         b.rateHz = r->number("rate_hz", b.rateHz, 0, 4000, "1/s", "bubbles per second", true);
         b.radiusMinMm = r->number("radius_min_mm", b.radiusMinMm, 0.1, 20, "mm", "", true);
@@ -142,7 +145,7 @@ WadingPreset parseWadingPreset(const std::string& text, const std::string& file)
             r->fail("radius_max_mm", "expected radius_max_mm above radius_min_mm");
     }
     auto& s = p.splash;
-    if (auto r = top.table("splash")) {
+    if (auto r = top.table("splash", "light splashes: bursts of larger bubbles and noise")) {
         s.levelDb = r->number("level_db", s.levelDb, -80, 12, "dB", "level at fader 0 dB");
         s.rateHz =
             r->number("rate_hz", s.rateHz, 0.1, 200, "1/s", "splash events per second", true);

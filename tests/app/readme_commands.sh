@@ -54,6 +54,19 @@ prepare() {
     cp "$src/engine/data/grf/heel_1.wav" "$dir/step.wav" # `render --grf step.wav`
 }
 
+# Files a document asks the reader to write: a fenced block opened as ```toml file=NAME (any
+# language) is written to NAME in the document's scratch folder before its commands run.
+write_files() {
+    awk -v dir="$2" '
+        /^```[A-Za-z]+ file=[A-Za-z0-9_.\/-]+[[:space:]]*$/ {
+            name = $2; sub(/^file=/, "", name)
+            if (name ~ /\.\./ || name ~ /^\//) { print "bad file name " name > "/dev/stderr"; exit 1 }
+            out = dir "/" name; printf "" > out; inside = 1; next
+        }
+        /^```/ { if (inside) close(out); inside = 0; next }
+        inside { print >> out }' "$1"
+}
+
 # Fenced sh/bash blocks of one file, one command per line (continuations joined, comments cut).
 commands_of() {
     awk '
@@ -89,6 +102,7 @@ for doc in "${docs[@]}"; do
     name="${name//\//_}"
     dir="$work/$name"
     mkdir -p "$dir" && prepare "$dir"
+    write_files "$doc" "$dir" || { echo "FAIL ${doc#$src/}: a file block could not be written"; fail=1; }
     n=0
     while IFS= read -r cmd; do
         n=$((n + 1))

@@ -15,7 +15,7 @@
 // Instructions per sample against zita-convolver (callgrind; difference of a long and a short
 // run, so that loading, planning and start-up cancel):
 //   bench_reverb --driver=ours --ir=hall --seconds=2     (and 12; likewise --driver=zita)
-// see docs/explanation/performance-reverb.md for the commands and figures.
+// see docs/explanation/performance.md and docs/decisions/time-distributed-convolver.md.
 //
 // Run: build/tests/bench/bench_reverb [--benchmark_filter=...]
 #include "engine/control/VirtualWalker.h"

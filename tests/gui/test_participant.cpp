@@ -11,6 +11,7 @@
 #include "app/gui/StudyView.h"
 #include "experiment/Catalogue.h"
 #include "experiment/Store.h"
+#include "tests/gui/support/Console.h"
 
 #include <QComboBox>
 #include <QGroupBox>
@@ -24,15 +25,10 @@
 #include <memory>
 
 using namespace underfoot;
+using gui_test::button;
 namespace ue = underfoot::experiment;
 
 namespace {
-QPushButton* button(QWidget* root, const QString& accessibleName) {
-    for (auto* b : root->findChildren<QPushButton*>())
-        if (b->accessibleName() == accessibleName) return b;
-    return nullptr;
-}
-
 /// Every text of the participant window, minus the heading (which carries the trial number).
 QString body(const gui::ParticipantWindow& pw) {
     QStringList texts = pw.visibleTexts();
@@ -44,31 +40,18 @@ QString body(const gui::ParticipantWindow& pw) {
 class ParticipantTest : public QObject {
     Q_OBJECT
   private:
-    QTemporaryDir home_;
+    gui_test::Console console_;
 
   private slots:
-    void initTestCase() {
-        QVERIFY(home_.isValid());
-        qputenv("XDG_CONFIG_HOME", home_.filePath("config").toUtf8());
-        qputenv("XDG_DATA_HOME", home_.filePath("share").toUtf8());
-        QCoreApplication::setApplicationName("underfoot-gui-test");
-    }
+    void initTestCase() { QVERIFY(console_.prepare()); }
 
     void participantWindowShowsNoAnswerKeyAndTakesAnswers() {
-        gui::MainWindow::Options o;
-        o.dataDir = home_.filePath("data");
-        o.createDemo = false;
-        o.startAudio = false;
-        gui::MainWindow w(o);
-        w.show();
-        const QString file = home_.filePath("exp2.db");
+        const auto window = console_.open("data");
+        gui::MainWindow& w = *window;
+        const QString file = console_.path("exp2.db");
         const QString protocolPath =
             QString(UNDERFOOT_SOURCE_DIR) + "/protocols/tvcg2011_exp2.toml";
-        w.showView(0);
-        w.studyView()->protocolBox()->setCurrentText(protocolPath);
-        w.studyView()->fileEdit()->setText(file);
-        QTest::mouseClick(button(w.studyView(), "Create study"), Qt::LeftButton);
-        QVERIFY(w.context().hasStudy());
+        QVERIFY(gui_test::Console::createByClicking(w, protocolPath, file));
         const ue::Protocol& p = w.context().store().protocol();
 
         // The participant window is open before the participant arrives.
@@ -195,16 +178,12 @@ class ParticipantTest : public QObject {
     }
 
     void participantClickAnswersAndScaleAnchors() {
-        gui::MainWindow::Options o;
-        o.dataDir = home_.filePath("data2");
-        o.createDemo = false;
-        o.startAudio = false;
-        gui::MainWindow w(o);
-        w.show();
+        const auto window = console_.open("data2");
+        gui::MainWindow& w = *window;
         ue::StudySettings settings;
         settings.code = "LAPS";
         const QString created = w.context().createStudy(
-            home_.filePath("laps.db"),
+            console_.path("laps.db"),
             QString(UNDERFOOT_SOURCE_DIR) + "/protocols/wading_interactive.toml", settings);
         QVERIFY2(created.isEmpty(), qPrintable(created));
         w.showView(1);

@@ -22,6 +22,7 @@
 #include "experiment/Catalogue.h"
 #include "experiment/Store.h"
 #include "experiment/TrialFlow.h"
+#include "tests/gui/support/Console.h"
 
 #include <QComboBox>
 #include <QDir>
@@ -39,15 +40,10 @@
 #include <set>
 
 using namespace underfoot;
+using gui_test::button;
 namespace ue = underfoot::experiment;
 
 namespace {
-
-QPushButton* button(QWidget* root, const QString& accessibleName) {
-    for (auto* b : root->findChildren<QPushButton*>())
-        if (b->accessibleName() == accessibleName) return b;
-    return nullptr;
-}
 
 QString s(const std::string& text) {
     return QString::fromStdString(text);
@@ -136,7 +132,7 @@ QString searchable(const gui::ParticipantWindow& pw, const ue::Protocol& p) {
 class ParticipantContractTest : public QObject {
     Q_OBJECT
   private:
-    QTemporaryDir home_;
+    gui_test::Console console_;
     int screens_ = 0;
     int layouts_ = 0;
     std::set<QString> searched_;
@@ -152,10 +148,10 @@ class ParticipantContractTest : public QObject {
         const auto m = seconds.match(text, clips);
         if (clips < 0 || !m.hasMatch()) return {};
         text.replace(m.capturedStart(), m.capturedLength(), "seconds = 0.5");
-        QDir().mkpath(home_.filePath("protocols"));
+        QDir().mkpath(console_.path("protocols"));
         QFile::link(QString(UNDERFOOT_SOURCE_DIR) + "/protocols/data",
-                    home_.filePath("protocols/data"));
-        const QString path = home_.filePath("protocols/" + QFileInfo(shipped).fileName());
+                    console_.path("protocols/data"));
+        const QString path = console_.path("protocols/" + QFileInfo(shipped).fileName());
         QFile out(path);
         if (!out.open(QIODevice::WriteOnly)) return {};
         out.write(text.toUtf8());
@@ -220,17 +216,13 @@ class ParticipantContractTest : public QObject {
         const QString name = QFileInfo(shipped).completeBaseName();
         const QString path = shippedProtocol.clips.enabled ? shortClips(shipped) : shipped;
         QVERIFY2(!path.isEmpty(), qPrintable(shipped));
-        gui::MainWindow::Options o;
-        o.dataDir = home_.filePath("data-" + name);
-        o.createDemo = false;
-        o.startAudio = false;
-        gui::MainWindow w(o);
-        w.show();
+        const auto window = console_.open("data-" + name);
+        gui::MainWindow& w = *window;
         ue::StudySettings settings;
         settings.code = "C" + name.toStdString().substr(0, 6);
         settings.seed = 20240517;
         const QString created =
-            w.context().createStudy(home_.filePath(name + ".db"), path, settings);
+            w.context().createStudy(console_.path(name + ".db"), path, settings);
         QVERIFY2(created.isEmpty(), qPrintable(created));
         const ue::Protocol& p = w.context().store().protocol();
         const Secrets study = studySecrets(p, settings.seed);
@@ -350,10 +342,7 @@ class ParticipantContractTest : public QObject {
 
   private slots:
     void initTestCase() {
-        QVERIFY(home_.isValid());
-        qputenv("XDG_CONFIG_HOME", home_.filePath("config").toUtf8());
-        qputenv("XDG_DATA_HOME", home_.filePath("share").toUtf8());
-        QCoreApplication::setApplicationName("underfoot-gui-test");
+        QVERIFY(console_.prepare());
         shotsDir_ = qEnvironmentVariable("UNDERFOOT_CONTRACT_SHOTS");
     }
 

@@ -9,6 +9,7 @@
 #include "app/gui/StudyView.h"
 #include "experiment/Clips.h"
 #include "experiment/Store.h"
+#include "tests/gui/support/Console.h"
 
 #include <QComboBox>
 #include <QFile>
@@ -28,15 +29,10 @@
 #include <unistd.h>
 
 using namespace underfoot;
+using gui_test::button;
 namespace ue = underfoot::experiment;
 
 namespace {
-
-QPushButton* button(QWidget* root, const QString& accessibleName) {
-    for (auto* b : root->findChildren<QPushButton*>())
-        if (b->accessibleName() == accessibleName) return b;
-    return nullptr;
-}
 
 void typeValue(QWidget* panel, int value) {
     if (value >= 10) {
@@ -78,22 +74,10 @@ void sendUdp(int port, const QByteArray& bytes) {
 class ProtocolsTest : public QObject {
     Q_OBJECT
   private:
-    QTemporaryDir home_;
-    std::unique_ptr<gui::MainWindow> makeWindow() {
-        gui::MainWindow::Options o;
-        o.dataDir = home_.filePath("data");
-        o.createDemo = false;
-        o.startAudio = false;
-        auto w = std::make_unique<gui::MainWindow>(o);
-        w->show();
-        return w;
-    }
-    bool createStudy(gui::MainWindow& w, const QString& protocol, const QString& file) {
-        w.showView(0);
-        w.studyView()->protocolBox()->setCurrentText(protocol);
-        w.studyView()->fileEdit()->setText(file);
-        QTest::mouseClick(button(w.studyView(), "Create study"), Qt::LeftButton);
-        return w.context().hasStudy() && w.context().path() == file;
+    gui_test::Console console_;
+    std::unique_ptr<gui::MainWindow> makeWindow() { return console_.open(); }
+    static bool createStudy(gui::MainWindow& w, const QString& protocol, const QString& file) {
+        return gui_test::Console::createByClicking(w, protocol, file);
     }
     void registerParticipant(gui::MainWindow& w, const QString& code) {
         w.showView(1);
@@ -112,7 +96,7 @@ class ProtocolsTest : public QObject {
             if (!text.contains(from)) return {};
             text.replace(from, to);
         }
-        const QString path = home_.filePath(shipped);
+        const QString path = console_.path(shipped);
         QFile out(path);
         if (!out.open(QIODevice::WriteOnly)) return {};
         out.write(text);
@@ -120,18 +104,13 @@ class ProtocolsTest : public QObject {
     }
 
   private slots:
-    void initTestCase() {
-        QVERIFY(home_.isValid());
-        qputenv("XDG_CONFIG_HOME", home_.filePath("config").toUtf8());
-        qputenv("XDG_DATA_HOME", home_.filePath("share").toUtf8());
-        QCoreApplication::setApplicationName("underfoot-gui-test");
-    }
+    void initTestCase() { QVERIFY(console_.prepare()); }
 
     void listeningTestRendersClipsAndRatesOneScalePerBlock() {
         const QString protocol =
             editedProtocol("wading_listening.toml", "seconds = 7", "seconds = 0.5");
         QVERIFY(!protocol.isEmpty());
-        const QString file = home_.filePath("listening.db");
+        const QString file = console_.path("listening.db");
         auto w = makeWindow();
         QVERIFY(createStudy(*w, protocol, file));
         auto* run = w->runView();
@@ -204,7 +183,7 @@ class ProtocolsTest : public QObject {
     void lapProtocolWalksSilentThenSoundLapsBeforeTheQuestions() {
         const QString protocol = editedProtocol("wading_interactive.toml", {}, {});
         QVERIFY(!protocol.isEmpty());
-        const QString file = home_.filePath("laps.db");
+        const QString file = console_.path("laps.db");
         auto w = makeWindow();
         QVERIFY(createStudy(*w, protocol, file));
         registerParticipant(*w, "W01");

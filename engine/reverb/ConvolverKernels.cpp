@@ -1,0 +1,176 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The convolver's kernels: products over partitions (SSE, AVX) and the direct-form head (SSE,
+// AVX, AVX-512), each giving the same sums whatever the instruction set.
+#include "engine/reverb/ConvolverKernels.h"
+
+#include "engine/dsp/Simd.h"
+
+namespace underfoot::engine::convolver_detail {
+
+// Per bin: s = s + (xr hr - xi hi), t = t + (xr hi + xi hr), partition after partition, no FMA:
+// the SSE and AVX kernels (and so every CPU) give the same sums.
+#define UNDERFOOT_MAC_KERNEL(NAME, ATTR, V, W, LOAD, STORE, ADD, SUB, MUL, ZERO)                   \
+    template <int C>                                                                               \
+    ATTR void NAME(const MacRun& r) noexcept {                                                     \
+        for (int k = 0; k < r.blocks; ++k) {                                                       \
+            const float* xb = r.x + static_cast<std::size_t>(k) * r.xBlock;                        \
+            const float* hb = r.h + static_cast<std::size_t>(k) * r.hBlock;                        \
+            const std::size_t ab = static_cast<std::size_t>(k) * kLanes;                           \
+            for (int w = 0; w < kLanes; w += W) {                                                  \
+                V sr[C], si[C];                                                                    \
+                for (int c = 0; c < C; ++c) {                                                      \
+                    float* ar = r.accRe + c * r.accStride + ab + w;                                \
+                    float* ai = r.accIm + c * r.accStride + ab + w;                                \
+                    sr[c] = r.first ? ZERO() : LOAD(ar);                                           \
+                    si[c] = r.first ? ZERO() : LOAD(ai);                                           \
+                }                                                                                  \
+                const float* hq = hb + w;                                                          \
+                for (int q = 0; q < r.count; ++q, hq += C * kRecord) {                             \
+                    const float* xq = xb + r.slotOff[q] + w;                                       \
+                    const V xr = LOAD(xq), xi = LOAD(xq + kLanes);                                 \
+                    for (int c = 0; c < C; ++c) {                                                  \
+                        const V hr = LOAD(hq + c * kRecord), hi = LOAD(hq + c * kRecord + kLanes); \
+                        sr[c] = ADD(sr[c], SUB(MUL(xr, hr), MUL(xi, hi)));                         \
+                        si[c] = ADD(si[c], ADD(MUL(xr, hi), MUL(xi, hr)));                         \
+                    }                                                                              \
+                }                                                                                  \
+                for (int c = 0; c < C; ++c) {                                                      \
+                    STORE(r.accRe + c * r.accStride + ab + w, sr[c]);                              \
+                    STORE(r.accIm + c * r.accStride + ab + w, si[c]);                              \
+                }                                                                                  \
+            }                                                                                      \
+        }                                                                                          \
+    }
+
+UNDERFOOT_MAC_KERNEL(macSse, , __m128, 4, _mm_loadu_ps, _mm_storeu_ps, _mm_add_ps, _mm_sub_ps,
+                     _mm_mul_ps, _mm_setzero_ps)
+UNDERFOOT_MAC_KERNEL(macAvx, __attribute__((target("avx"))), __m256, 8, _mm256_loadu_ps,
+                     _mm256_storeu_ps, _mm256_add_ps, _mm256_sub_ps, _mm256_mul_ps,
+                     _mm256_setzero_ps)
+#undef UNDERFOOT_MAC_KERNEL
+
+/// A record is kLanes wide, so AVX-512 runs the AVX kernel (same sums).
+template <int C>
+void mac(Convolver::Simd simd, const MacRun& r) noexcept {
+    if (simd == Convolver::Simd::Sse)
+        macSse<C>(r);
+    else
+        macAvx<C>(r);
+}
+
+template void mac<1>(Convolver::Simd, const MacRun&) noexcept;
+template void mac<2>(Convolver::Simd, const MacRun&) noexcept;
+
+namespace {
+/// The direct head's last outputs of a run, one at a time (the same sums as the vectors).
+inline void headScalar(const float* hl, const float* hr, const float* line, int t0, int m,
+                       float* yl, float* yr) noexcept {
+    constexpr int q = Convolver::kHeadLength;
+    for (int t = t0; t < m; ++t) {
+        float l = 0.0f, r = 0.0f;
+        for (int k = 0; k < q; ++k) {
+            const float x = line[q - 1 + t - k];
+            l = l + hl[k] * x;
+            r = r + hr[k] * x;
+        }
+        yl[t] = l;
+        yr[t] = r;
+    }
+}
+} // namespace
+
+void headSse(const float* hl, const float* hr, const float* line, int m, float* yl,
+             float* yr) noexcept {
+    constexpr int q = Convolver::kHeadLength;
+    int t = 0;
+    for (; t + 4 <= m; t += 4) {
+        __m128 l = _mm_setzero_ps(), r = l;
+        for (int k = 0; k < q; ++k) {
+            const __m128 x = _mm_loadu_ps(line + q - 1 + t - k);
+            l = _mm_add_ps(l, _mm_mul_ps(_mm_set1_ps(hl[k]), x));
+            r = _mm_add_ps(r, _mm_mul_ps(_mm_set1_ps(hr[k]), x));
+        }
+        _mm_storeu_ps(yl + t, l);
+        _mm_storeu_ps(yr + t, r);
+    }
+    headScalar(hl, hr, line, t, m, yl, yr);
+}
+
+__attribute__((target("avx"))) void headAvx(const float* hl, const float* hr, const float* line,
+                                            int m, float* yl, float* yr) noexcept {
+    constexpr int q = Convolver::kHeadLength;
+    int t = 0;
+    for (; t + 16 <= m; t += 16) { // two vectors of outputs share the tap broadcasts
+        __m256 l0 = _mm256_setzero_ps(), l1 = l0, r0 = l0, r1 = l0;
+        for (int k = 0; k < q; ++k) {
+            const __m256 x0 = _mm256_loadu_ps(line + q - 1 + t - k);
+            const __m256 x1 = _mm256_loadu_ps(line + q - 1 + t + 8 - k);
+            const __m256 a = _mm256_broadcast_ss(hl + k), b = _mm256_broadcast_ss(hr + k);
+            l0 = _mm256_add_ps(l0, _mm256_mul_ps(a, x0));
+            l1 = _mm256_add_ps(l1, _mm256_mul_ps(a, x1));
+            r0 = _mm256_add_ps(r0, _mm256_mul_ps(b, x0));
+            r1 = _mm256_add_ps(r1, _mm256_mul_ps(b, x1));
+        }
+        _mm256_storeu_ps(yl + t, l0);
+        _mm256_storeu_ps(yl + t + 8, l1);
+        _mm256_storeu_ps(yr + t, r0);
+        _mm256_storeu_ps(yr + t + 8, r1);
+    }
+    for (; t + 8 <= m; t += 8) {
+        __m256 l = _mm256_setzero_ps(), r = l;
+        for (int k = 0; k < q; ++k) {
+            const __m256 x = _mm256_loadu_ps(line + q - 1 + t - k);
+            l = _mm256_add_ps(l, _mm256_mul_ps(_mm256_broadcast_ss(hl + k), x));
+            r = _mm256_add_ps(r, _mm256_mul_ps(_mm256_broadcast_ss(hr + k), x));
+        }
+        _mm256_storeu_ps(yl + t, l);
+        _mm256_storeu_ps(yr + t, r);
+    }
+    headScalar(hl, hr, line, t, m, yl, yr);
+}
+
+// AVX-512F has fused multiply-adds, into which GCC would contract the intrinsics' products and
+// sums (-ffp-contract=fast is its default): not in this kernel, whose results must be those of
+// the SSE and AVX ones (tested).
+#define UNDERFOOT_AVX512 __attribute__((target("avx512f"), optimize("fp-contract=off")))
+UNDERFOOT_AVX512 void headAvx512(const float* hl, const float* hr, const float* line, int m,
+                                 float* yl, float* yr) noexcept {
+    constexpr int q = Convolver::kHeadLength;
+    int t = 0;
+    for (; t + 32 <= m; t += 32) { // two vectors of outputs share the tap broadcasts
+        __m512 l0 = _mm512_setzero_ps(), l1 = l0, r0 = l0, r1 = l0;
+        for (int k = 0; k < q; ++k) {
+            const __m512 x0 = _mm512_loadu_ps(line + q - 1 + t - k);
+            const __m512 x1 = _mm512_loadu_ps(line + q - 1 + t + 16 - k);
+            const __m512 a = _mm512_set1_ps(hl[k]), b = _mm512_set1_ps(hr[k]);
+            l0 = _mm512_add_ps(l0, _mm512_mul_ps(a, x0));
+            l1 = _mm512_add_ps(l1, _mm512_mul_ps(a, x1));
+            r0 = _mm512_add_ps(r0, _mm512_mul_ps(b, x0));
+            r1 = _mm512_add_ps(r1, _mm512_mul_ps(b, x1));
+        }
+        _mm512_storeu_ps(yl + t, l0);
+        _mm512_storeu_ps(yl + t + 16, l1);
+        _mm512_storeu_ps(yr + t, r0);
+        _mm512_storeu_ps(yr + t + 16, r1);
+    }
+    for (; t + 16 <= m; t += 16) {
+        __m512 l = _mm512_setzero_ps(), r = l;
+        for (int k = 0; k < q; ++k) {
+            const __m512 x = _mm512_loadu_ps(line + q - 1 + t - k);
+            l = _mm512_add_ps(l, _mm512_mul_ps(_mm512_set1_ps(hl[k]), x));
+            r = _mm512_add_ps(r, _mm512_mul_ps(_mm512_set1_ps(hr[k]), x));
+        }
+        _mm512_storeu_ps(yl + t, l);
+        _mm512_storeu_ps(yr + t, r);
+    }
+    if (t < m) headAvx(hl, hr, line + t, m - t, yl + t, yr + t); // the last < 16 outputs
+}
+#undef UNDERFOOT_AVX512
+
+Convolver::Simd cpuSimd() noexcept {
+    if (simdAllowsAvx512()) return Convolver::Simd::Avx512;
+    if (simdAllowsAvx()) return Convolver::Simd::Avx;
+    return Convolver::Simd::Sse;
+}
+
+} // namespace underfoot::engine::convolver_detail
