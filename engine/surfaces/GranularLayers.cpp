@@ -277,15 +277,13 @@ std::unique_ptr<SurfaceLayer> makeGrainsLayer(PresetReader& r, const AccuracyOpt
         m.noiseCornerHz = r.number("noise_corner_hz", 0.0, 0.0, 20000.0, "Hz",
                                    "excitation = \"noise\": the bursts' spectrum falls 6 dB per "
                                    "octave above this frequency (0: white)");
-        m.noiseAttackMs = r.number(
-            "noise_attack_ms", 0.0, 0.0, 50.0, "ms",
-            "excitation = \"noise\": each burst's power rises as exp(-2t / noise_decay_ms) - "
-            "exp(-2t / noise_attack_ms) instead of starting at once: grains rubbing and giving way "
-            "build up their noise, where an instantaneous start clicks like a hard tap (0: "
-            "instantaneous; below noise_decay_ms)");
-        if (m.noiseAttackMs >= m.noiseDecayMs)
-            r.fail("noise_attack_ms", "expected a time below noise_decay_ms (" +
-                                          std::to_string(m.noiseDecayMs) + " ms)");
+        m.noiseAttackMs =
+            m.noiseDecayMs *
+            r.number("noise_attack_ratio", 0.0, 0.0, 0.9, "x noise_decay_ms",
+                     "excitation = \"noise\": each burst's power rises as exp(-2t / D) - "
+                     "exp(-2t / (ratio x D)), D = noise_decay_ms, instead of starting at once: "
+                     "grains rubbing and giving way build up their noise, where an instantaneous "
+                     "start clicks like a hard tap (0: instantaneous)");
     } else {
         m.resonances = r.integer("resonances", 2, 1, 4, "damped resonances per event");
         std::tie(m.freqMinHz, m.freqMaxHz) =
