@@ -53,40 +53,11 @@ Foot renderFoot(const std::string& id, double seconds, std::uint64_t seed) {
     return foot;
 }
 
-// Median over the steps of the time from the foot's contact to the first 5 ms frame within
-// 6 dB of the step's loudest frame (in its first 0.4 s): how gradually the step sets in.
-double medianRiseMs(const Foot& f) {
-    constexpr std::size_t frame = 240; // 5 ms
-    std::vector<double> rises;
-    bool contact = false;
-    for (std::size_t i = 0; i < f.grf.size(); ++i) {
-        const bool c = f.grf[i] > 5;
-        if (c && !contact && i + static_cast<std::size_t>(0.4 * kFs) < f.audio.size()) {
-            std::vector<double> e;
-            for (std::size_t s = i; s + frame <= i + static_cast<std::size_t>(0.4 * kFs);
-                 s += frame) {
-                double sum = 0;
-                for (std::size_t k = 0; k < frame; ++k)
-                    sum += double(f.audio[s + k]) * f.audio[s + k];
-                e.push_back(sum);
-            }
-            const double peak = *std::max_element(e.begin(), e.end());
-            std::size_t first = 0;
-            while (e[first] < peak * 0.25) ++first;
-            rises.push_back(5.0 * static_cast<double>(first));
-        }
-        contact = c;
-    }
-    std::sort(rises.begin(), rises.end());
-    return rises.empty() ? 0.0 : rises[rises.size() / 2];
-}
-
 struct Spectrum {
     double flatnessDb = 0; // geometric over arithmetic mean power, 20 Hz-10.5 kHz
     double highDb = 0;     // 4-10.5 kHz re 20 Hz-10.5 kHz
     double lowDb = 0;      // 20-250 Hz re 20 Hz-10.5 kHz
     double centroidHz = 0;
-    double riseMs = 0; // median time from contact to within 6 dB of the step's loudest 5 ms
 };
 
 // Power spectrum (Hann, 1024 points, hop 512) averaged over the frames within 30 dB of the
@@ -139,11 +110,10 @@ Spectrum measure(const std::vector<float>& x) {
 
 Spectrum figures(const std::string& id) {
     const Foot foot = renderFoot(id, 6.0, 7);
-    Spectrum s = measure(foot.audio);
-    s.riseMs = medianRiseMs(foot);
+    const Spectrum s = measure(foot.audio);
     std::printf("%-14s flatness %6.1f dB, 4-10.5 kHz %6.1f dB, 20-250 Hz %6.1f dB, centroid %5.0f "
-                "Hz, rise %4.0f ms\n",
-                id.c_str(), s.flatnessDb, s.highDb, s.lowDb, s.centroidHz, s.riseMs);
+                "Hz\n",
+                id.c_str(), s.flatnessDb, s.highDb, s.lowDb, s.centroidHz);
     return s;
 }
 } // namespace
@@ -189,8 +159,20 @@ TEST(NoiseVoicedSurfaces, NoiseBurstRisesOverItsAttackAndDecaysAfter) {
     EXPECT_THROW(bad.validate(), std::invalid_argument);
 }
 
-TEST(NoiseVoicedSurfaces, FiguresOfTheNoiseVoicedSteps) {
-    for (const char* id : {"beach_sand", "dirt_pebbles", "deep_snow", "frozen_snow", "gravel",
-                           "high_grass", "concrete"})
-        figures(id);
+TEST(NoiseVoicedSurfaces, SandDirtAndDeepSnowAreBroadbandNoise) {
+    // Their ringing grains measured -22.3 (sand), -16.5 (dirt), -16.9 and -13.4 dB (the snows)
+    // in `underfoot compare -s ID`; this test's own measure of the noise-voiced walks (one foot,
+    // seed 7): sand -14.2, dirt -15.0, deep snow -12.4 dB.
+    EXPECT_GT(figures("beach_sand").flatnessDb, -16.0);
+    EXPECT_GT(figures("dirt_pebbles").flatnessDb, -17.0);
+    EXPECT_GT(figures("deep_snow").flatnessDb, -14.5);
+}
+
+TEST(NoiseVoicedSurfaces, SandIsBrightWhereRecordedSandIs) {
+    // Recorded sand: 4-16 kHz at -20.2..-12.7 dB of the whole band; its ringing grains had
+    // -27.8 dB. The hiss of rubbing grains: measured -21.8 dB (4-10.5 kHz, this test's measure),
+    // and still mostly low (the bed's crunch and the thump: 20-250 Hz at -4.6 dB).
+    const Spectrum s = figures("beach_sand");
+    EXPECT_GT(s.highDb, -24.0);
+    EXPECT_GT(s.lowDb, -8.0);
 }
