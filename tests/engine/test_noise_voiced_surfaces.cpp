@@ -27,10 +27,10 @@ constexpr double kFs = 48000.0;
 constexpr int kBlock = 256;
 
 struct Foot {
-    std::vector<float> audio, grf;
+    std::vector<float> audio;
 };
 
-// One foot's voice and load over `seconds` of walking (after one discarded stride).
+// One foot's voice over `seconds` of walking (after one discarded stride).
 Foot renderFoot(const std::string& id, double seconds, std::uint64_t seed) {
     auto s = Surface::loadById(id);
     s->prepare({kFs, kBlock});
@@ -47,7 +47,6 @@ Foot renderFoot(const std::string& id, double seconds, std::uint64_t seed) {
         s->process(gl.data(), out.data(), kBlock);
         if (done >= warmup) {
             foot.audio.insert(foot.audio.end(), out.begin(), out.end());
-            foot.grf.insert(foot.grf.end(), gl.begin(), gl.end());
         }
     }
     return foot;
