@@ -131,6 +131,9 @@ void AggregateParameters::validate() const {
             noiseDecayMs);
     require(finite(noiseCornerHz) && noiseCornerHz >= 0, "noiseCornerHz",
             "a frequency >= 0 (0: white)", noiseCornerHz);
+    require(finite(noiseAttackMs) && noiseAttackMs >= 0 && noiseAttackMs < noiseDecayMs,
+            "noiseAttackMs", "a time >= 0 and below noiseDecayMs (0: instantaneous)",
+            noiseAttackMs);
 }
 
 void AggregateModel::configure(const AggregateParameters& parameters) {
@@ -162,6 +165,9 @@ void AggregateModel::prepare(double sampleRateHz, int maxEventsPerSecond) {
     noise_ = params_.excitation == AggregateParameters::Excitation::Noise;
     noiseLogDecay_ = -1.0 / (params_.noiseDecayMs * 1e-3 * sampleRateHz_);
     noisePowerDecay_ = std::exp(2.0 * noiseLogDecay_);
+    noiseRiseDecay_ = params_.noiseAttackMs > 0
+                          ? std::exp(-2.0 / (params_.noiseAttackMs * 1e-3 * sampleRateHz_))
+                          : 0.0;
     // y += (1 - a) (x - y) with a = exp(-2 pi fc / fs); its output variance is (1 - a) / (1 + a).
     noiseColour_ = params_.noiseCornerHz > 0
                        ? std::exp(-kTwoPi * std::min(params_.noiseCornerHz, 0.45 * sampleRateHz_) /
@@ -236,10 +242,14 @@ void AggregateModel::ringNoise(float* out, int n) noexcept {
     const double a = noiseColour_;
     for (int t = 0; t < n; ++t) {
         noiseState_ += (1.0 - a) * (noiseRandom_.bipolar() - noiseState_);
-        out[t] += static_cast<float>(std::sqrt(noisePower_) * unitVariance * noiseState_);
+        // (without an attack noiseRise_ stays 0: the same samples as before)
+        const double power = std::max(noisePower_ - noiseRise_, 0.0);
+        out[t] += static_cast<float>(std::sqrt(power) * unitVariance * noiseState_);
         noisePower_ *= noisePowerDecay_;
+        noiseRise_ *= noiseRiseDecay_;
         if (noisePower_ < floor) { // 80 dB below the largest burst: silent
             noisePower_ = 0.0;
+            noiseRise_ = 0.0;
             return;
         }
     }
@@ -273,6 +283,7 @@ void AggregateModel::reset(std::uint64_t seed) noexcept {
     capped_ = 0;
     peakSummed_ = 0.0;
     noisePower_ = 0.0;
+    noiseRise_ = 0.0;
     noiseState_ = 0.0;
     noiseAmplitude_ = 0.0;
     noiseAmplitudeAt_ = 0;
@@ -281,6 +292,20 @@ void AggregateModel::reset(std::uint64_t seed) noexcept {
 
 void AggregateModel::trigger(double energy) noexcept {
     if (std::isfinite(energy) && energy > 0) pendingTrigger_ += energy;
+}
+
+bool AggregateModel::fitUnderCap(double summed, double& amplitude) noexcept {
+    const double room = params_.amplitudeCap - summed;
+    if (amplitude > room) {
+        ++capped_;
+        amplitude = room;
+        if (!(amplitude > silenceAmplitude_)) {
+            peakSummed_ = std::max(peakSummed_, summed);
+            return false; // the bed is at its bound: this break releases nothing audible
+        }
+    }
+    peakSummed_ = std::max(peakSummed_, summed + amplitude);
+    return true;
 }
 
 void AggregateModel::spawn(double energy, bool burst) noexcept {
@@ -313,16 +338,7 @@ void AggregateModel::spawn(double energy, bool burst) noexcept {
     }
     if (cap > 0) {
         if (full) summed -= quietest; // that voice is replaced
-        const double room = cap - summed;
-        if (amplitude > room) {
-            ++capped_;
-            amplitude = room;
-            if (!(amplitude > silenceAmplitude_)) {
-                peakSummed_ = std::max(peakSummed_, summed);
-                return; // the bed is at its bound: this break releases nothing audible
-            }
-        }
-        peakSummed_ = std::max(peakSummed_, summed + amplitude);
+        if (!fitUnderCap(summed, amplitude)) return;
     }
     int v;
     if (!full) {
@@ -388,19 +404,11 @@ void AggregateModel::spawnNoise(double amplitude) noexcept {
             std::exp(noiseLogDecay_ * static_cast<double>(sample_ - noiseAmplitudeAt_));
         noiseAmplitude_ = summed;
         noiseAmplitudeAt_ = sample_;
-        const double room = cap - summed;
-        if (amplitude > room) {
-            ++capped_;
-            amplitude = room;
-            if (!(amplitude > silenceAmplitude_)) {
-                peakSummed_ = std::max(peakSummed_, summed);
-                return; // the bed is at its bound
-            }
-        }
+        if (!fitUnderCap(summed, amplitude)) return;
         noiseAmplitude_ += amplitude;
-        peakSummed_ = std::max(peakSummed_, noiseAmplitude_);
     }
     noisePower_ += amplitude * amplitude;
+    if (noiseRiseDecay_ > 0) noiseRise_ += amplitude * amplitude; // the burst starts at 0
 }
 
 void AggregateModel::freeVoice(int v) noexcept {

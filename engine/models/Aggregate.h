@@ -52,7 +52,12 @@
 ///    noise, rescaled to unit variance, before the envelope: the bursts keep their sharp start),
 ///    then the layer's tone filters. The energy bound uses the bursts' amplitudes,
 ///    S(t) = sum_i sqrt(E_i) exp(-(t - t_i) / tau), as for resonant grains. The noise has its own
-///    random stream (one draw per sample while a burst sounds).
+///    random stream (one draw per sample while a burst sounds). Attack (noiseAttackMs = r > 0,
+///    below noiseDecayMs): a burst's power rises as E (exp(-2 t / tau) - exp(-2 t / r)) instead
+///    of starting at E: grains rubbing and giving way build up their noise over a millisecond or
+///    more, where an instantaneous start is heard as a click (a hard tap). Both power sums are
+///    kept (two multiplies per sample); the amplitude still stays below sqrt(E) exp(-t / tau),
+///    so the energy bound holds unchanged.
 ///  - Voices: a pool allocated in prepare(); a voice frees itself when its slowest resonance has
 ///    decayed 80 dB below the loudest possible event (computed at spawn, so no per-sample test);
 ///    when the pool is full the quietest voice is replaced. process() never allocates.
@@ -72,6 +77,7 @@ struct AggregateParameters {
     Excitation excitation = Excitation::Resonant; ///< ringing grains or noise bursts (above)
     double noiseDecayMs = 5.0; ///< Noise: decay time constant of each burst's amplitude
     double noiseCornerHz = 0;  ///< Noise: -6 dB/octave above this (0: white)
+    double noiseAttackMs = 0;  ///< Noise: rise time constant of each burst (0: instantaneous)
     double gamma = -1.5;       ///< exponent of p(E) ~ E^gamma
     double energyMin = 1e-3;   ///< smallest event energy (relative; the largest is energyMax)
     double energyMax = 1.0;    ///< largest event energy (peak amplitude sqrt(E))
@@ -190,6 +196,9 @@ class AggregateModel {
     void ringNoise(float* out, int n) noexcept;
     void spawn(double energy, bool burst) noexcept;
     void spawnNoise(double amplitude) noexcept;
+    /// The energy bound: lowers `amplitude` to the room left under amplitudeCap above `summed`
+    /// (the grains ringing now) and records the peak; false when nothing audible is left.
+    bool fitUnderCap(double summed, double& amplitude) noexcept;
     void freeVoice(int v) noexcept;
     void retireDeadVoices() noexcept;
 
@@ -229,6 +238,7 @@ class AggregateModel {
     // noise's own random stream.
     bool noise_ = false;
     double noisePower_ = 0.0, noisePowerDecay_ = 1.0, noiseLogDecay_ = 0.0;
+    double noiseRise_ = 0.0, noiseRiseDecay_ = 0.0; // the attack's power, subtracted (attack)
     double noiseColour_ = 0.0, noiseColourGain_ = 1.0, noiseState_ = 0.0; // one-pole, unit var.
     double noiseAmplitude_ = 0.0;
     std::int64_t noiseAmplitudeAt_ = 0;

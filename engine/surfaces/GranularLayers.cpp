@@ -279,6 +279,13 @@ std::unique_ptr<SurfaceLayer> makeGrainsLayer(PresetReader& r, const AccuracyOpt
         m.noiseCornerHz = r.number("noise_corner_hz", 0.0, 0.0, 20000.0, "Hz",
                                    "excitation = \"noise\": the bursts' spectrum falls 6 dB per "
                                    "octave above this frequency (0: white)");
+        m.noiseAttackMs =
+            m.noiseDecayMs *
+            r.number("noise_attack_ratio", 0.0, 0.0, 0.9, "x noise_decay_ms",
+                     "excitation = \"noise\": each burst's power rises as exp(-2t / D) - "
+                     "exp(-2t / (ratio x D)), D = noise_decay_ms, instead of starting at once: "
+                     "grains rubbing and giving way build up their noise, where an instantaneous "
+                     "start clicks like a hard tap (0: instantaneous)");
     } else {
         m.resonances = r.integer("resonances", 2, 1, 4, "damped resonances per event");
         std::tie(m.freqMinHz, m.freqMaxHz) =

@@ -43,8 +43,9 @@
 /// old maximum). The memory is cleared when the foot leaves (F <= contact_threshold_n). 0 (the
 /// default): every load rise counts.
 /// Excitation: "resonant" (the default: each event rings at random resonances) or "noise" (each
-/// event is a burst of white noise decaying with noise_decay_ms, Aggregate.h: grains too small
-/// to ring, heard as the hiss of sand or the crunch of snow rather than as pitched ticks).
+/// event is a burst of white noise decaying with noise_decay_ms and rising over
+/// noise_attack_ratio of it, Aggregate.h: grains too small to ring, heard as the hiss of sand or
+/// the crunch of snow rather than as pitched ticks).
 /// The sum of the voices goes through an optional 2nd-order Butterworth high-pass and low-pass
 /// (tone) and the layer gain.
 #include "engine/dsp/Biquad.h"
