@@ -43,6 +43,8 @@ enum class JournalEvent {
     OnlineInvited,
     OnlineRefused,
     OnlineUnavailable,
+    OnlineScreeningStarted,
+    OnlineScreeningAnswer,
     OnlineScreeningPassed,
     OnlineScreeningFailed,
 };
@@ -56,7 +58,7 @@ struct JournalEventInfo {
 };
 
 /// Every event, in the order of the enum.
-inline constexpr std::array<JournalEventInfo, 31> kJournalEvents{{
+inline constexpr std::array<JournalEventInfo, 33> kJournalEvents{{
     {JournalEvent::StudyCreated, "study_created", "the study file was created",
      "code, site, seed, protocol, hash"},
     {JournalEvent::SchemaMigrated, "schema_migrated", "the file was migrated one schema version up",
@@ -114,10 +116,18 @@ inline constexpr std::array<JournalEventInfo, 31> kJournalEvents{{
      "participant, request, status, reason"},
     {JournalEvent::OnlineUnavailable, "online_unavailable",
      "the web server could not open the participant's session (retryable)", "participant, reason"},
+    {JournalEvent::OnlineScreeningStarted, "online_screening_started",
+     "the server laid out the headphone check from a seed",
+     "test, seed, triplets, passMark, minResponseS"},
+    {JournalEvent::OnlineScreeningAnswer, "online_screening_answer",
+     "one triplet of the headphone check was answered and scored by the server",
+     "triplet, choice, correct, secondsSinceTones"},
     {JournalEvent::OnlineScreeningPassed, "online_screening_passed",
-     "the participant passed the headphone screening", "test, correct, total, passMark"},
+     "the participant passed the headphone screening",
+     "test, seed, layout, choices, correct, total, passMark"},
     {JournalEvent::OnlineScreeningFailed, "online_screening_failed",
-     "the participant failed the headphone screening", "test, correct, total, passMark"},
+     "the participant failed the headphone screening",
+     "test, seed, layout, choices, correct, total, passMark"},
 }};
 
 /// The name stored for `event`.

@@ -431,12 +431,12 @@ HeadphoneCheck* WebStudy::check(const Invitation& inv) {
     std::vector<std::pair<int, int>> answers;
     for (const Event& e : store_.events()) {
         if (e.participant != inv.participantCode) continue;
-        if (e.kind == "online_screening_started") {
+        if (e.event == JournalEvent::OnlineScreeningStarted) {
             const json d = json::parse(e.detail, nullptr, false);
             if (!d.is_object() || !d.contains("seed") || !d["seed"].is_number_unsigned()) continue;
             seed = d["seed"].get<std::uint64_t>();
             answers.clear();
-        } else if (e.kind == "online_screening_answer" && seed) {
+        } else if (e.event == JournalEvent::OnlineScreeningAnswer && seed) {
             const json d = json::parse(e.detail, nullptr, false);
             if (d.is_object() && d.value("triplet", -1) >= 0)
                 answers.emplace_back(d.value("triplet", -1), d.value("choice", 0));
@@ -468,7 +468,7 @@ json WebStudy::screeningStart(const std::string& token, const json&) {
         auto& entry = checks_[inv.participantCode];
         entry.check = std::make_unique<HeadphoneCheck>(seed, options_.screeningMinResponseS);
         entry.served.reset();
-        store_.journal("online_screening_started", inv.participantCode, std::nullopt,
+        store_.journal(JournalEvent::OnlineScreeningStarted, inv.participantCode, std::nullopt,
                        json({{"test", "woods2017_antiphase"},
                              {"seed", seed},
                              {"triplets", HeadphoneCheck::kTriplets},
@@ -525,7 +525,7 @@ json WebStudy::screening(const std::string& token, const json& body) {
                "screening: " + *problem);
     entry.served.reset();
     const auto k = static_cast<std::size_t>(*triplet);
-    store_.journal("online_screening_answer", inv.participantCode, std::nullopt,
+    store_.journal(JournalEvent::OnlineScreeningAnswer, inv.participantCode, std::nullopt,
                    json({{"triplet", *triplet},
                          {"choice", *choice},
                          {"correct", *choice - 1 == c->triplets()[k].quiet},

@@ -273,8 +273,7 @@ TEST(GranularSurfaces, SurfacesAreDistinctByTheNumbers) {
     // Recorded sand steps are lower than recorded snow steps (`underfoot compare` medians:
     // centroid 329 vs 558 Hz). Sand's grains come from the heel's impact alone; voiced as noise
     // (docs/decisions/noise-voiced-aggregates.md) its bursts merge into one hiss, so model events
-    // per step no longer count audible grains, and its heel burst settles over 130 ms (shorter,
-    // the listener hears it as a hard floor): measured 572 vs 611 Hz.
+    // per step no longer count audible grains: measured 572 vs 611 Hz.
     EXPECT_LT(at("beach_sand").centroidHz, at("deep_snow").centroidHz);
     // Snow keeps compacting through the stance: a good part of its energy comes after the heel
     // peak (measured 0.42 of the step's energy after 0.2 s, 0.76 of the walk within 20 dB of its
@@ -283,8 +282,8 @@ TEST(GranularSurfaces, SurfacesAreDistinctByTheNumbers) {
     EXPECT_GT(at("deep_snow").lateShare, 0.3);
     EXPECT_GT(at("deep_snow").activeFraction, 0.6);
     // Frozen snow is brighter and spikier than deep snow: the heel's cracks of its crust
-    // (measured 1118 vs 611 Hz, crest 23.6 vs 19.6 dB, both snows' crunch voiced as noise;
-    // docs/explanation/realism.md "Frozen snow: a crust that breaks").
+    // (measured 1118 vs 611 Hz, crest 23.6 vs 19.6 dB, deep snow's crunch voiced as noise;
+    // docs/decisions/noise-voiced-aggregates.md).
     EXPECT_GT(at("frozen_snow").centroidHz, 1.5 * at("deep_snow").centroidHz);
     EXPECT_GT(at("frozen_snow").crestDb, at("deep_snow").crestDb + 1.0);
     // Dirt plus pebbles: mostly low earth (more power below 500 Hz than gravel and sparser).
