@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
-/// The console's trial flow (its Run view and participant window), on top of
-/// experiment::Session, which the terminal session and the web server drive directly:
+/// The trial core: what a participant sees and may answer in one trial, on top of
+/// experiment::Session, for every front end (the terminal session, the console's Run view and
+/// participant window, the web API and simulated participants):
 ///
 /// - the answer being entered for the current trial: its sections (surface question, the scales
 ///   asked in this trial's block, soundscape question), the active section, letters, digits
