@@ -22,6 +22,7 @@
 #include "app/web/Api.h"
 #include "app/web/Limits.h"
 #include "app/web/WebStudy.h"
+#include "experiment/Clips.h"
 #include "experiment/Invitations.h"
 #include "experiment/Protocol.h"
 #include "experiment/Store.h"
@@ -99,10 +100,26 @@ Template& templ() {
                                 R"({"test": "passed in the fuzz template"})");
         }
         fs::create_directories(t.clips);
-        for (const auto& s : p.stimuli) {
-            std::ofstream out(experiment::clipPath(s, t.clips), std::ios::binary);
-            out << "RIFF"; // WebStudy checks that each clip exists; its bytes are not read here
+        // WebStudy checks that each clip exists and is the manifest's (its SHA-256); the
+        // samples are not read here, so a stand-in file with its manifest row will do.
+        std::vector<experiment::ClipRecord> records;
+        for (const auto& job : experiment::clipJobs(p, t.clips)) {
+            {
+                std::ofstream out(job.path, std::ios::binary);
+                out << "RIFF";
+            }
+            experiment::ClipRecord r;
+            r.stimulusId = job.stimulus.id;
+            r.file = fs::path(job.path).filename().string();
+            r.source = job.source;
+            r.seed = job.seed;
+            r.seconds = job.seconds;
+            r.sampleRateHz = 48000.0;
+            r.frames = static_cast<std::size_t>(job.seconds * 48000.0);
+            r.sha256 = experiment::fileSha256(job.path);
+            records.push_back(r);
         }
+        experiment::writeClipManifest(t.clips, records);
         return t;
     }();
     return t;
