@@ -124,7 +124,9 @@ def range_text(k: Key) -> str:
 def table(keys: dict[str, Key], presets: int) -> str:
     lines = ["| key | type | unit | range | default | what it does | set in |",
              "|---|---|---|---|---|---|---|"]
-    for k in keys.values():
+    # In name order: the order the engine reads the keys in is not the page's (two keys read as
+    # the arguments of one call come in either order, GCC's or clang's).
+    for k in sorted(keys.values(), key=lambda k: k.name):
         shown = k.set_in[:3]
         more = len(k.set_in) - len(shown)
         set_in = ", ".join(shown) + (f" (+{more})" if more > 0 else "")
