@@ -85,6 +85,10 @@ if [ ! -f build/CMakeCache.txt ]; then
   # shellcheck disable=SC2086
   cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
     -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g1 -DNDEBUG" $launcher
+else
+  # setup.sh configured build/ before the test tools were installed: configure again, so that
+  # GoogleTest and Google Benchmark are found and the tests are added.
+  cmake -S . -B build > /dev/null
 fi
 cmake --build build --parallel "$jobs"
 
