@@ -31,7 +31,7 @@ const CatalogueEntry* Catalogue::surfaceByCode(std::string_view code) const {
 
 const Catalogue& defaultCatalogue() {
     static const Catalogue catalogue{
-        // Codes from /work/shared/data/published/README.md.
+        // Codes of the published tables (protocols/data/README.md).
         {{"beach_sand", "beach sand", "BS"},
          {"gravel", "gravel", "GL"},
          {"dirt_pebbles", "dirt", "DR"},

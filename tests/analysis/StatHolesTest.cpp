@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Issue #15 "holes": fisher.test on r x c tables, cor.test (pearson, kendall) and
+// Statistics beyond the reference studies: fisher.test on r x c tables, cor.test (pearson, kendall) and
 // wilcox.test(conf.int = TRUE), against R 4.2.2 (Debian 12). Every reference value was printed
 // by R with sprintf("%.15g", ...) from the call quoted next to it; the R script that printed
 // them all is tests/analysis/data/stat_holes_reference.R.

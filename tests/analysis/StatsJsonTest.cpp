@@ -251,7 +251,7 @@ TEST(StatsJson, PairwiseWilcoxonAdjustsAllPairsTogether) {
               std::string::npos);
 }
 
-// Issue #16: a parse error says where (line and column), a wrong type or a missing field names
+// A parse error says where (line and column), a wrong type or a missing field names
 // the key.
 TEST(StatsJson, ParseErrorsGiveLineAndColumn) {
     const std::string msg = error("chisq", "{\n  \"table\": [[1, 2],\n            [3, x]]\n}");

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Issue #17, "every shipped protocol runs live and replays": one trial of each shipped protocol
+// Every shipped protocol runs live and replays: one trial of each shipped protocol
 // runs through the real live path and is then replayed offline, and the samples are compared.
 //
 // The live path is the one `underfoot session --live` builds:

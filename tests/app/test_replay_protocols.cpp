@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Issue #17, every trial replayable: the first trial of each shipped sensor-driven footstep
+// Every trial replayable: the first trial of each shipped sensor-driven footstep
 // protocol (microphones: TVCG 2011 exp. 1 and 2; FSR shoes: Eurohaptics 2010) runs through the
 // live path — a study, a Session, the LivePlayer on a LiveEngine whose callback body runs here at
 // the live block size (64 frames at 48 kHz) with the sensor's signal fed in — and

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue #18: the engine's kernels are chosen at run time (AVX where the CPU has it, else SSE2) and
+# The engine's kernels are chosen at run time (AVX where the CPU has it, else SSE2) and
 # must give the same samples bit for bit. Renders every bundled surface twice, once limited to
 # SSE2 (UNDERFOOT_SIMD=sse2) and once with the CPU's best kernels, as 32-bit float WAV, and
 # compares the files byte for byte. Also checks that an unknown UNDERFOOT_SIMD value is refused.

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Issue #18: the output is the same, to the last bit, for every host block size. A replay
+// The output is the same, to the last bit, for every host block size. A replay
 // renders a live trial at whatever block size it is given, so every decision a layer takes
 // (falling asleep, flushing tiny state, starting a grain) must not depend on where the host cuts
 // the signal. The layers decide on a fixed grid from reset (engine/dsp/SleepGrid.h).

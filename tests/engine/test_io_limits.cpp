@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Issue #16: audio and GRF readers bound what they allocate and compute by the documented limits
+// Audio and GRF readers bound what they allocate and compute by the documented limits
 // and the file's real size; headers claiming absurd rates or lengths are refused with a message.
 #include "../common/ScratchDir.h"
 #include "engine/control/GrfFile.h"
@@ -158,7 +158,7 @@ TEST(IoLimits, ShippedGrfStillLoads) {
     EXPECT_GT(g.frames(), 0u);
 }
 
-// Issue #16: empty or truncated settings and calibration files are refused with the file and
+// Empty or truncated settings and calibration files are refused with the file and
 // what is missing, never silently read as defaults.
 #include "engine/control/StepCalibration.h"
 #include "engine/io/AudioDevice.h"

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: GPL-3.0-or-later
-# Issue #17 through the `underfoot` program: every shipped protocol simulates with no further
+# Through the `underfoot` program: every shipped protocol simulates with no further
 # argument (the published data it names) and never touches a real participant; simulated
 # participants are flagged in the export and left out of `analyze`; a session without --live
 # says that no sound is played and stores it; trial numbers people type are 1-based;

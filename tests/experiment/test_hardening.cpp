@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Issue #16: a damaged study file is refused with its name and what is wrong, never indexed or run.
+// A damaged study file is refused with its name and what is wrong, never indexed or run.
 #include "TestSupport.h"
 #include "experiment/Store.h"
 

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Issue #17 "The experimenter's day": a simulation never writes into a real participant and
+// The experimenter's day: a simulation never writes into a real participant and
 // flags its own; every shipped protocol simulates end to end from the published data it names;
 // a resumed lap trial finishes; sessions store whether sound was played; people read 1-based
 // trial numbers; unknown ids get a sorted list and a suggestion.

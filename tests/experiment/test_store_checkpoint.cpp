@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Issue #16: an answer committed to the write-ahead log whose checkpoint into the study file then
+// An answer committed to the write-ahead log whose checkpoint into the study file then
 // fails is stored; the store says so (AnswerSavedButNotCopied) and the session moves on instead of
 // asking for the answer again (which would have stored it a second time, as a changed answer).
 //

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Issue #17: a live wading node's run is reproduced exactly from its gait arrivals (each frame
+// A live wading node's run is reproduced exactly from its gait arrivals (each frame
 // with the sample at which it took effect). A gait source delivers frames at jittered offsets,
 // as gyroscope packets land in whichever audio block is running when they arrive; the node's
 // output is compared with renderWadingArrivals() of what it recorded, bit for bit, and the same
