@@ -47,7 +47,7 @@ tail -n +2 tvcg2011_exp1.out/trials.csv | awk -F, -v t="$t" -v i="$i" '$t != $i 
 set +e
 "$underfoot" analyze --study tvcg2011_exp1.db > real.md 2> real.err
 set -e
-grep -q "2 simulated participant(s) left out" real.err
+grep -q "2 simulated participants left out" real.err
 "$underfoot" analyze --study tvcg2011_exp1.db --include-simulated > all.md
 grep -q "| Stimulus |" all.md
 
