@@ -319,7 +319,8 @@ void ResultsView::refresh() {
     double n = 0;
     for (const auto& s : report_.summary) n += s.n;
     status_->setText(
-        tr("%1 answered trials analysed (practice and excluded trials left out)").arg(n));
+        (n == 1 ? tr("1 answered trial analysed") : tr("%1 answered trials analysed").arg(n)) +
+        tr(" (practice and excluded trials left out)"));
     const auto groupLabel = [this](const std::string& id) {
         return groupLabelOf(context_.store().protocol(), id);
     };
