@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "experiment/Catalogue.h"
 
+#include "base/Catalogue.h"
+
 #include <algorithm>
 #include <cctype>
 
@@ -30,31 +32,15 @@ const CatalogueEntry* Catalogue::surfaceByCode(std::string_view code) const {
 }
 
 const Catalogue& defaultCatalogue() {
-    static const Catalogue catalogue{
-        // Codes of the published tables (protocols/data/README.md).
-        {{"beach_sand", "beach sand", "BS"},
-         {"gravel", "gravel", "GL"},
-         {"dirt_pebbles", "dirt", "DR"},
-         {"deep_snow", "snow", "SW"},
-         {"frozen_snow", "frozen snow", "FS"},
-         {"high_grass", "high grass", "HG"},
-         {"forest_underbrush", "forest underbrush", "UB"},
-         {"dry_leaves", "dry leaves", "DL"},
-         {"wood", "wood", "WD"},
-         {"creaking_wood", "creaking wood", "CW"},
-         {"metal", "metal", "MT"},
-         {"concrete", "concrete", "CC"},
-         {"carpet", "carpet", "CP"},
-         {"puddles", "puddles", "PD"},
-         {"water", "water", "WT"},
-         {"wood_reverb", "wood with reverb", "WR"},
-         {"creaking_wood_reverb", "creaking wood with reverb", "CR"},
-         {"metal_reverb", "metal with reverb", "MR"}},
-        {{"beach_summer", "beach in summer", ""},
-         {"farm_courtyard", "courtyard of a farm in the countryside", ""},
-         {"ski_slope", "ski slope", ""},
-         {"forest", "forest", ""},
-         {"park_fall", "park in the fall", ""}}};
+    // Built once from the project's catalogue, which the build generates from the presets.
+    static const Catalogue catalogue = [] {
+        Catalogue c;
+        for (const auto& s : base::surfaces())
+            c.surfaces.push_back({std::string(s.id), std::string(s.label), std::string(s.code)});
+        for (const auto& s : base::soundscapes())
+            c.soundscapes.push_back({std::string(s.id), std::string(s.label), ""});
+        return c;
+    }();
     return catalogue;
 }
 

@@ -32,8 +32,8 @@ struct Catalogue {
     const CatalogueEntry* surfaceByCode(std::string_view code) const;
 };
 
-/// The catalogue of the reference studies: 15 surfaces, 3 reverb variants and
-/// 5 soundscapes. Used by the CLI and the tests until the app passes the engine's list.
+/// Every surface preset and soundscape the program ships (base/Catalogue.h, generated from the
+/// preset files), with the labels and codes the analysis uses too.
 const Catalogue& defaultCatalogue();
 
 /// The candidate closest to `name` by edit distance (insertions, deletions, substitutions;

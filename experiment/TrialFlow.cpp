@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "experiment/TrialFlow.h"
+#include "base/Plural.h"
 
 #include <fmt/format.h>
 
@@ -90,7 +91,7 @@ std::string lockRefusal(const Protocol& protocol, bool laterTrialStarted) {
 }
 
 std::string progressText(int answered, int total) {
-    return fmt::format("{} of {} trials answered", answered, total);
+    return fmt::format("{} of {} answered", answered, counted(total, "trial"));
 }
 
 std::vector<std::string> anchorTexts(const Scale& scale) {
@@ -540,7 +541,7 @@ std::string TrialFlow::participantBriefing() const {
                                               p.laps.baseline, p.laps.feedback)
                                 : "");
     else
-        text += fmt::format("There are {} trials{}.", total,
+        text += fmt::format("There {} {}{}.", total == 1 ? "is" : "are", counted(total, "trial"),
                             practice ? fmt::format(" ({} for practice first)", practice) : "");
     std::vector<std::string> asked;
     if (q.asksSurface()) asked.push_back(q.surfacePrompt);
@@ -552,7 +553,10 @@ std::string TrialFlow::participantBriefing() const {
     }
     if (p.clips.enabled && p.clips.replay) text += "\n\nYou may listen to a clip again.";
     if (p.ordering.breakEvery > 0)
-        text += fmt::format("\n\nThere is a break after every {} trials.", p.ordering.breakEvery);
+        text +=
+            p.ordering.breakEvery == 1
+                ? std::string("\n\nThere is a break after every trial.")
+                : fmt::format("\n\nThere is a break after every {} trials.", p.ordering.breakEvery);
     text += "\n\nThere are no right or wrong answers: answer what you perceive.";
     return text;
 }
@@ -570,8 +574,8 @@ ParticipantScreen TrialFlow::participantScreen() const {
     case SessionPhase::Break:
         s.page = ParticipantScreen::Page::Break;
         s.heading = "Break";
-        s.text = fmt::format("{} of {} trials done. Please rest; the experimenter will continue.",
-                             s.answered, s.total);
+        s.text = fmt::format("{} of {} done. Please rest; the experimenter will continue.",
+                             s.answered, counted(s.total, "trial"));
         return s;
     case SessionPhase::Finished:
         s.page = ParticipantScreen::Page::Finished;

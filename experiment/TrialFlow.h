@@ -245,6 +245,15 @@ class TrialFlow {
     bool sectionAnswered(int index) const;
     /// "comment (Enter for none)> " when the protocol takes a comment, else "".
     std::string commentPrompt() const;
+    /// "Briefing done? Press Enter to start. " on the briefing page, "Press Enter to continue. "
+    /// on a break; "" otherwise.
+    std::string continuePrompt() const;
+    /// "PAUSED — <why>\nThe trial will be presented again. Fix the sensor, then press Enter to
+    /// resume. " while a sensor fault pauses the session; "" otherwise.
+    std::string pausePrompt() const;
+    /// What a session that plays nothing says at its start: "NO SOUND: this session plays
+    /// nothing (data entry: the answers are typed in as given; stored with the session)."
+    static std::string noSoundNotice();
 
     /// What the participant's screen shows now.
     ParticipantScreen participantScreen() const;

@@ -80,4 +80,27 @@ std::string TrialFlow::commentPrompt() const {
     return protocol().questions.comment ? "comment (Enter for none)> " : "";
 }
 
+std::string TrialFlow::continuePrompt() const {
+    switch (session_.phase()) {
+    case SessionPhase::Briefing:
+        return "Briefing done? Press Enter to start. ";
+    case SessionPhase::Break:
+        return "Press Enter to continue. ";
+    default:
+        return "";
+    }
+}
+
+std::string TrialFlow::pausePrompt() const {
+    if (!session_.paused()) return "";
+    return fmt::format("PAUSED — {}\nThe trial will be presented again. Fix the sensor, then "
+                       "press Enter to resume. ",
+                       session_.pauseReason());
+}
+
+std::string TrialFlow::noSoundNotice() {
+    return "NO SOUND: this session plays nothing (data entry: the answers are typed in as given; "
+           "stored with the session).";
+}
+
 } // namespace underfoot::experiment

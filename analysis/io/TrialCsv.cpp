@@ -3,6 +3,7 @@
 
 #include "analysis/io/Csv.h"
 #include "analysis/model/Catalog.h"
+#include "base/Plural.h"
 
 #include <fmt/format.h>
 
@@ -130,12 +131,16 @@ std::vector<TrialRecord> recordsToTrials(const std::vector<csv::Record>& records
                                                  sourceName, header.line, header.fields[i]));
     }
     std::string missing;
+    int missingCount = 0;
     for (const auto& column : requiredTrialCsvColumns())
-        if (!index.count(column)) missing += (missing.empty() ? "" : ", ") + column;
+        if (!index.count(column)) {
+            missing += (missing.empty() ? "" : ", ") + column;
+            ++missingCount;
+        }
     if (!missing.empty())
-        throw std::runtime_error(fmt::format(
-            "{}:{}: missing required column(s) {} (expected the header of `underfoot export`)",
-            sourceName, header.line, missing));
+        throw std::runtime_error(
+            fmt::format("{}:{}: missing required {} {} (expected the header of `underfoot export`)",
+                        sourceName, header.line, plural(missingCount, "column"), missing));
     std::vector<TrialRecord> out;
     out.reserve(records.size() - 1);
     for (std::size_t r = 1; r < records.size(); ++r) {

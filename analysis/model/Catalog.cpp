@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "analysis/model/Catalog.h"
 
+#include "base/Catalogue.h"
+
 #include <algorithm>
 #include <cctype>
 
@@ -18,27 +20,19 @@ bool equalsIgnoreCase(std::string_view a, std::string_view b) {
 } // namespace
 
 const std::vector<SurfaceInfo>& surfaceCatalog() {
-    using C = SurfaceCategory;
-    static const std::vector<SurfaceInfo> catalog{
-        {"beach_sand", "Beach sand", "BS", "beach_sand", C::Aggregate},
-        {"gravel", "Gravel", "GL", "gravel", C::Aggregate},
-        {"dirt_pebbles", "Dirt (pebbles)", "DR", "dirt_pebbles", C::Aggregate},
-        {"deep_snow", "Deep snow", "SW", "deep_snow", C::Aggregate},
-        {"high_grass", "High grass", "HG", "high_grass", C::Aggregate},
-        {"forest_underbrush", "Forest underbrush", "UB", "forest_underbrush", C::Aggregate},
-        {"dry_leaves", "Dry leaves", "DL", "dry_leaves", C::Aggregate},
-        {"wood", "Wood", "WD", "wood", C::Solid},
-        {"creaking_wood", "Creaking wood", "CW", "creaking_wood", C::Solid},
-        {"metal", "Metal", "MT", "metal", C::Solid},
-        {"wood_reverb", "Wood (reverb)", "WR", "wood", C::Solid},
-        {"creaking_wood_reverb", "Creaking wood (reverb)", "CR", "creaking_wood", C::Solid},
-        {"metal_reverb", "Metal (reverb)", "MR", "metal", C::Solid},
-        {"frozen_snow", "Frozen snow", "FS", "frozen_snow", C::Aggregate},
-        {"concrete", "Concrete", "CC", "concrete", C::Solid},
-        {"puddles", "Puddles", "PD", "puddles", C::Liquid},
-        {"water", "Water", "WT", "water", C::Liquid},
-        {"carpet", "Carpet", "CP", "carpet", C::Solid},
-    };
+    // The project's catalogue (generated from the presets), in the published tables' order.
+    static const std::vector<SurfaceInfo> catalog = [] {
+        std::vector<SurfaceInfo> out;
+        for (const auto& s : base::surfaces()) {
+            const auto category = s.category == "solid"       ? SurfaceCategory::Solid
+                                  : s.category == "aggregate" ? SurfaceCategory::Aggregate
+                                  : s.category == "liquid"    ? SurfaceCategory::Liquid
+                                                              : SurfaceCategory::Unknown;
+            out.push_back({std::string(s.id), std::string(s.label), std::string(s.code),
+                           std::string(s.baseId), category});
+        }
+        return out;
+    }();
     return catalog;
 }
 
@@ -73,11 +67,12 @@ const char* categoryName(SurfaceCategory category) {
 }
 
 const std::vector<SoundscapeInfo>& soundscapeCatalog() {
-    static const std::vector<SoundscapeInfo> catalog{
-        {"beach_summer", "Beach in summer"}, {"farm_courtyard", "Courtyard of a farm"},
-        {"ski_slope", "Ski slope"},          {"forest", "Forest"},
-        {"park_fall", "Park in the fall"},
-    };
+    static const std::vector<SoundscapeInfo> catalog = [] {
+        std::vector<SoundscapeInfo> out;
+        for (const auto& s : base::soundscapes())
+            out.push_back({std::string(s.id), std::string(s.label)});
+        return out;
+    }();
     return catalog;
 }
 

@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
-/// The surfaces, soundscapes and answer lists of the reference studies, with the codes of the
-/// published tables (docs/explanation/studies.md; tests/analysis/data/published/README.md).
+/// The surfaces and soundscapes the analysis knows (the project's catalogue, base/Catalogue.h,
+/// generated from the preset files) with the codes of the published tables, and the answer
+/// lists of the reference studies (docs/explanation/studies.md).
 #include "base/AnswerRule.h"
 
 #include <optional>

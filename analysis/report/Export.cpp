@@ -128,17 +128,21 @@ TextTable categoryTable(const CategoryMatrix& m) {
 
 TextTable summaryTable(const AnalysisReport& r) {
     TextTable t;
-    t.caption = "Per-stimulus summary: % with 95% Wilson interval; realism on correct answers "
-                "only, quality on all answers except \"I don't know\" (mean ± SD)";
+    const bool anySoundscape =
+        std::any_of(r.summary.begin(), r.summary.end(),
+                    [](const SummaryRow& s) { return s.soundscapeCorrect.n > 0; });
+    // The caption says what the columns below hold, no more.
+    t.caption = "Per-stimulus summary: % with 95% Wilson interval";
+    if (r.hasRatings)
+        t.caption += "; realism on correct answers only, quality on all answers except \"I "
+                     "don't know\" (mean ± SD)";
+    if (anySoundscape) t.caption += "; % soundscape: the soundscape named correctly";
     t.header = {"Group", "Stimulus", "n", "% correct", "% wrong", "% don't know"};
     t.numeric = {false, false, true, true, true, true};
     if (r.hasRatings) {
         t.header.insert(t.header.end(), {"Realism", "Quality"});
         t.numeric.insert(t.numeric.end(), {true, true});
     }
-    const bool anySoundscape =
-        std::any_of(r.summary.begin(), r.summary.end(),
-                    [](const SummaryRow& s) { return s.soundscapeCorrect.n > 0; });
     if (anySoundscape) {
         t.header.push_back("% soundscape");
         t.numeric.push_back(true);

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "analysis/report/Markup.h"
+#include "base/Plural.h"
 
 #include <fmt/format.h>
 
@@ -106,9 +107,9 @@ std::string markdownCell(std::string_view text) {
 
 std::string simulatedNotice(int simulated, int total) {
     if (simulated <= 0) return "";
-    const std::string who =
-        total > 0 ? fmt::format("{} of {} participants", simulated, total)
-                  : fmt::format("{} participant{}", simulated, simulated == 1 ? "" : "s");
+    const std::string who = total > 0
+                                ? fmt::format("{} of {}", simulated, counted(total, "participant"))
+                                : counted(simulated, "participant");
     return fmt::format("Simulated data: {} in this report {} synthetic (made by `underfoot session "
                        "--simulate`), not people; its figures describe the simulation.",
                        who, simulated == 1 && total <= 1 ? "is" : "are");

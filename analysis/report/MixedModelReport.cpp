@@ -5,6 +5,7 @@
 #include "analysis/stats/OrdinalMixed.h"
 #include "analysis/stats/Tests.h"
 #include "analysis/tables/ScoringRules.h"
+#include "base/Plural.h"
 
 #include <fmt/format.h>
 
@@ -171,15 +172,15 @@ void addMixedModelComparisons(AnalysisReport& report, std::span<const TrialRecor
                     }
             }
     report.mixedModelAdvice = fmt::format(
-        "Which test to cite: the mixed models. Each participant gave up to {} answers per "
+        "Which test to cite: the mixed models. Each participant gave up to {} per "
         "surface, and answers of one participant are not independent; the chi-square and t-tests "
         "pool them as if they were, which understates their p-values when participants differ, "
         "while the mixed models (participant as random intercept; lme4 glmer / lmerTest lmer, "
         "likelihood-ratio test of the group) account for it. The chi-square / t-tests are shown "
         "to compare with the reference papers{}.{}",
-        repeated,
-        compared > 0 ? fmt::format(" (here they disagree about p < 0.05 in {} of {} comparisons)",
-                                   disagreements, compared)
+        counted(repeated, "answer"),
+        compared > 0 ? fmt::format(" (here they disagree about p < 0.05 in {} of {})",
+                                   disagreements, counted(compared, "comparison"))
                      : std::string(),
         report.hasRatings
             ? " For the ratings cite the cumulative link mixed model (clmm, ordinal::clmm): a "

@@ -6,6 +6,7 @@
 #include "analysis/report/Markup.h"
 #include "analysis/report/Words.h"
 #include "analysis/stats/Numerics.h"
+#include "base/Plural.h"
 
 #include <fmt/format.h>
 
@@ -165,16 +166,16 @@ Table modelTable(const ScaleAnalysis& s) {
         {}};
     t.rows.push_back({s.omnibus.conditions.size() >= 3 ? "Friedman (friedman.test)"
                                                        : "Wilcoxon signed-rank (wilcox.test)",
-                      fmt::format("cell means of {} participants", s.omnibus.participants),
+                      "cell means of " + counted(s.omnibus.participants, "participant"),
                       num(s.omnibus.result.statistic),
                       s.omnibus.result.df.empty() ? "" : num(s.omnibus.result.df[0], 3),
                       pText(s.omnibus.result.p), "", s.omnibus.result.error});
     auto model = [&](const std::string& name, const MixedModelResult& r) {
         if (!r.ok()) {
-            t.rows.push_back({name, fmt::format("{} ratings", m.ratings), "", "", "", "", r.error});
+            t.rows.push_back({name, counted(m.ratings, "rating"), "", "", "", "", r.error});
             return;
         }
-        t.rows.push_back({name, fmt::format("{} ratings", static_cast<std::size_t>(r.nObs)),
+        t.rows.push_back({name, counted(static_cast<std::size_t>(r.nObs), "rating"),
                           "LRT X² = " + num(r.lrt.statistic), num(r.lrt.df, 3), pText(r.lrt.p),
                           num(r.randomVariance), warningsText(r.warnings)});
     };
@@ -217,10 +218,10 @@ std::vector<Section> sections(const RatingStudyAnalysis& a, const RatingLabels& 
                                   num(fe.levelStats[i].median, 2),
                                   fmt::format("{}-{}", num(fe.levelStats[i].q1, 2),
                                               num(fe.levelStats[i].q3, 2))});
-            sec.text +=
-                fmt::format("\n\nMain effect of {} (each participant's median over the "
-                            "other factors; {} participants): {}.",
-                            fe.factor, fe.omnibus.participants, statisticText(fe.omnibus.result));
+            sec.text += fmt::format("\n\nMain effect of {} (each participant's median over the "
+                                    "other factors; {}): {}.",
+                                    fe.factor, counted(fe.omnibus.participants, "participant"),
+                                    statisticText(fe.omnibus.result));
             sec.tables.push_back(t);
             sec.tables.push_back(pairTable(fe.pairs, labels));
         }
@@ -457,7 +458,7 @@ std::string renderRatingReport(const RatingStudyAnalysis& a, ReportFormat format
             out += "**" +
                    simulatedNotice(labels.simulatedParticipants, static_cast<int>(a.participants)) +
                    "**\n\n";
-        out += fmt::format("{} participants. {}\n", a.participants, kMethods);
+        out += fmt::format("{}. {}\n", counted(a.participants, "participant"), kMethods);
         for (const auto& s : secs) {
             out += fmt::format("\n## {}\n\n{}\n\n", s.heading, s.text);
             for (const auto& t : s.tables) out += t.markdown() + "\n";
@@ -470,8 +471,9 @@ std::string renderRatingReport(const RatingStudyAnalysis& a, ReportFormat format
                            "<style>body{{font-family:sans-serif;max-width:70em;margin:auto}}"
                            "table{{border-collapse:collapse;margin:0.6em 0}}td,th{{border:1px "
                            "solid #ccc;padding:2px 6px}}</style></head><body>\n<h1>{}</h1>\n"
-                           "<p>{} participants. {}</p>\n",
-                           xmlEscape(title), xmlEscape(title), a.participants, xmlEscape(kMethods));
+                           "<p>{}. {}</p>\n",
+                           xmlEscape(title), xmlEscape(title),
+                           counted(a.participants, "participant"), xmlEscape(kMethods));
         out += simulatedBannerHtml(labels.simulatedParticipants, static_cast<int>(a.participants));
         for (const auto& s : secs) {
             out += fmt::format("<h2>{}</h2>\n", xmlEscape(s.heading));

@@ -4,6 +4,7 @@
 #include "analysis/stats/Numerics.h"
 #include "analysis/stats/Tests.h"
 #include "analysis/tables/ScoringRules.h"
+#include "base/Plural.h"
 
 #include <algorithm>
 #include <cmath>
@@ -366,10 +367,10 @@ AnalysisReport analyzeTrials(std::span<const TrialRecord> trials, const Analysis
         if (!std::isnan(t.realism) || !std::isnan(t.quality)) report.hasRatings = true;
     }
     report.groups = sortedGroups(groupSet, options.groupOrder);
-    report.notes.push_back(fmt::format(
-        "{} trials of {} participants enter the tables; left out: {} practice, {} excluded, {} "
-        "unanswered.",
-        entered, participants.size(), practice, excluded, unanswered));
+    report.notes.push_back(
+        fmt::format("{} of {} {} the tables; left out: {} practice, {} excluded, {} unanswered.",
+                    counted(entered, "trial"), counted(participants.size(), "participant"),
+                    entered == 1 ? "enters" : "enter", practice, excluded, unanswered));
     for (const auto& group : report.groups) {
         auto confusion = buildConfusion(trials, options.answers, options.split,
                                         options.byGroup ? group : std::string());

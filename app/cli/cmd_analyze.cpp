@@ -10,15 +10,14 @@
 #include "analysis/report/RatingReport.h"
 #include "analysis/tables/Tables.h"
 #include "app/cli/CommandRegistry.h"
+#include "app/wiring/StudyAnalysis.h"
+#include "base/Plural.h"
 
 #include "experiment/Export.h"
 #include "experiment/Store.h"
 
-#include <filesystem>
 #include <fmt/core.h>
 #include <fmt/format.h>
-#include <fstream>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -55,15 +54,8 @@ struct AnalyzeOptions {
     bool includeSimulated = false;
 };
 
-/// Simulated participants of a study.
-int simulatedCount(const experiment::StudyStore& store) {
-    int n = 0;
-    for (const auto& p : store.participants()) n += p.simulated ? 1 : 0;
-    return n;
-}
-
-/// The participants a report covers and how many of them are simulated (its banner); the
-/// console hears it too.
+/// The participants a report of a trial CSV covers and how many of them are simulated (its
+/// banner); the console hears it too.
 void countParticipants(analysis::AnalysisReport& report,
                        const std::vector<analysis::TrialRecord>& trials) {
     std::set<std::string> all, simulated;
@@ -73,24 +65,35 @@ void countParticipants(analysis::AnalysisReport& report,
     }
     report.participants = static_cast<int>(all.size());
     report.simulatedParticipants = static_cast<int>(simulated.size());
-    if (!simulated.empty())
-        fmt::print(
-            stderr, "analyze: {}\n",
-            analysis::markup::simulatedNotice(report.simulatedParticipants, report.participants));
 }
 
-/// Simulated participants are left out of an analysis unless asked for; says so.
-experiment::SimulatedRows simulatedRows(const AnalyzeOptions& o,
-                                        const experiment::StudyStore& store) {
-    if (o.includeSimulated) return experiment::SimulatedRows::Include;
-    int simulated = 0;
-    for (const auto& p : store.participants()) simulated += p.simulated ? 1 : 0;
+/// Says on standard error who of the study's participants are simulated and whether they are
+/// analysed.
+void noteSimulated(const AnalyzeOptions& o, const experiment::StudyStore& store, int analysed,
+                   int total) {
+    if (o.includeSimulated) {
+        if (analysed > 0)
+            fmt::print(stderr, "analyze: {}\n", analysis::markup::simulatedNotice(analysed, total));
+        return;
+    }
+    const int simulated = wiring::simulatedParticipants(store);
     if (simulated > 0)
-        fmt::print(stderr,
-                   "analyze: {} simulated participant(s) left out (--include-simulated keeps "
-                   "them)\n",
-                   simulated);
-    return experiment::SimulatedRows::Exclude;
+        fmt::print(stderr, "analyze: {} left out (--include-simulated keeps them)\n",
+                   counted(simulated, "simulated participant"));
+}
+
+/// The study's defaults with what the command line asked for.
+wiring::StudyAnalysisOverrides overridesOf(const AnalyzeOptions& o) {
+    wiring::StudyAnalysisOverrides w;
+    if (o.by == "group") w.byGroup = true;
+    if (o.by == "none") w.byGroup = false;
+    w.groupOrder = o.groupOrder;
+    w.poolSoundscapes = o.poolSoundscapes;
+    w.confLevel = o.confLevel;
+    w.includeSimulated = o.includeSimulated;
+    w.title = o.title;
+    w.ratingGroupFields = o.groupFields;
+    return w;
 }
 
 void writeText(const std::string& output, const std::string& text) {
@@ -106,43 +109,22 @@ void writeText(const std::string& output, const std::string& text) {
 
 /// Rating studies (the wading studies and any protocol of scales): the paper's form.
 int analyzeRatings(const AnalyzeOptions& o, analysis::ReportFormat format) {
-    analysis::RatingData data;
-    analysis::RatingLabels labels;
     try {
+        auto overrides = overridesOf(o);
+        wiring::StudyRatings ratings;
         if (!o.study.empty()) {
             const auto store = experiment::StudyStore::openForReading(o.study);
-            std::ostringstream ratings, participants, scales;
-            const auto rows = simulatedRows(o, store);
-            experiment::writeRatingsCsv(store, ratings, experiment::ExportScope::Answered, rows);
-            experiment::writeParticipantsCsv(store, participants, rows);
-            experiment::writeScalesCsv(store, scales);
-            data = analysis::parseRatingData(ratings.str(), o.study + " (ratings)",
-                                             participants.str(), o.study + " (participants)",
-                                             scales.str(), o.study + " (scales)");
-            data.title = store.protocol().title;
-            if (rows == experiment::SimulatedRows::Include)
-                labels.simulatedParticipants = simulatedCount(store);
-            if (labels.simulatedParticipants > 0)
-                fmt::print(stderr, "analyze: {}\n",
-                           analysis::markup::simulatedNotice(labels.simulatedParticipants, 0));
-            labels.stimuli = experiment::stimulusDisplayLabels(store.protocol());
+            ratings = wiring::studyRatings(store, overrides);
+            noteSimulated(o, store, ratings.labels.simulatedParticipants, 0);
         } else if (!o.ratings.empty()) {
-            data = analysis::readRatingData(o.ratings, o.participants, o.scales);
+            ratings.data = analysis::readRatingData(o.ratings, o.participants, o.scales);
+            if (!o.title.empty()) ratings.data.title = o.title;
         } else {
             throw cli::UserError("--form ratings needs --study FILE or --ratings FILE (the "
                                  "ratings CSV of `underfoot export`)");
         }
-        if (!o.title.empty()) data.title = o.title;
-        analysis::RatingAnalysisOptions options;
-        options.groupingFields = o.groupFields;
-        for (const auto& f : o.groupFields)
-            if (std::find(data.groupingFields.begin(), data.groupingFields.end(), f) ==
-                data.groupingFields.end())
-                throw cli::UserError(fmt::format("--group-by {}: not a participant field of "
-                                                 "this study (fields: {})",
-                                                 f, fmt::join(data.groupingFields, ", ")));
-        const auto result = analysis::analyzeRatingStudy(data, options);
-        writeText(o.output, analysis::renderRatingReport(result, format, labels));
+        const auto result = wiring::analyzeRatings(ratings, overrides);
+        writeText(o.output, analysis::renderRatingReport(result, format, ratings.labels));
     } catch (const std::runtime_error& e) {
         throw cli::UserError(e.what());
     } catch (const std::invalid_argument& e) {
@@ -161,8 +143,7 @@ int analyze(const AnalyzeOptions& o) {
         // A protocol that only rates (no surface question) is analysed in the paper's form.
         try {
             const auto store = experiment::StudyStore::openForReading(o.study);
-            const auto& q = store.protocol().questions;
-            ratingsForm = !q.asksSurface() && !q.scales.empty();
+            ratingsForm = wiring::isRatingStudy(store.protocol());
         } catch (const std::runtime_error& e) {
             throw cli::UserError(e.what());
         }
@@ -181,8 +162,8 @@ int analyze(const AnalyzeOptions& o) {
     if (int(!o.study.empty()) + int(!o.trials.empty()) + int(!o.counts.empty()) != 1)
         throw cli::UserError(
             "give one source: --study FILE (a study store), --trials FILE or --counts FILE...");
-    if (!o.by.empty() && o.by != "group")
-        throw cli::UserError(fmt::format("--by {}: expected 'group'", o.by));
+    if (!o.by.empty() && o.by != "group" && o.by != "none")
+        throw cli::UserError(fmt::format("--by {}: expected group or none", o.by));
     const auto format = analysis::parseReportFormat(o.format);
     if (!format)
         throw cli::UserError(
@@ -198,55 +179,40 @@ int analyze(const AnalyzeOptions& o) {
         if (!(p > 0) || p != std::floor(p))
             throw cli::UserError(fmt::format("--presentations {}: expected a positive integer", p));
 
+    auto overrides = overridesOf(o);
+    if (!o.answers.empty()) {
+        analysis::AnswerList answers;
+        answers.options.clear();
+        for (const auto& id : o.answers) {
+            if (id.empty() || answers.indexOf(id) ||
+                std::count(o.answers.begin(), o.answers.end(), id) > 1)
+                throw cli::UserError(fmt::format(
+                    "--answers: '{}' is empty or listed twice (expected answer ids)", id));
+            if (id != analysis::kDontKnowId)
+                answers.options.push_back({id, analysis::labelFor(id)});
+        }
+        // "I don't know" is always the last column
+        answers.options.push_back(
+            {std::string(analysis::kDontKnowId), analysis::labelFor(analysis::kDontKnowId)});
+        overrides.answers = std::move(answers);
+    }
+    // A trial CSV or count tables have no protocol: no split unless --by group, the TVCG 2011
+    // answer sheet unless --answers.
     analysis::AnalysisOptions options;
     options.byGroup = o.by == "group";
     options.split = o.poolSoundscapes ? analysis::SoundscapeSplit::Pooled
                                       : analysis::SoundscapeSplit::BySoundscape;
     options.confLevel = o.confLevel;
     options.groupOrder = o.groupOrder;
-    if (!o.answers.empty()) {
-        options.answers.options.clear();
-        for (const auto& id : o.answers) {
-            if (id.empty() || options.answers.indexOf(id) ||
-                std::count(o.answers.begin(), o.answers.end(), id) > 1)
-                throw cli::UserError(fmt::format(
-                    "--answers: '{}' is empty or listed twice (expected answer ids)", id));
-            if (id != analysis::kDontKnowId)
-                options.answers.options.push_back({id, analysis::labelFor(id)});
-        }
-        // "I don't know" is always the last column
-        options.answers.options.push_back(
-            {std::string(analysis::kDontKnowId), analysis::labelFor(analysis::kDontKnowId)});
-    }
+    if (overrides.answers) options.answers = *overrides.answers;
     analysis::AnalysisReport report;
     try {
         if (!o.study.empty()) {
-            // Straight from the study store: its trials, exported in the long format the
-            // analysis reads, with the protocol's answer-list order unless --answers says else.
+            // Straight from the study store, set up as the console sets it up.
             const auto store = experiment::StudyStore::openForReading(o.study);
-            const auto dir = std::filesystem::temp_directory_path() /
-                             fmt::format("underfoot_analyze_{}", ::getpid());
-            std::filesystem::create_directories(dir);
-            const auto csv = (dir / "trials.csv").string();
-            {
-                std::ofstream out(csv);
-                experiment::writeTrialsCsv(store, out, experiment::ExportScope::Answered,
-                                           simulatedRows(o, store));
-            }
-            const auto trials = analysis::readTrialCsv(csv);
-            std::filesystem::remove_all(dir);
-            if (o.answers.empty() && !store.protocol().questions.surfaceOptions.empty()) {
-                options.answers.options.clear();
-                for (const auto& a : store.protocol().questions.surfaceOptions)
-                    if (a.id != analysis::kDontKnowId)
-                        options.answers.options.push_back({a.id, a.label});
-                options.answers.options.push_back({std::string(analysis::kDontKnowId),
-                                                   analysis::labelFor(analysis::kDontKnowId)});
-            }
-            report = analysis::analyzeTrials(trials, options);
-            analysis::addMixedModelComparisons(report, trials, options);
+            report = wiring::analyzeStudy(store, overrides);
             report.source = o.study;
-            countParticipants(report, trials);
+            noteSimulated(o, store, report.simulatedParticipants, report.participants);
         } else if (!o.trials.empty()) {
             auto trials = analysis::readTrialCsv(o.trials);
             if (!o.includeSimulated) {
@@ -254,14 +220,18 @@ int analyze(const AnalyzeOptions& o) {
                 std::erase_if(trials, [](const analysis::TrialRecord& t) { return t.simulated; });
                 if (trials.size() != before)
                     fmt::print(stderr,
-                               "analyze: {} trial(s) of simulated participants left out "
+                               "analyze: {} of simulated participants left out "
                                "(--include-simulated keeps them)\n",
-                               before - trials.size());
+                               counted(before - trials.size(), "trial"));
             }
             report = analysis::analyzeTrials(trials, options);
             analysis::addMixedModelComparisons(report, trials, options);
             report.source = o.trials;
             countParticipants(report, trials);
+            if (report.simulatedParticipants > 0)
+                fmt::print(stderr, "analyze: {}\n",
+                           analysis::markup::simulatedNotice(report.simulatedParticipants,
+                                                             report.participants));
         } else {
             std::vector<analysis::ConfusionMatrix> tables;
             for (std::size_t i = 0; i < o.counts.size(); ++i) {
@@ -276,7 +246,7 @@ int analyze(const AnalyzeOptions& o) {
     } catch (const std::runtime_error& e) {
         throw cli::UserError(e.what());
     }
-    report.title = o.title.empty() ? "Underfoot analysis" : o.title;
+    if (o.study.empty()) report.title = o.title.empty() ? "Underfoot analysis" : o.title;
     const std::string text = analysis::renderReport(report, *format);
     if (o.output.empty() || o.output == "-") {
         fmt::print("{}", text);
@@ -302,15 +272,19 @@ const cli::CommandRegistrar registrar("analyze", [](CLI::App& app, int& exitCode
     cmd->add_option("--presentations", o->presentations,
                     "Presentations per stimulus row of the --counts tables (one value, or one "
                     "per file), to flag rows that do not add up");
-    cmd->add_option("--by", o->by, "Split tables and compare between: group");
+    cmd->add_option("--by", o->by,
+                    "Split tables and compare between: group, or none (default for --study: "
+                    "group when the protocol's design is between participants)");
     cmd->add_option("--format", o->format, "csv (tidy), latex (booktabs), markdown or html")
         ->capture_default_str();
     cmd->add_option("-o,--output", o->output, "Output file (default: standard output)");
-    cmd->add_option("--title", o->title, "Report title");
+    cmd->add_option("--title", o->title,
+                    "Report title (default for --study: the protocol's title)");
     cmd->add_option("--conf-level", o->confLevel, "Confidence level of the intervals")
         ->capture_default_str();
     cmd->add_option("--group-order", o->groupOrder,
-                    "Order of the groups (e.g. none,coherent,incoherent); others follow")
+                    "Order of the groups (e.g. none,coherent,incoherent); others follow "
+                    "(default for --study: the protocol's order)")
         ->delimiter(',');
     cmd->add_option("--answers", o->answers,
                     "Answer-list order of the protocol for --trials (comma-separated ids; "

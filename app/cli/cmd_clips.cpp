@@ -5,6 +5,7 @@
 // checks before it starts. The rendering is app/wiring renderClipFolder, which the console uses.
 #include "app/cli/CommandRegistry.h"
 #include "app/wiring/ClipPlayer.h"
+#include "base/Plural.h"
 #include "engine/io/AudioDevice.h"
 #include "engine/scene/LiveEngine.h"
 #include "experiment/Clips.h"
@@ -92,7 +93,8 @@ int runClips(const ClipsArgs& a) {
     if (a.checkOnly) {
         const auto problems = exp::checkClips(protocol, a.output);
         for (const auto& p : problems) fmt::print("{}\n", p);
-        if (problems.empty()) fmt::print("clips: {} clips ready in {}\n", jobs.size(), a.output);
+        if (problems.empty())
+            fmt::print("clips: {} ready in {}\n", counted(jobs.size(), "clip"), a.output);
         if (problems.empty() && a.live) playClips(a, jobs);
         return problems.empty() ? 0 : 1;
     }
@@ -109,7 +111,8 @@ int runClips(const ClipsArgs& a) {
                    (fs::path(a.output) / r.file).string());
     const double elapsed =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-    fmt::print("clips: {} clips in {} ({:.1f} s); manifest {}\n", records.size(), a.output, elapsed,
+    fmt::print("clips: {} in {} ({:.1f} s); manifest {}\n", counted(records.size(), "clip"),
+               a.output, elapsed,
                (fs::path(a.output) / exp::kClipManifest).lexically_normal().string());
     if (a.live) playClips(a, jobs);
     return 0;

@@ -10,6 +10,7 @@
 // Without --real, recordings come from the cache of scripts/fetch-recordings.sh
 // (--recordings DIR, default $UNDERFOOT_RECORDINGS or build/recordings).
 #include "app/cli/CommandRegistry.h"
+#include "base/Plural.h"
 #include "engine/control/VirtualWalker.h"
 #include "engine/surfaces/Surface.h"
 #include "realism/Compare.h"
@@ -168,9 +169,9 @@ int runOne(const CompareArgs& a) {
     } catch (const std::invalid_argument& e) {
         throw UserError(std::string("compare: ") + e.what());
     }
-    fmt::print("{} vs {} recording(s) ({}), walker {}, {} s, seed {}\n", a.surface, real.size(),
-               c.material.empty() ? "user files" : c.material, a.spec.walker, a.spec.seconds,
-               a.spec.seed);
+    fmt::print("{} vs {} ({}), walker {}, {} s, seed {}\n", a.surface,
+               counted(real.size(), "recording"), c.material.empty() ? "user files" : c.material,
+               a.spec.walker, a.spec.seconds, a.spec.seed);
     if (c.room) fmt::print("{}\n", roomNote(c.room));
     fmt::print("{}", rl::descriptorTableText(c));
     if (!a.output.empty()) {
@@ -574,11 +575,12 @@ void printRefitNested(const CompareArgs& a, const std::vector<rl::Recording>& re
                 "held-out source",
                 out);
     out.line(fmt::format(
-        "{} fits ({} evaluations each at most, contrast 2, margin 0.1, {} thread(s)) in {:.0f} s. "
+        "{} ({} each at most, contrast 2, margin 0.1, {}) in {:.0f} s. "
         "Refitted without each source: {}. A preset of a material the held-out source did not "
         "record, or recorded alone, keeps its shipped (all-source) fit; a preset with a base "
         "inherits its base's refit.",
-        n.jobs.size(), a.evaluations, a.threads, seconds, list));
+        counted(n.jobs.size(), "fit"), counted(a.evaluations, "evaluation"),
+        counted(a.threads, "thread"), seconds, list));
 }
 
 // The default listener and the first one (realism/Listener.h, --classic-listener).

@@ -2,6 +2,7 @@
 // `underfoot export`: the long-format trials CSV (one row per trial), the ratings CSV, the
 // participants and scales tables, and the codebook of a study.
 #include "app/cli/CommandRegistry.h"
+#include "base/Plural.h"
 #include "experiment/Export.h"
 #include "experiment/Store.h"
 
@@ -68,9 +69,10 @@ const underfoot::cli::CommandRegistrar registrar{
                 audio.close();
                 if (!trials || !ratings || !participants || !scales || !codebook || !audio)
                     throw UserError(fmt::format("{}: writing the export failed", o.outDir));
-                fmt::print("wrote {} trial rows, {} rating rows, {} participants, {} scales, {} "
-                           "audio rows and the codebook to {}\n",
-                           rows, ratingRows, participantRows, scaleRows, audioRows, o.outDir);
+                fmt::print("wrote {}, {}, {}, {}, {} and the codebook to {}\n",
+                           counted(rows, "trial row"), counted(ratingRows, "rating row"),
+                           counted(participantRows, "participant"), counted(scaleRows, "scale"),
+                           counted(audioRows, "audio row"), o.outDir);
             } catch (const StoreError& e) {
                 throw UserError(e.what());
             } catch (const std::filesystem::filesystem_error& e) {

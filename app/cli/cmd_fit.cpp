@@ -13,6 +13,7 @@
 // Without --real the recordings of the surface's material come from the cache of
 // scripts/fetch-recordings.sh. The output is a normal preset with a [provenance] table.
 #include "app/cli/CommandRegistry.h"
+#include "base/Plural.h"
 #include "engine/surfaces/Surface.h"
 #include "realism/Fit.h"
 #include "realism/Modal.h"
@@ -153,8 +154,8 @@ int runFit(FitArgs& a) {
     }
     std::ofstream out(a.output);
     if (!out) throw UserError(fmt::format("-o {}: cannot write this file", a.output));
-    out << "# Fitted by `underfoot fit` to " << real.size()
-        << " recording(s); see [provenance] at the end and docs/explanation/realism.md.\n"
+    out << "# Fitted by `underfoot fit` to " << counted(real.size(), "recording")
+        << "; see [provenance] at the end and docs/explanation/realism.md.\n"
         << r.presetText;
     out.close();
     // The result must load as a normal preset.

@@ -7,6 +7,7 @@
 // GRF files are float WAVs whose samples are newtons / full scale (default 1000 N), as read by
 // loadGrfFile (engine/control/GrfFile.h).
 #include "app/cli/CommandRegistry.h"
+#include "base/Plural.h"
 #include "engine/control/CookEnvelope.h"
 #include "engine/control/GrfBank.h"
 #include "engine/control/GrfFile.h"
@@ -129,8 +130,8 @@ int infoCommand(const Options& o) {
         lo.tare = GrfTareMode::Measure; // what `render --grf` and `live --grf` will take off
         const GrfSignal g = loadGrfFile(o.input, lo);
         const std::vector<GrfTare>& tare = g.tare;
-        fmt::print("{}: {} channel(s) at {:.0f} Hz, {:.3f} s\n", o.input, g.channels.size(),
-                   g.sampleRateHz, g.durationSeconds());
+        fmt::print("{}: {} at {:.0f} Hz, {:.3f} s\n", o.input,
+                   counted(g.channels.size(), "channel"), g.sampleRateHz, g.durationSeconds());
         for (std::size_t c = 0; c < g.channels.size(); ++c) {
             const auto& x = g.channels[c];
             const float peak = x.empty() ? 0.0f : *std::max_element(x.begin(), x.end());
@@ -146,9 +147,10 @@ int infoCommand(const Options& o) {
                     on = false;
             }
             fmt::print("  {:<8} peak {:8.1f} N ({:.2f} body weights of {} kg), mean {:7.1f} N, "
-                       "{} contact(s)\n",
+                       "{}\n",
                        g.names[c], peak, peak / (o.massKg * kGravity), o.massKg,
-                       x.empty() ? 0.0 : sum / static_cast<double>(x.size()), contacts);
+                       x.empty() ? 0.0 : sum / static_cast<double>(x.size()),
+                       counted(contacts, "contact"));
             if (c < tare.size()) {
                 const GrfTare& t = tare[c];
                 if (t.subtractedN > 0.0)

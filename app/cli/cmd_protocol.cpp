@@ -4,6 +4,7 @@
 #include "analysis/model/Catalog.h"
 #include "app/cli/CommandRegistry.h"
 #include "app/wiring/StimulusRender.h"
+#include "base/Plural.h"
 #include "experiment/Catalogue.h"
 #include "experiment/Plan.h"
 #include "experiment/Protocol.h"
@@ -133,7 +134,8 @@ const underfoot::cli::CommandRegistrar registrar{
                 p = loadProtocol(file);
             } catch (const ProtocolError& e) {
                 fmt::print(stderr, "{}\n", e.what());
-                fmt::print(stderr, "underfoot: {} problem(s) in {}\n", e.problems().size(), file);
+                fmt::print(stderr, "underfoot: {} in {}\n", counted(e.problems().size(), "problem"),
+                           file);
                 exitCode = 2;
                 return;
             }
@@ -160,8 +162,8 @@ const underfoot::cli::CommandRegistrar registrar{
                 return;
             }
             printSummary(p, seed, n);
-            fmt::print("\nrenders: {} distinct stimulus render(s) made, every stimulus renders\n",
-                       rendered);
+            fmt::print("\nrenders: {} made, every stimulus renders\n",
+                       counted(rendered, "distinct stimulus render"));
             exitCode = 0;
         });
     }};

@@ -5,6 +5,7 @@
 #include "analysis/power/Power.h"
 #include "app/cli/CommandRegistry.h"
 #include "app/cli/PowerSimulators.h"
+#include "base/Plural.h"
 #include "experiment/Catalogue.h"
 #include "experiment/Plan.h"
 #include "experiment/Protocol.h"
@@ -219,7 +220,7 @@ void printCurve(const PowerArgs& a, const underfoot::analysis::PowerCurve& curve
     auto smallest = [&](int n) {
         return n < 0
                    ? fmt::format("none of the simulated sizes reaches {:g} %", 100 * a.target)
-                   : fmt::format("{} participants{}", n,
+                   : fmt::format("{}{}", counted(n, "participant"),
                                  curve.groups > 0 && sizeLabel == "per group" ? " per group" : "");
     };
     fmt::print("\nsmallest {} reaching {:g} % power: classic test {}",
@@ -229,9 +230,11 @@ void printCurve(const PowerArgs& a, const underfoot::analysis::PowerCurve& curve
     if (curve.ordinal) fmt::print("; ordinal model {}", smallest(curve.smallestOrdinal));
     fmt::print("\n");
     if (ordinalFailures > 0)
-        fmt::print("({} clmm fits stopped and count as not significant)\n", ordinalFailures);
-    fmt::print("({:.1f} s on {} thread(s))\n", seconds,
-               a.threads ? a.threads : std::max(1u, std::thread::hardware_concurrency()));
+        fmt::print("({} stopped and {} as not significant)\n", counted(ordinalFailures, "clmm fit"),
+                   ordinalFailures == 1 ? "counts" : "count");
+    fmt::print("({:.1f} s on {})\n", seconds,
+               counted(a.threads ? a.threads : std::max(1u, std::thread::hardware_concurrency()),
+                       "thread"));
 }
 
 /// Rating protocols (no surface question): a within-subject comparison of two levels of a
@@ -665,8 +668,8 @@ int runPower(const PowerArgs& a) {
                     fmt::format("--groups: '{}' is not a group of protocol {}", id, p.id));
         if (groups.size() < 2)
             throw underfoot::cli::UserError(
-                fmt::format("protocol {} has {} group(s) to compare; power needs at least two",
-                            p.id, groups.size()));
+                fmt::format("protocol {} has {} to compare; power needs at least two", p.id,
+                            counted(groups.size(), "group")));
         for (const Group* g : groups) {
             byGroup.push_back(&matrixFor(matrices, p, *g));
             names.push_back(g->id);

@@ -9,6 +9,7 @@
 #include "app/wiring/ClipPlayer.h"
 #include "app/wiring/Players.h"
 #include "app/wiring/SessionRig.h"
+#include "base/Plural.h"
 #include "base/Version.h"
 #include "engine/control/StepCalibration.h"
 #include "engine/control/StepGrfPlayer.h"
@@ -106,12 +107,10 @@ std::unique_ptr<wir::SessionRig> openLiveRig(const Options& o) {
 
 /// While the session is paused by a sensor fault: says why, and resumes when the experimenter
 /// confirms that the sensor is back (refused, with the reason, while it still fails).
-void waitOutSensorFault(Session& session) {
+void waitOutSensorFault(Session& session, const TrialFlow& flow) {
     while (session.paused()) {
-        fmt::print("\nPAUSED — {}\nThe trial will be presented again. Fix the sensor, then press "
-                   "Enter to resume. ",
-                   session.pauseReason());
-        askLine("");
+        fmt::print("\n");
+        askLine(flow.pausePrompt());
         try {
             session.resumeAfterFault();
         } catch (const std::logic_error& e) {
@@ -196,9 +195,8 @@ int runInteractive(const Options& o) {
         clipPlayer = std::make_unique<ClipPlayer>(p, o.clips, play, stop);
     }
     if (!o.live)
-        fmt::print("NO SOUND: this session plays nothing (data entry: the answers are typed in "
-                   "as given; stored with the session). Add --live [--settings FILE] to "
-                   "play the stimuli.\n");
+        fmt::print("{} Add --live [--settings FILE] to play the stimuli.\n",
+                   TrialFlow::noSoundNotice());
     StimulusPlayer& player = clipPlayer ? static_cast<StimulusPlayer&>(*clipPlayer)
                              : rig      ? static_cast<StimulusPlayer&>(*rig->player)
                                         : silent;
@@ -222,13 +220,14 @@ int runInteractive(const Options& o) {
             switch (screen.page) {
             case ParticipantScreen::Page::Briefing:
                 fmt::print("\n{}\n\n{}\n", screen.heading, screen.text);
-                askLine("\nBriefing done? Press Enter to start. ");
+                fmt::print("\n");
+                askLine(flow.continuePrompt());
                 session.finishBriefing();
                 flow.reset();
                 continue;
             case ParticipantScreen::Page::Break:
                 fmt::print("\n{}. {}\n", screen.heading, screen.text);
-                askLine("Press Enter to continue. ");
+                askLine(flow.continuePrompt());
                 session.finishBreak();
                 flow.reset();
                 continue;
@@ -250,7 +249,7 @@ int runInteractive(const Options& o) {
                 askLine(prompt);
                 if (const auto r = flow.start(); !r) {
                     fmt::print("not started: {}\n", r.message);
-                    if (session.paused()) waitOutSensorFault(session);
+                    if (session.paused()) waitOutSensorFault(session, flow);
                     flow.reset();
                     continue;
                 }
@@ -262,7 +261,7 @@ int runInteractive(const Options& o) {
                 if (const auto r = flow.completeLap(); !r) fmt::print("{}\n", r.message);
             }
             if (faulted || session.checkSensors()) {
-                waitOutSensorFault(session);
+                waitOutSensorFault(session, flow);
                 flow.reset();
                 continue; // the same trial again, from the start
             }
@@ -270,13 +269,13 @@ int runInteractive(const Options& o) {
             if (const std::string prompt = flow.commentPrompt(); !prompt.empty())
                 flow.setComment(askLine(prompt));
             if (session.checkSensors()) { // nothing stored: the trial comes again
-                waitOutSensorFault(session);
+                waitOutSensorFault(session, flow);
                 flow.reset();
                 continue;
             }
             if (const auto r = flow.commit(); !r) {
                 fmt::print("not stored: {}\n", r.message);
-                if (session.paused()) waitOutSensorFault(session);
+                if (session.paused()) waitOutSensorFault(session, flow);
                 flow.reset();
                 continue; // the same trial: its questions again
             }
@@ -288,7 +287,7 @@ int runInteractive(const Options& o) {
                    progressText(session.answeredCount(), session.trialCount()));
         return 3;
     }
-    fmt::print("\nsession complete: {} trials answered\n", session.trialCount());
+    fmt::print("\nsession complete: {} answered\n", counted(session.trialCount(), "trial"));
     return 0;
 }
 
@@ -374,9 +373,9 @@ int runSimulation(const Options& o) {
     int real = 0;
     for (const auto& p : store.participants()) real += p.simulated ? 0 : 1;
     if (real > 0)
-        fmt::print("{} real participant(s) left untouched: a simulation answers only for the "
-                   "simulated participants it creates\n",
-                   real);
+        fmt::print("{} left untouched: a simulation answers only for the simulated participants it "
+                   "creates\n",
+                   counted(real, "real participant"));
     const int answers = simulateStudy(store, matrices, o.participants, settings, o.prefix,
                                       [&](const std::string& code, int index) {
                                           if (!o.ack) return;
@@ -385,9 +384,9 @@ int runSimulation(const Options& o) {
                                       });
     int simulated = 0;
     for (const auto& p : store.participants()) simulated += p.simulated ? 1 : 0;
-    fmt::print("simulated: {} answers committed; {} simulated and {} real participants in the "
-               "study\n",
-               answers, simulated, real);
+    fmt::print("simulated: {} committed; {} simulated and {} real {} in the study\n",
+               counted(answers, "answer"), simulated, real,
+               plural(simulated + real, "participant"));
     return 0;
 }
 

@@ -3,6 +3,7 @@
 // inspect a study, its journal and what replay needs for a trial.
 #include "app/cli/CommandRegistry.h"
 #include "app/wiring/StimulusRender.h"
+#include "base/Plural.h"
 #include "base/Version.h"
 #include "experiment/Export.h"
 #include "experiment/Invitations.h"
@@ -117,9 +118,9 @@ const underfoot::cli::CommandRegistrar registrar{
                     simulated += p.simulated ? 1 : 0;
                 }
                 if (simulated > 0)
-                    fmt::print("\n{} simulated participant(s) (`session --simulate`): not people; "
-                               "left out of `analyze` unless --include-simulated\n",
-                               simulated);
+                    fmt::print("\n{} (`session --simulate`): not people; left out of "
+                               "`analyze` unless --include-simulated\n",
+                               counted(simulated, "simulated participant"));
             });
             exitCode = 0;
         });

@@ -2,16 +2,15 @@
 #include "app/gui/ResultsView.h"
 #include "app/gui/QtText.h"
 
-#include "analysis/io/TrialCsv.h"
 #include "analysis/ratings/RatingAnalysis.h"
 #include "analysis/report/Export.h"
-#include "analysis/report/MixedModelReport.h"
 #include "app/gui/AudioOutput.h"
 #include "app/gui/Figures.h"
 #include "app/gui/HeatMap.h"
 #include "app/gui/RatingsPlot.h"
 #include "app/gui/Replay.h"
 #include "app/gui/StudyContext.h"
+#include "app/wiring/StudyAnalysis.h"
 #include "engine/control/GrfFile.h"
 #include "experiment/Export.h"
 #ifdef UNDERFOOT_HAVE_WIRING
@@ -41,7 +40,6 @@
 
 #include <cmath>
 #include <fstream>
-#include <sstream>
 
 namespace underfoot::gui {
 
@@ -63,45 +61,25 @@ QString pval(double p) {
 }
 } // namespace
 
+namespace {
+/// The console shows every participant, the simulated ones too (the Study view marks them, the
+/// report's banner counts them); otherwise the study is analysed as `underfoot analyze
+/// --study --include-simulated` does.
+wiring::StudyAnalysisOverrides consoleOverrides() {
+    wiring::StudyAnalysisOverrides o;
+    o.includeSimulated = true;
+    return o;
+}
+} // namespace
+
 an::AnalysisReport analyzeStudy(const exp::StudyStore& store) {
-    std::ostringstream csv;
-    exp::writeTrialsCsv(store, csv);
-    const auto trials = an::parseTrialCsv(csv.str(), store.path());
-    an::AnalysisOptions options;
-    const auto& p = store.protocol();
-    options.byGroup = p.design == exp::DesignKind::Between;
-    for (const auto& g : p.groups) options.groupOrder.push_back(g.id);
-    if (p.questions.asksSurface()) {
-        options.answers.options.clear();
-        for (const auto& a : p.questions.surfaceOptions)
-            if (a.id != an::kDontKnowId) options.answers.options.push_back({a.id, a.label});
-        options.answers.options.push_back(
-            {std::string(an::kDontKnowId), an::labelFor(an::kDontKnowId)});
-    }
-    auto report = an::analyzeTrials(trials, options);
-    an::addMixedModelComparisons(report, trials, options); // glmer; lmer and clmm for ratings
-    report.title = p.title;
-    report.source = store.path();
-    return report;
+    return wiring::analyzeStudy(store, consoleOverrides());
 }
 
 an::RatingStudyAnalysis analyzeRatingStudy(const exp::StudyStore& store) {
-    const exp::Protocol& p = store.protocol();
-    an::RatingData data;
-    data.title = p.title;
-    for (const auto& sc : p.questions.scales)
-        data.scales.push_back(
-            {sc.id, sc.prompt, static_cast<double>(sc.min), static_cast<double>(sc.max), {}});
-    for (const auto& st : p.stimuli) data.stimulusOrder.push_back(st.id);
-    for (const auto& person : store.participants())
-        for (const auto& t : store.trials(person.code)) {
-            if (!t.answered || t.excluded || t.practice) continue;
-            for (const auto& [scale, value] : t.answer.ratings)
-                data.ratings.push_back(
-                    {person.code, t.stimulus.id, t.stimulus.factors, scale, double(value)});
-        }
-    if (data.ratings.empty()) return {};
-    return an::analyzeRatingStudy(data);
+    const auto ratings = wiring::studyRatings(store, consoleOverrides());
+    if (ratings.data.ratings.empty()) return {};
+    return wiring::analyzeRatings(ratings, consoleOverrides());
 }
 
 QString exportStudy(const QString& studyPath, const QString& folder,
@@ -341,7 +319,8 @@ void ResultsView::refresh() {
     double n = 0;
     for (const auto& s : report_.summary) n += s.n;
     status_->setText(
-        tr("%1 answered trials analysed (practice and excluded trials left out)").arg(n));
+        (n == 1 ? tr("1 answered trial analysed") : tr("%1 answered trials analysed").arg(n)) +
+        tr(" (practice and excluded trials left out)"));
     const auto groupLabel = [this](const std::string& id) {
         return groupLabelOf(context_.store().protocol(), id);
     };

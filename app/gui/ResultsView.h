@@ -26,12 +26,13 @@ class HeatMap;
 class RatingsPlot;
 class AudioOutput;
 
-/// The analysis of a study's answered trials (the protocol's answer order; by group for
-/// between-subject designs), as `underfoot analyze --study` computes it.
+/// The analysis of a study's answered trials, simulated participants included, set up by
+/// wiring::analyzeStudy as `underfoot analyze --study --include-simulated` sets it up.
 analysis::AnalysisReport analyzeStudy(const experiment::StudyStore& store);
 
-/// A rating study (no surface question) analysed as `underfoot analyze --form ratings` does,
-/// with the mixed models of every scale; empty without ratings.
+/// A rating study (no surface question) analysed by wiring::analyzeRatings as `underfoot
+/// analyze --study --include-simulated` does, with the mixed models of every scale; empty
+/// without ratings.
 analysis::RatingStudyAnalysis analyzeRatingStudy(const experiment::StudyStore& store);
 
 /// Writes every export of the study at `studyPath` into `folder`; `progress(done, total)` is

@@ -49,6 +49,7 @@ void Surface::loadLayers(const std::string& file, const toml::table& root,
     // Header keys are read by loadSurfaceFromString() for the outermost file.
     for (const char* k : {"id", "name", "category", "description", "gain_db", "reverb"})
         top.allow(k);
+    top.allow("code", "the code of the published tables (two capital letters, e.g. \"BS\")");
     top.allow("base", "the id of another preset whose layers come first (a string)");
     top.allow("provenance", "a free table recording where the values came from (not read)");
     if (const auto* baseNode = root.get("base")) {

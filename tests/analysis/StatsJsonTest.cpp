@@ -231,7 +231,7 @@ TEST(AnalyzeCommand, BadInputIsReportedWithFileAndLine) {
     std::ofstream(dir / "broken.csv", std::ios::binary) << "participant,group\nP1,A\n";
     const auto r = runProgram("analyze --trials '" + (dir / "broken.csv").string() + "'", "");
     EXPECT_EQ(r.exitCode, 2);
-    EXPECT_NE(r.err.find("broken.csv:1: missing required column(s)"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("broken.csv:1: missing required columns"), std::string::npos) << r.err;
     const auto none = runProgram("analyze", "");
     EXPECT_NE(none.exitCode, 0);
     const auto format = runProgram("analyze --counts x.csv --format pdf", "");

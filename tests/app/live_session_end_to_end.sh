@@ -80,7 +80,7 @@ sleep 1
 kill "$(cat sim2.pid)" 2> /dev/null || true
 grep -q "FSR shoes on" fsr.txt
 grep -q "PAUSED — FSR shoes" fsr.txt || { cat fsr.txt; exit 1; }
-grep -q "session complete: 1 trials answered" fsr.txt
+grep -q "session complete: 1 trial answered" fsr.txt
 "$underfoot" export --study fsr.db -o fout > /dev/null
 # The stored trial: answered, one interruption, a sensor log that exists.
 row=$(sed -n 2p fout/audio.csv)

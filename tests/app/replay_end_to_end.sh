@@ -28,7 +28,7 @@ cmp a.wav rendered.wav
 
 # The study store analyses directly, columns in the protocol's answer order.
 "$underfoot" analyze --study walk.db --format markdown 2> left_out.txt > analysis.md
-grep -q "1 simulated participant(s) left out" left_out.txt
+grep -q "1 simulated participant left out" left_out.txt
 "$underfoot" analyze --study walk.db --include-simulated --format markdown > analysis.md
 grep -q "| Stimulus | BS | GL | WD | DK | n |" analysis.md
 

@@ -183,7 +183,8 @@ TEST(TerminalParticipantLines, ExperimenterLinesAreFound) {
     EXPECT_TRUE(group);
 }
 
-// The terminal prints the trial core's prompts and forwards what is typed. With the laps of the
+// The terminal prints the trial core's prompts and control lines (briefing, NO SOUND) and forwards
+// what is typed. With the laps of the
 // protocol changed (1 silent baseline lap and 2 with sound instead of 3 + 3), `underfoot session`
 // asks exactly the lap prompts that the core's TrialFlow gives for that protocol; the lines the
 // protocol refuses (a rating off its scale, a word) are refused with the core's messages and
@@ -211,8 +212,11 @@ TEST(TerminalParticipantLines, LapPromptsAndTypedLinesComeFromTheTrialCore) {
         xp::SilentPlayer silent;
         xp::Session session(store, "P1", silent, {});
         xp::TrialFlow flow(store, session);
+        corePrompts.push_back(flow.continuePrompt()); // the briefing's
+        EXPECT_EQ(flow.pausePrompt(), "");            // no sensor fault
         session.finishBriefing();
         flow.reset();
+        EXPECT_EQ(flow.continuePrompt(), "");
         corePrompts.push_back(flow.startPrompt());
         ASSERT_TRUE(flow.start());
         for (std::string lap; !(lap = flow.lapPrompt()).empty();) {
@@ -229,8 +233,9 @@ TEST(TerminalParticipantLines, LapPromptsAndTypedLinesComeFromTheTrialCore) {
         session.interrupt();
     }
     ASSERT_GE(scales, 1u);
-    ASSERT_EQ(corePrompts.size(), 1u + 3u + scales + 1u); // start, 3 laps, the scales, comment
-    EXPECT_NE(corePrompts[1].find("Lap 1 of 3 (silent baseline)"), std::string::npos);
+    // briefing, start, 3 laps, the scales, comment
+    ASSERT_EQ(corePrompts.size(), 2u + 3u + scales + 1u);
+    EXPECT_NE(corePrompts[2].find("Lap 1 of 3 (silent baseline)"), std::string::npos);
     {
         std::ofstream in(dir / "input.txt");
         in << "\n\n\n\n\n";    // briefing, start, three laps
@@ -252,6 +257,7 @@ TEST(TerminalParticipantLines, LapPromptsAndTypedLinesComeFromTheTrialCore) {
                                             << printed;
         if (found != std::string::npos) from = found + prompt.size();
     }
+    EXPECT_NE(printed.find(xp::TrialFlow::noSoundNotice()), std::string::npos) << printed;
     EXPECT_NE(printed.find(rangeMessage), std::string::npos) << printed;
     EXPECT_NE(printed.find("expected a whole number from 1 to 7"), std::string::npos) << printed;
     const xp::StudyStore store = xp::StudyStore::openForReading(study);

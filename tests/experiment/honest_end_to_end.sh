@@ -24,7 +24,7 @@ for protocol in "$src"/protocols/*.toml; do
   "$underfoot" study register --study "$name.db" --participant P01 "${fields[@]}" > /dev/null
   "$underfoot" session --study "$name.db" --simulate --participants 2 > "$name.sim.txt" \
     2>&1 || { echo "$name: simulation failed"; cat "$name.sim.txt"; exit 1; }
-  grep -q "1 real participant(s) left untouched" "$name.sim.txt"
+  grep -q "1 real participant left untouched" "$name.sim.txt"
   grep -q "2 simulated and 1 real participants" "$name.sim.txt"
   grep -q "named by the protocol" "$name.sim.txt"
   "$underfoot" export --study "$name.db" -o "$name.out" > /dev/null
@@ -47,7 +47,7 @@ tail -n +2 tvcg2011_exp1.out/trials.csv | awk -F, -v t="$t" -v i="$i" '$t != $i 
 set +e
 "$underfoot" analyze --study tvcg2011_exp1.db > real.md 2> real.err
 set -e
-grep -q "2 simulated participant(s) left out" real.err
+grep -q "2 simulated participants left out" real.err
 "$underfoot" analyze --study tvcg2011_exp1.db --include-simulated > all.md
 grep -q "| Stimulus |" all.md
 
