@@ -28,15 +28,15 @@ std::string joinProblems(const std::vector<TomlProblem>& problems) {
     }
     return out;
 }
+} // namespace
 
-bool validId(std::string_view id) {
+bool isValidId(std::string_view id) {
     if (id.empty() || id.size() > 64) return false;
     return std::all_of(id.begin(), id.end(), [](char c) {
         return (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' || c == '-' ||
                (c >= 'A' && c <= 'Z');
     });
 }
-} // namespace
 
 TomlError::TomlError(std::vector<TomlProblem> problems)
     : std::runtime_error(joinProblems(problems)), problems_(std::move(problems)) {}
@@ -178,7 +178,7 @@ std::optional<std::string> TomlReader::string(const toml::table& t, std::string_
 std::optional<std::string> TomlReader::id(const toml::table& t, std::string_view key,
                                           std::string_view context, bool required) {
     auto value = string(t, key, context, required);
-    if (value && !validId(*value)) {
+    if (value && !isValidId(*value)) {
         problem(*t.get(key),
                 fmt::format("'{}' in {} is '{}'; expected an id of letters, digits, '_' or "
                             "'-' (1 to 64 characters)",

@@ -153,6 +153,9 @@ class TomlReader {
     std::vector<TomlProblem> problems_;
 };
 
+/// An id: letters, digits, '_' or '-', 1 to 64 characters (what TomlReader::id accepts).
+bool isValidId(std::string_view id);
+
 /// toml++'s name of a node's type ("string", "integer", "floating-point", ...).
 std::string_view tomlTypeName(const toml::node& node);
 
