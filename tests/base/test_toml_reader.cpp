@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <iterator>
 
 using namespace underfoot::base;
 
@@ -113,4 +114,32 @@ TEST(TomlReader, ThrowModeStopsAtTheFirstAndRootCausesComeFirst) {
     r.problem(*root["b"].node(), "root cause");
     const std::string m = messageOf([&] { r.throwIfProblems(); });
     EXPECT_EQ(m, "t.toml:2:5: root cause\nt.toml:1:5: follows");
+}
+
+// Every reader of TOML goes through base/TomlReader: no other source file of the program calls
+// toml++'s parser or catches its parse_error (each would bring its own message format back).
+TEST(TomlReader, IsTheOnlyCallerOfTheTomlParser) {
+    namespace fs = std::filesystem;
+    const fs::path root = UNDERFOOT_SOURCE_DIR;
+    std::vector<std::string> offenders;
+    std::size_t scanned = 0;
+    for (const char* part : {"base", "engine", "experiment", "analysis", "realism", "soundscapes",
+                             "app", "hardware"}) {
+        if (!fs::exists(root / part)) continue;
+        for (const auto& entry : fs::recursive_directory_iterator(root / part)) {
+            const auto ext = entry.path().extension();
+            if (!entry.is_regular_file() || (ext != ".cpp" && ext != ".h")) continue;
+            const std::string relative = fs::relative(entry.path(), root).generic_string();
+            if (relative == "base/TomlReader.cpp") continue;
+            std::ifstream in(entry.path(), std::ios::binary);
+            const std::string text((std::istreambuf_iterator<char>(in)),
+                                   std::istreambuf_iterator<char>());
+            ++scanned;
+            for (const char* call : {"toml::parse(", "toml::parse_file(", "toml::parse_error"})
+                if (text.find(call) != std::string::npos)
+                    offenders.push_back(relative + ": " + call);
+        }
+    }
+    EXPECT_GT(scanned, 100u); // the tree was found
+    EXPECT_TRUE(offenders.empty()) << ::testing::PrintToString(offenders);
 }
