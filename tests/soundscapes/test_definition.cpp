@@ -174,6 +174,23 @@ TEST(SoundscapeLibrary, ForestIsDenserInNaturalEventsThanThePark) {
     EXPECT_GT(birdRate(loadSoundscape("forest")), 3 * birdRate(loadSoundscape("park_fall")));
 }
 
+TEST(Coherence, UnknownKeysAndWrongTypesNameTheirPlace) {
+    auto errorOf = [](const std::string& text) {
+        try {
+            (void)CoherenceTable::parse(text, "c.toml");
+        } catch (const DefinitionError& e) {
+            return std::string(e.what());
+        }
+        return std::string("no error");
+    };
+    EXPECT_EQ(errorOf("[[coherent]]\nsurface = \"wood\"\nsoundscap = \"forest\"\n"),
+              "c.toml:3:1: unknown key 'soundscap' in [[coherent]]; expected one of: soundscape, "
+              "surface (did you mean 'soundscape'?)");
+    EXPECT_EQ(
+        errorOf("[[incoherent]]\nsurface = \"wood\"\nsoundscapes = [3]\n").rfind("c.toml:3:", 0),
+        0u);
+}
+
 TEST(Coherence, AnswersTheCoherentPairsOfTheStudy) {
     const auto& t = CoherenceTable::builtin();
     EXPECT_EQ(t.coherentSoundscapeFor("beach_sand"), "beach_summer");
