@@ -10,6 +10,8 @@
 ///  - the unknown-key check, with the did-you-mean of base/Suggest.h.
 /// Every problem names the file and line:column; a reader either collects them all (a protocol
 /// lists every problem at once, root causes first) or throws at the first.
+#include "base/TomlError.h"
+
 #include <toml++/toml.h>
 
 #include <cstddef>
@@ -23,28 +25,6 @@
 #include <vector>
 
 namespace underfoot::base {
-
-/// One problem in a TOML file.
-struct TomlProblem {
-    std::string file;
-    int line = 0; ///< 0: the file as a whole (no position)
-    int column = 0;
-    std::string message;
-    /// A consequence of an earlier problem (listed after the root causes).
-    bool derived = false;
-    /// "file:line:column: message" ("file: message" without a position).
-    std::string toString() const;
-};
-
-/// Problems of a TOML file; what() lists them, one a line.
-class TomlError : public std::runtime_error {
-  public:
-    explicit TomlError(std::vector<TomlProblem> problems);
-    const std::vector<TomlProblem>& problems() const { return problems_; }
-
-  private:
-    std::vector<TomlProblem> problems_;
-};
 
 /// The largest TOML file read (a protocol or preset is a few kB).
 inline constexpr std::size_t kMaxTomlFileBytes = 4u << 20;

@@ -6,7 +6,7 @@
 /// docs/reference/protocol.md). Loading validates everything against a catalogue of known surface /
 /// soundscape ids and reports every problem found, each with file:line:column and what was
 /// expected.
-#include "base/TomlReader.h"
+#include "base/TomlError.h"
 #include "experiment/Catalogue.h"
 
 #include <cstdint>
