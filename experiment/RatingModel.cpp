@@ -137,7 +137,7 @@ RatingModel parseRatingModel(const std::string& text, const std::string& sourceN
             }
         } else {
             const std::string close = base::closestName(k, {"model", "scales"});
-            r.problem(key.source().begin.line ? key.source() : node.source(),
+            r.problem(node.source(), // the [header]
                       fmt::format("unknown table '{}' in a rating model; expected [model] or "
                                   "[scales.<id>]{}",
                                   k, close.empty() ? "" : " (did you mean '" + close + "'?)"));

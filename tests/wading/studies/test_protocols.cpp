@@ -299,6 +299,10 @@ TEST(WadingProtocols, RatingModelErrorsAreLocatedAndCheckedAgainstTheProtocol) {
                   std::string::npos)
             << text;
         EXPECT_NE(text.find("m.toml:5:1: unknown table 'other'"), std::string::npos) << text;
+        EXPECT_NE(text.find("expected one of: base, effects, fields, noise_sd, participant_sd, "
+                            "stimuli"),
+                  std::string::npos)
+            << text;
     }
     const Protocol p = loadProtocol(shippedProtocol("wading_listening.toml"));
     const RatingModel m =
