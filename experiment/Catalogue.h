@@ -3,6 +3,7 @@
 /// The ids a protocol may name: surfaces and soundscapes. The experiment library does not know
 /// the engine; the caller passes the list it knows (the app passes the engine's own list).
 #include "base/AnswerRule.h"
+#include "base/Suggest.h"
 
 #include <optional>
 #include <string>
@@ -36,12 +37,9 @@ struct Catalogue {
 /// preset files), with the labels and codes the analysis uses too.
 const Catalogue& defaultCatalogue();
 
-/// The candidate closest to `name` by edit distance (insertions, deletions, substitutions;
-/// case-insensitive), or "" when none is within half the name's length: the "did you mean"
-/// of messages about unknown ids.
-std::string closestName(std::string_view name, const std::vector<std::string>& candidates);
-/// "a, b, c (did you mean b?)": the ids sorted, and the closest one to `name` when there is one.
-std::string sortedIdsWithSuggestion(std::string_view name, std::vector<std::string> ids);
+/// The did-you-mean of messages about unknown ids (base/Suggest.h).
+using base::closestName;
+using base::sortedIdsWithSuggestion;
 
 /// The id of the "I don't know" answer option.
 inline constexpr std::string_view kDontKnow = "dont_know";

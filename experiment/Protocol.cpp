@@ -3,6 +3,7 @@
 #include "experiment/ProtocolReader.h"
 
 #include "base/DataDir.h"
+#include "base/TomlReader.h"
 #include "experiment/Random.h"
 
 #include <fmt/format.h>
@@ -133,25 +134,6 @@ const Group* Protocol::group(const std::string& groupId) const {
     return nullptr;
 }
 
-std::string ProtocolProblem::toString() const {
-    if (line > 0) return fmt::format("{}:{}:{}: {}", file, line, column, message);
-    return fmt::format("{}: {}", file, message);
-}
-
-namespace {
-std::string joinProblems(const std::vector<ProtocolProblem>& problems) {
-    std::string out;
-    for (const auto& p : problems) {
-        if (!out.empty()) out += '\n';
-        out += p.toString();
-    }
-    return out;
-}
-} // namespace
-
-ProtocolError::ProtocolError(std::vector<ProtocolProblem> problems)
-    : std::runtime_error(joinProblems(problems)), problems_(std::move(problems)) {}
-
 std::string sha256Hex(const std::string& text) {
     unsigned char digest[EVP_MAX_MD_SIZE];
     unsigned int length = 0;
@@ -208,10 +190,9 @@ Protocol parseProtocol(const std::string& text, const std::string& sourceName,
     Reader r(sourceName);
     toml::table root;
     try {
-        root = toml::parse(std::string_view(text), std::string_view(sourceName));
-    } catch (const toml::parse_error& e) {
-        r.problem(e.source(), fmt::format("TOML syntax error: {}", e.description()));
-        throw ProtocolError(r.problems());
+        root = base::parseToml(text, sourceName);
+    } catch (const base::TomlError& e) {
+        throw ProtocolError(e.problems());
     }
 
     Protocol p;
@@ -237,28 +218,18 @@ Protocol parseProtocol(const std::string& text, const std::string& sourceName,
     readSettings(x);
     checkDriverKeys(x);
 
-    if (!r.problems().empty()) {
-        auto problems = r.problems();
-        std::stable_sort(problems.begin(), problems.end(),
-                         [](const ProtocolProblem& a, const ProtocolProblem& b) {
-                             // Root causes first, then what follows from them.
-                             return std::tie(a.derived, a.line, a.column) <
-                                    std::tie(b.derived, b.line, b.column);
-                         });
-        throw ProtocolError(std::move(problems));
-    }
+    if (!r.problems().empty()) throw ProtocolError(r.sortedProblems()); // root causes first
     return p;
 }
 
 Protocol loadProtocol(const std::string& path, const Catalogue& catalogue) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in)
-        throw ProtocolError({{path, 0, 0,
-                              "cannot open the file; expected a readable TOML "
-                              "protocol"}});
-    std::ostringstream text;
-    text << in.rdbuf();
-    return parseProtocol(text.str(), path, catalogue);
+    std::string text;
+    try {
+        text = base::readTomlFile(path, "a readable TOML protocol");
+    } catch (const base::TomlError& e) {
+        throw ProtocolError(e.problems());
+    }
+    return parseProtocol(text, path, catalogue);
 }
 
 // ----------------------------------------------------------------------------------------------

@@ -6,6 +6,7 @@
 /// docs/reference/protocol.md). Loading validates everything against a catalogue of known surface /
 /// soundscape ids and reports every problem found, each with file:line:column and what was
 /// expected.
+#include "base/TomlError.h"
 #include "experiment/Catalogue.h"
 
 #include <cstdint>
@@ -194,17 +195,8 @@ struct Timing {
     double breakS = 60.0;
 };
 
-/// One problem found while loading a protocol.
-struct ProtocolProblem {
-    std::string file;
-    int line = 0;
-    int column = 0;
-    std::string message;
-    /// A consequence of an earlier problem (listed after the root causes).
-    bool derived = false;
-    /// "file:line:column: message".
-    std::string toString() const;
-};
+/// One problem found while loading a protocol ("file:line:column: message").
+using ProtocolProblem = base::TomlProblem;
 
 /// A loaded, validated protocol.
 struct Protocol {
@@ -251,14 +243,11 @@ struct Protocol {
     const ParticipantField* participantField(const std::string& fieldId) const;
 };
 
-/// Thrown when a protocol has problems; carries every problem found.
-class ProtocolError : public std::runtime_error {
+/// Thrown when a protocol has problems; carries every problem found (a TOML file's problems,
+/// like every reader's of base/TomlReader.h).
+class ProtocolError : public base::TomlError {
   public:
-    explicit ProtocolError(std::vector<ProtocolProblem> problems);
-    const std::vector<ProtocolProblem>& problems() const { return problems_; }
-
-  private:
-    std::vector<ProtocolProblem> problems_;
+    using base::TomlError::TomlError;
 };
 
 /// Parses and validates protocol text. `sourceName` names the file in messages.

@@ -15,6 +15,29 @@ void ProtocolParse::addStimulus(Stimulus s, const toml::source_region& where) {
     p.stimuli.push_back(std::move(s));
 }
 
+Parameters readParameters(Reader& r, const toml::table& t, std::string_view context) {
+    Parameters out;
+    for (auto&& [key, node] : t) {
+        const std::string name(key.str());
+        if (node.is_boolean())
+            out[name] = node.as_boolean()->get();
+        else if (node.is_string())
+            out[name] = node.as_string()->get();
+        else if (node.is_integer())
+            out[name] = static_cast<double>(node.as_integer()->get());
+        else if (node.is_floating_point()) {
+            const double v = node.as_floating_point()->get();
+            if (!std::isfinite(v))
+                r.problem(node, fmt::format("'{}' in {} is not a finite number", name, context));
+            else
+                out[name] = v;
+        } else
+            r.problem(node, fmt::format("'{}' in {} must be a number, a string or a boolean", name,
+                                        context));
+    }
+    return out;
+}
+
 Input readInput(Reader& r, const toml::table& t, std::string_view context, const Input& fallback) {
     r.checkKeys(t, {"type", "sensor", "walker"}, context);
     Input input = fallback;
@@ -45,7 +68,7 @@ Input readInput(Reader& r, const toml::table& t, std::string_view context, const
                       fmt::format("'sensor' in {} needs type = \"sensor\"", context));
         input.walker.clear();
         if (auto w = r.table(t, "walker", context, false))
-            input.walker = r.parameters(*w, std::string(context) + ".walker");
+            input.walker = readParameters(r, *w, std::string(context) + ".walker");
     }
     return input;
 }
@@ -83,7 +106,7 @@ void readStimulusFields(Reader& r, const toml::table& t, std::string_view contex
     if (auto in = r.table(t, "input", context, false))
         s.input = readInput(r, *in, std::string(context) + ".input", defaultInput);
     if (auto wading = r.table(t, "wading", context, false)) {
-        s.wading = r.parameters(*wading, std::string(context) + ".wading");
+        s.wading = readParameters(r, *wading, std::string(context) + ".wading");
         if (s.surface != "water")
             r.problem(*t.get("wading"),
                       fmt::format("a 'wading' table in {} needs surface = \"water\" (surface is "
@@ -248,7 +271,7 @@ void readFactorial(ProtocolParse& x) {
                         r.problem(t, fmt::format("{} writes wading factors but surface is '{}'; "
                                                  "expected \"water\"",
                                                  context, s.surface));
-                    if (!validId(s.id))
+                    if (!base::isValidId(s.id))
                         r.problem(*t.get("id"), fmt::format("generated stimulus id '{}' is not a "
                                                             "valid id",
                                                             s.id));

@@ -1,6 +1,9 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "experiment/RatingModel.h"
 
+#include "base/Suggest.h"
+#include "base/TomlReader.h"
+
 #include <fmt/format.h>
 #include <toml++/toml.h>
 
@@ -37,41 +40,19 @@ double RatingModel::expected(const std::string& scaleId, const Stimulus& stimulu
 
 namespace {
 
-struct ModelReader {
-    std::string file;
-    std::vector<ProtocolProblem> problems;
+/// The rating model's tables: the shared collecting reader and two nestings of numbers.
+struct ModelReader : base::TomlReader {
+    using base::TomlReader::TomlReader;
 
-    void problem(const toml::source_region& where, std::string message) {
-        problems.push_back({file, static_cast<int>(where.begin.line),
-                            static_cast<int>(where.begin.column), std::move(message)});
-    }
-    std::optional<double> number(const toml::node& node, const std::string& what, double min,
-                                 double max) {
-        double v = 0;
-        if (node.is_integer())
-            v = static_cast<double>(node.as_integer()->get());
-        else if (node.is_floating_point())
-            v = node.as_floating_point()->get();
-        else {
-            problem(node.source(), fmt::format("{} must be a number", what));
-            return std::nullopt;
-        }
-        if (!std::isfinite(v) || v < min || v > max) {
-            problem(node.source(), fmt::format("{} is {}; expected a finite number from {} to {}",
-                                               what, v, min, max));
-            return std::nullopt;
-        }
-        return v;
-    }
     std::map<std::string, double> numbers(const toml::node& node, const std::string& what) {
         std::map<std::string, double> out;
         const toml::table* t = node.as_table();
         if (!t) {
-            problem(node.source(), fmt::format("{} must be a table of numbers", what));
+            problem(node, fmt::format("{} must be a table of numbers", what));
             return out;
         }
         for (auto&& [key, value] : *t)
-            if (auto v = number(value, fmt::format("{}.{}", what, key.str()), -1000, 1000))
+            if (auto v = numberNode(value, fmt::format("{}.{}", what, key.str()), -1000, 1000))
                 out[std::string(key.str())] = *v;
         return out;
     }
@@ -79,7 +60,7 @@ struct ModelReader {
                 std::map<std::string, std::map<std::string, double>>& into) {
         const toml::table* t = node.as_table();
         if (!t) {
-            problem(node.source(), fmt::format("{} must be a table of tables", what));
+            problem(node, fmt::format("{} must be a table of tables", what));
             return;
         }
         for (auto&& [key, value] : *t)
@@ -90,13 +71,12 @@ struct ModelReader {
 } // namespace
 
 RatingModel parseRatingModel(const std::string& text, const std::string& sourceName) {
-    ModelReader r{sourceName, {}};
+    ModelReader r(sourceName);
     toml::table root;
     try {
-        root = toml::parse(std::string_view(text), std::string_view(sourceName));
-    } catch (const toml::parse_error& e) {
-        r.problem(e.source(), fmt::format("TOML syntax error: {}", e.description()));
-        throw ProtocolError(r.problems);
+        root = base::parseToml(text, sourceName);
+    } catch (const base::TomlError& e) {
+        throw ProtocolError(e.problems());
     }
     RatingModel model;
     model.source = sourceName;
@@ -105,54 +85,47 @@ RatingModel parseRatingModel(const std::string& text, const std::string& sourceN
         if (k == "model") {
             const toml::table* t = node.as_table();
             if (!t) {
-                r.problem(node.source(), "[model] must be a table");
+                r.problem(node, "[model] must be a table");
                 continue;
             }
-            for (auto&& [mk, mv] : *t) {
-                if (mk.str() == "replay_probability") {
-                    if (auto v = r.number(mv, "[model].replay_probability", 0, 0.95))
-                        model.replayProbability = *v;
-                } else
-                    r.problem(mv.source(), fmt::format("unknown key '{}' in [model]; expected "
-                                                       "replay_probability",
-                                                       mk.str()));
-            }
+            r.checkKeys(*t, {"replay_probability"}, "[model]");
+            if (const auto* mv = t->get("replay_probability"))
+                if (auto v = r.numberNode(*mv, "[model].replay_probability", 0, 0.95))
+                    model.replayProbability = *v;
         } else if (k == "scales") {
             const toml::table* t = node.as_table();
             if (!t) {
-                r.problem(node.source(), "'scales' must be a table of [scales.<id>] tables");
+                r.problem(node, "'scales' must be a table of [scales.<id>] tables");
                 continue;
             }
             for (auto&& [scaleId, scaleNode] : *t) {
                 const std::string ctx = fmt::format("[scales.{}]", scaleId.str());
                 const toml::table* st = scaleNode.as_table();
                 if (!st) {
-                    r.problem(scaleNode.source(), fmt::format("{} must be a table", ctx));
+                    r.problem(scaleNode, fmt::format("{} must be a table", ctx));
                     continue;
                 }
                 ScaleRatingModel m;
                 bool hasBase = false;
+                r.checkKeys(*st,
+                            {"base", "participant_sd", "noise_sd", "effects", "stimuli", "fields"},
+                            ctx);
                 for (auto&& [sk, sv] : *st) {
                     const std::string name(sk.str());
                     const std::string what = ctx + "." + name;
                     if (name == "base") {
-                        if (auto v = r.number(sv, what, -1000, 1000)) m.base = *v;
+                        if (auto v = r.numberNode(sv, what, -1000, 1000)) m.base = *v;
                         hasBase = true;
                     } else if (name == "participant_sd") {
-                        if (auto v = r.number(sv, what, 0, 100)) m.participantSd = *v;
+                        if (auto v = r.numberNode(sv, what, 0, 100)) m.participantSd = *v;
                     } else if (name == "noise_sd") {
-                        if (auto v = r.number(sv, what, 0, 100)) m.noiseSd = *v;
+                        if (auto v = r.numberNode(sv, what, 0, 100)) m.noiseSd = *v;
                     } else if (name == "effects") {
                         r.nested(sv, what, m.effects);
                     } else if (name == "stimuli") {
                         m.stimulusEffects = r.numbers(sv, what);
                     } else if (name == "fields") {
                         r.nested(sv, what, m.fieldEffects);
-                    } else {
-                        r.problem(sv.source(), fmt::format("unknown key '{}' in {}; expected one "
-                                                           "of: base, participant_sd, noise_sd, "
-                                                           "effects, stimuli, fields",
-                                                           name, ctx));
                     }
                 }
                 if (!hasBase)
@@ -163,33 +136,27 @@ RatingModel parseRatingModel(const std::string& text, const std::string& sourceN
                 model.scales[std::string(scaleId.str())] = std::move(m);
             }
         } else {
-            r.problem(node.source(),
+            const std::string close = base::closestName(k, {"model", "scales"});
+            r.problem(node.source(), // the [header]
                       fmt::format("unknown table '{}' in a rating model; expected [model] or "
-                                  "[scales.<id>]",
-                                  k));
+                                  "[scales.<id>]{}",
+                                  k, close.empty() ? "" : " (did you mean '" + close + "'?)"));
         }
     }
-    if (model.scales.empty() && r.problems.empty())
+    if (model.scales.empty() && r.problems().empty())
         r.problem(root.source(), "the rating model declares no [scales.<id>]");
-    if (!r.problems.empty()) {
-        std::stable_sort(r.problems.begin(), r.problems.end(),
-                         [](const ProtocolProblem& a, const ProtocolProblem& b) {
-                             return std::tie(a.line, a.column) < std::tie(b.line, b.column);
-                         });
-        throw ProtocolError(r.problems);
-    }
+    if (!r.problems().empty()) throw ProtocolError(r.sortedProblems());
     return model;
 }
 
 RatingModel loadRatingModel(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in)
-        throw ProtocolError({{path, 0, 0,
-                              "cannot open the file; expected a readable TOML rating "
-                              "model"}});
-    std::ostringstream text;
-    text << in.rdbuf();
-    return parseRatingModel(text.str(), path);
+    std::string text;
+    try {
+        text = base::readTomlFile(path, "a readable TOML rating model");
+    } catch (const base::TomlError& e) {
+        throw ProtocolError(e.problems());
+    }
+    return parseRatingModel(text, path);
 }
 
 std::vector<std::string> checkRatingModel(const RatingModel& model, const Protocol& protocol) {

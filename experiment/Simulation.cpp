@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "experiment/Simulation.h"
+#include "base/TomlReader.h"
 #include "base/Version.h"
 #include "experiment/Clips.h"
 
@@ -547,12 +548,13 @@ std::optional<SimulatedWalker> parseSimulatedWalker(const std::string& reference
     if (reference.rfind(kSimulatedWalkerTablePrefix, 0) != 0) return std::nullopt;
     toml::table doc;
     try {
-        doc = toml::parse("walker = " + reference.substr(kSimulatedWalkerTablePrefix.size()));
-    } catch (const toml::parse_error& e) {
+        doc = base::parseToml("walker = " + reference.substr(kSimulatedWalkerTablePrefix.size()),
+                              "stored control stream");
+    } catch (const base::TomlError& e) {
         throw std::invalid_argument(fmt::format(
             "stored control stream '{}': expected {}{{ seconds = S, cadence = ..., mass = ..., "
             "shoe = ..., variability = ... }} ({})",
-            reference, kSimulatedWalkerTablePrefix, e.description()));
+            reference, kSimulatedWalkerTablePrefix, e.problems().front().message));
     }
     const toml::table* t = doc["walker"].as_table();
     if (!t)

@@ -1,6 +1,9 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // A stimulus as a TOML table: what each trial stores so that replay needs nothing else.
 #include "experiment/Protocol.h"
+#include "experiment/ProtocolReader.h"
+
+#include "base/TomlReader.h"
 
 #include <fmt/format.h>
 #include <toml++/toml.h>
@@ -24,21 +27,6 @@ toml::table parametersToToml(const Parameters& parameters) {
     return t;
 }
 
-Parameters parametersFromToml(const toml::table* t) {
-    Parameters out;
-    if (!t) return out;
-    for (auto&& [key, node] : *t) {
-        if (node.is_boolean())
-            out[std::string(key.str())] = node.as_boolean()->get();
-        else if (node.is_floating_point())
-            out[std::string(key.str())] = node.as_floating_point()->get();
-        else if (node.is_integer())
-            out[std::string(key.str())] = static_cast<double>(node.as_integer()->get());
-        else if (node.is_string())
-            out[std::string(key.str())] = node.as_string()->get();
-    }
-    return out;
-}
 } // namespace
 
 std::string stimulusToToml(const Stimulus& s) {
@@ -70,37 +58,47 @@ std::string stimulusToToml(const Stimulus& s) {
 }
 
 Stimulus stimulusFromToml(const std::string& text) {
-    toml::table t;
-    try {
-        t = toml::parse(text, std::string_view("stored stimulus"));
-    } catch (const toml::parse_error& e) {
-        throw std::runtime_error(fmt::format("stored stimulus: {}", e.description()));
-    }
+    // Written by stimulusToToml(); read back with the protocol's checks, stopping at the first
+    // problem (a stored row is not edited by hand).
+    static constexpr std::string_view kSource = "stored stimulus";
+    const toml::table t = base::parseToml(text, kSource);
+    protocol_detail::Reader r{std::string(kSource), base::TomlReader::Mode::Throw};
+    r.checkKeys(t,
+                {"id", "label", "surface", "soundscape", "modalities", "reverb", "input", "wading",
+                 "practice_only", "clip", "factors"},
+                kSource);
     Stimulus s;
-    s.id = t["id"].value_or(std::string{});
-    s.label = t["label"].value_or(std::string{});
-    s.surface = t["surface"].value_or(std::string{});
-    if (auto v = t["soundscape"].value<std::string>()) s.soundscape = *v;
-    const std::string m = t["modalities"].value_or(std::string("audio"));
-    s.modalities = m == "haptic" ? Modalities::Haptic
-                   : m == "both" ? Modalities::AudioHaptic
-                                 : Modalities::Audio;
-    if (auto v = t["reverb"].value<std::string>()) s.reverb = *v;
-    const std::string kind = t["input"]["type"].value_or(std::string("sensor"));
-    s.input.kind = kind == "walker" ? InputKind::Walker : InputKind::Sensor;
-    const std::string sensor = t["input"]["sensor"].value_or(std::string("none"));
-    s.input.sensor = sensor == "microphones" ? SensorKind::Microphones
-                     : sensor == "fsr"       ? SensorKind::Fsr
-                     : sensor == "gyro"      ? SensorKind::Gyro
-                                             : SensorKind::None;
-    s.input.walker = parametersFromToml(t["input"]["walker"].as_table());
-    s.wading = parametersFromToml(t["wading"].as_table());
-    s.practiceOnly = t["practice_only"].value_or(false);
-    if (auto v = t["clip"].value<std::string>()) s.clip = *v;
-    if (const toml::table* f = t["factors"].as_table())
-        for (auto&& [k, v] : *f) s.factors[std::string(k.str())] = v.value_or(std::string{});
+    s.id = r.string(t, "id", kSource, true).value_or("");
+    s.label = r.string(t, "label", kSource, false).value_or("");
+    s.surface = r.string(t, "surface", kSource, true).value_or("");
+    s.soundscape = r.string(t, "soundscape", kSource, false);
+    s.modalities = r.choice(t, "modalities", kSource, protocol_detail::kModalityNames)
+                       .value_or(Modalities::Audio);
+    s.reverb = r.string(t, "reverb", kSource, false);
+    if (const toml::table* input = r.table(t, "input", kSource, false)) {
+        r.checkKeys(*input, {"type", "sensor", "walker"}, "[input]");
+        s.input.kind =
+            r.choice<InputKind>(*input, "type", "[input]",
+                                {{"sensor", InputKind::Sensor}, {"walker", InputKind::Walker}})
+                .value_or(InputKind::Sensor);
+        s.input.sensor = r.choice<SensorKind>(*input, "sensor", "[input]",
+                                              {{"none", SensorKind::None},
+                                               {"microphones", SensorKind::Microphones},
+                                               {"fsr", SensorKind::Fsr},
+                                               {"gyro", SensorKind::Gyro}})
+                             .value_or(SensorKind::None);
+        if (const toml::table* w = r.table(*input, "walker", "[input]", false))
+            s.input.walker = protocol_detail::readParameters(r, *w, "[input.walker]");
+    }
+    if (const toml::table* w = r.table(t, "wading", kSource, false))
+        s.wading = protocol_detail::readParameters(r, *w, "[wading]");
+    s.practiceOnly = r.boolean(t, "practice_only", kSource).value_or(false);
+    s.clip = r.string(t, "clip", kSource, false);
+    if (const toml::table* f = r.table(t, "factors", kSource, false))
+        for (auto&& [k, v] : *f)
+            s.factors[std::string(k.str())] = r.string(*f, k.str(), "[factors]", true).value_or("");
     if (s.id.empty() || s.surface.empty())
-        throw std::runtime_error("stored stimulus: missing id or surface");
+        throw base::TomlError({{std::string(kSource), 0, 0, "empty id or surface"}});
     return s;
 }
 

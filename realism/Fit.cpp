@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "realism/Fit.h"
+#include "base/TomlReader.h"
 #include "base/Version.h"
 
 #include "engine/render/Renderer.h"
@@ -450,12 +451,8 @@ void seedImpactModes(toml::table& root, const std::vector<RecordedMode>& recorde
 }
 
 toml::table parsePreset(const std::string& presetFile) {
-    try {
-        return toml::parse_file(presetFile);
-    } catch (const toml::parse_error& e) {
-        throw std::invalid_argument(
-            fmt::format("{}: not a TOML preset: {}", presetFile, e.description()));
-    }
+    return base::rethrowTomlAs<std::invalid_argument>(
+        [&] { return base::parseTomlFile(presetFile, "a surface preset (TOML)"); });
 }
 
 } // namespace

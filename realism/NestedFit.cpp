@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "realism/NestedFit.h"
 
+#include "base/TomlReader.h"
+
 #include "engine/surfaces/Surface.h"
 
 #include <fmt/core.h>
@@ -52,7 +54,7 @@ fittableSurfaces(const std::vector<Recording>& recordings) {
     for (const auto& info : engine::listSurfaces()) {
         const auto m = materialOfSurface(info.id);
         if (m.empty() || !recorded.count(m)) continue;
-        if (toml::parse_file(info.file).get("base")) continue; // inherits its base's fit
+        if (base::parseTomlFile(info.file).get("base")) continue; // inherits its base's fit
         out.emplace_back(info.id, m);
     }
     return out;

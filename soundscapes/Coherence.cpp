@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "soundscapes/Coherence.h"
 
+#include "base/TomlReader.h"
+
 #include "soundscapes/Definition.h"
 #include "soundscapes/Library.h"
 
@@ -33,23 +35,17 @@ std::string str(const std::string& source, const toml::table& t, const char* key
 }
 void onlyKeys(const std::string& source, const toml::table& t, std::set<std::string> allowed,
               const char* context) {
-    for (const auto& [k, v] : t)
-        if (!allowed.count(std::string(k.str())))
-            fail(source, v,
-                 fmt::format("unknown key '{}' in {} (expected: {})", k.str(), context,
-                             fmt::join(allowed, ", ")));
+    base::rethrowTomlAs<DefinitionError>([&] {
+        base::TomlReader(source, base::TomlReader::Mode::Throw)
+            .checkKeys(t, std::vector<std::string>(allowed.begin(), allowed.end()), context);
+    });
 }
 
 } // namespace
 
 CoherenceTable CoherenceTable::parse(const std::string& text, const std::string& source) {
-    toml::table root;
-    try {
-        root = toml::parse(text, source);
-    } catch (const toml::parse_error& e) {
-        throw DefinitionError(fmt::format("{}:{}:{}: {}", source, e.source().begin.line,
-                                          e.source().begin.column, e.description()));
-    }
+    const toml::table root =
+        base::rethrowTomlAs<DefinitionError>([&] { return base::parseToml(text, source); });
     onlyKeys(source, root, {"coherent", "incoherent"}, "the coherence file");
     CoherenceTable table;
     auto entryFor = [&](const std::string& surface) -> CoherenceEntry& {
@@ -104,13 +100,9 @@ CoherenceTable CoherenceTable::parse(const std::string& text, const std::string&
 }
 
 CoherenceTable CoherenceTable::load(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in)
-        throw DefinitionError(fmt::format(
-            "{}: cannot open the coherence table (expected a readable TOML file)", path));
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return parse(ss.str(), path);
+    return parse(base::rethrowTomlAs<DefinitionError>(
+                     [&] { return base::readTomlFile(path, "a readable TOML coherence table"); }),
+                 path);
 }
 
 const CoherenceTable& CoherenceTable::builtin() {

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "soundscapes/Definition.h"
 
+#include "base/TomlReader.h"
+
 #include <fmt/format.h>
 #include <toml++/toml.h>
 
@@ -29,16 +31,14 @@ class Reader {
         throw DefinitionError(fmt::format("{}: {}", where, what));
     }
 
+    // The unknown-key check and the number checks of the shared reader (base/TomlReader.h),
+    // stopping at the first problem.
     void checkKeys(const toml::table& t, const std::set<std::string>& allowed,
                    const std::string& context) const {
-        for (const auto& [key, value] : t) {
-            if (allowed.count(std::string(key.str())) == 0) {
-                std::string list;
-                for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-                fail(value, fmt::format("unknown key '{}' in {} (expected one of: {})", key.str(),
-                                        context, list));
-            }
-        }
+        base::rethrowTomlAs<DefinitionError>([&] {
+            base::TomlReader(source_, base::TomlReader::Mode::Throw)
+                .checkKeys(t, std::vector<std::string>(allowed.begin(), allowed.end()), context);
+        });
     }
 
     std::string string(const toml::table& t, std::string_view key, const std::string& context,
@@ -53,17 +53,10 @@ class Reader {
     }
 
     double number(const toml::node& n, std::string_view key, double lo, double hi) const {
-        double v = 0;
-        if (n.is_integer())
-            v = static_cast<double>(n.as_integer()->get());
-        else if (n.is_floating_point())
-            v = n.as_floating_point()->get();
-        else
-            fail(n, fmt::format("'{}' must be a number", key));
-        if (!std::isfinite(v)) fail(n, fmt::format("'{}' must be a finite number", key));
-        if (v < lo || v > hi)
-            fail(n, fmt::format("'{}' = {} is out of range (expected {} to {})", key, v, lo, hi));
-        return v;
+        return base::rethrowTomlAs<DefinitionError>([&] {
+            return *base::TomlReader(source_, base::TomlReader::Mode::Throw)
+                        .numberNode(n, fmt::format("'{}'", key), lo, hi);
+        });
     }
     double number(const toml::table& t, std::string_view key, double lo, double hi,
                   double fallback) const {
@@ -203,14 +196,8 @@ LayerDefinition parseLayer(const Reader& r, const toml::node& node, LayerKind ki
 
 SoundscapeDefinition parseSoundscapeDefinition(std::string_view text, const std::string& sourceName,
                                                const std::string& baseDirectory) {
-    toml::table root;
-    try {
-        root = toml::parse(text, sourceName);
-    } catch (const toml::parse_error& e) {
-        const auto& b = e.source().begin;
-        throw DefinitionError(
-            fmt::format("{}:{}:{}: {}", sourceName, b.line, b.column, e.description()));
-    }
+    const toml::table root =
+        base::rethrowTomlAs<DefinitionError>([&] { return base::parseToml(text, sourceName); });
     Reader r(sourceName);
     r.checkKeys(root, {"soundscape", "bed", "event"}, "the file");
 
@@ -257,15 +244,10 @@ SoundscapeDefinition parseSoundscapeDefinition(std::string_view text, const std:
 }
 
 SoundscapeDefinition loadSoundscapeDefinition(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in)
-        throw DefinitionError(fmt::format("{}: cannot open the soundscape definition (expected a "
-                                          "readable TOML file)",
-                                          path));
-    std::stringstream ss;
-    ss << in.rdbuf();
-    const std::string base = std::filesystem::path(path).parent_path().string();
-    SoundscapeDefinition def = parseSoundscapeDefinition(ss.str(), path, base);
+    const std::string text = base::rethrowTomlAs<DefinitionError>(
+        [&] { return base::readTomlFile(path, "a readable TOML soundscape definition"); });
+    const std::string directory = std::filesystem::path(path).parent_path().string();
+    SoundscapeDefinition def = parseSoundscapeDefinition(text, path, directory);
     def.sourcePath = path;
     return def;
 }

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "app/gui/PresetEdit.h"
 
+#include "base/TomlReader.h"
+
 #include <toml++/toml.h>
 
 #include <filesystem>
@@ -21,14 +23,7 @@ struct Flat {
 };
 
 toml::table parse(const std::string& file) {
-    try {
-        return toml::parse_file(file);
-    } catch (const toml::parse_error& e) {
-        std::ostringstream s;
-        s << file << ":" << e.source().begin.line << ":" << e.source().begin.column << ": "
-          << e.description();
-        throw std::runtime_error(s.str());
-    }
+    return base::parseTomlFile(file, "a surface preset (TOML)"); // TomlError: a runtime_error
 }
 
 /// The preset with every base preset's layers copied in front of its own (the engine's order).

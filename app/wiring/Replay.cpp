@@ -3,6 +3,7 @@
 
 #include "app/wiring/Players.h"
 #include "app/wiring/StimulusRender.h"
+#include "base/TomlReader.h"
 #include "engine/control/GrfFile.h"
 #include "engine/render/Renderer.h"
 #include "engine/scene/WadingNode.h"
@@ -93,15 +94,14 @@ ReplayRender replayClip(const ReplayRequest& q, const exp::ReplayInfo& info) {
 LiveMeters parseLiveMeters(const std::string& text, const std::string& file) {
     LiveMeters run;
     try {
-        const toml::table t = toml::parse(text, file);
+        const toml::table t = base::parseToml(text, file);
         if (auto r = t["sample_rate"].value<double>(); r && *r > 0) run.sampleRateHz = *r;
         // as_integer, not value<int64_t>: toml++ casts a float such as 1.8e91 to int64_t
         // unchecked (undefined behaviour; found by fuzz_live_meters).
         if (const auto* b = t["block_size"].as_integer(); b && b->get() > 0 && b->get() <= 65536)
             run.blockSize = static_cast<int>(b->get());
-    } catch (const toml::parse_error& e) {
-        throw ReplayError(fmt::format("{}:{}:{}: {}", file, e.source().begin.line,
-                                      e.source().begin.column, e.description()));
+    } catch (const base::TomlError& e) {
+        throw ReplayError(e.what());
     }
     return run;
 }

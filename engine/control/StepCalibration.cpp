@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "engine/control/StepCalibration.h"
 
+#include "base/TomlReader.h"
+
 #include <fmt/core.h>
 #include <toml++/toml.h>
 
@@ -165,17 +167,14 @@ void saveStepThresholds(const std::string& path, const StepThresholds& t,
 }
 
 StepThresholds loadStepThresholds(const std::string& path) {
-    toml::table root;
-    try {
-        root = toml::parse_file(path);
-    } catch (const toml::parse_error& e) {
-        const auto& b = e.source().begin;
-        if (b.line == 0)
-            throw std::runtime_error(fmt::format("{}: expected a readable step-thresholds file: {}",
-                                                 path, e.description()));
-        throw std::runtime_error(
-            fmt::format("{}:{}:{}: {}", path, b.line, b.column, e.description()));
-    }
+    const toml::table root = base::parseTomlFile(path, "a readable step-thresholds file");
+    // Unknown keys (a typo would silently keep a default) with the shared check.
+    base::TomlReader keys(path, base::TomlReader::Mode::Throw);
+    std::vector<std::string> top = {
+        "format",        "version",        "participant", "frame_rate_hz", "derivative_span_ms",
+        "refractory_ms", "release_hold_ms"};
+    for (std::size_t i = 0; i < kShoeSensorCount; ++i) top.emplace_back(shoeSensorName(i));
+    keys.checkKeys(root, top, "a step-thresholds file");
     auto where = [&](const toml::node* n) {
         if (!n) return path;
         return fmt::format("{}:{}:{}", path, n->source().begin.line, n->source().begin.column);
@@ -213,6 +212,10 @@ StepThresholds loadStepThresholds(const std::string& path) {
             throw std::runtime_error(
                 fmt::format("{}: expected a table [{}] with the sensor's thresholds", path, name));
         const std::string section = "[" + name + "] ";
+        keys.checkKeys(*sensor,
+                       {"rest_level", "peak_level", "onset_derivative_per_s", "contact_level",
+                        "release_level", "reference_derivative_per_s", "measured"},
+                       "[" + name + "]");
         StepSensorThresholds& s = t.sensors[i];
         number(*sensor, "rest_level", section, s.restLevel);
         number(*sensor, "peak_level", section, s.peakLevel);

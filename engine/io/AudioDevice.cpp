@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "engine/io/AudioDevice.h"
 
+#include "base/TomlReader.h"
+
 #include <RtAudio.h>
 #include <fmt/format.h>
 #include <toml++/toml.h>
@@ -16,13 +18,11 @@ namespace underfoot::engine {
 namespace {
 
 std::string where(const std::string& file, const toml::source_region& r) {
-    return fmt::format("{}:{}:{}", file, r.begin.line, r.begin.column);
+    return base::sourcePlace(file, r);
 }
 
 std::string typeName(const toml::node& node) {
-    std::ostringstream os;
-    os << node.type();
-    return os.str();
+    return std::string(base::tomlTypeName(node));
 }
 
 /// An integer from a TOML node (rejects floats with a fraction, strings...).
@@ -62,16 +62,9 @@ int channelAt(const toml::node& node, const std::string& file, const std::string
 
 void rejectUnknownKeys(const toml::table& table, const std::string& file,
                        std::initializer_list<std::string_view> known, const std::string& section) {
-    for (const auto& [key, node] : table) {
-        (void)node;
-        if (std::find(known.begin(), known.end(), key.str()) == known.end()) {
-            std::string list;
-            for (auto k : known) list += fmt::format("{}{}", list.empty() ? "" : ", ", k);
-            throw AudioSettingsError(
-                fmt::format("{}: unknown key `{}` in [{}]; expected one of: {}",
-                            where(file, node.source()), key.str(), section, list));
-        }
-    }
+    base::rethrowTomlAs<AudioSettingsError>([&] {
+        base::TomlReader(file, base::TomlReader::Mode::Throw).checkKeys(table, known, section);
+    });
 }
 
 } // namespace
@@ -147,19 +140,15 @@ void AudioSettings::validate(const std::string& w) const {
 }
 
 AudioSettings parseAudioSettings(const std::string& text, const std::string& file) {
-    toml::table root;
-    try {
-        root = toml::parse(text, file);
-    } catch (const toml::parse_error& e) {
-        throw AudioSettingsError(fmt::format("{}: {}", where(file, e.source()), e.description()));
-    }
+    const toml::table root =
+        base::rethrowTomlAs<AudioSettingsError>([&] { return base::parseToml(text, file); });
     AudioSettings s;
-    rejectUnknownKeys(root, file, {"audio", "channels"}, "top level");
+    rejectUnknownKeys(root, file, {"audio", "channels"}, "the audio settings");
     if (auto* audio = root["audio"].as_table()) {
         rejectUnknownKeys(*audio, file,
                           {"api", "device", "input_device", "sample_rate", "block_size",
                            "crossfade_ms", "client_name", "connect_ports"},
-                          "audio");
+                          "[audio]");
         for (const auto& [key, node] : *audio) {
             const std::string k(key.str());
             if (k == "api") {
@@ -222,7 +211,7 @@ AudioSettings parseAudioSettings(const std::string& text, const std::string& fil
                                              where(file, root["audio"].node()->source())));
     }
     if (auto* ch = root["channels"].as_table()) {
-        rejectUnknownKeys(*ch, file, {"headphones", "microphones", "haptic"}, "channels");
+        rejectUnknownKeys(*ch, file, {"headphones", "microphones", "haptic"}, "[channels]");
         if (auto* node = ch->get("headphones")) {
             auto* arr = node->as_array();
             if (!arr || arr->size() != 2)
@@ -249,7 +238,7 @@ AudioSettings parseAudioSettings(const std::string& text, const std::string& fil
                     fmt::format("{}: `haptic` must be a table ([channels.haptic])",
                                 where(file, node->source())));
             rejectUnknownKeys(*h, file, {"left_heel", "left_toe", "right_heel", "right_toe"},
-                              "channels.haptic");
+                              "[channels.haptic]");
             for (const auto& [key, n] : *h) {
                 const std::string k(key.str());
                 const int c = channelAt(n, file, k);
@@ -266,19 +255,14 @@ AudioSettings parseAudioSettings(const std::string& text, const std::string& fil
 }
 
 AudioSettings loadAudioSettings(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in)
-        throw AudioSettingsError(
-            fmt::format("{}: cannot open the audio settings file (expected a TOML file written by "
-                        "`underfoot devices --save`)",
-                        path));
-    std::stringstream ss;
-    ss << in.rdbuf();
-    const std::string text = ss.str();
+    const std::string text = base::rethrowTomlAs<AudioSettingsError>([&] {
+        return base::readTomlFile(path, "the audio settings (a TOML file written by `underfoot "
+                                        "devices --save`)");
+    });
     AudioSettings settings = parseAudioSettings(text, path);
     // An empty or truncated file is refused rather than silently read as the defaults
     //: the file `underfoot devices --save` writes always has an [audio] table.
-    const toml::table root = toml::parse(text, path);
+    const toml::table root = base::parseToml(text, path); // parsed without error above
     const toml::table* audio = root["audio"].as_table();
     if (!audio || audio->empty())
         throw AudioSettingsError(fmt::format(

@@ -1,17 +1,14 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "engine/surfaces/Preset.h"
 
+#include "base/TomlReader.h"
+
 #include <fmt/core.h>
 
 #include <algorithm>
 #include <cmath>
 
 namespace underfoot::engine {
-
-std::string sourcePlace(const std::string& file, const toml::source_region& where) {
-    if (where.begin.line == 0) return file;
-    return fmt::format("{}:{}:{}", file, where.begin.line, where.begin.column);
-}
 
 namespace {
 thread_local std::vector<KeyInfo>* catalog = nullptr;
@@ -77,10 +74,8 @@ double PresetReader::number(std::string_view key, double defaultValue, double mi
         if (auto v = node->value<double>()) {
             value = *v;
         } else {
-            fail(key,
-                 "expected a number in " + rangeText(min, max, unit) + ", got " +
-                     std::string(
-                         toml::impl::node_type_friendly_names[static_cast<int>(node->type())]));
+            fail(key, "expected a number in " + rangeText(min, max, unit) + ", got " +
+                          std::string(base::tomlTypeName(*node)));
         }
         if (!std::isfinite(value))
             fail(key, "expected a finite number in " + rangeText(min, max, unit) + ", got " +
@@ -207,16 +202,14 @@ void PresetReader::allow(std::string_view key, std::string_view help) {
 }
 
 void PresetReader::finish() const {
-    for (const auto& [key, node] : *table_) {
-        if (std::find(used_.begin(), used_.end(), key.str()) == used_.end()) {
-            const std::string name =
-                path_.empty() ? std::string(key.str()) : path_ + "." + std::string(key.str());
-            std::string known;
-            for (const auto& u : used_) known += (known.empty() ? "" : ", ") + u;
-            throw PresetError(fmt::format("{}: unknown key `{}` (known here: {})",
-                                          sourcePlace(file_, node.source()), name, known));
-        }
-    }
+    // The shared unknown-key check (base/TomlReader.h): position, known keys, did-you-mean.
+    std::vector<std::string> known = used_;
+    std::sort(known.begin(), known.end());
+    known.erase(std::unique(known.begin(), known.end()), known.end());
+    base::rethrowTomlAs<PresetError>([&] {
+        base::TomlReader(file_, base::TomlReader::Mode::Throw)
+            .checkKeys(*table_, known, path_.empty() ? "the preset" : path_);
+    });
 }
 
 } // namespace underfoot::engine

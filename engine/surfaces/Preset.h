@@ -6,6 +6,8 @@
 ///    an unknown key, with a message naming the file, line:column and what was expected;
 ///  - records every parameter it read (ParamInfo), so that the sound palette can show units and
 ///    ranges and the stability suite can sweep each preset's documented ranges.
+#include "base/TomlReader.h"
+
 #include <toml++/toml.h>
 
 #include <optional>
@@ -59,7 +61,7 @@ class KeyCatalog {
 };
 
 /// "file:line:column" for a TOML node (or just the file when it has no source position).
-std::string sourcePlace(const std::string& file, const toml::source_region& where);
+using base::sourcePlace;
 
 class PresetReader {
   public:

@@ -2,6 +2,8 @@
 #include "engine/surfaces/Surface.h"
 
 #include "base/DataDir.h"
+#include "base/Suggest.h"
+#include "base/TomlReader.h"
 #include "engine/dsp/Random.h"
 
 #include <fmt/core.h>
@@ -32,12 +34,8 @@ std::string surfacesDirectory() {
 
 namespace {
 toml::table parseFile(const std::string& file) {
-    if (!fs::exists(file)) throw PresetError(file + ": no such preset file");
-    try {
-        return toml::parse_file(file);
-    } catch (const toml::parse_error& e) {
-        throw PresetError(fmt::format("{}: {}", sourcePlace(file, e.source()), e.description()));
-    }
+    return base::rethrowTomlAs<PresetError>(
+        [&] { return base::parseTomlFile(file, "a surface preset (TOML)"); });
 }
 } // namespace
 
@@ -91,12 +89,8 @@ void Surface::loadLayers(const std::string& file, const toml::table& root,
 
 std::unique_ptr<Surface> loadSurfaceFromString(const std::string& text, const std::string& file,
                                                const AccuracyOptions& options) {
-    toml::table root;
-    try {
-        root = toml::parse(text, std::string_view(file));
-    } catch (const toml::parse_error& e) {
-        throw PresetError(fmt::format("{}: {}", sourcePlace(file, e.source()), e.description()));
-    }
+    const toml::table root =
+        base::rethrowTomlAs<PresetError>([&] { return base::parseToml(text, file); });
     return Surface::fromTable(root, file, options);
 }
 
@@ -152,33 +146,9 @@ std::unique_ptr<Surface> Surface::loadById(const std::string& idOrPath,
         std::vector<std::string> names;
         for (const auto& e : fs::directory_iterator(surfacesDirectory()))
             if (e.path().extension() == ".toml") names.push_back(e.path().stem().string());
-        std::sort(names.begin(), names.end());
-        std::string ids, closest;
-        std::size_t best = std::max<std::size_t>(1, idOrPath.size() / 2) + 1;
-        for (const auto& n : names) {
-            ids += (ids.empty() ? "" : ", ") + n;
-            // Edit distance (two-row Wagner-Fischer); a name containing the id counts as 1.
-            std::vector<std::size_t> prev(n.size() + 1), row(n.size() + 1);
-            for (std::size_t j = 0; j <= n.size(); ++j) prev[j] = j;
-            for (std::size_t i = 1; i <= idOrPath.size(); ++i) {
-                row[0] = i;
-                for (std::size_t j = 1; j <= n.size(); ++j)
-                    row[j] = std::min({prev[j] + 1, row[j - 1] + 1,
-                                       prev[j - 1] + (idOrPath[i - 1] == n[j - 1] ? 0 : 1)});
-                std::swap(row, prev);
-            }
-            std::size_t d = prev[n.size()];
-            if (!idOrPath.empty() && n.find(idOrPath) != std::string::npos)
-                d = std::min<std::size_t>(d, 1);
-            if (d < best) {
-                best = d;
-                closest = n;
-            }
-        }
-        throw PresetError(fmt::format(
-            "unknown surface \"{}\": expected one of {} (or a .toml "
-            "file){}",
-            idOrPath, ids, closest.empty() ? "" : fmt::format("; did you mean \"{}\"?", closest)));
+        throw PresetError(
+            fmt::format("unknown surface \"{}\": expected one of {} (or a .toml file)", idOrPath,
+                        base::sortedIdsWithSuggestion(idOrPath, names)));
     }
     return load(file, options);
 }

@@ -2,6 +2,7 @@
 #include "engine/wading/WadingScene.h"
 
 #include "base/DataDir.h"
+#include "base/TomlReader.h"
 #include "engine/dsp/Denormals.h"
 #include "engine/dsp/ProcessSpec.h"
 #include "engine/io/AudioFile.h"
@@ -32,12 +33,8 @@ std::string wadingPresetDirectory() {
 }
 
 WadingPreset parseWadingPreset(const std::string& text, const std::string& file) {
-    toml::table root;
-    try {
-        root = toml::parse(text, file);
-    } catch (const toml::parse_error& e) {
-        throw PresetError(fmt::format("{}: {}", sourcePlace(file, e.source()), e.description()));
-    }
+    const toml::table root =
+        base::rethrowTomlAs<PresetError>([&] { return base::parseToml(text, file); });
     WadingPreset p;
     p.file = file;
     PresetReader top(file, root, "", &p.params);
@@ -181,10 +178,10 @@ WadingPreset loadWadingPreset(const std::string& nameOrPath) {
                                           file, nameOrPath));
         throw PresetError(file + ": no such wading preset file");
     }
-    std::ifstream in(file, std::ios::binary);
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    return parseWadingPreset(ss.str(), file);
+    return parseWadingPreset(base::rethrowTomlAs<PresetError>([&] {
+                                 return base::readTomlFile(file, "a wading preset (TOML)");
+                             }),
+                             file);
 }
 
 // ---------------------------------------------------------------------------------------------

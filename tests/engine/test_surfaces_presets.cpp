@@ -302,7 +302,10 @@ TEST(SurfacePresets, BrokenPresetsFailWithFileLineColumnAndWhatWasExpected) {
         "expected a number in [10000, 1e+11]");
     expectError(
         "[[layer]]\ntype = \"impact\"\npurpose = \"strikes of the sole\"\nstifness = 1e7\n" + modes,
-        "unknown key `layer[1].stifness`");
+        ":8:1: unknown key 'stifness' in layer[1]; expected one of: ");
+    expectError(
+        "[[layer]]\ntype = \"impact\"\npurpose = \"strikes of the sole\"\nstifness = 1e7\n" + modes,
+        "(did you mean 'stiffness'?)");
     expectError("[[layer]]\ntype = \"impactt\"\npurpose = \"x\"\n", "expected a layer type");
     expectError("[[layer]]\ntype = \"impact\"\npurpose = \"strikes of the sole\"\nalpha = nan\n" +
                     modes,

@@ -85,7 +85,7 @@ grep -q "beach_sand, carpet, concrete" bad.txt
 set +e
 "$underfoot" render --surface gravle --seconds 1 -o x.wav 2> render.txt
 set -e
-grep -q 'did you mean "gravel"' render.txt
+grep -q "did you mean 'gravel'" render.txt
 
 # clips --live refuses with the reason when no sound can be played (here: no settings file).
 printf '[protocol]\nid = "cl"\nversion = 1\ntitle = "c"\n[design]\ntype = "within"\n[input]\ntype = "walker"\n[clips]\nseconds = 0.5\n[[stimuli]]\nid = "GL"\nsurface = "gravel"\n[[questions.scales]]\nid = "realism"\nprompt = "R"\nmin = 1\nmax = 7\n' > cl.toml

@@ -249,6 +249,28 @@ TEST(ExperimentProtocol, StimulusTomlRoundTrip) {
     for (const auto& s : e.stimuli) EXPECT_EQ(stimulusFromToml(stimulusToToml(s)), s) << s.id;
 }
 
+TEST(StoredStimulus, UnknownKeysAndWrongTypesAreRefusedWithTheirPlace) {
+    auto errorOf = [](const std::string& text) {
+        try {
+            (void)stimulusFromToml(text);
+        } catch (const std::runtime_error& e) {
+            return std::string(e.what());
+        }
+        return std::string("no error");
+    };
+    EXPECT_EQ(errorOf("id = \"a\"\nsurface = \"wood\"\nsurfce = \"x\"\n"),
+              "stored stimulus:3:1: unknown key 'surfce' in stored stimulus; expected one of: "
+              "clip, factors, id, input, label, modalities, practice_only, reverb, soundscape, "
+              "surface, wading (did you mean 'surface'?)");
+    EXPECT_EQ(errorOf("id = \"a\"\nsurface = 3\n"),
+              "stored stimulus:2:11: 'surface' in stored stimulus must be a string");
+    EXPECT_EQ(errorOf("id = \"a\"\nsurface = \"wood\"\nmodalities = \"smell\"\n"),
+              "stored stimulus:3:14: 'modalities' in stored stimulus is 'smell'; expected one of: "
+              "audio, haptic, both, audio_haptic");
+    EXPECT_EQ(errorOf("id = \"a\"\nsurface = \"wood\"\n[wading]\ndepth = nan\n"),
+              "stored stimulus:4:9: 'depth' in [wading] is not a finite number");
+}
+
 TEST(ExperimentProtocol, MissingFileIsAProblemNotACrash) {
     EXPECT_THROW(loadProtocol("/nonexistent/protocol.toml"), ProtocolError);
 }

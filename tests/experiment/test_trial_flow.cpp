@@ -56,14 +56,32 @@ std::string screenText(const ParticipantScreen& s) {
     }
     return all;
 }
+/// The study, player, session and flow most tests open with: participant P1 of the mini
+/// protocol, lock rule `lock`, in the briefing.
+class TrialFlowTest : public ::testing::Test {
+  protected:
+    explicit TrialFlowTest(const std::string& lock = "next_trial")
+        : store(makeStudy(dir, lock)), session(store, "P1", player, {}), flow(store, session) {}
+    /// Ends the briefing and starts the draft of the first trial.
+    void briefed() {
+        session.finishBriefing();
+        flow.reset();
+    }
+    TempDir dir;
+    StudyStore store;
+    FakePlayer player;
+    Session session;
+    TrialFlow flow;
+};
+
+/// The same with the lock rule "answer" (an answer is final once committed).
+class TrialFlowAnswerLockTest : public TrialFlowTest {
+  protected:
+    TrialFlowAnswerLockTest() : TrialFlowTest("answer") {}
+};
 } // namespace
 
-TEST(TrialFlow, DraftLettersDigitsValidationAndCommit) {
-    TempDir dir;
-    StudyStore store = makeStudy(dir, "next_trial");
-    FakePlayer player;
-    Session session(store, "P1", player, {});
-    TrialFlow flow(store, session);
+TEST_F(TrialFlowTest, DraftLettersDigitsValidationAndCommit) {
     EXPECT_TRUE(flow.sections().empty()) << "no questions during the briefing";
     EXPECT_EQ(flow.start().refusal, Refusal::NotInTrial);
     session.finishBriefing();
@@ -113,13 +131,8 @@ TEST(TrialFlow, DraftLettersDigitsValidationAndCommit) {
     (void)saved;
 }
 
-TEST(TrialFlow, LockRuleNextTrialAllowsChangeUntilTheNextStimulus) {
-    TempDir dir;
-    StudyStore store = makeStudy(dir, "next_trial");
-    FakePlayer player;
-    Session session(store, "P1", player, {});
-    session.finishBriefing();
-    TrialFlow flow(store, session);
+TEST_F(TrialFlowTest, LockRuleNextTrialAllowsChangeUntilTheNextStimulus) {
+    briefed();
     EXPECT_EQ(flow.revisePrevious().refusal, Refusal::NoPrevious);
     ASSERT_TRUE(flow.start());
     flow.chooseLetter('a');
@@ -143,13 +156,8 @@ TEST(TrialFlow, LockRuleNextTrialAllowsChangeUntilTheNextStimulus) {
     EXPECT_EQ(flow.exclusionTarget(false), session.current().index);
 }
 
-TEST(TrialFlow, LockRuleAnswerRefusesEveryChange) {
-    TempDir dir;
-    StudyStore store = makeStudy(dir, "answer");
-    FakePlayer player;
-    Session session(store, "P1", player, {});
-    session.finishBriefing();
-    TrialFlow flow(store, session);
+TEST_F(TrialFlowAnswerLockTest, LockRuleAnswerRefusesEveryChange) {
+    briefed();
     ASSERT_TRUE(flow.start());
     flow.chooseLetter('a');
     flow.typeDigit(2);
@@ -160,12 +168,7 @@ TEST(TrialFlow, LockRuleAnswerRefusesEveryChange) {
     EXPECT_NE(r.message.find("lock = \"answer\""), std::string::npos) << r.message;
 }
 
-TEST(TrialFlow, ParticipantScreenNeverShowsStimulusOrderOrNotes) {
-    TempDir dir;
-    StudyStore store = makeStudy(dir, "next_trial");
-    FakePlayer player;
-    Session session(store, "P1", player, {});
-    TrialFlow flow(store, session);
+TEST_F(TrialFlowTest, ParticipantScreenNeverShowsStimulusOrderOrNotes) {
     const auto plan = store.trials("P1");
     ParticipantScreen s = flow.participantScreen();
     EXPECT_EQ(s.page, ParticipantScreen::Page::Briefing);
@@ -252,13 +255,8 @@ TEST(TrialFlow, LapsAndClipsOfTheShippedProtocols) {
     }
 }
 
-TEST(TrialFlow, RefusedDoneTellsTheParticipantWhichQuestionsAreOpen) {
-    TempDir dir;
-    StudyStore store = makeStudy(dir, "next_trial");
-    FakePlayer player;
-    Session session(store, "P1", player, {});
-    session.finishBriefing();
-    TrialFlow flow(store, session);
+TEST_F(TrialFlowTest, RefusedDoneTellsTheParticipantWhichQuestionsAreOpen) {
+    briefed();
     ASSERT_TRUE(flow.start());
     EXPECT_TRUE(flow.participantScreen().notice.empty()) << "nothing refused yet";
     flow.chooseLetter('a');
@@ -279,12 +277,7 @@ TEST(TrialFlow, RefusedDoneTellsTheParticipantWhichQuestionsAreOpen) {
     EXPECT_TRUE(flow.participantScreen().notice.empty()) << "a new trial starts clean";
 }
 
-TEST(TrialFlow, ExperimenterPauseHoldsEverythingAndIsJournaled) {
-    TempDir dir;
-    StudyStore store = makeStudy(dir, "next_trial");
-    FakePlayer player;
-    Session session(store, "P1", player, {});
-    TrialFlow flow(store, session);
+TEST_F(TrialFlowTest, ExperimenterPauseHoldsEverythingAndIsJournaled) {
     EXPECT_EQ(flow.pause().refusal, Refusal::NotInTrial) << "only a trial is paused";
     session.finishBriefing();
     flow.reset();
@@ -382,12 +375,7 @@ TEST(TrialFlow, LockRuleCountsTrialsStartedInAnEarlierSession) {
 
 // The text front end's model: the terminal prints these prompts and forwards typed lines, which
 // the flow reads (a letter, a whole number on the scale) and refuses with what was expected.
-TEST(TrialFlow, TextPromptsAndTypedLinesAreTheCores) {
-    TempDir dir;
-    StudyStore store = makeStudy(dir, "next_trial");
-    FakePlayer player;
-    Session session(store, "P1", player, {});
-    TrialFlow flow(store, session);
+TEST_F(TrialFlowTest, TextPromptsAndTypedLinesAreTheCores) {
     EXPECT_EQ(flow.startPrompt(), "") << "no trial during the briefing";
     session.finishBriefing();
     flow.reset();

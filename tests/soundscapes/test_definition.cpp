@@ -80,7 +80,7 @@ TEST(SoundscapeDefinition, ErrorsNameFileLineColumnAndWhatWasExpected) {
               "sea, tractor, traffic, wind)");
     EXPECT_EQ(errorOf(std::string(kHead) + "[[bed]]\nname = \"w\"\ngenerator = \"wind\"\n"
                                            "params = { centre_hz = 99999 }\n"),
-              "test.toml:8:24: 'centre_hz' = 99999 is out of range (expected 80 to 4000)");
+              "test.toml:8:24: 'centre_hz' is 99999; expected a finite number from 80 to 4000");
     EXPECT_EQ(errorOf(std::string(kHead) + "[[bed]]\nname = \"w\"\ngenerator = \"wind\"\n"
                                            "params = { center_hz = 500 }\n"),
               "test.toml:8:24: generator 'wind' has no parameter 'center_hz' (expected one of: "
@@ -90,9 +90,9 @@ TEST(SoundscapeDefinition, ErrorsNameFileLineColumnAndWhatWasExpected) {
               "'mean_interval_s'");
     EXPECT_EQ(errorOf(std::string(kHead) + "[[event]]\nname = \"g\"\ngenerator = \"gull\"\n"
                                            "rate_per_minute = 2\nlevel = 3\n"),
-              "test.toml:9:9: unknown key 'level' in [[event]] (expected one of: enabled, "
+              "test.toml:9:1: unknown key 'level' in [[event]]; expected one of: enabled, "
               "file, files, first_onset_s, gain_db, generator, jitter, level_db, max_voices, "
-              "mean_interval_s, name, pan, params, rate_per_minute)");
+              "mean_interval_s, name, pan, params, rate_per_minute (did you mean 'level_db'?)");
     EXPECT_EQ(errorOf(std::string(kHead) + "[[event]]\nname = \"g\"\ngenerator = \"gull\"\n"
                                            "rate_per_minute = 2\ngain_db = [0, -6]\n"),
               "test.toml:9:11: 'gain_db' must be [min, max] with min <= max");
@@ -113,7 +113,7 @@ TEST(SoundscapeDefinition, ErrorsNameFileLineColumnAndWhatWasExpected) {
     EXPECT_EQ(errorOf("[soundscape\n").rfind("test.toml:1:", 0), 0u) << errorOf("[soundscape\n");
     EXPECT_NE(errorOf(std::string(kHead) + "[[bed]]\nname = \"w\"\ngenerator = \"wind\"\n"
                                            "level_db = nan\n")
-                  .find("test.toml:8:12: 'level_db' must be a finite number"),
+                  .find("test.toml:8:12: 'level_db' is nan; expected a finite number"),
               std::string::npos);
 }
 
@@ -137,7 +137,8 @@ TEST(SoundscapeDefinition, MissingFileIsReportedWithItsPath) {
         loadSoundscapeDefinition("/nonexistent/x.toml");
         FAIL();
     } catch (const DefinitionError& e) {
-        EXPECT_NE(std::string(e.what()).find("/nonexistent/x.toml: cannot open"),
+        EXPECT_NE(std::string(e.what()).find(
+                      "/nonexistent/x.toml: no such file; expected a readable TOML soundscape"),
                   std::string::npos);
     }
 }
@@ -173,6 +174,23 @@ TEST(SoundscapeLibrary, ForestIsDenserInNaturalEventsThanThePark) {
     EXPECT_GT(birdRate(loadSoundscape("forest")), 3 * birdRate(loadSoundscape("park_fall")));
 }
 
+TEST(Coherence, UnknownKeysAndWrongTypesNameTheirPlace) {
+    auto errorOf = [](const std::string& text) {
+        try {
+            (void)CoherenceTable::parse(text, "c.toml");
+        } catch (const DefinitionError& e) {
+            return std::string(e.what());
+        }
+        return std::string("no error");
+    };
+    EXPECT_EQ(errorOf("[[coherent]]\nsurface = \"wood\"\nsoundscap = \"forest\"\n"),
+              "c.toml:3:1: unknown key 'soundscap' in [[coherent]]; expected one of: soundscape, "
+              "surface (did you mean 'soundscape'?)");
+    EXPECT_EQ(
+        errorOf("[[incoherent]]\nsurface = \"wood\"\nsoundscapes = [3]\n").rfind("c.toml:3:", 0),
+        0u);
+}
+
 TEST(Coherence, AnswersTheCoherentPairsOfTheStudy) {
     const auto& t = CoherenceTable::builtin();
     EXPECT_EQ(t.coherentSoundscapeFor("beach_sand"), "beach_summer");
@@ -189,8 +207,8 @@ TEST(Coherence, AnswersTheCoherentPairsOfTheStudy) {
 }
 
 TEST(Coherence, AnswersTheIncoherentPairsOfGroupThree) {
-    // TVCG 2011 experiment 2, group 3: beach sand with forest and ski slope; snow with forest and beach;
-    // forest underbrush with beach and ski slope.
+    // TVCG 2011 experiment 2, group 3: beach sand with forest and ski slope; snow with forest and
+    // beach; forest underbrush with beach and ski slope.
     const auto& t = CoherenceTable::builtin();
     EXPECT_EQ(t.incoherentSoundscapesFor("beach_sand"),
               (std::vector<std::string>{"forest", "ski_slope"}));

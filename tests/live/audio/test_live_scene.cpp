@@ -105,7 +105,10 @@ TEST(AudioSettings, BadFilesNameFileLineColumnAndWhatWasExpected) {
             EXPECT_NE(msg.find(fragment), std::string::npos) << msg;
         }
     };
-    expectError("[audio]\nsample_rate = 48000\nblock = 64\n", ":3:9: unknown key `block`");
+    expectError("[audio]\nsample_rate = 48000\nblock = 64\n",
+                ":3:1: unknown key 'block' in [audio]; expected one of: api, block_size, "
+                "client_name, connect_ports, crossfade_ms, device, input_device, sample_rate (did "
+                "you mean 'block_size'?)");
     expectError("[audio]\nsample_rate = \"fast\"\n", ":2:15: `sample_rate` must be an integer");
     expectError("[audio]\nsample_rate = 1000\n", ":2:15: sample_rate: sample rate 1000 Hz");
     expectError("[audio]\nblock_size = 7\n", "block size 7 frames; expected 16 to 4096");

@@ -270,6 +270,16 @@ TEST(StepCalibration, BadThresholdFilesNameTheFileThePlaceAndWhatWasExpected) {
               std::string::npos)
         << message(missing);
     EXPECT_NE(message((dir / "absent.toml").string()).find("absent.toml"), std::string::npos);
+    // A typo is refused with its place and the nearest key, not read as the default.
+    std::string typo = text;
+    typo.replace(pos, std::string("onset_derivative_per_s").size(), "onset_derivative_per_sec");
+    const auto typoPath = write("typo.toml", typo);
+    EXPECT_NE(message(typoPath).find("unknown key 'onset_derivative_per_sec' in ["),
+              std::string::npos)
+        << message(typoPath);
+    EXPECT_NE(message(typoPath).find("(did you mean 'onset_derivative_per_s'?)"), std::string::npos)
+        << message(typoPath);
+    EXPECT_NE(message(typoPath).find(typoPath + ":"), std::string::npos) << message(typoPath);
 }
 
 TEST(StepGrfPlayer, SameSeedSameGrfsAndNoAllocationOnTheAudioThread) {

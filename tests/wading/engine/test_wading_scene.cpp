@@ -225,8 +225,13 @@ TEST(WadingPresets, ErrorsNameFileLineAndExpectation) {
                   .find("p.toml:3:15: mapping.c1_exponent: expected a number in [0.35, 6], got 9"),
               std::string::npos)
         << message("id = \"x\"\n[mapping]\nc1_exponent = 9\n");
-    EXPECT_NE(message("id = \"x\"\n[flowing]\nlevel_dbb = 1\n").find("level_dbb"),
-              std::string::npos);
+    EXPECT_NE(message("id = \"x\"\n[flowing]\nlevel_dbb = 1\n")
+                  .find("p.toml:3:1: unknown key 'level_dbb' in flowing; expected one of: "),
+              std::string::npos)
+        << message("id = \"x\"\n[flowing]\nlevel_dbb = 1\n");
+    EXPECT_NE(message("id = \"x\"\n[flowing]\nlevel_dbb = 1\n").find("(did you mean 'level_db'?)"),
+              std::string::npos)
+        << message("id = \"x\"\n[flowing]\nlevel_dbb = 1\n");
     EXPECT_NE(message("id = \"x\"\n[mapping]\nsplash_min_db = -10\nsplash_max_db = -20\n")
                   .find("expected splash_max_db above splash_min_db"),
               std::string::npos);

@@ -295,8 +295,14 @@ TEST(WadingProtocols, RatingModelErrorsAreLocatedAndCheckedAgainstTheProtocol) {
         const std::string text = e.what();
         EXPECT_NE(text.find("m.toml:3:12: [scales.depth].noise_sd is -1"), std::string::npos)
             << text;
-        EXPECT_NE(text.find("m.toml:4:10: unknown key 'wobble'"), std::string::npos) << text;
+        EXPECT_NE(text.find("m.toml:4:1: unknown key 'wobble' in [scales.depth]"),
+                  std::string::npos)
+            << text;
         EXPECT_NE(text.find("m.toml:5:1: unknown table 'other'"), std::string::npos) << text;
+        EXPECT_NE(text.find("expected one of: base, effects, fields, noise_sd, participant_sd, "
+                            "stimuli"),
+                  std::string::npos)
+            << text;
     }
     const Protocol p = loadProtocol(shippedProtocol("wading_listening.toml"));
     const RatingModel m =
