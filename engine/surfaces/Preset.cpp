@@ -56,6 +56,7 @@ void PresetReader::fail(std::string_view key, const std::string& message) const 
     const std::string name = path_.empty() ? std::string(key)
                              : key.empty() ? path_
                                            : path_ + "." + std::string(key);
+    if (name.empty()) throw PresetError(fmt::format("{}: {}", sourcePlace(file_, where), message));
     throw PresetError(fmt::format("{}: {}: {}", sourcePlace(file_, where), name, message));
 }
 

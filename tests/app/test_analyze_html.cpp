@@ -179,6 +179,8 @@ TEST(AnalyzeHtml, IdentificationStudyShowsHeatMapsWithCountsAndRowPercentsAndTes
     const auto trials = an::parseTrialCsv(csv.str(), "trials");
     an::AnalysisOptions options;
     options.byGroup = true;
+    // The groups compared in the protocol's order, as `analyze --study` does by default.
+    for (const auto& g : store.protocol().groups) options.groupOrder.push_back(g.id);
     options.answers.options.clear();
     for (const auto& o : store.protocol().questions.surfaceOptions)
         if (o.id != an::kDontKnowId) options.answers.options.push_back({o.id, o.label});
