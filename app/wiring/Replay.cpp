@@ -95,11 +95,13 @@ LiveMeters parseLiveMeters(const std::string& text, const std::string& file) {
     LiveMeters run;
     try {
         const toml::table t = base::parseToml(text, file);
-        if (auto r = t["sample_rate"].value<double>(); r && *r > 0) run.sampleRateHz = *r;
-        // as_integer, not value<int64_t>: toml++ casts a float such as 1.8e91 to int64_t
-        // unchecked (undefined behaviour; found by fuzz_live_meters).
-        if (const auto* b = t["block_size"].as_integer(); b && b->get() > 0 && b->get() <= 65536)
-            run.blockSize = static_cast<int>(b->get());
+        // The rate and block size the replay runs at: a value it cannot use is refused (naming
+        // the file, line and column), never replaced by the replay's defaults. Its other keys
+        // (scene, frames, xruns, loads) are the live run's report, not read here.
+        base::TomlReader reader(file, base::TomlReader::Mode::Throw);
+        run.sampleRateHz = reader.number(t, "sample_rate", "the live meters", 8000.0, 768000.0);
+        if (const auto b = reader.integer(t, "block_size", "the live meters", false, 1, 65536))
+            run.blockSize = static_cast<int>(*b);
     } catch (const base::TomlError& e) {
         throw ReplayError(e.what());
     }

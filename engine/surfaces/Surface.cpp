@@ -106,7 +106,8 @@ std::unique_ptr<Surface> Surface::fromTable(const toml::table& root, const std::
         top.string("name", info.id, {}, "the name shown to the experimenter (default: the id)");
     info.description =
         top.string("description", "", {}, "one line: what it sounds like (required)");
-    if (info.description.empty()) top.fail("", "missing key `description`: one line saying what the surface sounds like");
+    if (info.description.empty())
+        top.fail("", "missing key `description`: one line saying what the surface sounds like");
     const std::string category = top.string("category", "", {"solid", "aggregate", "liquid"},
                                             "the kind of ground (required)");
     if (category.empty())

@@ -266,8 +266,8 @@ TEST(Wiring, WaterStimulusPlaysTheWadingNodeAndRecordsItsGait) {
 }
 
 // The `.meters.toml` side file the replay reads (parseLiveMeters, fuzzed by fuzz_live_meters):
-// what LivePlayer writes gives the live rate and block size; a value out of range is left unset
-// (the replay's defaults); bad syntax is a ReplayError naming the file, line and column.
+// what LivePlayer writes gives the live rate and block size; a value the replay cannot use and
+// bad syntax are a ReplayError naming the file, line and column (never the replay's defaults).
 TEST(Wiring, MetersFileGivesTheLiveRateAndBlockSize) {
     const auto m = wir::parseLiveMeters("# Measured by the live engine\nscene = \"gravel\"\n"
                                         "sample_rate = 44100\nblock_size = 64\nframes = 11200\n",
@@ -275,13 +275,24 @@ TEST(Wiring, MetersFileGivesTheLiveRateAndBlockSize) {
     ASSERT_TRUE(m.sampleRateHz && m.blockSize);
     EXPECT_EQ(*m.sampleRateHz, 44100.0);
     EXPECT_EQ(*m.blockSize, 64);
-    const auto unset = wir::parseLiveMeters("sample_rate = -1\nblock_size = 70000\n", "x");
-    EXPECT_FALSE(unset.sampleRateHz);
-    EXPECT_FALSE(unset.blockSize);
-    // A float block size is not a block size; 1.8e91 was cast to an integer unchecked by toml++
-    // (undefined behaviour; found by fuzz_live_meters, regressions/live_meters/).
-    for (const char* text : {"block_size = 1.8e91\n", "block_size = 64.0\n"})
-        EXPECT_FALSE(wir::parseLiveMeters(text, "x").blockSize) << text;
+    // Out of range, not a number, or a float block size (1.8e91 was once cast to an integer
+    // unchecked by toml++: undefined behaviour found by fuzz_live_meters,
+    // regressions/live_meters/).
+    for (const char* text :
+         {"sample_rate = -1\n", "sample_rate = nan\n", "sample_rate = \"fast\"\n",
+          "block_size = 70000\n", "block_size = 1.8e91\n", "block_size = 64.0\n"}) {
+        try {
+            (void)wir::parseLiveMeters(std::string("scene = \"x\"\n") + text,
+                                       "grf.wav.meters.toml");
+            ADD_FAILURE() << "accepted: " << text;
+        } catch (const wir::ReplayError& e) {
+            EXPECT_NE(std::string(e.what()).find("grf.wav.meters.toml:2:"), std::string::npos)
+                << e.what();
+        }
+    }
+    const auto none = wir::parseLiveMeters("scene = \"gravel\"\n", "x");
+    EXPECT_FALSE(none.sampleRateHz);
+    EXPECT_FALSE(none.blockSize);
     try {
         (void)wir::parseLiveMeters("sample_rate = 48000\nblock_size = [\n", "grf.wav.meters.toml");
         FAIL() << "bad TOML was accepted";
