@@ -329,6 +329,16 @@ std::vector<std::string> sortedGroups(const std::set<std::string>& groups,
 
 AnalysisReport analyzeTrials(std::span<const TrialRecord> trials, const AnalysisOptions& options) {
     AnalysisReport report;
+    {
+        // Who the report covers, and how many of them are simulated (its banner says so).
+        std::set<std::string> everyone, simulated;
+        for (const auto& t : trials) {
+            everyone.insert(t.participant);
+            if (t.simulated) simulated.insert(t.participant);
+        }
+        report.participants = static_cast<int>(everyone.size());
+        report.simulatedParticipants = static_cast<int>(simulated.size());
+    }
     std::set<std::string> groupSet;
     std::size_t entered = 0, practice = 0, excluded = 0, unanswered = 0;
     std::set<std::string> participants;

@@ -159,7 +159,8 @@ ConfusionMatrix buildConfusion(std::span<const TrialRecord> trials, const Answer
 /// Category matrix derived from a confusion matrix.
 CategoryMatrix buildCategoryMatrix(const ConfusionMatrix& confusion);
 
-/// Full analysis of trial records.
+/// Full analysis of trial records (`participants` and `simulatedParticipants` count everyone in
+/// `trials`).
 AnalysisReport analyzeTrials(std::span<const TrialRecord> trials, const AnalysisOptions& options);
 
 /// Analysis of imported count tables (one per group): summaries of proportions and the

@@ -54,19 +54,6 @@ struct AnalyzeOptions {
     bool includeSimulated = false;
 };
 
-/// The participants a report of a trial CSV covers and how many of them are simulated (its
-/// banner); the console hears it too.
-void countParticipants(analysis::AnalysisReport& report,
-                       const std::vector<analysis::TrialRecord>& trials) {
-    std::set<std::string> all, simulated;
-    for (const auto& t : trials) {
-        all.insert(t.participant);
-        if (t.simulated) simulated.insert(t.participant);
-    }
-    report.participants = static_cast<int>(all.size());
-    report.simulatedParticipants = static_cast<int>(simulated.size());
-}
-
 /// Says on standard error who of the study's participants are simulated and whether they are
 /// analysed.
 void noteSimulated(const AnalyzeOptions& o, const experiment::StudyStore& store, int analysed,
@@ -227,7 +214,6 @@ int analyze(const AnalyzeOptions& o) {
             report = analysis::analyzeTrials(trials, options);
             analysis::addMixedModelComparisons(report, trials, options);
             report.source = o.trials;
-            countParticipants(report, trials);
             if (report.simulatedParticipants > 0)
                 fmt::print(stderr, "analyze: {}\n",
                            analysis::markup::simulatedNotice(report.simulatedParticipants,

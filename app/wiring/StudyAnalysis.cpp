@@ -64,13 +64,6 @@ an::AnalysisReport analyzeStudy(const exp::StudyStore& store,
     an::addMixedModelComparisons(report, trials, options);
     report.title = overrides.title.empty() ? store.protocol().title : overrides.title;
     report.source = store.path();
-    std::set<std::string> all, simulated;
-    for (const auto& t : trials) {
-        all.insert(t.participant);
-        if (t.simulated) simulated.insert(t.participant);
-    }
-    report.participants = static_cast<int>(all.size());
-    report.simulatedParticipants = static_cast<int>(simulated.size());
     return report;
 }
 

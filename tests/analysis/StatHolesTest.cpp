@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Statistics beyond the reference studies: fisher.test on r x c tables, cor.test (pearson, kendall) and
-// wilcox.test(conf.int = TRUE), against R 4.2.2 (Debian 12). Every reference value was printed
+// Statistics beyond the reference studies: fisher.test on r x c tables, cor.test (pearson, kendall)
+// and wilcox.test(conf.int = TRUE), against R 4.2.2 (Debian 12). Every reference value was printed
 // by R with sprintf("%.15g", ...) from the call quoted next to it; the R script that printed
 // them all is tests/analysis/data/stat_holes_reference.R.
 #include "analysis/io/StatsJson.h"
@@ -66,7 +66,8 @@ TEST(FisherRxC, MatchesRsNetworkAlgorithmOnStudySizedTables) {
     // R: fisher.test(matrix(c(1,2,3, 3,2,1), 2, byrow=TRUE))$p.value (mirror tables, equal P)
     expectRel(fisherTestRxC({{1, 2, 3}, {3, 2, 1}}).p, 0.766233766233766, 1e-7);
     // Larger problems (R: Job <- matrix(c(1,2,1,0, 3,3,6,1, 10,10,14,9, 6,7,12,11), 4, 4),
-    // fisher.test(Job) = 0.782684938965639, 9e7 tables) take seconds; see docs/reference/statistics.md.
+    // fisher.test(Job) = 0.782684938965639, 9e7 tables) take seconds; see
+    // docs/reference/statistics.md.
     const auto big = fisherTestRxC({{5, 1, 0}, {2, 4, 3}, {0, 2, 6}});
     EXPECT_EQ(big.method, "Fisher's Exact Test for Count Data");
     EXPECT_TRUE(big.estimate.empty());
