@@ -101,11 +101,15 @@ ConfusionMatrix parseConfusionMatrix(const std::string& text, const std::string&
                     continue;
                 }
                 const std::string id = surfaceFor(cells[i], catalogue);
-                if (id.empty())
+                if (id.empty()) {
+                    std::string codes;
+                    for (const auto& e : catalogue.surfaces)
+                        if (!e.code.empty()) codes += (codes.empty() ? "" : ", ") + e.code;
                     throw std::runtime_error(fmt::format(
                         "{}:{}: column {} header '{}' is not a surface code or id (expected one "
-                        "of the codes of data/published/README.md, or DK)",
-                        source, lineNo, i + 1, cells[i]));
+                        "of {}, a surface id, or DK)",
+                        source, lineNo, i + 1, cells[i], codes));
+                }
                 m.answers.push_back(id);
             }
             continue;

@@ -35,7 +35,7 @@ struct ConfusionMatrix {
 };
 
 /// Reads the published CSV format (`stimulus[,soundscape],CODE,...,DK`; codes as in
-/// data/published/README.md; surface ids are accepted too). Throws std::runtime_error naming
+/// protocols/data/README.md; surface ids are accepted too). Throws std::runtime_error naming
 /// file:line and what was expected.
 ConfusionMatrix loadConfusionMatrix(const std::string& path,
                                     const Catalogue& catalogue = defaultCatalogue());

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
-/// Import of published confusion tables (data/published/*_confusion.csv): a `stimulus` column,
+/// Import of published confusion tables (protocols/data/*_confusion.csv): a `stimulus` column,
 /// an optional `soundscape` column, then one column per answer code (BS, GL, ..., DK).
 #include "analysis/tables/Tables.h"
 

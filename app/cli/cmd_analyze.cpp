@@ -253,7 +253,7 @@ const cli::CommandRegistrar registrar("analyze", [](CLI::App& app, int& exitCode
     cmd->add_option("--study", o->study, "A study store (.db): analyse its answered trials");
     cmd->add_option("--trials", o->trials, "Long-format trial CSV written by `underfoot export`");
     cmd->add_option("--counts", o->counts,
-                    "Count table(s) in the format of data/published/*_confusion.csv; one group "
+                    "Count table(s) in the format of protocols/data/*_confusion.csv; one group "
                     "per file");
     cmd->add_option("--presentations", o->presentations,
                     "Presentations per stimulus row of the --counts tables (one value, or one "

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The published count tables (tests/analysis/data/published, copied from shared/data/published)
+// The published count tables (tests/analysis/data/published, transcribed from the papers' tables)
 // import and reproduce their own percentages; rows that do not add up are flagged.
 #include "analysis/io/CountTables.h"
 #include "analysis/io/Csv.h"

@@ -13,7 +13,8 @@ import sys
 
 PATTERNS = [
     (re.compile(r"\b(STUDIES|MODELS|STYLE)\.md\b"), "cites a background note outside the repository"),
-    (re.compile(r"(\.\./shared/|/work/shared)"), "cites a folder outside the repository"),
+    (re.compile(r"(\.\./shared/|/work/shared|\bshared/(data|docs|seeds)\b|(?<![\w/])data/published\b)"),
+     "cites a folder outside the repository"),
     (re.compile(r"\b[Ii]ssue #\d+|\(#\d+\)|\bsee #\d+"), "cites an issue number"),
 ]
 ALLOWED_PREFIXES = ("CHANGELOG.md", "docs/decisions/")
