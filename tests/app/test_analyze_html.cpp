@@ -13,6 +13,7 @@
 #include "analysis/tables/Tables.h"
 #include "experiment/Export.h"
 #include "experiment/Store.h"
+#include "tests/common/ReadFile.h"
 #include "tests/common/ScratchDir.h"
 
 #include <boost/math/distributions/students_t.hpp>
@@ -29,6 +30,8 @@ namespace an = underfoot::analysis;
 namespace xp = underfoot::experiment;
 namespace fs = std::filesystem;
 
+using underfoot::test::readFile;
+
 namespace {
 
 const fs::path kDir = underfoot::test::scratchDir("analyze_html");
@@ -43,13 +46,6 @@ void runUnderfoot(const std::string& args) {
     std::stringstream text;
     text << in.rdbuf();
     ASSERT_EQ(rc, 0) << command << "\n" << text.str();
-}
-
-std::string readFile(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    std::stringstream s;
-    s << in.rdbuf();
-    return s.str();
 }
 
 std::size_t occurrences(const std::string& text, const std::string& what) {

@@ -8,6 +8,7 @@
 #include "app/wiring/StudyAnalysis.h"
 #include "base/Plural.h"
 #include "experiment/Store.h"
+#include "tests/common/ReadFile.h"
 #include "tests/common/ScratchDir.h"
 
 #include <fmt/format.h>
@@ -23,14 +24,9 @@ namespace xp = underfoot::experiment;
 namespace wir = underfoot::wiring;
 namespace fs = std::filesystem;
 
-namespace {
+using underfoot::test::readFile;
 
-std::string readFile(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    std::ostringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
+namespace {
 
 /// Runs the program with `args` (stdout to `out`, stderr to `err`); fails the test on a non-zero
 /// exit.

@@ -8,6 +8,7 @@
 #include "experiment/Protocol.h"
 #include "experiment/Store.h"
 #include "experiment/TrialFlow.h"
+#include "tests/common/ReadFile.h"
 #include "tests/common/ScratchDir.h"
 #include "tests/experiment/support/ParticipantScreens.h"
 
@@ -28,14 +29,9 @@ namespace xt = underfoot::experiment::test;
 namespace wir = underfoot::wiring;
 namespace fs = std::filesystem;
 
-namespace {
+using underfoot::test::readFile;
 
-std::string readFile(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    std::ostringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
+namespace {
 
 /// The protocol's own wording (prompts, option labels, anchors, briefing): what the terminal
 /// prints on every trial alike; removed from a trial's lines to leave what varies.
