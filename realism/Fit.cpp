@@ -278,6 +278,19 @@ std::vector<Knob> knobsFor(const toml::table& root) {
                                                             *v * std::exp2(x)));
                      });
                  }});
+            // The bursts' build-up (0: they start at once, like a tap; up to 0.9 of the decay:
+            // grains rubbing and giving way). An offset, since the preset's own ratio may be 0.
+            k.push_back(
+                {{"noise_attack", "noise bursts' build-up: noise_attack_ratio + k", -0.6, 0.6, 0,
+                  0},
+                 [](toml::table& r, double x, const Ranges& rg) {
+                     eachNoiseLayer(r, [&](toml::table& t, int i) {
+                         const double v = t["noise_attack_ratio"].value<double>().value_or(0);
+                         t.insert_or_assign(
+                             "noise_attack_ratio",
+                             clampTo(rg, fmt::format("layer[{}].noise_attack_ratio", i), v + x));
+                     });
+                 }});
         }
         if (grainLayers > 1)
             k.push_back(

@@ -13,7 +13,9 @@
 ///    rates (events_per_* x 2^k, at most x 2 so that the cost stays bounded), the heel's thud
 ///    (gain_db + k of the onset-only layers, when there is one), crunch cascades (burst_events + k,
 ///    at least 0, on the layers of ongoing events) and their length (burst_ms x 2^k), balance of
-///    the first layer against the others (+-k dB);
+///    the first layer against the others (+-k dB); on layers of noise bursts
+///    (excitation = "noise"): their decay (noise_decay_ms x 2^k), colour (noise_corner_hz and
+///    the tone filters x 2^k) and build-up (noise_attack_ratio + k);
 ///  - bubbles: bubble size (radius_min/max_mm x 2^k), splash noise band (splash_hz x 2^k),
 ///    level (splash_noise_db + k) and length (splash_ms, splash_decay_ms x 2^k), slosh level
 ///    (slosh_db + k).
