@@ -4,7 +4,7 @@
 category: liquids, snows, leaves and underbrush").
 
     underfoot compare --listener --features features.csv
-    python3 tools/research/category_why.py features.csv [--all] [--surface ID ...]
+    python3 tools/research/category_why.py features.csv [--all] [--without SOURCE] [ID ...]
 
 Reads the per-file listener features written by `compare --features` and rebuilds the default
 listener of realism/Listener.cpp exactly (every source, the renders as source "synthetic"
@@ -21,7 +21,9 @@ recordings' pooled median and IQR / 1.349 with the descriptors' floors; one cent
     own category (centred the same way): median and interquartile range, and "<" or ">" when
     the render lies below or above that range; then the heard and the own-category centroid.
 
-Without --all only the renders heard in another category are shown. Pure Python, no numpy.
+Without --all only the renders heard in another category are shown. --without SOURCE is the
+nested listener of `compare --listener`: trained (standardised, centroids) without that source's
+recordings, every source still centred on its own median. Pure Python, no numpy.
 """
 import csv
 import math
@@ -66,6 +68,13 @@ def category_of_render(e):
 
 
 def main(argv):
+    without = None
+    if "--without" in argv:
+        i = argv.index("--without")
+        if i + 1 >= len(argv):
+            sys.exit("--without needs a source name")
+        without = argv[i + 1]
+        argv = argv[:i] + argv[i + 2:]
     args = [a for a in argv[1:] if not a.startswith("--")]
     if not args:
         sys.exit(__doc__)
@@ -74,6 +83,10 @@ def main(argv):
     ex = read(args[0])
     centre_by_source(ex)
     rec = [e for e in ex if e["source"] != "synthetic"]
+    if without is not None:
+        if without not in {e["source"] for e in rec}:
+            sys.exit(f"{args[0]}: no recording of source '{without}'")
+        rec = [e for e in rec if e["source"] != without]
     syn = [e for e in ex if e["source"] == "synthetic"]
     if not rec or not syn:
         sys.exit(f"{args[0]}: needs recordings and renders (source 'synthetic')")

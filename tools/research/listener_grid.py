@@ -8,7 +8,9 @@
 Reads the per-file listener features written by `compare --features` and evaluates, leave-one-
 source-out on the recordings only, a small fixed grid: feature set (all, scalar descriptors
 only, scalars + third-octave bands from 200 Hz), centring (none, each source on its own median,
-each source standardised by its own median and spread) and classifier (one centroid per
+each source standardised by its own median and spread, each source on its own median with the
+sources of one material left out of training: centring puts their one material at the origin)
+and classifier (one centroid per
 material, one per source and material, 3 nearest neighbours). Same scaling as realism/
 Listener.cpp (training set median and IQR / 1.349 with the descriptors' floors).
 
@@ -36,6 +38,8 @@ def spread(v, k):
 def centre(examples, mode):
     if mode == "none":
         return examples
+    if mode == "c-multi":
+        mode = "c"
     out = []
     for s in sorted({e[1] for e in examples}):
         es = [e for e in examples if e[1] == s]
@@ -85,6 +89,11 @@ def loso(examples, feats, mode, method, only=None):
         if only and held != only:
             continue
         train = [e for e in ex if e[1] != held]
+        if mode == "c-multi":
+            mats_of = {}
+            for e in train:
+                mats_of.setdefault(e[1], set()).add(e[2])
+            train = [e for e in train if len(mats_of[e[1]]) > 1]
         m = scaling(train, feats)
         mats = {e[2] for e in train}
         for e in ex:
@@ -106,15 +115,15 @@ def main():
     sets = {"all": list(range(nf)), "scalars": list(range(NS)),
             "scalars+bands>=200Hz": list(range(NS)) +
             [k for k in range(NS, nf) if float(header[3 + k][2:]) >= 200]}
-    grid = [(f, c, m) for f in sets for c in ("none", "centre", "z")
+    grid = [(f, c, m) for f in sets for c in ("none", "centre", "z", "centre-multi")
             for m in ("centroid", "source-centroid", "3-nn")]
     method = {"centroid": "centroid", "source-centroid": "source-centroid", "3-nn": "knn"}
-    mode = {"none": "none", "centre": "c", "z": "z"}
+    mode = {"none": "none", "centre": "c", "z": "z", "centre-multi": "c-multi"}
     print(f"{len(rec)} recordings from {len({e[1] for e in rec})} sources")
-    print(f"{'features':22} {'centring':8} {'classifier':16} material  category")
+    print(f"{'features':22} {'centring':12} {'classifier':16} material  category")
     for f, c, m in grid:
         mc, cc, n = loso(rec, sets[f], mode[c], method[m])
-        print(f"{f:22} {c:8} {m:16} {mc:3}/{n}    {cc:3}/{n}")
+        print(f"{f:22} {c:12} {m:16} {mc:3}/{n}    {cc:3}/{n}")
     tot = [0, 0, 0]
     for held in sorted({e[1] for e in rec}):
         inner = [e for e in rec if e[1] != held]
