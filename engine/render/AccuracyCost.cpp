@@ -414,9 +414,10 @@ const std::vector<std::string>& scenarioIds() {
 
 void configureCreakScenario(ElastoPlasticFriction& f, FrictionParams p) {
     // The creaking-wood friction layer as it was when the cost table was measured
-    // (engine/data/surfaces/creaking_wood.toml before its creak was re-voiced on 28 Nov 2026:
-    // sigma3 0.05, top modes 1130/1870/2650 Hz). A fixed benchmark of the solver: it stays as it
-    // is so that its figures stay comparable with the Sound Design Toolkit's.
+    // (engine/data/surfaces/creaking_wood.toml before its creak was re-voiced,
+    // docs/decisions/realism-revoicing.md: sigma3 0.05, top modes 1130/1870/2650 Hz). A fixed
+    // benchmark of the solver: it stays as it is so that its figures stay comparable with the Sound
+    // Design Toolkit's.
     p.sigma0 = 2e5;
     p.sigma1 = 150.0;
     p.sigma2 = 0.2;

@@ -23,11 +23,11 @@
 /// walker makes more and stronger breaks, but the bed under the sole releases only so much
 /// energy at a time, so the layer's output stays below sqrt(resonances) x cap x gain for any
 /// load. 0 (the default): no bound.
-/// Heel burst (heel_rate_hz > 0; docs/explanation/realism.md "Heel-driven grains and several
-/// starts"): the heel's first impact crushes the most grains. The sole lands at its highest speed
-/// and stops within tens of ms, before the load has built up, so a bed of sand or dirt crushes and
-/// shifts most in the first 20-30 ms of the contact (recorded sand and dirt steps peak there)
-/// whatever the slower load curve does later. When the load first exceeds the contact
+/// Heel burst (heel_rate_hz > 0; docs/decisions/realism-revoicing.md "Heel-driven grains and
+/// several starts"): the heel's first impact crushes the most grains. The sole lands at its highest
+/// speed and stops within tens of ms, before the load has built up, so a bed of sand or dirt
+/// crushes and shifts most in the first 20-30 ms of the contact (recorded sand and dirt steps peak
+/// there) whatever the slower load curve does later. When the load first exceeds the contact
 /// threshold in a step, an envelope starts: e(t) = (t / T) exp(1 - t / T) up to its peak 1 at
 /// T = heel_ms, then exp(-(t - T) / D), D = heel_decay_ms (the crushed bed settling; it ends at
 /// T + 10 D). It adds heel_rate_hz x e(t) events/s whose energy

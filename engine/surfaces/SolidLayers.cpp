@@ -9,7 +9,7 @@
 //    floor's bending under the load, and the contact damping while standing);
 //  - optionally (`heel_graze` > 0) the heel's rear edge touches first, lightly, and the heel lands
 //    flat `heel_graze_lead_s` later: recorded steps on wood rise to their peak over several
-//    milliseconds (docs/explanation/realism.md, "The heel's edge before the heel").
+//    milliseconds (docs/decisions/realism-revoicing.md, "The heel's edge before the heel").
 #include "engine/surfaces/SolidLayers.h"
 
 #include "engine/dsp/Envelope.h"

@@ -271,11 +271,11 @@ TEST(GranularSurfaces, SurfacesAreDistinctByTheNumbers) {
     // impacts (measured 589 vs 1177 events per step).
     EXPECT_LT(at("deep_snow").eventsPerStep, 0.6 * at("gravel").eventsPerStep);
     // Recorded sand steps are lower, sparser and shorter than recorded snow steps (`underfoot
-    // compare` medians: centroid 329 vs 558 Hz, 38 vs 61 grains/s; docs/explanation/realism.md
-    // "Heel-driven grains and several starts"): sand's grains now come from the heel's impact
-    // alone, below deep snow (measured 371 vs 440 Hz, 59 vs 589 events per step, 0.00 vs 0.72
-    // of the step's energy after 0.2 s). Before, sand was the brighter, denser one (1073 vs
-    // 694 Hz, 964 vs 589 events), which the recordings contradict.
+    // compare` medians: centroid 329 vs 558 Hz, 38 vs 61 grains/s;
+    // docs/decisions/realism-revoicing.md "Heel-driven grains and several starts"): sand's grains
+    // now come from the heel's impact alone, below deep snow (measured 371 vs 440 Hz, 59 vs 589
+    // events per step, 0.00 vs 0.72 of the step's energy after 0.2 s). Before, sand was the
+    // brighter, denser one (1073 vs 694 Hz, 964 vs 589 events), which the recordings contradict.
     EXPECT_LT(at("beach_sand").centroidHz, at("deep_snow").centroidHz);
     EXPECT_LT(at("beach_sand").eventsPerStep, 0.5 * at("deep_snow").eventsPerStep);
     EXPECT_LT(at("beach_sand").lateShare + 0.3, at("deep_snow").lateShare);
@@ -286,7 +286,7 @@ TEST(GranularSurfaces, SurfacesAreDistinctByTheNumbers) {
     EXPECT_GT(at("deep_snow").activeFraction, at("gravel").activeFraction + 0.05);
     // Frozen snow is brighter and spikier than deep snow: the heel's cracks of its crust
     // (measured 947 vs 440 Hz, crest 24.7 vs 20.0 dB; 2069 Hz before its re-voicing against the
-    // snow recordings, docs/explanation/realism.md "Frozen snow: a crust that breaks").
+    // snow recordings, docs/decisions/realism-revoicing.md "Frozen snow: a crust that breaks").
     EXPECT_GT(at("frozen_snow").centroidHz, 2.0 * at("deep_snow").centroidHz);
     EXPECT_GT(at("frozen_snow").crestDb, at("deep_snow").crestDb + 1.0);
     // Dirt plus pebbles: mostly low earth (more power below 500 Hz than gravel and sparser).

@@ -1,9 +1,10 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The heel burst of a grains layer (engine/surfaces/GranularLayers.h, docs/explanation/realism.md
-// "Heel-driven grains and several starts"): extra events at the heel's contact whose rate and
-// energy follow e(t) = (t / T) exp(1 - t / T) up to T = heel_ms, then exp(-(t - T) / D); none
-// for a load that appears mid-stance; off (heel_rate_hz = 0) it changes nothing; block-size
-// independent, deterministic, bounded by energy_saturation and amplitude_cap, no allocation.
+// The heel burst of a grains layer (engine/surfaces/GranularLayers.h,
+// docs/decisions/realism-revoicing.md "Heel-driven grains and several starts"): extra events at the
+// heel's contact whose rate and energy follow e(t) = (t / T) exp(1 - t / T) up to T = heel_ms, then
+// exp(-(t - T) / D); none for a load that appears mid-stance; off (heel_rate_hz = 0) it changes
+// nothing; block-size independent, deterministic, bounded by energy_saturation and amplitude_cap,
+// no allocation.
 #include "engine/control/VirtualWalker.h"
 #include "engine/render/Renderer.h"
 #include "engine/surfaces/GranularLayers.h"

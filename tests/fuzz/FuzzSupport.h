@@ -82,7 +82,7 @@ inline std::string writeInput(const std::string& name, const std::uint8_t* data,
 /// Copies a file through the stream buffers, which retry a read or write a signal interrupts.
 /// libFuzzer's -timeout watchdog raises SIGALRM every timeout/2 + 1 s with a handler installed
 /// without SA_RESTART; std::filesystem::copy_file (sendfile) then fails with "Interrupted system
-/// call" now and then (a CI run's fuzz_web_request failed so, 28 Nov 2026). Stops the run with
+/// call" now and then (a CI run's fuzz_web_request failed so). Stops the run with
 /// a finding that names the files when the copy really fails.
 inline void copyFile(const std::string& from, const std::string& to) {
     std::ifstream in(from, std::ios::binary);

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""Why the listener hears a render in another category (docs/explanation/realism.md, "Heard in their
+"""Why the listener hears a render in another category (docs/decisions/realism-revoicing.md, "Heard in their
 category: liquids, snows, leaves and underbrush").
 
     underfoot compare --listener --features features.csv
