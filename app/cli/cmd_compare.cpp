@@ -7,9 +7,12 @@
 //           [--markdown]                    tables as Markdown (docs/explanation/realism.md)
 //           [--refit [--evaluations N] [--threads T]]   nested estimate, presets refitted
 //           [--classic-listener | --onset-listener [--listener-grid]]   other listeners
+//   compare --figures [--seeds 3,7,11] [--markdown] [-o report.html]   per surface and seed:
+//           nested listener, distances, flatness, centroid, cost (cmd_compare_figures.cpp)
 // Without --real, recordings come from the cache of scripts/fetch-recordings.sh
 // (--recordings DIR, default $UNDERFOOT_RECORDINGS or build/recordings).
 #include "app/cli/CommandRegistry.h"
+#include "app/cli/CompareShared.h"
 #include "base/Plural.h"
 #include "engine/control/VirtualWalker.h"
 #include "engine/surfaces/Surface.h"
@@ -17,6 +20,7 @@
 #include "realism/Listener.h"
 #include "realism/NestedFit.h"
 #include "realism/OnsetListener.h"
+#include "realism/SurfaceFigures.h"
 
 #include <fmt/core.h>
 #include <fmt/format.h>
@@ -37,25 +41,6 @@ namespace eng = underfoot::engine;
 namespace rl = underfoot::realism;
 namespace fs = std::filesystem;
 
-struct CompareArgs {
-    std::string surface;
-    std::vector<std::string> real;
-    std::string recordings;
-    bool all = false;
-    bool listener = false;
-    std::string output;
-    std::string features;         ///< --features: CSV of every file's listener features
-    bool classicListener = false; ///< --classic-listener: no centring, bands, one centroid
-    bool onsetListener = false;   ///< --onset-listener: onset features, configuration grid
-    bool listenerGrid = false;    ///< --listener-grid: every configuration's figures
-    bool dryRecordings = false;   ///< --dry-recordings: no room on the recordings
-    bool markdown = false;        ///< --markdown: the listener's tables as Markdown
-    bool refit = false;           ///< --refit: the nested estimate with refitted presets
-    int evaluations = 80;         ///< --evaluations: renders per refit (as fit)
-    int threads = 1;              ///< --threads: refits at once
-    rl::RenderSpec spec;
-};
-
 // One CSV line of listener features (names carry no commas: manifest paths and surface ids).
 std::string featureLine(const rl::Example& e) {
     std::string s =
@@ -75,15 +60,6 @@ std::string roomNote(const std::optional<eng::ReverbSpec>& room) {
                               "dry {:+.1f} dB)",
                               room->impulseResponse, room->wetDb, room->dryDb)
                 : std::string();
-}
-
-std::vector<rl::Recording> manifest(const CompareArgs& a) {
-    const auto dir = a.recordings.empty() ? rl::defaultRecordingsDir() : a.recordings;
-    try {
-        return rl::loadManifest(dir);
-    } catch (const std::runtime_error& e) {
-        throw UserError(e.what());
-    }
 }
 
 std::vector<rl::Recording> ofMaterial(const std::vector<rl::Recording>& all, const std::string& m) {
@@ -254,77 +230,6 @@ int runAll(const CompareArgs& a) {
     return 0;
 }
 
-// A table printed on the terminal (aligned, or Markdown with --markdown, to paste into the
-// docs verbatim) and appended to the HTML report.
-struct Table {
-    std::vector<std::string> head;
-    std::vector<std::vector<std::string>> rows;
-    std::size_t leftFrom = 1000; ///< columns from this one on are text, aligned left
-
-    std::string text(bool markdown) const {
-        std::vector<std::size_t> w(head.size());
-        for (std::size_t c = 0; c < head.size(); ++c) w[c] = head[c].size();
-        for (const auto& r : rows)
-            for (std::size_t c = 0; c < r.size() && c < w.size(); ++c)
-                w[c] = std::max(w[c], r[c].size());
-        auto line = [&](const std::vector<std::string>& cells) {
-            std::string out = markdown ? "|" : "";
-            for (std::size_t c = 0; c < head.size(); ++c) {
-                const auto& v = c < cells.size() ? cells[c] : std::string();
-                const auto cell =
-                    c == 0 ? fmt::format("{:<{}}", v, w[c]) : fmt::format("{:>{}}", v, w[c]);
-                out += markdown ? " " + cell + " |" : (c == 0 ? "" : "  ") + cell;
-            }
-            return out + "\n";
-        };
-        std::string out = line(head);
-        if (markdown) {
-            out += "|";
-            for (std::size_t c = 0; c < head.size(); ++c) {
-                const bool left = c == 0 || c >= leftFrom;
-                out += (left ? " :" : " ") + std::string(w[c] - 1, '-') + (left ? " |" : ": |");
-            }
-            out += "\n";
-        }
-        for (const auto& r : rows) out += line(r);
-        return out;
-    }
-    std::string html() const {
-        std::string out = "<table><tr>";
-        for (const auto& h : head) out += "<th>" + h + "</th>";
-        out += "</tr>\n";
-        for (const auto& r : rows) {
-            out += "<tr>";
-            for (const auto& v : r) out += "<td>" + v + "</td>";
-            out += "</tr>\n";
-        }
-        return out + "</table>\n";
-    }
-};
-
-// The listener's output: lines and tables on the terminal (Markdown with --markdown) and in the
-// HTML body.
-struct Out {
-    bool markdown = false;
-    std::string body;
-    void heading(const std::string& h) {
-        if (markdown)
-            fmt::print("\n#### {}\n\n", h);
-        else
-            fmt::print("\n{}:\n", h);
-        body += "<h2>" + h + "</h2>\n";
-    }
-    void line(const std::string& l) {
-        fmt::print("{}\n{}", l, markdown ? "\n" : "");
-        body += "<p>" + l + "</p>\n";
-    }
-    void table(const Table& t) {
-        fmt::print("{}", t.text(markdown));
-        if (markdown) fmt::print("\n");
-        body += t.html();
-    }
-};
-
 std::string ratio(int ok, int n) {
     return fmt::format("{}/{}", ok, n);
 }
@@ -404,8 +309,7 @@ void printNested(const std::vector<eng::SurfaceInfo>& infos, const std::vector<r
     Table perSource{{"held out", "its recordings: material", "category", "renders: category (all)",
                      "its materials: category", "material"},
                     {}};
-    std::map<std::string, std::array<int, 3>> perSurface; // id -> (sources, cat ok, mat ok)
-    int totals[4] = {0, 0, 0, 0};                         // cat all, n all, own n, own cat
+    int totals[4] = {0, 0, 0, 0}; // cat all, n all, own n, own cat
     int totalMat = 0;
     for (const auto& [src, h] : heard) {
         int catAll = 0, n = 0, catOwn = 0, matOwn = 0;
@@ -418,10 +322,6 @@ void printNested(const std::vector<eng::SurfaceInfo>& infos, const std::vector<r
             ++n;
             catOwn += catOk;
             matOwn += h[i] == mat;
-            auto& ps = perSurface[infos[i].id];
-            ++ps[0];
-            ps[1] += catOk;
-            ps[2] += h[i] == mat;
         }
         totals[0] += catAll;
         totals[1] += int(infos.size());
@@ -443,15 +343,19 @@ void printNested(const std::vector<eng::SurfaceInfo>& infos, const std::vector<r
     out.table(perSource);
     Table perSurf{
         {"surface", "sources", "category", "material", "heard without each source"}, {}, 4};
-    for (std::size_t i = 0; i < infos.size(); ++i) {
+    std::vector<rl::SurfaceUnderTest> surfaces;
+    for (const auto& info : infos)
+        surfaces.push_back(
+            {info.id, rl::materialOfSurface(info.id), std::string(eng::toString(info.category))});
+    std::vector<rl::SurfaceFigures> scored(infos.size());
+    rl::scoreNested(surfaces, heard, recorded, scored);
+    for (const auto& f : scored) {
         std::string list;
-        for (const auto& [src, h] : heard)
-            list += fmt::format("{}{}:{}", list.empty() ? "" : " ", src, h[i]);
-        const auto it = perSurface.find(infos[i].id);
-        const std::array<int, 3> ps =
-            it == perSurface.end() ? std::array<int, 3>{0, 0, 0} : it->second;
-        perSurf.rows.push_back(
-            {infos[i].id, std::to_string(ps[0]), ratio(ps[1], ps[0]), ratio(ps[2], ps[0]), list});
+        for (const auto& v : f.heardWithout)
+            list += fmt::format("{}{}:{}", list.empty() ? "" : " ", v.source, v.heard);
+        perSurf.rows.push_back({f.surface, std::to_string(f.sources),
+                                ratio(f.categoryRight, f.sources),
+                                ratio(f.materialRight, f.sources), list});
     }
     out.line("per surface (sources: held-out sources that recorded its material; category and "
              "material right without those sources):");
@@ -656,17 +560,22 @@ int runListener(const CompareArgs& a) {
 }
 
 int runCompare(const CompareArgs& a) {
-    const int modes = int(!a.surface.empty()) + int(a.all) + int(a.listener);
+    const int modes = int(!a.surface.empty()) + int(a.all) + int(a.listener) + int(a.figures);
     if (modes != 1)
-        throw UserError("compare: give exactly one of --surface S, --all or --listener");
+        throw UserError("compare: give exactly one of --surface S, --all, --listener or --figures");
     if (a.classicListener && a.onsetListener)
         throw UserError("compare: give at most one of --classic-listener and --onset-listener");
     if (a.listenerGrid && !a.onsetListener)
         throw UserError("compare: --listener-grid goes with --onset-listener");
     if (!a.real.empty() && a.surface.empty())
         throw UserError("compare: --real goes with --surface");
-    if ((a.refit || a.markdown) && !a.listener)
-        throw UserError("compare: --refit and --markdown go with --listener");
+    if (a.refit && !a.listener) throw UserError("compare: --refit goes with --listener");
+    if (a.markdown && !a.listener && !a.figures)
+        throw UserError("compare: --markdown goes with --listener or --figures");
+    if (a.seedGiven && a.figures)
+        throw UserError("compare: --figures renders every seed of --seeds; give --seeds N");
+    if (a.seedsGiven && !a.figures)
+        throw UserError("compare: --seeds goes with --figures (--seed sets one render's seed)");
     if (a.refit && (a.onsetListener || a.classicListener))
         throw UserError("compare: --refit goes with the default listener");
     try {
@@ -676,6 +585,7 @@ int runCompare(const CompareArgs& a) {
     }
     if (!a.surface.empty()) return runOne(a);
     try {
+        if (a.figures) return runFigures(a);
         return a.all ? runAll(a) : runListener(a);
     } catch (const eng::FileError& e) {
         throw UserError(e.what());
@@ -701,12 +611,22 @@ CommandRegistrar reg("compare", [](CLI::App& app, int& exitCode) {
                   "(dry) instead of with the recordings heard through the same room");
     cmd->add_flag("--listener", args->listener,
                   "the listener: leave-one-source-out baseline and its verdict on every surface");
+    cmd->add_flag("--figures", args->figures,
+                  "per surface and render seed: the nested listener's verdicts, the distance to "
+                  "its own recordings and the nearest other material, flatness and centroid "
+                  "against its recordings, CPU time per frame (docs/explanation/realism.md)");
+    cmd->add_option("--seeds", args->seeds, "with --figures: the render seeds")
+        ->delimiter(',')
+        ->capture_default_str()
+        ->each([args](const std::string&) { args->seedsGiven = true; });
     cmd->add_option("--walker", args->spec.walker, "virtual walker of the render")
         ->capture_default_str();
     cmd->add_option("--seconds", args->spec.seconds, "length of the render")
         ->capture_default_str()
         ->check(CLI::Range(1.0, 600.0));
-    cmd->add_option("--seed", args->spec.seed, "seed of the render")->capture_default_str();
+    cmd->add_option("--seed", args->spec.seed, "seed of the render")
+        ->capture_default_str()
+        ->each([args](const std::string&) { args->seedGiven = true; });
     cmd->add_option("-o,--output", args->output, "HTML report (SVG figures beside it)");
     cmd->add_flag("--classic-listener", args->classicListener,
                   "with --listener: the first listener (one centroid per material on all "
@@ -719,8 +639,8 @@ CommandRegistrar reg("compare", [](CLI::App& app, int& exitCode) {
                   "with --onset-listener: print every configuration's leave-one-source-out "
                   "figures");
     cmd->add_flag("--markdown", args->markdown,
-                  "with --listener: print the tables as Markdown (pasted verbatim into "
-                  "docs/explanation/realism.md)");
+                  "with --listener or --figures: print the tables as Markdown (pasted verbatim "
+                  "into docs/explanation/realism.md)");
     cmd->add_flag("--refit", args->refit,
                   "with --listener: the nested estimate with the presets refitted (as `underfoot "
                   "fit` does) without each held-out source; slow: one fit per preset and source "

@@ -61,4 +61,12 @@ check grf_huge_claim ok "" -- "$underfoot" render --surface wood --grf huge_clai
 check stats_parse refused "line 2, column 12" -- bash -c "printf '{\"table\":\n [[8, 12], x]}' | '$underfoot' stats chisq"
 check stats_type refused "'table\[1\]\[0\]'" -- bash -c "echo '{\"table\": [[8, 12], [\"a\", 2]]}' | '$underfoot' stats chisq"
 
+# 5. `compare --figures` renders every seed of --seeds: a lone --seed would be ignored silently,
+#    and --seeds means nothing without --figures.
+check compare_figures_seed refused "give --seeds N" -- "$underfoot" compare --figures --seed 5
+check compare_seeds_without_figures refused "--seeds goes with --figures" -- \
+    "$underfoot" compare --all --seeds 3
+check compare_markdown_all refused "--markdown goes with --listener or --figures" -- \
+    "$underfoot" compare --all --markdown
+
 exit $fail

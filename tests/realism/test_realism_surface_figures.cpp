@@ -1,0 +1,132 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The per-surface, per-seed figures of `underfoot compare --figures` (realism/SurfaceFigures.h):
+// the nested listener's counts, and distances and descriptors equal to those `compare --all` and
+// `compare --surface` compute.
+#include "realism/Compare.h"
+#include "realism/SurfaceFigures.h"
+#include "tests/realism/RecordingsCache.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+#include <set>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+using namespace underfoot::realism;
+
+TEST(SurfaceFigures, NestedCountsOnlyTheSourcesThatRecordedTheMaterial) {
+    const std::vector<SurfaceUnderTest> surfaces{
+        {"wood", "wood", "solid"}, {"gravel", "gravel", "aggregate"}, {"leaves", "", "aggregate"}};
+    // Source a recorded wood and gravel, b wood only, c neither.
+    const std::map<std::string, std::set<std::string>> recorded{
+        {"a", {"wood", "gravel"}}, {"b", {"wood"}}, {"c", {"water"}}};
+    const std::map<std::string, std::vector<std::string>> heard{{"a", {"hard", "water", "gravel"}},
+                                                                {"b", {"wood", "sand", "hard"}},
+                                                                {"c", {"metal", "water", "water"}}};
+    std::vector<SurfaceFigures> f(3);
+    scoreNested(surfaces, heard, recorded, f);
+    // wood: a (hard: solid, not wood) and b (wood) count; c did not record wood.
+    EXPECT_EQ(f[0].surface, "wood");
+    EXPECT_EQ(f[0].sources, 2);
+    EXPECT_EQ(f[0].categoryRight, 2);
+    EXPECT_EQ(f[0].materialRight, 1);
+    // gravel: only a, which heard water (another category).
+    EXPECT_EQ(f[1].sources, 1);
+    EXPECT_EQ(f[1].categoryRight, 0);
+    EXPECT_EQ(f[1].materialRight, 0);
+    // No recorded material: nothing scored, every verdict still listed in source order.
+    EXPECT_EQ(f[2].sources, 0);
+    ASSERT_EQ(f[2].heardWithout.size(), 3u);
+    EXPECT_EQ(f[2].heardWithout[0].source, "a");
+    EXPECT_EQ(f[2].heardWithout[2].heard, "water");
+    std::vector<SurfaceFigures> tooFew(2);
+    EXPECT_THROW(scoreNested(surfaces, heard, recorded, tooFew), std::out_of_range);
+}
+
+class SurfaceFiguresOnRecordings : public underfoot::realism::test::RecordingsCacheTest {};
+
+TEST_F(SurfaceFiguresOnRecordings, DistancesAndDescriptorsAreThoseOfCompare) {
+    const std::vector<SurfaceUnderTest> surfaces{{"wood", "wood", "solid"},
+                                                 {"wood_reverb", "wood", "solid"},
+                                                 {"gravel", "gravel", "aggregate"}};
+    SurfaceFiguresOptions o;
+    o.spec.seconds = 4.0;
+    o.seeds = {7};
+    const auto figs = surfaceFigures(surfaces, recs_, o);
+    ASSERT_EQ(figs.size(), 3u);
+    std::set<std::string> materials;
+    std::map<std::string, std::set<std::string>> sourcesOf;
+    for (const auto& r : recs_) {
+        materials.insert(r.material);
+        sourcesOf[r.material].insert(r.source);
+    }
+    RenderSpec spec = o.spec;
+    spec.seed = 7;
+    for (std::size_t i = 0; i < surfaces.size(); ++i) {
+        const auto& f = figs[i];
+        const auto& s = surfaces[i];
+        SCOPED_TRACE(s.surface);
+        EXPECT_EQ(f.seed, 7u);
+        ASSERT_TRUE(f.hasRecordings);
+        // As `compare --surface`: the own material's recordings, through the surface's room.
+        const auto audio = renderForComparison(s.surface, spec);
+        const auto room = roomOfSurface(s.surface);
+        EXPECT_EQ(room.has_value(), s.surface == "wood_reverb");
+        std::vector<Recording> own;
+        for (const auto& r : recs_)
+            if (r.material == s.material) own.push_back(r);
+        const auto c = compareAudio(s.surface, audio, own, room);
+        EXPECT_DOUBLE_EQ(f.ownDistance, c.comparison.distance);
+        EXPECT_DOUBLE_EQ(f.flatness.synthetic, c.comparison.d[kFlatness].synthetic);
+        EXPECT_DOUBLE_EQ(f.flatness.realQ1, c.comparison.d[kFlatness].realQ1);
+        EXPECT_DOUBLE_EQ(f.centroid.realQ3, c.comparison.d[kCentroid].realQ3);
+        // As `compare --all`: the nearest of every other material's recordings (dry surfaces:
+        // a room's convolution of every recording would make this test slow).
+        if (!room) {
+            std::string other;
+            double otherD = 1e300;
+            for (const auto& m : materials) {
+                if (m == s.material) continue;
+                std::vector<Recording> of;
+                for (const auto& r : recs_)
+                    if (r.material == m) of.push_back(r);
+                const double d = compareAudio(s.surface, audio, of).comparison.distance;
+                if (d < otherD) {
+                    otherD = d;
+                    other = m;
+                }
+            }
+            EXPECT_EQ(f.nearestOther, other);
+            EXPECT_DOUBLE_EQ(f.nearestOtherDistance, otherD);
+        }
+        // Every source that recorded the material is a held-out verdict on it.
+        EXPECT_EQ(f.sources, int(sourcesOf[s.material].size()));
+        EXPECT_LE(f.categoryRight, f.sources);
+        EXPECT_LE(f.materialRight, f.categoryRight);
+        EXPECT_GT(f.nanosecondsPerFrame, 0.0);
+        EXPECT_TRUE(std::isfinite(f.nanosecondsPerFrame));
+    }
+    // The room changes the comparison: wood with reverb is not wood's figure again.
+    EXPECT_NE(figs[0].ownDistance, figs[1].ownDistance);
+}
+
+TEST_F(SurfaceFiguresOnRecordings, RefusesWhatItCannotJudge) {
+    SurfaceFiguresOptions o;
+    o.spec.seconds = 2.0;
+    EXPECT_THROW(surfaceFigures({}, recs_, o), std::invalid_argument);
+    o.seeds.clear();
+    EXPECT_THROW(surfaceFigures({{"wood", "wood", "solid"}}, recs_, o), std::invalid_argument);
+    o.seeds = {7};
+    std::vector<Recording> oneSource;
+    for (const auto& r : recs_)
+        if (r.source == recs_.front().source) oneSource.push_back(r);
+    try {
+        surfaceFigures({{"wood", "wood", "solid"}}, oneSource, o);
+        ADD_FAILURE() << "one source was accepted";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("two sources"), std::string::npos) << e.what();
+    }
+}
