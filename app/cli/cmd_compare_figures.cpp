@@ -5,6 +5,7 @@
 // flatness and centroid against its recordings, and the render's cost in this run.
 #include "app/cli/CommandRegistry.h"
 #include "app/cli/CompareShared.h"
+#include "base/Plural.h"
 #include "realism/SurfaceFigures.h"
 
 #include <fmt/core.h>
@@ -100,11 +101,11 @@ int runFigures(const CompareArgs& a) {
         always += alwaysInCategory[s.surface];
     }
     out.line(fmt::format(
-        "nested, over {} seeds: category right {}/{}, material right {}/{}; surfaces in their "
+        "nested, over {}: category right {}/{}, material right {}/{}; surfaces in their "
         "category for every held-out source that recorded their material, at every seed: {}/{}; "
         "own material closest {}/{}; flatness inside the recordings' IQR {}/{}",
-        a.seeds.size(), catRight, catN, matRight, catN, always, scoredSurfaces, ownClosest, ownN,
-        flatIn, flatN));
+        counted(a.seeds.size(), "seed"), catRight, catN, matRight, catN, always, scoredSurfaces,
+        ownClosest, ownN, flatIn, flatN));
     if (!a.output.empty()) {
         std::ofstream html(a.output);
         if (!html) throw UserError(fmt::format("-o {}: cannot write this file", a.output));
