@@ -267,9 +267,12 @@ TEST(GranularSurfaces, SurfacesAreDistinctByTheNumbers) {
     EXPECT_GT(at("gravel").centroidHz, 2.0 * at("beach_sand").centroidHz);
     // Deep snow: muffled, far lower than gravel (measured 440 Hz).
     EXPECT_LT(at("deep_snow").centroidHz, 0.4 * at("gravel").centroidHz);
-    // Snow crunches are cascades of fewer, larger breaks; gravel is a dense stream of small
-    // impacts (measured 589 vs 1177 events per step).
-    EXPECT_LT(at("deep_snow").eventsPerStep, 0.6 * at("gravel").eventsPerStep);
+    // Gravel is an immediate crunch: a dense burst of small impacts released by the heel's
+    // impact, nothing after 0.2 s (docs/decisions/revoice-grass-gravel-metal.md; measured 333
+    // events per step, 0.00 of the step's energy after 0.2 s; before, load-driven grains: 1177
+    // events spread over the stance, 0.44 after 0.2 s).
+    EXPECT_GT(at("gravel").eventsPerStep, 250.0);
+    EXPECT_LT(at("gravel").lateShare, 0.1);
     // Recorded sand steps are lower, sparser and shorter than recorded snow steps (`underfoot
     // compare` medians: centroid 329 vs 558 Hz, 38 vs 61 grains/s;
     // docs/decisions/realism-revoicing.md "Heel-driven grains and several starts"): sand's grains
@@ -289,9 +292,8 @@ TEST(GranularSurfaces, SurfacesAreDistinctByTheNumbers) {
     // snow recordings, docs/decisions/realism-revoicing.md "Frozen snow: a crust that breaks").
     EXPECT_GT(at("frozen_snow").centroidHz, 2.0 * at("deep_snow").centroidHz);
     EXPECT_GT(at("frozen_snow").crestDb, at("deep_snow").crestDb + 1.0);
-    // Dirt plus pebbles: mostly low earth (more power below 500 Hz than gravel and sparser).
+    // Dirt plus pebbles: mostly low earth (more power below 500 Hz than gravel).
     EXPECT_GT(at("dirt_pebbles").lowShare, at("gravel").lowShare + 0.3);
-    EXPECT_LT(at("dirt_pebbles").eventsPerStep, 0.5 * at("gravel").eventsPerStep);
     // Dry leaves: long low + high layers: the densest, sounding the longest.
     EXPECT_GT(at("dry_leaves").eventsPerStep, at("gravel").eventsPerStep);
     EXPECT_GT(at("dry_leaves").activeFraction, at("forest_underbrush").activeFraction);

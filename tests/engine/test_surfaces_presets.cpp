@@ -226,7 +226,9 @@ TEST(SurfacePresets, AfterTheLastStepEverySurfaceFallsSilentAndSleeps) {
 // 0.5 s fade), creaking boards stop shearing and their roughness stops with the shear: every
 // surface is silent well before 10 s of standing (they sounded for ever: gravel at -44 dBFS RMS,
 // deep snow at -32, creaking wood at -90). A shift of the weight (700 -> 350 N in 0.25 s) wakes
-// the beds and the boards again.
+// the beds and the boards again. Gravel, sand, dirt and grass are not in that set: their grains
+// come from the heel's impact alone (docs/decisions/revoice-grass-gravel-metal.md), so a shift of
+// a standing weight is silent on them.
 TEST(SurfacePresets, StandingStillFallsSilentAndAWeightShiftWakesTheBed) {
     const double fs = 48000.0;
     auto load = [&](std::size_t i) {
@@ -239,7 +241,7 @@ TEST(SurfacePresets, StandingStillFallsSilentAndAWeightShiftWakesTheBed) {
     const std::size_t frames = static_cast<std::size_t>(13.0 * fs);
     std::vector<float> grf(frames);
     for (std::size_t i = 0; i < frames; ++i) grf[i] = static_cast<float>(load(i));
-    const std::set<std::string> wake = {"gravel", "dry_leaves", "deep_snow", "creaking_wood"};
+    const std::set<std::string> wake = {"dry_leaves", "deep_snow", "creaking_wood"};
     for (const auto& s : listSurfaces()) {
         FootstepScene scene;
         scene.build(s.id, {});

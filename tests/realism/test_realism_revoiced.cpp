@@ -1,0 +1,83 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// High grass, gravel and metal keep their re-voicing against the recordings of their material
+// (docs/decisions/revoice-grass-gravel-metal.md): the descriptors on which the listener misplaced
+// them lie within the bounds below. Each check is a robust z of realism/Distance.h against the
+// recordings of scripts/fetch-recordings.sh (either cache: the four-source one CI has, or the
+// seven-source one of `--large`), not a listener verdict, which moves with every other preset
+// (the renders are centred as one source). The presets before the re-voicing fail every
+// descriptor bound below on both caches (their figures, `underfoot compare -s ID --seed 7`, are
+// in the comments: seven-source / four-source cache where they differ); skipped without the
+// cache.
+#include "realism/Compare.h"
+#include "realism/Recordings.h"
+#include "tests/realism/RecordingsCache.h"
+
+#include <fmt/core.h>
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+using namespace underfoot::realism;
+
+namespace {
+
+class Revoiced : public underfoot::realism::test::RecordingsCacheTest {
+  protected:
+    // Renders the surface as `underfoot compare` does (walker cadence=100, 10 s, seed 7) against
+    // the recordings of its material and prints every descriptor's synthetic median and z.
+    SurfaceComparison compare(const std::string& surface, const std::string& material) const {
+        std::vector<Recording> real;
+        for (const auto& r : recs_)
+            if (r.material == material) real.push_back(r);
+        EXPECT_GE(real.size(), 5u) << surface;
+        auto c = compareSurface(surface, real, RenderSpec{});
+        std::string line = fmt::format("{:<11} distance {:.2f}:", surface, c.comparison.distance);
+        for (int d = 0; d < kDescriptorCount; ++d) {
+            const auto& x = c.comparison.d[static_cast<std::size_t>(d)];
+            line += fmt::format(" {} {:.4g} (z {:.2f})", descriptorInfo(d).key, x.synthetic, x.z);
+        }
+        std::printf("%s\n", line.c_str());
+        EXPECT_GE(c.comparison.syntheticSteps, 8) << surface;
+        return c;
+    }
+    static const DescriptorComparison& at(const SurfaceComparison& c, Descriptor d) {
+        return c.comparison.d[static_cast<std::size_t>(d)];
+    }
+};
+
+} // namespace
+
+// High grass: the soil's thud under the swish and the snaps of thicker stems. Before: 20-250 Hz
+// share -15.8 dB against a recorded median of -7.0 (z 1.72), peakiness 9.1 against 15.1 dB
+// (z 1.03), distance 0.55. Now (both caches): -5.7 dB (z 0.25), 14.5 dB (z 0.11), 0.41.
+TEST_F(Revoiced, HighGrassHasTheSoilsLowEnd) {
+    const auto c = compare("high_grass", "grass");
+    EXPECT_LE(at(c, kBandLow).z, 0.8);
+    EXPECT_LE(at(c, kPeakiness).z, 0.6);
+    EXPECT_LE(c.comparison.distance, 0.5);
+}
+
+// Metal: one or two clangs, not a stream of small events. Before: 121 micro-events per second
+// of step against a recorded median of 36 / 28 (z 1.76 / 2.32), crest 20.5 dB against 17.9 /
+// 17.1 (z 0.85 / 1.14). Now: 22 / s (z 0.70 / 0.41), crest z 0.35 / 0.64, distance 0.41 / 0.44.
+TEST_F(Revoiced, MetalIsAFewClangsNotAStreamOfGrains) {
+    const auto c = compare("metal", "metal");
+    EXPECT_LE(at(c, kGrainRate).synthetic, 60.0) << "micro-events per second of step";
+    EXPECT_LE(at(c, kGrainRate).z, 1.0);
+    EXPECT_LE(at(c, kCrest).z, 0.8);
+    EXPECT_LE(c.comparison.distance, 0.5);
+}
+
+// Gravel: the heel's impact crushes the bed at once. Before: attack 0.119 s against a recorded
+// median of 0.044 (z 1.44), temporal centroid 0.123 s against 0.061 (z 1.17): the crunch built
+// up with the load. Now (both caches): 0.021 s (z 1.07), 0.039 s (z 0.79); the step decays
+// faster than the recorded ones (decay to -20 dB 0.043 s against 0.018, z 1.26), which the
+// distance (0.54, was 0.48) carries.
+TEST_F(Revoiced, GravelCrunchesAtOnce) {
+    const auto c = compare("gravel", "gravel");
+    EXPECT_LE(at(c, kAttack).synthetic, 0.06) << "s from the step's onset to its peak";
+    EXPECT_LE(at(c, kTemporalCentroid).synthetic, at(c, kTemporalCentroid).realMedian);
+    EXPECT_LE(at(c, kTemporalCentroid).z, 1.0);
+    EXPECT_LE(c.comparison.distance, 0.6);
+}
