@@ -72,7 +72,7 @@ TEST_F(Revoiced, MetalIsAFewClangsNotAStreamOfGrains) {
 // Gravel: the heel's impact crushes the bed at once. Before: attack 0.119 s against a recorded
 // median of 0.044 (z 1.44), temporal centroid 0.123 s against 0.061 (z 1.17): the crunch built
 // up with the load. Now (both caches): 0.021 s (z 1.07), 0.039 s (z 0.79); the step decays
-// faster than the recorded ones (decay to -20 dB 0.043 s against 0.018, z 1.26), which the
+// more slowly than the recorded ones (decay to -20 dB 0.043 s against 0.018, z 1.26), which the
 // distance (0.54, was 0.48) carries.
 TEST_F(Revoiced, GravelCrunchesAtOnce) {
     const auto c = compare("gravel", "gravel");
