@@ -33,9 +33,10 @@ void scoreNested(const std::vector<SurfaceUnderTest>& surfaces,
         const auto& mat = surfaces[i].material;
         for (const auto& [source, h] : heard) {
             const auto& verdict = h.at(i);
-            f.heardWithout.push_back({source, verdict});
             const auto r = recorded.find(source);
-            if (mat.empty() || r == recorded.end() || !r->second.count(mat)) continue;
+            const bool scored = !mat.empty() && r != recorded.end() && r->second.count(mat) > 0;
+            f.heardWithout.push_back({source, verdict, scored});
+            if (!scored) continue;
             ++f.sources;
             f.categoryRight += categoryOfMaterial(verdict) == surfaces[i].category;
             f.materialRight += verdict == mat;

@@ -38,6 +38,7 @@ std::vector<SurfaceUnderTest> bundledSurfaces();
 /// How one held-out source heard one render.
 struct HeldOutVerdict {
     std::string source, heard;
+    bool scored = false; ///< the source recorded the surface's material: counted in the figures
 };
 
 struct SurfaceFigures {

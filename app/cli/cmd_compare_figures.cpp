@@ -57,13 +57,8 @@ int runFigures(const CompareArgs& a) {
     for (const auto& f : figs) {
         std::string wrong;
         for (const auto& v : f.heardWithout)
-            if (f.sources > 0 && realism::categoryOfMaterial(v.heard) != f.category) {
-                // only sources that recorded its material are scored
-                bool scored = false;
-                for (const auto& r : recs)
-                    scored = scored || (r.source == v.source && r.material == f.material);
-                if (scored) wrong += (wrong.empty() ? "" : " ") + v.source + ":" + v.heard;
-            }
+            if (v.scored && realism::categoryOfMaterial(v.heard) != f.category)
+                wrong += (wrong.empty() ? "" : " ") + v.source + ":" + v.heard;
         catRight += f.categoryRight;
         matRight += f.materialRight;
         catN += f.sources;

@@ -42,6 +42,11 @@ TEST(SurfaceFigures, NestedCountsOnlyTheSourcesThatRecordedTheMaterial) {
     ASSERT_EQ(f[2].heardWithout.size(), 3u);
     EXPECT_EQ(f[2].heardWithout[0].source, "a");
     EXPECT_EQ(f[2].heardWithout[2].heard, "water");
+    EXPECT_FALSE(f[2].heardWithout[0].scored);
+    // wood: a and b scored, c not.
+    EXPECT_TRUE(f[0].heardWithout[0].scored);
+    EXPECT_TRUE(f[0].heardWithout[1].scored);
+    EXPECT_FALSE(f[0].heardWithout[2].scored);
     std::vector<SurfaceFigures> tooFew(2);
     EXPECT_THROW(scoreNested(surfaces, heard, recorded, tooFew), std::out_of_range);
 }
