@@ -208,4 +208,23 @@ heardWithoutEachSource(const std::vector<Example>& recordings, const std::vector
     return heard;
 }
 
+std::map<std::string, std::map<std::string, HeldOutCounts>>
+heldOutRecordings(const std::vector<Example>& input, ListenerOptions o) {
+    std::vector<Example> ex = input;
+    if (o.centrePerSource) centreBySource(ex);
+    std::map<std::string, std::map<std::string, HeldOutCounts>> counts;
+    for (const auto& held : twoSourcesOrMore(ex, "heldOutRecordings")) {
+        const Listener l = trainedWithout(ex, held, o);
+        for (const auto& e : ex) {
+            if (e.source != held) continue;
+            const auto heard = l.classify(e.features);
+            auto& c = counts[held][e.material];
+            ++c.files;
+            c.categoryRight += categoryOfMaterial(heard) == categoryOfMaterial(e.material);
+            c.materialRight += heard == e.material;
+        }
+    }
+    return counts;
+}
+
 } // namespace underfoot::realism

@@ -103,4 +103,21 @@ std::map<std::string, std::vector<std::string>>
 heardWithoutEachSource(const std::vector<Example>& recordings, const std::vector<Example>& renders,
                        ListenerOptions o = {});
 
+/// How a held-out source's own recordings of one material are heard.
+struct HeldOutCounts {
+    int files = 0;         ///< the source's files of the material
+    int categoryRight = 0; ///< of those, put in the material's category
+    int materialRight = 0; ///< of those, named as the material (0 when no other source has it)
+};
+
+/// The recordings' side of the nested figures: every source S's own recordings judged by the
+/// listener trained without S (the listener heardWithoutEachSource judges the renders with).
+/// counts[S][material] covers every file of S, also those of a material no other source
+/// recorded (their category can still be right; leaveOneSourceOut leaves them out), as the
+/// renders' figures count such a source. A render cannot be asked to be heard in its category
+/// more often than the held-out source's own recordings of its material are. Throws
+/// std::invalid_argument with fewer than two sources.
+std::map<std::string, std::map<std::string, HeldOutCounts>>
+heldOutRecordings(const std::vector<Example>& recordings, ListenerOptions o = {});
+
 } // namespace underfoot::realism

@@ -5,8 +5,10 @@
 
 #include <fmt/core.h>
 
+#include <algorithm>
 #include <chrono>
 #include <ctime>
+#include <iterator>
 #include <set>
 #include <stdexcept>
 
@@ -35,13 +37,63 @@ void scoreNested(const std::vector<SurfaceUnderTest>& surfaces,
             const auto& verdict = h.at(i);
             const auto r = recorded.find(source);
             const bool scored = !mat.empty() && r != recorded.end() && r->second.count(mat) > 0;
-            f.heardWithout.push_back({source, verdict, scored});
+            f.heardWithout.push_back({source, verdict, scored, {}});
             if (!scored) continue;
             ++f.sources;
             f.categoryRight += categoryOfMaterial(verdict) == surfaces[i].category;
             f.materialRight += verdict == mat;
         }
     }
+}
+
+void addHeldOutRecordings(const std::map<std::string, std::map<std::string, HeldOutCounts>>& own,
+                          std::vector<SurfaceFigures>& figures) {
+    for (auto& f : figures)
+        for (auto& v : f.heardWithout) {
+            v.recordings = {};
+            if (!v.scored) continue;
+            const auto s = own.find(v.source);
+            if (s == own.end()) continue;
+            const auto m = s->second.find(f.material);
+            if (m != s->second.end()) v.recordings = m->second;
+        }
+}
+
+bool SurfaceOverSeeds::alwaysInCategory() const {
+    for (const auto& s : sources)
+        if (s.seedsInCategory != s.seeds) return false;
+    return true;
+}
+
+bool SurfaceOverSeeds::atLeastAsOftenAsRecordings() const {
+    for (const auto& s : sources)
+        if (!s.atLeastAsOftenAsRecordings()) return false;
+    return true;
+}
+
+std::vector<SurfaceOverSeeds> overSeeds(const std::vector<SurfaceFigures>& figures) {
+    std::vector<SurfaceOverSeeds> out;
+    for (const auto& f : figures) {
+        auto it = std::find_if(out.begin(), out.end(),
+                               [&](const SurfaceOverSeeds& s) { return s.surface == f.surface; });
+        if (it == out.end()) {
+            out.push_back({f.surface, {}});
+            it = std::prev(out.end());
+        }
+        for (const auto& v : f.heardWithout) {
+            if (!v.scored) continue;
+            auto src =
+                std::find_if(it->sources.begin(), it->sources.end(),
+                             [&](const HeldOutOverSeeds& h) { return h.source == v.source; });
+            if (src == it->sources.end()) {
+                it->sources.push_back({v.source, 0, 0, v.recordings});
+                src = std::prev(it->sources.end());
+            }
+            ++src->seeds;
+            src->seedsInCategory += categoryOfMaterial(v.heard) == f.category;
+        }
+    }
+    return out;
 }
 
 namespace {
@@ -114,6 +166,7 @@ std::vector<SurfaceFigures> surfaceFigures(const std::vector<SurfaceUnderTest>& 
     for (const auto& s : surfaces)
         rooms.push_back(o.dryRecordings ? std::nullopt : roomOfSurface(s.surface));
 
+    const auto ownHeard = heldOutRecordings(examples, o.listener);
     std::vector<SurfaceFigures> all;
     for (const auto seed : o.seeds) {
         RenderSpec spec = o.spec;
@@ -163,6 +216,7 @@ std::vector<SurfaceFigures> surfaceFigures(const std::vector<SurfaceUnderTest>& 
         }
         scoreNested(surfaces, heardWithoutEachSource(examples, renders, o.listener), recorded,
                     figs);
+        addHeldOutRecordings(ownHeard, figs);
         all.insert(all.end(), figs.begin(), figs.end());
     }
     return all;

@@ -4,7 +4,9 @@
 /// (`underfoot compare --figures`, docs/explanation/realism.md, "The current result"):
 ///  - the nested listener (Listener.h, heardWithoutEachSource): for every recording source S
 ///    that recorded the surface's material, whether a listener
-///    trained without S hears the render in its category and as its material;
+///    trained without S hears the render in its category and as its material, beside how that
+///    listener hears S's own recordings of the material (heldOutRecordings): the bar a render
+///    faithful to S's recordings can reach;
 ///  - the distance (Distance.h) to the recordings of its own material and to the nearest other
 ///    material's, exactly as `underfoot compare --all` computes them (a surface with a room is
 ///    compared with recordings heard through that room);
@@ -39,6 +41,7 @@ std::vector<SurfaceUnderTest> bundledSurfaces();
 struct HeldOutVerdict {
     std::string source, heard;
     bool scored = false; ///< the source recorded the surface's material: counted in the figures
+    HeldOutCounts recordings; ///< the source's own recordings of the material, same listener
 };
 
 struct SurfaceFigures {
@@ -81,5 +84,31 @@ void scoreNested(const std::vector<SurfaceUnderTest>& surfaces,
                  const std::map<std::string, std::vector<std::string>>& heard,
                  const std::map<std::string, std::set<std::string>>& recorded,
                  std::vector<SurfaceFigures>& out);
+
+/// Fills heardWithout[].recordings of every scored verdict from heldOutRecordings' counts.
+void addHeldOutRecordings(const std::map<std::string, std::map<std::string, HeldOutCounts>>& own,
+                          std::vector<SurfaceFigures>& figures);
+
+/// One surface's nested verdicts over every seed, per held-out source that recorded its material.
+struct HeldOutOverSeeds {
+    std::string source;
+    int seeds = 0, seedsInCategory = 0; ///< renders of the surface this source's listener judged
+    HeldOutCounts recordings;           ///< the source's own recordings of the material
+    /// The render is heard in its category at least as often (as a share) as the recordings.
+    bool atLeastAsOftenAsRecordings() const {
+        return std::int64_t(seedsInCategory) * recordings.files >=
+               std::int64_t(recordings.categoryRight) * seeds;
+    }
+};
+
+struct SurfaceOverSeeds {
+    std::string surface;
+    std::vector<HeldOutOverSeeds> sources;   ///< empty: no source recorded the material
+    bool alwaysInCategory() const;           ///< every source, every seed
+    bool atLeastAsOftenAsRecordings() const; ///< for every source
+};
+
+/// The surfaces of `figures` (any number of seeds each), in order of first appearance.
+std::vector<SurfaceOverSeeds> overSeeds(const std::vector<SurfaceFigures>& figures);
 
 } // namespace underfoot::realism

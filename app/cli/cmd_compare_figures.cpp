@@ -11,7 +11,6 @@
 #include <fmt/core.h>
 
 #include <fstream>
-#include <map>
 #include <string>
 
 namespace underfoot::cli::compare_command {
@@ -44,7 +43,8 @@ int runFigures(const CompareArgs& a) {
     out.line(fmt::format(
         "Per surface and render seed (walker {}, {} s, seeds {}): nested listener (trained "
         "without each source that recorded the surface's material: category and material right, "
-        "and the sources whose listener put it in another category), distance to its own "
+        "and the sources whose listener put it in another category, with how often that listener "
+        "put the source's own recordings of the material in its category), distance to its own "
         "recordings and to the nearest other material, flatness and centroid with the "
         "recordings' interquartile range, CPU time per rendered frame in this run.",
         a.spec.walker, a.spec.seconds, seeds));
@@ -53,17 +53,15 @@ int runFigures(const CompareArgs& a) {
             {},
             4};
     int catRight = 0, catN = 0, matRight = 0, flatIn = 0, flatN = 0, ownClosest = 0, ownN = 0;
-    std::map<std::string, bool> alwaysInCategory; // surface -> every source, every seed
     for (const auto& f : figs) {
         std::string wrong;
         for (const auto& v : f.heardWithout)
             if (v.scored && realism::categoryOfMaterial(v.heard) != f.category)
-                wrong += (wrong.empty() ? "" : " ") + v.source + ":" + v.heard;
+                wrong += fmt::format("{}{}:{} ({}/{})", wrong.empty() ? "" : " ", v.source, v.heard,
+                                     v.recordings.categoryRight, v.recordings.files);
         catRight += f.categoryRight;
         matRight += f.materialRight;
         catN += f.sources;
-        auto& always = alwaysInCategory.try_emplace(f.surface, true).first->second;
-        always = always && f.categoryRight == f.sources;
         std::vector<std::string> row{
             f.surface, std::to_string(f.seed),
             f.sources ? fmt::format("{}/{}", f.categoryRight, f.sources) : "-",
@@ -87,20 +85,29 @@ int runFigures(const CompareArgs& a) {
         t.rows.push_back(std::move(row));
     }
     out.table(t);
-    int always = 0, scoredSurfaces = 0;
-    for (const auto& s : surfaces) {
-        bool scored = false;
-        for (const auto& f : figs) scored = scored || (f.surface == s.surface && f.sources > 0);
-        if (!scored) continue;
+    int always = 0, atPar = 0, scoredSurfaces = 0;
+    std::string below;
+    for (const auto& s : realism::overSeeds(figs)) {
+        if (s.sources.empty()) continue;
         ++scoredSurfaces;
-        always += alwaysInCategory[s.surface];
+        always += s.alwaysInCategory();
+        atPar += s.atLeastAsOftenAsRecordings();
+        for (const auto& h : s.sources)
+            if (!h.atLeastAsOftenAsRecordings())
+                below +=
+                    fmt::format("{}{} without {} ({}/{} seeds; its recordings {}/{})",
+                                below.empty() ? "" : ", ", s.surface, h.source, h.seedsInCategory,
+                                h.seeds, h.recordings.categoryRight, h.recordings.files);
     }
     out.line(fmt::format(
         "nested, over {}: category right {}/{}, material right {}/{}; surfaces in their "
         "category for every held-out source that recorded their material, at every seed: {}/{}; "
+        "in their category at least as often as each such source's own recordings: {}/{}; "
         "own material closest {}/{}; flatness inside the recordings' IQR {}/{}",
         counted(a.seeds.size(), "seed"), catRight, catN, matRight, catN, always, scoredSurfaces,
-        ownClosest, ownN, flatIn, flatN));
+        atPar, scoredSurfaces, ownClosest, ownN, flatIn, flatN));
+    out.line("heard in their category less often than the held-out source's own recordings: " +
+             (below.empty() ? std::string("none") : below));
     if (!a.output.empty()) {
         std::ofstream html(a.output);
         if (!html) throw UserError(fmt::format("-o {}: cannot write this file", a.output));

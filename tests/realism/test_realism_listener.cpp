@@ -131,6 +131,70 @@ TEST(RealismListener, RendersAreJudgedByListenersThatNeverHeardASource) {
     EXPECT_THROW(heardWithoutEachSource(one, renders), std::invalid_argument);
 }
 
+TEST(RealismListener, HeldOutRecordingsAreJudgedByTheRendersListener) {
+    // Source c alone recorded gravel, next to everyone's metal: the listener without c, which
+    // hears a gravel-like render as metal, hears c's own gravel as metal too.
+    std::mt19937 g(5);
+    std::vector<Example> rec;
+    for (const char* src : {"a", "b", "c"})
+        for (int i = 0; i < 3; ++i) {
+            rec.push_back(example(src, "metal", 0.0, g));
+            rec.push_back(example(src, "water", 8.0, g));
+        }
+    for (int i = 0; i < 3; ++i) rec.push_back(example("c", "gravel", 1.0, g));
+    const ListenerOptions plain{false, true, true};
+    const auto own = heldOutRecordings(rec, plain);
+    ASSERT_EQ(own.size(), 3u);
+    const auto& cg = own.at("c").at("gravel");
+    EXPECT_EQ(cg.files, 3);
+    EXPECT_EQ(cg.categoryRight, 0) << "heard as metal, a solid";
+    EXPECT_EQ(cg.materialRight, 0) << "no other source recorded gravel";
+    EXPECT_EQ(own.at("a").at("metal").categoryRight, 3);
+    EXPECT_EQ(own.at("b").at("water").materialRight, 3);
+    EXPECT_EQ(own.at("a").count("gravel"), 0u);
+    std::vector<Example> one = {example("a", "metal", 0, g)};
+    EXPECT_THROW(heldOutRecordings(one), std::invalid_argument);
+}
+
+TEST(RealismListener, HeldOutRecordingsAddUpToLeaveOneSourceOut) {
+    // Overlapping materials, so that some files are misheard, and one material a single source
+    // has: the counts per source and material add up to leaveOneSourceOut's totals, and the
+    // files of the single source's material are its unseen files.
+    std::mt19937 g(11);
+    std::vector<Example> ex;
+    for (const char* src : {"a", "b", "c", "d"})
+        for (int i = 0; i < 4; ++i) {
+            ex.push_back(example(src, "metal", 0.0, g));
+            ex.push_back(example(src, "wood", 0.4, g));
+            ex.push_back(example(src, "gravel", 0.8, g));
+            ex.push_back(example(src, "water", 1.2, g));
+        }
+    for (int i = 0; i < 2; ++i) ex.push_back(example("d", "sand", 0.6, g));
+    for (const ListenerOptions o : {ListenerOptions{}, ListenerOptions{false, true, false}}) {
+        const auto r = leaveOneSourceOut(ex, o);
+        ASSERT_LT(r.categoryCorrect, r.files) << "the test needs misheard files";
+        ASSERT_GT(r.categoryCorrect, r.materialCorrect);
+        int files = 0, cat = 0, mat = 0, unseen = 0;
+        for (const auto& [src, mats] : heldOutRecordings(ex, o))
+            for (const auto& [m, c] : mats) {
+                EXPECT_LE(c.materialRight, c.categoryRight) << src << " " << m;
+                if (m == "sand") {
+                    unseen += c.files;
+                    EXPECT_EQ(c.materialRight, 0);
+                    continue;
+                }
+                files += c.files;
+                cat += c.categoryRight;
+                mat += c.materialRight;
+                EXPECT_EQ(c.files, 4) << src << " " << m;
+            }
+        EXPECT_EQ(files, r.files);
+        EXPECT_EQ(cat, r.categoryCorrect);
+        EXPECT_EQ(mat, r.materialCorrect);
+        EXPECT_EQ(unseen, r.unseenMaterialFiles);
+    }
+}
+
 TEST(RealismRecordings, ManifestErrorsNameTheFileAndLine) {
     const auto dir = scratch("manifest");
     EXPECT_THROW(loadManifest(dir.string()), std::runtime_error); // missing

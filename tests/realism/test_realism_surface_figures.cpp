@@ -51,6 +51,52 @@ TEST(SurfaceFigures, NestedCountsOnlyTheSourcesThatRecordedTheMaterial) {
     EXPECT_THROW(scoreNested(surfaces, heard, recorded, tooFew), std::out_of_range);
 }
 
+TEST(SurfaceFigures, OverSeedsSetsEachSourceAgainstItsOwnRecordings) {
+    // wood over two seeds: source a heard it in its category once (a's own wood: 1 of 2 files),
+    // source b never (b's own wood: 0 of 3); gravel: a heard it right twice, a's gravel 4/4.
+    auto fig = [](const std::string& surface, const std::string& material,
+                  const std::string& category, std::vector<HeldOutVerdict> v) {
+        SurfaceFigures f;
+        f.surface = surface;
+        f.material = material;
+        f.category = category;
+        f.heardWithout = std::move(v);
+        return f;
+    };
+    std::vector<SurfaceFigures> figs{
+        fig("wood", "wood", "solid", {{"a", "hard", true, {}}, {"b", "sand", true, {}}}),
+        fig("gravel", "gravel", "aggregate",
+            {{"a", "gravel", true, {}}, {"b", "metal", false, {}}}),
+        fig("wood", "wood", "solid", {{"a", "water", true, {}}, {"b", "snow", true, {}}}),
+        fig("gravel", "gravel", "aggregate", {{"a", "sand", true, {}}, {"b", "wood", false, {}}}),
+        fig("leaves", "", "aggregate", {{"a", "wood", false, {}}})};
+    const std::map<std::string, std::map<std::string, HeldOutCounts>> own{
+        {"a", {{"wood", {2, 1, 1}}, {"gravel", {4, 4, 3}}}}, {"b", {{"wood", {3, 0, 0}}}}};
+    addHeldOutRecordings(own, figs);
+    EXPECT_EQ(figs[0].heardWithout[0].recordings.files, 2);
+    EXPECT_EQ(figs[1].heardWithout[1].recordings.files, 0) << "b did not record gravel";
+    const auto s = overSeeds(figs);
+    ASSERT_EQ(s.size(), 3u);
+    EXPECT_EQ(s[0].surface, "wood");
+    ASSERT_EQ(s[0].sources.size(), 2u);
+    EXPECT_EQ(s[0].sources[0].seeds, 2);
+    EXPECT_EQ(s[0].sources[0].seedsInCategory, 1);
+    EXPECT_TRUE(s[0].sources[0].atLeastAsOftenAsRecordings()) << "1/2 against 1/2";
+    EXPECT_EQ(s[0].sources[1].seedsInCategory, 0);
+    EXPECT_TRUE(s[0].sources[1].atLeastAsOftenAsRecordings()) << "0/2 against 0/3";
+    EXPECT_FALSE(s[0].alwaysInCategory());
+    EXPECT_TRUE(s[0].atLeastAsOftenAsRecordings());
+    // gravel: only a counts; 2 of 2 seeds against 4 of 4 recordings.
+    ASSERT_EQ(s[1].sources.size(), 1u);
+    EXPECT_TRUE(s[1].alwaysInCategory());
+    EXPECT_TRUE(s[1].atLeastAsOftenAsRecordings());
+    // A seed heard wrong where every recording was heard right falls below them.
+    figs[3].heardWithout[0].heard = "water";
+    const auto below = overSeeds(figs);
+    EXPECT_FALSE(below[1].atLeastAsOftenAsRecordings()) << "1/2 seeds against 4/4";
+    EXPECT_TRUE(below[2].sources.empty()) << "leaves: no recorded material";
+}
+
 class SurfaceFiguresOnRecordings : public underfoot::realism::test::RecordingsCacheTest {};
 
 TEST_F(SurfaceFiguresOnRecordings, DistancesAndDescriptorsAreThoseOfCompare) {
@@ -111,6 +157,14 @@ TEST_F(SurfaceFiguresOnRecordings, DistancesAndDescriptorsAreThoseOfCompare) {
         EXPECT_EQ(f.sources, int(sourcesOf[s.material].size()));
         EXPECT_LE(f.categoryRight, f.sources);
         EXPECT_LE(f.materialRight, f.categoryRight);
+        // Each scored verdict carries how that listener heard the source's own recordings.
+        for (const auto& v : f.heardWithout) {
+            if (!v.scored) continue;
+            int files = 0;
+            for (const auto& r : recs_) files += r.source == v.source && r.material == s.material;
+            EXPECT_EQ(v.recordings.files, files) << v.source;
+            EXPECT_LE(v.recordings.categoryRight, v.recordings.files) << v.source;
+        }
         EXPECT_GT(f.nanosecondsPerFrame, 0.0);
         EXPECT_TRUE(std::isfinite(f.nanosecondsPerFrame));
     }
