@@ -299,10 +299,13 @@ void printVerdicts(const std::vector<eng::SurfaceInfo>& infos,
 // Renders judged by listeners that never heard a source: heard[S][i] is the material heard in
 // infos[i]'s render without S. Per held-out source: its recordings' leave-one-source-out score
 // (loso), every surface's category, and the surfaces of a material S recorded (category and
-// material right or not); then per surface over the sources that recorded its material.
+// material right or not); then per surface over the sources that recorded its material, with how
+// the same listener heard the source's own recordings of it where the render was put in another
+// category.
 void printNested(const std::vector<eng::SurfaceInfo>& infos, const std::vector<rl::Example>& recs,
                  const std::map<std::string, std::vector<std::string>>& heard,
-                 const rl::LosoResult& loso, const std::string& title, Out& out) {
+                 const rl::LosoResult& loso, const rl::ListenerOptions& lo,
+                 const std::string& title, Out& out) {
     std::map<std::string, std::set<std::string>> recorded; // source -> materials
     for (const auto& e : recs) recorded[e.source].insert(e.material);
     out.heading(title);
@@ -349,17 +352,32 @@ void printNested(const std::vector<eng::SurfaceInfo>& infos, const std::vector<r
             {info.id, rl::materialOfSurface(info.id), std::string(eng::toString(info.category))});
     std::vector<rl::SurfaceFigures> scored(infos.size());
     rl::scoreNested(surfaces, heard, recorded, scored);
+    rl::addHeldOutRecordings(rl::heldOutRecordings(recs, lo), scored);
     for (const auto& f : scored) {
         std::string list;
-        for (const auto& v : f.heardWithout)
+        for (const auto& v : f.heardWithout) {
             list += fmt::format("{}{}:{}", list.empty() ? "" : " ", v.source, v.heard);
+            if (v.scored && rl::categoryOfMaterial(v.heard) != f.category)
+                list += fmt::format(" ({}/{})", v.recordings.categoryRight, v.recordings.files);
+        }
         perSurf.rows.push_back({f.surface, std::to_string(f.sources),
                                 ratio(f.categoryRight, f.sources),
                                 ratio(f.materialRight, f.sources), list});
     }
     out.line("per surface (sources: held-out sources that recorded its material; category and "
-             "material right without those sources):");
+             "material right without those sources; after a verdict in another category, how "
+             "often that listener put the source's own recordings of the material in its "
+             "category):");
     out.table(perSurf);
+    int atPar = 0, withSources = 0;
+    for (const auto& s : rl::overSeeds(scored)) {
+        if (s.sources.empty()) continue;
+        ++withSources;
+        atPar += s.atLeastAsOftenAsRecordings();
+    }
+    out.line(fmt::format("surfaces heard in their category at least as often as each held-out "
+                         "source's own recordings of their material: {}/{}",
+                         atPar, withSources));
 }
 
 // The onset listener (realism/OnsetListener.h): its configuration chosen from a fixed grid by
@@ -474,7 +492,7 @@ void printRefitNested(const CompareArgs& a, const std::vector<rl::Recording>& re
     for (const auto& info : eng::listSurfaces())
         if (std::find(n.surfaces.begin(), n.surfaces.end(), info.id) != n.surfaces.end())
             infos.push_back(info);
-    printNested(infos, ex, n.heard, loso,
+    printNested(infos, ex, n.heard, loso, lo,
                 "Nested, presets refitted: listener trained and presets fitted without the "
                 "held-out source",
                 out);
@@ -549,7 +567,7 @@ int runListener(const CompareArgs& a) {
     std::vector<std::string> heard;
     for (const auto& e : synth) heard.push_back(l.classify(e.features));
     // centreBySource above changed synth: heardWithoutEachSource centres its own copies.
-    printNested(infos, ex, rl::heardWithoutEachSource(ex, synthUncentred, lo), loso,
+    printNested(infos, ex, rl::heardWithoutEachSource(ex, synthUncentred, lo), loso, lo,
                 "Nested, presets not refitted: listener trained without the held-out source, "
                 "presets as shipped (fitted with it)",
                 out);
