@@ -676,7 +676,11 @@ FitResult fitSurface(const std::string& presetFile, const std::vector<Recording>
         std::vector<std::string> skipped;
     };
     std::vector<Start> starts;
-    if (options.modalSeed && hasLayer(root, "impact")) {
+    // The preset itself is always a start: a seed whose refinement ends farther than the preset's
+    // own modes would otherwise make the fit worse than no fit.
+    starts.push_back({root, "the preset's own parameters", {}, {}});
+    const bool seedTried = options.modalSeed && hasLayer(root, "impact");
+    if (seedTried) {
         for (bool emphasis : {false, true}) {
             auto so = options.seed;
             so.maxModes = impactModeCount(root);
@@ -687,8 +691,6 @@ FitResult fitSurface(const std::string& presetFile, const std::vector<Recording>
             seedImpactModes(s.table, s.modes, so.clusterOctaves);
             starts.push_back(std::move(s));
         }
-    } else {
-        starts.push_back({root, "the preset's own parameters", {}, {}});
     }
     const auto points = fitStartPoints(options.starts, lo, hi);
     result.startPoints = static_cast<int>(points.size());
@@ -756,11 +758,12 @@ FitResult fitSurface(const std::string& presetFile, const std::vector<Recording>
     result.bestStartPoint = static_cast<int>(overallPoint);
     root = starts[overallStart].table;
     bestX = overallX;
-    if (options.modalSeed && hasLayer(originalTable, "impact")) {
+    result.seedTried = seedTried;
+    result.seedStart = starts[overallStart].name;
+    if (seedTried && overallStart > 0) {
         result.modalSeeded = true;
         result.seededModes = starts[overallStart].modes;
         result.seedSkipped = starts[overallStart].skipped;
-        result.seedStart = starts[overallStart].name;
     }
     // Keep the original's loudness: the render's peak equals the original's.
     toml::table fitted = build(bestX);
@@ -845,7 +848,7 @@ FitResult fitSurface(const std::string& presetFile, const std::vector<Recording>
         ct.insert("nearest_other_distance_after", std::round(result.after.nearest * 1000) / 1000);
         prov.insert("contrast", ct);
     }
-    if (result.modalSeeded) {
+    if (seedTried) {
         toml::table seed;
         seed.insert("method", "matrix pencil on the strongest steps, clustered across files "
                               "and sources (realism/ModalSeed.h)");
@@ -854,7 +857,8 @@ FitResult fitSurface(const std::string& presetFile, const std::vector<Recording>
         seed.insert("modes_per_step", options.seed.modesPerStep);
         seed.insert("steps_per_file", options.seed.stepsPerFile);
         seed.insert("starts_tried", static_cast<std::int64_t>(starts.size()));
-        seed.insert("distance", std::round(result.distanceSeeded * 1000) / 1000);
+        if (result.modalSeeded)
+            seed.insert("distance", std::round(result.distanceSeeded * 1000) / 1000);
         prov.insert("modal_seed", seed);
     }
     fitted.insert_or_assign("provenance", prov);

@@ -33,8 +33,9 @@
 /// (10) the mass is lowered instead (same g^2 / m). With fewer recorded modes than the preset
 /// has, the original modes above the highest recorded one fill the rest. Two seeds are made,
 /// from the pencil on the signal and on its first difference (ModalSeedOptions::preEmphasis;
-/// the first finds the strong low modes, the second the modes of the upper octaves); each is
-/// refined by the knobs with up to maxEvaluations renders, and the better result is kept.
+/// the first finds the strong low modes, the second the modes of the upper octaves). The preset
+/// with its own modes is a third start; each is refined by the knobs with up to maxEvaluations
+/// renders, and the best result is kept, so a seed never leaves the fit worse than the preset.
 ///
 /// Contrastive objective (FitOptions::others, contrast, margin; `underfoot fit --contrast
 /// LAMBDA --margin M`): minimising the distance to the own recordings alone can land a render
@@ -120,7 +121,8 @@ struct FitResult {
     double seconds = 0; ///< wall-clock time of the fit
     std::vector<FitKnob> knobs;
     std::string optimiser;
-    bool modalSeeded = false; ///< the modes were seeded from the recordings
+    bool seedTried = false;   ///< recorded modes were tried as starts (a solid, modalSeed on)
+    bool modalSeeded = false; ///< the result was refined from recorded modes (else its own)
     double distanceSeeded =
         0; ///< objective J of the seeded preset before refining (its distance without contrast)
     std::vector<RecordedMode> seededModes; ///< the recorded modes written into the preset

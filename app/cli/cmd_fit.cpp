@@ -174,6 +174,8 @@ int runFit(FitArgs& a) {
                        m.frequencyHz, m.t60S, 20 * std::log10(m.gain), 100 * m.support,
                        m.observations);
         for (const auto& f : r.seedSkipped) fmt::print("  (no mode from {})\n", f);
+    } else if (r.seedTried) {
+        fmt::print("modal seed tried: the preset's own modes refined better and were kept\n");
     }
     fmt::print("{}: distance {:.3f} -> {:.3f} after {} evaluations ({}) in {:.1f} s -> {}\n",
                a.surface, r.distanceBefore, r.distanceAfter, r.evaluations, r.optimiser, r.seconds,

@@ -208,10 +208,11 @@ class PaletteCompareTest : public QObject {
         QVERIFY2(finished.front().front().toBool(), qPrintable(c->message()));
         QVERIFY(!progress.isEmpty());
         int last = 0;
-        // A solid is refined from two starting points (its recorded modes from the signal and
-        // from its first difference, realism/Fit.h): the budget is 8 per start.
+        // A solid is refined from three starting points (its own modes, and its recorded modes
+        // from the signal and from its first difference, realism/Fit.h): the budget is 8 per
+        // start.
         const int budget = progress.front().at(1).toInt();
-        QVERIFY(budget == 8 || budget == 16);
+        QVERIFY(budget == 8 || budget == 24);
         for (const auto& args : progress) {
             QCOMPARE(args.at(1).toInt(), budget);
             QVERIFY(args.at(0).toInt() > last); // evaluation k of N, increasing
