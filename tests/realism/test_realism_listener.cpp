@@ -28,6 +28,19 @@ Example example(const std::string& source, const std::string& material, double c
     return e;
 }
 
+// Sources a, b and c recorded metal (at 0) and water (at 8), three files each; c alone also
+// recorded gravel, at 1, next to metal.
+std::vector<Example> metalWaterAndALoneGravel(std::mt19937& g) {
+    std::vector<Example> rec;
+    for (const char* src : {"a", "b", "c"})
+        for (int i = 0; i < 3; ++i) {
+            rec.push_back(example(src, "metal", 0.0, g));
+            rec.push_back(example(src, "water", 8.0, g));
+        }
+    for (int i = 0; i < 3; ++i) rec.push_back(example("c", "gravel", 1.0, g));
+    return rec;
+}
+
 fs::path scratch(const std::string& name) {
     auto p = fs::temp_directory_path() / ("underfoot_realism_" + name);
     fs::remove_all(p);
@@ -104,13 +117,7 @@ TEST(RealismListener, RendersAreJudgedByListenersThatNeverHeardASource) {
     // own median is 1.2 and centring leaves them in place relative to the recordings' median)
     // is heard as gravel by the listener that knows c, as metal by the one trained without c.
     std::mt19937 g(5);
-    std::vector<Example> rec;
-    for (const char* src : {"a", "b", "c"})
-        for (int i = 0; i < 3; ++i) {
-            rec.push_back(example(src, "metal", 0.0, g));
-            rec.push_back(example(src, "water", 8.0, g));
-        }
-    for (int i = 0; i < 3; ++i) rec.push_back(example("c", "gravel", 1.0, g));
+    const auto rec = metalWaterAndALoneGravel(g);
     const auto n = static_cast<std::size_t>(kDescriptorCount + 4);
     const std::vector<Example> renders = {{"m", "synthetic", "", std::vector<double>(n, 0.0)},
                                           {"g", "synthetic", "", std::vector<double>(n, 1.2)},
@@ -135,13 +142,7 @@ TEST(RealismListener, HeldOutRecordingsAreJudgedByTheRendersListener) {
     // Source c alone recorded gravel, next to everyone's metal: the listener without c, which
     // hears a gravel-like render as metal, hears c's own gravel as metal too.
     std::mt19937 g(5);
-    std::vector<Example> rec;
-    for (const char* src : {"a", "b", "c"})
-        for (int i = 0; i < 3; ++i) {
-            rec.push_back(example(src, "metal", 0.0, g));
-            rec.push_back(example(src, "water", 8.0, g));
-        }
-    for (int i = 0; i < 3; ++i) rec.push_back(example("c", "gravel", 1.0, g));
+    const auto rec = metalWaterAndALoneGravel(g);
     const ListenerOptions plain{false, true, true};
     const auto own = heldOutRecordings(rec, plain);
     ASSERT_EQ(own.size(), 3u);

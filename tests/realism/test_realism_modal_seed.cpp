@@ -105,6 +105,15 @@ class ModalSeed : public ::testing::Test {
         std::ofstream(preset_) << kPreset;
     }
     void TearDown() override { fs::remove_all(dir_); }
+    // A fit small enough for a test: 2 s renders, 6 evaluations per start, one step per file.
+    static FitOptions smallFit() {
+        FitOptions o;
+        o.spec.seconds = 2.0;
+        o.maxEvaluations = 6;
+        o.seed.stepsPerFile = 1;
+        o.seed.maxSamples = 768;
+        return o;
+    }
     fs::path dir_;
     std::vector<Recording> recordings_;
     std::string preset_;
@@ -211,11 +220,7 @@ TEST_F(ModalSeed, TheSeededPresetCarriesTheRecordedModes) {
 }
 
 TEST_F(ModalSeed, ASeededFitIsDeterministic) {
-    FitOptions o;
-    o.spec.seconds = 2.0;
-    o.maxEvaluations = 6;
-    o.seed.stepsPerFile = 1;
-    o.seed.maxSamples = 768;
+    FitOptions o = smallFit();
     // Modes two to four octaves above the recorded ones: the knobs (decay, tilt) cannot bring
     // them down, the seed can.
     std::string high = kPreset;
@@ -259,11 +264,7 @@ TEST_F(ModalSeed, ASeedThatRefinesWorseThanThePresetIsNotKept) {
     // The test preset's modes (100, 900, 3000 Hz) straddle the recorded ones: with six
     // evaluations the knobs bring them as close as the seeds get (objective 1.475 against
     // 1.491 and 1.491). The fit keeps the preset's own modes and is never worse than them.
-    FitOptions o;
-    o.spec.seconds = 2.0;
-    o.maxEvaluations = 6;
-    o.seed.stepsPerFile = 1;
-    o.seed.maxSamples = 768;
+    FitOptions o = smallFit();
     const auto r = fitSurface(preset_, recordings_, o);
     ASSERT_EQ(r.startObjectives.size(), 3u);
     EXPECT_TRUE(r.seedTried);
