@@ -630,9 +630,10 @@ CommandRegistrar reg("compare", [](CLI::App& app, int& exitCode) {
     cmd->add_flag("--listener", args->listener,
                   "the listener: leave-one-source-out baseline and its verdict on every surface");
     cmd->add_flag("--figures", args->figures,
-                  "per surface and render seed: the nested listener's verdicts, the distance to "
-                  "its own recordings and the nearest other material, flatness and centroid "
-                  "against its recordings, CPU time per frame (docs/explanation/realism.md)");
+                  "per surface and render seed: the nested listener's verdicts (beside how it "
+                  "heard the held-out source's own recordings), the distance to its own "
+                  "recordings and the nearest other material, flatness and centroid against its "
+                  "recordings, CPU time per frame (docs/explanation/realism.md)");
     cmd->add_option("--seeds", args->seeds, "with --figures: the render seeds")
         ->delimiter(',')
         ->capture_default_str()
