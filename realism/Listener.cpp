@@ -159,24 +159,36 @@ Listener trainedWithout(const std::vector<Example>& ex, const std::string& held,
     l.train(train);
     return l;
 }
-} // namespace
 
-LosoResult leaveOneSourceOut(const std::vector<Example>& input, ListenerOptions o) {
+// Every labelled file of every source S judged by the listener trained without S (examples
+// centred by source first when the options say so): judge(file, heard, seen), seen false for a
+// material no other source recorded. Throws std::invalid_argument with fewer than two sources.
+template <typename Judge>
+void judgeEachSourceWithout(const std::vector<Example>& input, ListenerOptions o, const char* who,
+                            Judge judge) {
     std::vector<Example> ex = input;
     if (o.centrePerSource) centreBySource(ex);
-    LosoResult r;
-    for (const auto& held : twoSourcesOrMore(ex, "leave-one-source-out")) {
+    for (const auto& held : twoSourcesOrMore(ex, who)) {
         const Listener l = trainedWithout(ex, held, o);
         const auto& mats = l.materials();
         for (const auto& e : ex) {
             if (e.source != held) continue;
-            if (std::find(mats.begin(), mats.end(), e.material) == mats.end()) {
-                ++r.unseenMaterialFiles;
-                continue;
-            }
-            r.score(held, e.material, l.classify(e.features));
+            judge(e, l.classify(e.features),
+                  std::find(mats.begin(), mats.end(), e.material) != mats.end());
         }
     }
+}
+} // namespace
+
+LosoResult leaveOneSourceOut(const std::vector<Example>& input, ListenerOptions o) {
+    LosoResult r;
+    judgeEachSourceWithout(input, o, "leave-one-source-out",
+                           [&](const Example& e, const std::string& heard, bool seen) {
+                               if (seen)
+                                   r.score(e.source, e.material, heard);
+                               else
+                                   ++r.unseenMaterialFiles;
+                           });
     return r;
 }
 
@@ -210,20 +222,14 @@ heardWithoutEachSource(const std::vector<Example>& recordings, const std::vector
 
 std::map<std::string, std::map<std::string, HeldOutCounts>>
 heldOutRecordings(const std::vector<Example>& input, ListenerOptions o) {
-    std::vector<Example> ex = input;
-    if (o.centrePerSource) centreBySource(ex);
     std::map<std::string, std::map<std::string, HeldOutCounts>> counts;
-    for (const auto& held : twoSourcesOrMore(ex, "heldOutRecordings")) {
-        const Listener l = trainedWithout(ex, held, o);
-        for (const auto& e : ex) {
-            if (e.source != held) continue;
-            const auto heard = l.classify(e.features);
-            auto& c = counts[held][e.material];
+    judgeEachSourceWithout(
+        input, o, "heldOutRecordings", [&](const Example& e, const std::string& heard, bool) {
+            auto& c = counts[e.source][e.material];
             ++c.files;
             c.categoryRight += categoryOfMaterial(heard) == categoryOfMaterial(e.material);
             c.materialRight += heard == e.material;
-        }
-    }
+        });
     return counts;
 }
 
