@@ -41,6 +41,24 @@ void onlyKeys(const std::string& source, const toml::table& t, std::set<std::str
     });
 }
 
+// Calls each(entry, node) for every entry of the array of tables [[key]] of root (if present),
+// each entry checked to be a table with only the allowed keys.
+template <class Each>
+void forEachEntry(const std::string& source, const toml::table& root, const char* key,
+                  const std::set<std::string>& allowed, Each each) {
+    const toml::node* n = root.get(key);
+    if (!n) return;
+    const std::string context = fmt::format("[[{}]]", key);
+    const toml::array* arr = n->as_array();
+    if (!arr) fail(source, *n, fmt::format("'{}' must be an array of tables: {}", key, context));
+    for (const auto& item : *arr) {
+        const toml::table* t = item.as_table();
+        if (!t) fail(source, item, context + " entries must be tables");
+        onlyKeys(source, *t, allowed, context.c_str());
+        each(*t, item);
+    }
+}
+
 } // namespace
 
 CoherenceTable CoherenceTable::parse(const std::string& text, const std::string& source) {
@@ -54,30 +72,20 @@ CoherenceTable CoherenceTable::parse(const std::string& text, const std::string&
         table.entries_.push_back({surface, std::nullopt, {}});
         return table.entries_.back();
     };
-    if (const toml::node* n = root.get("coherent")) {
-        const toml::array* arr = n->as_array();
-        if (!arr) fail(source, *n, "'coherent' must be an array of tables: [[coherent]]");
-        for (const auto& item : *arr) {
-            const toml::table* t = item.as_table();
-            if (!t) fail(source, item, "[[coherent]] entries must be tables");
-            onlyKeys(source, *t, {"surface", "soundscape"}, "[[coherent]]");
-            CoherenceEntry& e = entryFor(str(source, *t, "surface", item));
-            if (e.coherent)
-                fail(source, item,
-                     fmt::format("surface '{}' already has a coherent soundscape ('{}')", e.surface,
-                                 *e.coherent));
-            e.coherent = str(source, *t, "soundscape", item);
-        }
-    }
-    if (const toml::node* n = root.get("incoherent")) {
-        const toml::array* arr = n->as_array();
-        if (!arr) fail(source, *n, "'incoherent' must be an array of tables: [[incoherent]]");
-        for (const auto& item : *arr) {
-            const toml::table* t = item.as_table();
-            if (!t) fail(source, item, "[[incoherent]] entries must be tables");
-            onlyKeys(source, *t, {"surface", "soundscapes"}, "[[incoherent]]");
-            CoherenceEntry& e = entryFor(str(source, *t, "surface", item));
-            const toml::node* s = t->get("soundscapes");
+    forEachEntry(source, root, "coherent", {"surface", "soundscape"},
+                 [&](const toml::table& t, const toml::node& item) {
+                     CoherenceEntry& e = entryFor(str(source, t, "surface", item));
+                     if (e.coherent)
+                         fail(source, item,
+                              fmt::format("surface '{}' already has a coherent soundscape ('{}')",
+                                          e.surface, *e.coherent));
+                     e.coherent = str(source, t, "soundscape", item);
+                 });
+    forEachEntry(
+        source, root, "incoherent", {"surface", "soundscapes"},
+        [&](const toml::table& t, const toml::node& item) {
+            CoherenceEntry& e = entryFor(str(source, t, "surface", item));
+            const toml::node* s = t.get("soundscapes");
             const toml::array* list = s ? s->as_array() : nullptr;
             if (!list || list->empty())
                 fail(source, s ? *s : item, "expected 'soundscapes' = a non-empty array of ids");
@@ -88,8 +96,7 @@ CoherenceTable CoherenceTable::parse(const std::string& text, const std::string&
                     fail(source, id, fmt::format("'{}' is listed twice for '{}'", v, e.surface));
                 e.incoherent.push_back(std::move(v));
             }
-        }
-    }
+        });
     for (const auto& e : table.entries_)
         for (const auto& inc : e.incoherent)
             if (e.coherent && inc == *e.coherent)

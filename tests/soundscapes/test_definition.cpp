@@ -189,6 +189,9 @@ TEST(Coherence, UnknownKeysAndWrongTypesNameTheirPlace) {
     EXPECT_EQ(
         errorOf("[[incoherent]]\nsurface = \"wood\"\nsoundscapes = [3]\n").rfind("c.toml:3:", 0),
         0u);
+    EXPECT_EQ(errorOf("incoherent = 3\n"),
+              "c.toml:1:14: 'incoherent' must be an array of tables: [[incoherent]]");
+    EXPECT_EQ(errorOf("coherent = [1]\n"), "c.toml:1:13: [[coherent]] entries must be tables");
 }
 
 TEST(Coherence, AnswersTheCoherentPairsOfTheStudy) {
