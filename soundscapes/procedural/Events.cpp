@@ -72,7 +72,7 @@ double lerp(double a, double b, double u) noexcept {
 }
 
 // A voice whose event is a series of calls: silent in the gaps, `callSample` inside a call (u is
-// the position in it, 0..1). The event ends `tail` seconds after its last call.
+// the position in it, 0..1); `endAfterLastCall(tail)` ends the event tail seconds after the last.
 template <std::size_t N>
 class SeriesVoice : public VoiceBase {
   protected:
@@ -371,7 +371,12 @@ class BurstSeriesVoice : public FormantSeriesVoice<N> {
 // Hen: 3-8 clucks ("buk") of 50-90 ms with falling pitch, sometimes ending in a "ba-GAWK".
 class HenVoice final : public BurstSeriesVoice<12> {
   public:
-    explicit HenVoice(const ParamSet& p) : BurstSeriesVoice(p, {0.006, 0.45, 8.0, 0.15, 0.6}) {}
+    explicit HenVoice(const ParamSet& p)
+        : BurstSeriesVoice(p, {.attackS = 0.006,
+                               .decayShare = 0.45,
+                               .releaseSlope = 8.0,
+                               .noiseMix = 0.15,
+                               .f2Gain = 0.6}) {}
     void start(Random& rng) noexcept override {
         series_.clear();
         const double p = pitchHz_ * rng.uniform(0.85, 1.15);
@@ -397,7 +402,12 @@ class HenVoice final : public BurstSeriesVoice<12> {
 // Dog barks: 1-4 (sometimes up to 7) barks of 90-180 ms, pitch falling, a noisy harsh source.
 class DogVoice final : public BurstSeriesVoice<8> {
   public:
-    explicit DogVoice(const ParamSet& p) : BurstSeriesVoice(p, {0.008, 0.4, 6.0, 0.35, 0.7}) {}
+    explicit DogVoice(const ParamSet& p)
+        : BurstSeriesVoice(p, {.attackS = 0.008,
+                               .decayShare = 0.4,
+                               .releaseSlope = 6.0,
+                               .noiseMix = 0.35,
+                               .f2Gain = 0.7}) {}
     void start(Random& rng) noexcept override {
         series_.clear();
         const double p = pitchHz_ * rng.uniform(0.85, 1.15);
