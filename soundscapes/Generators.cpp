@@ -10,8 +10,8 @@
 namespace underfoot::soundscapes {
 namespace {
 
-using BedFactory = std::unique_ptr<BedGenerator> (*)(const ParamSet&);
-using VoiceFactory = std::unique_ptr<EventVoice> (*)(const ParamSet&);
+using procedural::BedFactory;
+using procedural::VoiceFactory;
 
 // One generator: what the catalogue says about it and its factory (which also gives its kind).
 struct Entry {

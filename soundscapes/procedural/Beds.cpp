@@ -607,28 +607,20 @@ class LiftBed final : public BedBase {
     std::array<Channel, 2> ch_{};
 };
 
+// The factories that Procedural.h declares (constant-initialised: usable at any time).
+template <class Generator>
+std::unique_ptr<BedGenerator> makeBed(const ParamSet& p) {
+    return std::make_unique<Generator>(p);
+}
+
 } // namespace
 
-std::unique_ptr<BedGenerator> makeSea(const ParamSet& p) {
-    return std::make_unique<SeaBed>(p);
-}
-std::unique_ptr<BedGenerator> makeWind(const ParamSet& p) {
-    return std::make_unique<WindBed>(p);
-}
-std::unique_ptr<BedGenerator> makeLeaves(const ParamSet& p) {
-    return std::make_unique<LeavesBed>(p);
-}
-std::unique_ptr<BedGenerator> makeTraffic(const ParamSet& p) {
-    return std::make_unique<TrafficBed>(p);
-}
-std::unique_ptr<BedGenerator> makeBabble(const ParamSet& p) {
-    return std::make_unique<BabbleBed>(p);
-}
-std::unique_ptr<BedGenerator> makeTractor(const ParamSet& p) {
-    return std::make_unique<TractorBed>(p);
-}
-std::unique_ptr<BedGenerator> makeLift(const ParamSet& p) {
-    return std::make_unique<LiftBed>(p);
-}
+constinit const BedFactory makeSea = makeBed<SeaBed>;
+constinit const BedFactory makeWind = makeBed<WindBed>;
+constinit const BedFactory makeLeaves = makeBed<LeavesBed>;
+constinit const BedFactory makeTraffic = makeBed<TrafficBed>;
+constinit const BedFactory makeBabble = makeBed<BabbleBed>;
+constinit const BedFactory makeTractor = makeBed<TractorBed>;
+constinit const BedFactory makeLift = makeBed<LiftBed>;
 
 } // namespace underfoot::soundscapes::procedural

@@ -732,46 +732,26 @@ class SkitterVoice final : public VoiceBase {
     Svf band_;
 };
 
+// The factories that Procedural.h declares (constant-initialised: usable at any time).
+template <class Generator>
+std::unique_ptr<EventVoice> makeVoice(const ParamSet& p) {
+    return std::make_unique<Generator>(p);
+}
+
 } // namespace
 
-std::unique_ptr<EventVoice> makeSongbird(const ParamSet& p) {
-    return std::make_unique<SongbirdVoice>(p);
-}
-std::unique_ptr<EventVoice> makeGull(const ParamSet& p) {
-    return std::make_unique<GullVoice>(p);
-}
-std::unique_ptr<EventVoice> makeCuckoo(const ParamSet& p) {
-    return std::make_unique<CuckooVoice>(p);
-}
-std::unique_ptr<EventVoice> makeWoodpecker(const ParamSet& p) {
-    return std::make_unique<WoodpeckerVoice>(p);
-}
-std::unique_ptr<EventVoice> makeHen(const ParamSet& p) {
-    return std::make_unique<HenVoice>(p);
-}
-std::unique_ptr<EventVoice> makeRooster(const ParamSet& p) {
-    return std::make_unique<RoosterVoice>(p);
-}
-std::unique_ptr<EventVoice> makeCow(const ParamSet& p) {
-    return std::make_unique<CowVoice>(p);
-}
-std::unique_ptr<EventVoice> makeDog(const ParamSet& p) {
-    return std::make_unique<DogVoice>(p);
-}
-std::unique_ptr<EventVoice> makeSwish(const ParamSet& p) {
-    return std::make_unique<SwishVoice>(p);
-}
-std::unique_ptr<EventVoice> makeScrape(const ParamSet& p) {
-    return std::make_unique<ScrapeVoice>(p);
-}
-std::unique_ptr<EventVoice> makeClank(const ParamSet& p) {
-    return std::make_unique<ClankVoice>(p);
-}
-std::unique_ptr<EventVoice> makeShout(const ParamSet& p) {
-    return std::make_unique<ShoutVoice>(p);
-}
-std::unique_ptr<EventVoice> makeSkitter(const ParamSet& p) {
-    return std::make_unique<SkitterVoice>(p);
-}
+constinit const VoiceFactory makeSongbird = makeVoice<SongbirdVoice>;
+constinit const VoiceFactory makeGull = makeVoice<GullVoice>;
+constinit const VoiceFactory makeCuckoo = makeVoice<CuckooVoice>;
+constinit const VoiceFactory makeWoodpecker = makeVoice<WoodpeckerVoice>;
+constinit const VoiceFactory makeHen = makeVoice<HenVoice>;
+constinit const VoiceFactory makeRooster = makeVoice<RoosterVoice>;
+constinit const VoiceFactory makeCow = makeVoice<CowVoice>;
+constinit const VoiceFactory makeDog = makeVoice<DogVoice>;
+constinit const VoiceFactory makeSwish = makeVoice<SwishVoice>;
+constinit const VoiceFactory makeScrape = makeVoice<ScrapeVoice>;
+constinit const VoiceFactory makeClank = makeVoice<ClankVoice>;
+constinit const VoiceFactory makeShout = makeVoice<ShoutVoice>;
+constinit const VoiceFactory makeSkitter = makeVoice<SkitterVoice>;
 
 } // namespace underfoot::soundscapes::procedural
