@@ -4,6 +4,7 @@
 #include "base/TomlReader.h"
 
 #include "soundscapes/Definition.h"
+#include "soundscapes/DefinitionReader.h"
 #include "soundscapes/Library.h"
 
 #include <fmt/format.h>
@@ -18,27 +19,14 @@
 namespace underfoot::soundscapes {
 namespace {
 
-std::string where(const std::string& source, const toml::node& n) {
-    return fmt::format("{}:{}:{}", source, n.source().begin.line, n.source().begin.column);
-}
-[[noreturn]] void fail(const std::string& source, const toml::node& n, const std::string& what) {
-    throw DefinitionError(fmt::format("{}: {}", where(source, n), what));
-}
-std::string str(const std::string& source, const toml::table& t, const char* key,
+// A required, non-empty string.
+std::string str(const DefinitionReader& r, const toml::table& t, const char* key,
                 const toml::node& owner) {
     const toml::node* n = t.get(key);
-    if (!n || !n->is_string())
-        fail(source, n ? *n : owner, fmt::format("expected a string '{}'", key));
+    if (!n || !n->is_string()) r.fail(n ? *n : owner, fmt::format("expected a string '{}'", key));
     std::string s(*n->as_string());
-    if (s.empty()) fail(source, *n, fmt::format("'{}' must not be empty", key));
+    if (s.empty()) r.fail(*n, fmt::format("'{}' must not be empty", key));
     return s;
-}
-void onlyKeys(const std::string& source, const toml::table& t, std::set<std::string> allowed,
-              const char* context) {
-    base::rethrowTomlAs<DefinitionError>([&] {
-        base::TomlReader(source, base::TomlReader::Mode::Throw)
-            .checkKeys(t, std::vector<std::string>(allowed.begin(), allowed.end()), context);
-    });
 }
 
 } // namespace
@@ -46,7 +34,8 @@ void onlyKeys(const std::string& source, const toml::table& t, std::set<std::str
 CoherenceTable CoherenceTable::parse(const std::string& text, const std::string& source) {
     const toml::table root =
         base::rethrowTomlAs<DefinitionError>([&] { return base::parseToml(text, source); });
-    onlyKeys(source, root, {"coherent", "incoherent"}, "the coherence file");
+    const DefinitionReader r(source);
+    r.checkKeys(root, {"coherent", "incoherent"}, "the coherence file");
     CoherenceTable table;
     auto entryFor = [&](const std::string& surface) -> CoherenceEntry& {
         for (auto& e : table.entries_)
@@ -54,42 +43,29 @@ CoherenceTable CoherenceTable::parse(const std::string& text, const std::string&
         table.entries_.push_back({surface, std::nullopt, {}});
         return table.entries_.back();
     };
-    if (const toml::node* n = root.get("coherent")) {
-        const toml::array* arr = n->as_array();
-        if (!arr) fail(source, *n, "'coherent' must be an array of tables: [[coherent]]");
-        for (const auto& item : *arr) {
-            const toml::table* t = item.as_table();
-            if (!t) fail(source, item, "[[coherent]] entries must be tables");
-            onlyKeys(source, *t, {"surface", "soundscape"}, "[[coherent]]");
-            CoherenceEntry& e = entryFor(str(source, *t, "surface", item));
-            if (e.coherent)
-                fail(source, item,
-                     fmt::format("surface '{}' already has a coherent soundscape ('{}')", e.surface,
-                                 *e.coherent));
-            e.coherent = str(source, *t, "soundscape", item);
+    r.forEachTable(root, "coherent", [&](const toml::table& t, const toml::node& item) {
+        r.checkKeys(t, {"surface", "soundscape"}, "[[coherent]]");
+        CoherenceEntry& e = entryFor(str(r, t, "surface", item));
+        if (e.coherent)
+            r.fail(item, fmt::format("surface '{}' already has a coherent soundscape ('{}')",
+                                     e.surface, *e.coherent));
+        e.coherent = str(r, t, "soundscape", item);
+    });
+    r.forEachTable(root, "incoherent", [&](const toml::table& t, const toml::node& item) {
+        r.checkKeys(t, {"surface", "soundscapes"}, "[[incoherent]]");
+        CoherenceEntry& e = entryFor(str(r, t, "surface", item));
+        const toml::node* s = t.get("soundscapes");
+        const toml::array* list = s ? s->as_array() : nullptr;
+        if (!list || list->empty())
+            r.fail(s ? *s : item, "expected 'soundscapes' = a non-empty array of ids");
+        for (const auto& id : *list) {
+            if (!id.is_string()) r.fail(id, "soundscape ids must be strings");
+            std::string v(*id.as_string());
+            if (std::find(e.incoherent.begin(), e.incoherent.end(), v) != e.incoherent.end())
+                r.fail(id, fmt::format("'{}' is listed twice for '{}'", v, e.surface));
+            e.incoherent.push_back(std::move(v));
         }
-    }
-    if (const toml::node* n = root.get("incoherent")) {
-        const toml::array* arr = n->as_array();
-        if (!arr) fail(source, *n, "'incoherent' must be an array of tables: [[incoherent]]");
-        for (const auto& item : *arr) {
-            const toml::table* t = item.as_table();
-            if (!t) fail(source, item, "[[incoherent]] entries must be tables");
-            onlyKeys(source, *t, {"surface", "soundscapes"}, "[[incoherent]]");
-            CoherenceEntry& e = entryFor(str(source, *t, "surface", item));
-            const toml::node* s = t->get("soundscapes");
-            const toml::array* list = s ? s->as_array() : nullptr;
-            if (!list || list->empty())
-                fail(source, s ? *s : item, "expected 'soundscapes' = a non-empty array of ids");
-            for (const auto& id : *list) {
-                if (!id.is_string()) fail(source, id, "soundscape ids must be strings");
-                std::string v(*id.as_string());
-                if (std::find(e.incoherent.begin(), e.incoherent.end(), v) != e.incoherent.end())
-                    fail(source, id, fmt::format("'{}' is listed twice for '{}'", v, e.surface));
-                e.incoherent.push_back(std::move(v));
-            }
-        }
-    }
+    });
     for (const auto& e : table.entries_)
         for (const auto& inc : e.incoherent)
             if (e.coherent && inc == *e.coherent)

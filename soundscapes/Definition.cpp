@@ -2,6 +2,7 @@
 #include "soundscapes/Definition.h"
 
 #include "base/TomlReader.h"
+#include "soundscapes/DefinitionReader.h"
 
 #include <fmt/format.h>
 #include <toml++/toml.h>
@@ -14,68 +15,6 @@
 
 namespace underfoot::soundscapes {
 namespace {
-
-// Reads one TOML file with located, explicit error messages.
-class Reader {
-  public:
-    explicit Reader(std::string source) : source_(std::move(source)) {}
-
-    std::string where(const toml::node& node) const {
-        const auto& b = node.source().begin;
-        return fmt::format("{}:{}:{}", source_, b.line, b.column);
-    }
-    [[noreturn]] void fail(const toml::node& node, const std::string& what) const {
-        throw DefinitionError(fmt::format("{}: {}", where(node), what));
-    }
-    [[noreturn]] void failAt(const std::string& where, const std::string& what) const {
-        throw DefinitionError(fmt::format("{}: {}", where, what));
-    }
-
-    // The unknown-key check and the number checks of the shared reader (base/TomlReader.h),
-    // stopping at the first problem.
-    void checkKeys(const toml::table& t, const std::set<std::string>& allowed,
-                   const std::string& context) const {
-        base::rethrowTomlAs<DefinitionError>([&] {
-            base::TomlReader(source_, base::TomlReader::Mode::Throw)
-                .checkKeys(t, std::vector<std::string>(allowed.begin(), allowed.end()), context);
-        });
-    }
-
-    std::string string(const toml::table& t, std::string_view key, const std::string& context,
-                       const toml::node& owner, bool required) const {
-        const toml::node* n = t.get(key);
-        if (!n) {
-            if (required) fail(owner, fmt::format("{} needs a string '{}'", context, key));
-            return {};
-        }
-        if (!n->is_string()) fail(*n, fmt::format("'{}' must be a string", key));
-        return std::string(*n->as_string());
-    }
-
-    double number(const toml::node& n, std::string_view key, double lo, double hi) const {
-        return base::rethrowTomlAs<DefinitionError>([&] {
-            return *base::TomlReader(source_, base::TomlReader::Mode::Throw)
-                        .numberNode(n, fmt::format("'{}'", key), lo, hi);
-        });
-    }
-    double number(const toml::table& t, std::string_view key, double lo, double hi,
-                  double fallback) const {
-        const toml::node* n = t.get(key);
-        return n ? number(*n, key, lo, hi) : fallback;
-    }
-    std::pair<double, double> range(const toml::node& n, std::string_view key, double lo,
-                                    double hi) const {
-        const toml::array* a = n.as_array();
-        if (!a || a->size() != 2)
-            fail(n, fmt::format("'{}' must be a two-number array [min, max]", key));
-        const double x = number(*a->get(0), key, lo, hi), y = number(*a->get(1), key, lo, hi);
-        if (x > y) fail(n, fmt::format("'{}' must be [min, max] with min <= max", key));
-        return {x, y};
-    }
-
-  private:
-    std::string source_;
-};
 
 bool validId(const std::string& s) {
     if (s.empty()) return false;
@@ -90,11 +29,9 @@ std::string resolvePath(const std::string& file, const std::string& base) {
     return (std::filesystem::path(base) / p).lexically_normal().string();
 }
 
-LayerDefinition parseLayer(const Reader& r, const toml::node& node, LayerKind kind,
-                           const std::string& base) {
+LayerDefinition parseLayer(const DefinitionReader& r, const toml::table& t, const toml::node& node,
+                           LayerKind kind, const std::string& base) {
     const std::string context = kind == LayerKind::Bed ? "[[bed]]" : "[[event]]";
-    const toml::table* t = node.as_table();
-    if (!t) r.fail(node, context + " entries must be tables");
     std::set<std::string> allowed{"name",     "generator", "file",   "files",
                                   "level_db", "params",    "enabled"};
     if (kind == LayerKind::Bed)
@@ -102,27 +39,27 @@ LayerDefinition parseLayer(const Reader& r, const toml::node& node, LayerKind ki
     else
         allowed.insert({"rate_per_minute", "mean_interval_s", "jitter", "gain_db", "pan",
                         "max_voices", "first_onset_s"});
-    r.checkKeys(*t, allowed, context);
+    r.checkKeys(t, allowed, context);
 
     LayerDefinition layer;
     layer.kind = kind;
     layer.location = r.where(node);
-    layer.name = r.string(*t, "name", context, node, true);
+    layer.name = r.string(t, "name", context, node, true);
     if (!validId(layer.name))
-        r.fail(*t->get("name"), "layer name must be letters, digits or '_' (it names the layer "
-                                "in messages and statistics)");
-    layer.levelDb = r.number(*t, "level_db", -80.0, 40.0, 0.0);
+        r.fail(*t.get("name"), "layer name must be letters, digits or '_' (it names the layer "
+                               "in messages and statistics)");
+    layer.levelDb = r.number(t, "level_db", -80.0, 40.0, 0.0);
 
-    const toml::node* gen = t->get("generator");
-    const toml::node* file = t->get("file");
-    const toml::node* files = t->get("files");
+    const toml::node* gen = t.get("generator");
+    const toml::node* file = t.get("file");
+    const toml::node* files = t.get("files");
     const int sources = (gen ? 1 : 0) + (file ? 1 : 0) + (files ? 1 : 0);
     if (sources != 1)
         r.fail(node, fmt::format("layer '{}' needs exactly one of 'generator', 'file' or 'files'",
                                  layer.name));
     if (gen) {
         layer.source = LayerSource::Procedural;
-        layer.generator = r.string(*t, "generator", context, node, true);
+        layer.generator = r.string(t, "generator", context, node, true);
         const GeneratorInfo* info = findGenerator(layer.generator);
         if (!info || info->kind != kind) {
             std::string list;
@@ -133,7 +70,7 @@ LayerDefinition parseLayer(const Reader& r, const toml::node& node, LayerKind ki
                                kind == LayerKind::Bed ? "bed" : "event", layer.generator, list));
         }
         layer.params.setGenerator(info);
-        if (const toml::node* params = t->get("params")) {
+        if (const toml::node* params = t.get("params")) {
             const toml::table* pt = params->as_table();
             if (!pt) r.fail(*params, "'params' must be a table, e.g. params = { pitch_hz = 500 }");
             for (const auto& [key, value] : *pt) {
@@ -151,10 +88,10 @@ LayerDefinition parseLayer(const Reader& r, const toml::node& node, LayerKind ki
             }
         }
     } else {
-        if (t->get("params")) r.fail(*t->get("params"), "'params' applies to generators only");
+        if (t.get("params")) r.fail(*t.get("params"), "'params' applies to generators only");
         layer.source = LayerSource::Recording;
         if (file) {
-            layer.files.push_back(resolvePath(r.string(*t, "file", context, node, true), base));
+            layer.files.push_back(resolvePath(r.string(t, "file", context, node, true), base));
         } else {
             const toml::array* a = files->as_array();
             if (!a || a->empty()) r.fail(*files, "'files' must be a non-empty array of paths");
@@ -166,27 +103,27 @@ LayerDefinition parseLayer(const Reader& r, const toml::node& node, LayerKind ki
                 r.fail(*files, "a bed loops one recording: use 'file'");
         }
     }
-    if (const toml::node* en = t->get("enabled"); en && !en->is_boolean())
+    if (const toml::node* en = t.get("enabled"); en && !en->is_boolean())
         r.fail(*en, "'enabled' must be true or false");
 
     if (kind == LayerKind::Bed) {
-        layer.crossfadeSeconds = r.number(*t, "crossfade_s", 0.0, 60.0, 2.0);
+        layer.crossfadeSeconds = r.number(t, "crossfade_s", 0.0, 60.0, 2.0);
     } else {
-        const toml::node* rate = t->get("rate_per_minute");
-        const toml::node* interval = t->get("mean_interval_s");
+        const toml::node* rate = t.get("rate_per_minute");
+        const toml::node* interval = t.get("mean_interval_s");
         if ((rate ? 1 : 0) + (interval ? 1 : 0) != 1)
             r.fail(node, fmt::format("event layer '{}' needs exactly one of 'rate_per_minute' "
                                      "or 'mean_interval_s'",
                                      layer.name));
         layer.ratePerMinute = rate ? r.number(*rate, "rate_per_minute", 0.01, 6000.0)
                                    : 60.0 / r.number(*interval, "mean_interval_s", 0.01, 6000.0);
-        layer.jitter = r.number(*t, "jitter", 0.0, 1.0, 1.0);
-        if (const toml::node* g = t->get("gain_db"))
+        layer.jitter = r.number(t, "jitter", 0.0, 1.0, 1.0);
+        if (const toml::node* g = t.get("gain_db"))
             std::tie(layer.gainDbMin, layer.gainDbMax) = r.range(*g, "gain_db", -80.0, 40.0);
-        if (const toml::node* p = t->get("pan"))
+        if (const toml::node* p = t.get("pan"))
             std::tie(layer.panMin, layer.panMax) = r.range(*p, "pan", -1.0, 1.0);
-        layer.maxVoices = static_cast<int>(r.number(*t, "max_voices", 1.0, 64.0, 4.0));
-        if (const toml::node* f = t->get("first_onset_s"))
+        layer.maxVoices = static_cast<int>(r.number(t, "max_voices", 1.0, 64.0, 4.0));
+        if (const toml::node* f = t.get("first_onset_s"))
             layer.firstOnsetSeconds = r.range(*f, "first_onset_s", 0.0, 3600.0);
     }
     return layer;
@@ -198,7 +135,7 @@ SoundscapeDefinition parseSoundscapeDefinition(std::string_view text, const std:
                                                const std::string& baseDirectory) {
     const toml::table root =
         base::rethrowTomlAs<DefinitionError>([&] { return base::parseToml(text, sourceName); });
-    Reader r(sourceName);
+    DefinitionReader r(sourceName);
     r.checkKeys(root, {"soundscape", "bed", "event"}, "the file");
 
     const toml::node* head = root.get("soundscape");
@@ -223,18 +160,14 @@ SoundscapeDefinition parseSoundscapeDefinition(std::string_view text, const std:
     std::set<std::string> names;
     for (const auto& [key, kind] :
          {std::pair{"bed", LayerKind::Bed}, std::pair{"event", LayerKind::Event}}) {
-        const toml::node* n = root.get(key);
-        if (!n) continue;
-        const toml::array* arr = n->as_array();
-        if (!arr) r.fail(*n, fmt::format("'{}' must be an array of tables: [[{}]]", key, key));
-        for (const auto& item : *arr) {
-            LayerDefinition layer = parseLayer(r, item, kind, baseDirectory);
+        r.forEachTable(root, key, [&](const toml::table& t, const toml::node& item) {
+            LayerDefinition layer = parseLayer(r, t, item, kind, baseDirectory);
             if (!names.insert(layer.name).second)
                 r.failAt(layer.location, fmt::format("duplicate layer name '{}'", layer.name));
-            const toml::node* en = item.as_table()->get("enabled");
-            if (en && !en->as_boolean()->get()) continue; // declared off: never computed
+            const toml::node* en = t.get("enabled");
+            if (en && !en->as_boolean()->get()) return; // declared off: never computed
             def.layers.push_back(std::move(layer));
-        }
+        });
     }
     if (def.layers.empty())
         throw DefinitionError(fmt::format("{}: a soundscape needs at least one enabled [[bed]] or "

@@ -14,19 +14,37 @@ using engine::Random;
 
 constexpr int kControlInterval = 16; // samples between filter retunings
 
+// Shared mechanics: the sample rate, and the bed's one random stream, seeded at each reset
+// before the bed restarts its own state.
+class BedBase : public BedGenerator {
+  public:
+    void prepare(const ProcessSpec& spec) override {
+        fs_ = spec.sampleRateHz;
+        onPrepare();
+    }
+    void reset(std::uint64_t seed) noexcept override {
+        rng_.setSeed(seed);
+        onReset();
+    }
+
+  protected:
+    virtual void onPrepare() {}
+    virtual void onReset() noexcept = 0;
+    double fs_ = 48000.0;
+    Random rng_;
+};
+
 // ---------------------------------------------------------------------------------------------
 // Sea: each wave is a swell (quadratic rise over 30 % of its period) that breaks and washes out
 // exponentially. The swell opens a low-pass on pink noise (the roar) and, as it breaks, lets
 // high-passed white noise through (the foam). The right channel hears the same waves a little
 // later (the wave breaks along the shore), with its own noise.
-class SeaBed final : public BedGenerator {
+class SeaBed final : public BedBase {
   public:
     explicit SeaBed(const ParamSet& p)
         : periodS_(p.get("wave_period_s")), brightHz_(p.get("brightness_hz")),
           foam_(p.get("foam")) {}
-    void prepare(const ProcessSpec& spec) override { fs_ = spec.sampleRateHz; }
-    void reset(std::uint64_t seed) noexcept override {
-        rng_.setSeed(seed);
+    void onReset() noexcept override {
         for (auto& c : ch_) {
             c.pink.reset();
             c.body.reset();
@@ -102,8 +120,7 @@ class SeaBed final : public BedGenerator {
         PinkNoise pink;
         Svf body, foamHp, rumble;
     };
-    double periodS_, brightHz_, foam_, fs_ = 48000.0;
-    Random rng_;
+    double periodS_, brightHz_, foam_;
     std::array<Channel, 2> ch_{};
     long len_ = 1, pos_ = 0;
     double peak_ = 0.7, prevPeak_ = 0.7, shift_ = 0.05;
@@ -115,19 +132,17 @@ class SeaBed final : public BedGenerator {
 // Wind: white noise through a band-pass whose centre and level follow a slow random gust signal
 // (Farnell, "Designing Sound", ch. 40, reduced to one band); a low rumble of pink noise and an
 // optional narrow whistle band that only speaks in strong gusts.
-class WindBed final : public BedGenerator {
+class WindBed final : public BedBase {
   public:
     explicit WindBed(const ParamSet& p)
         : centreHz_(p.get("centre_hz")), gust_(p.get("gustiness")), whistle_(p.get("whistle")) {}
-    void prepare(const ProcessSpec& spec) override {
-        fs_ = spec.sampleRateHz;
+    void onPrepare() override {
         // Modulators run at the control rate (one step per kControlInterval samples).
         const double controlRate = fs_ / kControlInterval;
         gustMod_.configure(2.5, 1.0, controlRate);
         for (auto& c : ch_) c.mod.configure(1.0, 0.4, controlRate);
     }
-    void reset(std::uint64_t seed) noexcept override {
-        rng_.setSeed(seed);
+    void onReset() noexcept override {
         gustMod_.reset(rng_);
         for (auto& c : ch_) {
             c.mod.reset(rng_);
@@ -183,8 +198,7 @@ class WindBed final : public BedGenerator {
         PinkNoise pink;
         double amp = 0, ampStep = 0, wh = 0, whStep = 0;
     };
-    double centreHz_, gust_, whistle_, fs_ = 48000.0;
-    Random rng_;
+    double centreHz_, gust_, whistle_;
     SmoothRandom gustMod_;
     std::array<Channel, 2> ch_{};
     int counter_ = 0;
@@ -194,17 +208,13 @@ class WindBed final : public BedGenerator {
 // Leaves: rustling as a Poisson stream of tiny clicks (leaf contacts) whose rate follows the
 // square of a gust signal, each click ringing two broad bands; plus a breathy high-passed hiss
 // in the gusts. Density scales the click rate (dry park leaves vs. a canopy in the wind).
-class LeavesBed final : public BedGenerator {
+class LeavesBed final : public BedBase {
   public:
     explicit LeavesBed(const ParamSet& p)
         : density_(p.get("density")), brightHz_(p.get("brightness_hz")), gust_(p.get("gustiness")) {
     }
-    void prepare(const ProcessSpec& spec) override {
-        fs_ = spec.sampleRateHz;
-        gustMod_.configure(3.0, 1.2, fs_);
-    }
-    void reset(std::uint64_t seed) noexcept override {
-        rng_.setSeed(seed);
+    void onPrepare() override { gustMod_.configure(3.0, 1.2, fs_); }
+    void onReset() noexcept override {
         gustMod_.reset(rng_);
         for (auto& c : ch_) {
             c.hi.reset();
@@ -240,8 +250,7 @@ class LeavesBed final : public BedGenerator {
     struct Channel {
         Svf hi, lo, hiss;
     };
-    double density_, brightHz_, gust_, fs_ = 48000.0;
-    Random rng_;
+    double density_, brightHz_, gust_;
     SmoothRandom gustMod_;
     std::array<Channel, 2> ch_{};
 };
@@ -249,17 +258,13 @@ class LeavesBed final : public BedGenerator {
 // ---------------------------------------------------------------------------------------------
 // Distant traffic: a steady low-passed brown-noise rumble plus passing cars, each a Gaussian
 // swell of rumble and tyre hiss (3-7 s) that travels from one side to the other.
-class TrafficBed final : public BedGenerator {
+class TrafficBed final : public BedBase {
   public:
     explicit TrafficBed(const ParamSet& p)
         : carsPerMinute_(p.get("cars_per_minute")), cutoffHz_(p.get("cutoff_hz")),
           hiss_(p.get("hiss")) {}
-    void prepare(const ProcessSpec& spec) override {
-        fs_ = spec.sampleRateHz;
-        swell_.configure(6.0, 3.0, fs_);
-    }
-    void reset(std::uint64_t seed) noexcept override {
-        rng_.setSeed(seed);
+    void onPrepare() override { swell_.configure(6.0, 3.0, fs_); }
+    void onReset() noexcept override {
         swell_.reset(rng_);
         for (auto& c : ch_) {
             c.brown = 0.0;
@@ -349,8 +354,7 @@ class TrafficBed final : public BedGenerator {
         double brown = 0, gain = 0, target = 0, hissGain = 0, hissTarget = 0;
         Svf low, tyre;
     };
-    double carsPerMinute_, cutoffHz_, hiss_, fs_ = 48000.0;
-    Random rng_;
+    double carsPerMinute_, cutoffHz_, hiss_;
     SmoothRandom swell_;
     std::array<Channel, 2> ch_{};
     std::array<Car, 8> cars_{};
@@ -364,20 +368,18 @@ class TrafficBed final : public BedGenerator {
 // pitch, two formant band-passes whose targets change per syllable) gated by syllables at
 // about 4 Hz inside utterances separated by pauses; summed with fixed pans and low-passed by
 // distance. Higher pitch and "excitement" (pitch leaps, louder accents) give children.
-class BabbleBed final : public BedGenerator {
+class BabbleBed final : public BedBase {
   public:
     explicit BabbleBed(const ParamSet& p)
         : talkers_(static_cast<int>(p.get("talkers"))), pitchHz_(p.get("pitch_hz")),
           syllableHz_(p.get("syllable_rate_hz")), distanceHz_(p.get("distance_hz")),
           activity_(p.get("activity")), excitement_(p.get("excitement")) {}
-    void prepare(const ProcessSpec& spec) override {
-        fs_ = spec.sampleRateHz;
+    void onPrepare() override {
         ft_ = 0.5 * fs_; // talkers run at half rate (their formants stay below 3 kHz)
         voices_.assign(static_cast<std::size_t>(talkers_), Talker{});
         for (auto& v : voices_) v.contour.configure(0.6, 0.25, ft_);
     }
-    void reset(std::uint64_t seed) noexcept override {
-        rng_.setSeed(seed);
+    void onReset() noexcept override {
         for (auto& v : voices_) {
             v.saw.reset(rng_.uniform());
             v.f1.reset();
@@ -486,10 +488,9 @@ class BabbleBed final : public BedGenerator {
         v.leap = accent ? excitement_ * rng_.uniform(-0.2, 0.6) : 0.0;
     }
     int talkers_;
-    double pitchHz_, syllableHz_, distanceHz_, activity_, excitement_, fs_ = 48000.0, ft_ = 24000.0;
+    double pitchHz_, syllableHz_, distanceHz_, activity_, excitement_, ft_ = 24000.0;
     double prevL_ = 0.0, prevR_ = 0.0;
     bool odd_ = false;
-    Random rng_;
     std::vector<Talker> voices_;
     std::array<Svf, 2> dist_{}, dist2_{};
     int counter_ = 0;
@@ -500,18 +501,16 @@ class BabbleBed final : public BedGenerator {
 // is a sawtooth buzz at rpm/30 Hz with a half-rate sub-harmonic (cylinder imbalance) and
 // combustion noise gated by the firing phase, low-passed by distance; rpm drifts +-8 % and the
 // tractor slowly moves around the yard (level and pan wander over tens of seconds).
-class TractorBed final : public BedGenerator {
+class TractorBed final : public BedBase {
   public:
     explicit TractorBed(const ParamSet& p)
         : rpm_(p.get("rpm")), distanceHz_(p.get("distance_hz")), drift_(p.get("drift")) {}
-    void prepare(const ProcessSpec& spec) override {
-        fs_ = spec.sampleRateHz;
+    void onPrepare() override {
         rpmMod_.configure(4.0, 2.0, fs_);
         levelMod_.configure(10.0, 5.0, fs_);
         panMod_.configure(14.0, 7.0, fs_);
     }
-    void reset(std::uint64_t seed) noexcept override {
-        rng_.setSeed(seed);
+    void onReset() noexcept override {
         rpmMod_.reset(rng_);
         levelMod_.reset(rng_);
         panMod_.reset(rng_);
@@ -549,8 +548,7 @@ class TractorBed final : public BedGenerator {
     }
 
   private:
-    double rpm_, distanceHz_, drift_, fs_ = 48000.0;
-    Random rng_;
+    double rpm_, distanceHz_, drift_;
     SmoothRandom rpmMod_, levelMod_, panMod_;
     SawOsc saw_;
     SineOsc sub_;
@@ -563,16 +561,14 @@ class TractorBed final : public BedGenerator {
 // Chairlift machinery: the drive's hum (fundamental and two harmonics, slightly wavering), the
 // cable's low rumble over the sheaves (pink noise below 150 Hz, decorrelated per channel) and a
 // faint sheave whine. The pylon clanks are a separate event layer ("clank").
-class LiftBed final : public BedGenerator {
+class LiftBed final : public BedBase {
   public:
     explicit LiftBed(const ParamSet& p) : humHz_(p.get("hum_hz")), squeal_(p.get("squeal")) {}
-    void prepare(const ProcessSpec& spec) override {
-        fs_ = spec.sampleRateHz;
+    void onPrepare() override {
         waver_.configure(1.5, 0.7, fs_);
         whine_.configure(3.0, 1.5, fs_);
     }
-    void reset(std::uint64_t seed) noexcept override {
-        rng_.setSeed(seed);
+    void onReset() noexcept override {
         waver_.reset(rng_);
         whine_.reset(rng_);
         for (auto& o : osc_) o.reset(rng_.uniform());
@@ -605,35 +601,26 @@ class LiftBed final : public BedGenerator {
         PinkNoise pink;
         Svf low;
     };
-    double humHz_, squeal_, fs_ = 48000.0;
-    Random rng_;
+    double humHz_, squeal_;
     SmoothRandom waver_, whine_;
     std::array<SineOsc, 4> osc_{};
     std::array<Channel, 2> ch_{};
 };
 
+// The factories that Procedural.h declares (constant-initialised: usable at any time).
+template <class Generator>
+std::unique_ptr<BedGenerator> makeBed(const ParamSet& p) {
+    return std::make_unique<Generator>(p);
+}
+
 } // namespace
 
-std::unique_ptr<BedGenerator> makeSea(const ParamSet& p) {
-    return std::make_unique<SeaBed>(p);
-}
-std::unique_ptr<BedGenerator> makeWind(const ParamSet& p) {
-    return std::make_unique<WindBed>(p);
-}
-std::unique_ptr<BedGenerator> makeLeaves(const ParamSet& p) {
-    return std::make_unique<LeavesBed>(p);
-}
-std::unique_ptr<BedGenerator> makeTraffic(const ParamSet& p) {
-    return std::make_unique<TrafficBed>(p);
-}
-std::unique_ptr<BedGenerator> makeBabble(const ParamSet& p) {
-    return std::make_unique<BabbleBed>(p);
-}
-std::unique_ptr<BedGenerator> makeTractor(const ParamSet& p) {
-    return std::make_unique<TractorBed>(p);
-}
-std::unique_ptr<BedGenerator> makeLift(const ParamSet& p) {
-    return std::make_unique<LiftBed>(p);
-}
+constinit const BedFactory makeSea = makeBed<SeaBed>;
+constinit const BedFactory makeWind = makeBed<WindBed>;
+constinit const BedFactory makeLeaves = makeBed<LeavesBed>;
+constinit const BedFactory makeTraffic = makeBed<TrafficBed>;
+constinit const BedFactory makeBabble = makeBed<BabbleBed>;
+constinit const BedFactory makeTractor = makeBed<TractorBed>;
+constinit const BedFactory makeLift = makeBed<LiftBed>;
 
 } // namespace underfoot::soundscapes::procedural

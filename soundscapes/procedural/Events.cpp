@@ -71,12 +71,27 @@ double lerp(double a, double b, double u) noexcept {
     return a + (b - a) * u;
 }
 
+// A voice whose event is a series of calls: silent in the gaps, `callSample` inside a call (u is
+// the position in it, 0..1); `endAfterLastCall(tail)` ends the event tail seconds after the last.
+template <std::size_t N>
+class SeriesVoice : public VoiceBase {
+  protected:
+    double sample(double t) noexcept override {
+        double u = 0;
+        const Call* c = series_.at(t, u);
+        return c ? callSample(*c, u) : 0.0;
+    }
+    virtual double callSample(const Call& c, double u) noexcept = 0;
+    void endAfterLastCall(double tail) noexcept { setLengthSeconds(series_.total() + tail); }
+    Series<N> series_;
+};
+
 // ---------------------------------------------------------------------------------------------
 // Songbirds: a population of `species` songs drawn once from the layer seed (each song 3-8
 // notes: sine glides of 30-180 ms between 0.6 and 2 times the pitch, some with a 25-70 Hz trill
 // and a weak second harmonic); an event picks a species and sings its song 1-3 times with small
 // variations, so the same birds recur, as in a real wood.
-class SongbirdVoice final : public VoiceBase {
+class SongbirdVoice final : public SeriesVoice<32> {
   public:
     explicit SongbirdVoice(const ParamSet& p)
         : species_(static_cast<int>(p.get("species"))), pitchHz_(p.get("pitch_hz")) {}
@@ -103,7 +118,7 @@ class SongbirdVoice final : public VoiceBase {
         }
         osc_.reset();
         trill_.reset();
-        setLengthSeconds(series_.total() + 0.01);
+        endAfterLastCall(0.01);
     }
 
   protected:
@@ -126,12 +141,9 @@ class SongbirdVoice final : public VoiceBase {
             }
         }
     }
-    double sample(double t) noexcept override {
-        double u = 0;
-        const Call* c = series_.at(t, u);
-        if (!c) return 0.0;
-        const double trill = c->c > 0 ? c->d * trill_.next(c->c, fs_) : 0.0;
-        const double f = lerp(c->a, c->b, u) * (1.0 + trill);
+    double callSample(const Call& c, double u) noexcept override {
+        const double trill = c.c > 0 ? c.d * trill_.next(c.c, fs_) : 0.0;
+        const double f = lerp(c.a, c.b, u) * (1.0 + trill);
         const double phase = osc_.phase();
         const double y = osc_.next(f, fs_) + 0.15 * fastSin2Pi(2.0 * phase);
         return 0.8 * y * 4.0 * u * (1.0 - u); // close to sqrt(hann(u)) = sin(pi u)
@@ -148,14 +160,13 @@ class SongbirdVoice final : public VoiceBase {
     int species_;
     double pitchHz_;
     std::array<Song, 12> songs_{};
-    Series<32> series_;
     SineOsc osc_, trill_;
 };
 
 // ---------------------------------------------------------------------------------------------
 // Gull (herring-gull "kyow"): 2-6 calls of 0.18-0.4 s; each a harsh sawtooth whose pitch leaps
 // up then falls below the start, through nasal formants near 1.8 and 3.2 kHz.
-class GullVoice final : public VoiceBase {
+class GullVoice final : public SeriesVoice<8> {
   public:
     explicit GullVoice(const ParamSet& p) : pitchHz_(p.get("pitch_hz")) {}
     void start(Random& rng) noexcept override {
@@ -178,17 +189,13 @@ class GullVoice final : public VoiceBase {
         f1_.reset();
         f2_.reset();
         saw_.reset();
-        setLengthSeconds(series_.total() + 0.02);
+        endAfterLastCall(0.02);
     }
 
   protected:
-    double sample(double t) noexcept override {
-        double u = 0;
-        const Call* c = series_.at(t, u);
-        if (!c) return 0.0;
-        const double f =
-            u < 0.15 ? lerp(c->a, c->b, u / 0.15) : lerp(c->b, c->c, (u - 0.15) / 0.85);
-        const double env = std::min(1.0, u * c->dur / 0.015) * std::min(1.0, (1.0 - u) / 0.3);
+    double callSample(const Call& c, double u) noexcept override {
+        const double f = u < 0.15 ? lerp(c.a, c.b, u / 0.15) : lerp(c.b, c.c, (u - 0.15) / 0.85);
+        const double env = std::min(1.0, u * c.dur / 0.015) * std::min(1.0, (1.0 - u) / 0.3);
         const double s = saw_.next(f, fs_) + 0.2 * whiteNoise(noise_);
         return env * (f1_.bandNormalised(s) + 0.7 * f2_.bandNormalised(s) + 0.15 * s);
     }
@@ -199,7 +206,6 @@ class GullVoice final : public VoiceBase {
 
   private:
     double pitchHz_;
-    Series<8> series_;
     SawOsc saw_;
     Svf f1_, f2_;
 };
@@ -207,7 +213,7 @@ class GullVoice final : public VoiceBase {
 // ---------------------------------------------------------------------------------------------
 // Cuckoo: a series of 3-9 "cu-coo" pairs, about one per second; the second note a minor/major
 // third below the first (ratio 0.80-0.86), soft sines with a weak second harmonic.
-class CuckooVoice final : public VoiceBase {
+class CuckooVoice final : public SeriesVoice<20> {
   public:
     explicit CuckooVoice(const ParamSet& p) : pitchHz_(p.get("pitch_hz")) {}
     void start(Random& rng) noexcept override {
@@ -227,24 +233,20 @@ class CuckooVoice final : public VoiceBase {
             b.a = f * ratio;
         }
         osc_.reset();
-        setLengthSeconds(series_.total() + 0.01);
+        endAfterLastCall(0.01);
     }
 
   protected:
-    double sample(double t) noexcept override {
-        double u = 0;
-        const Call* c = series_.at(t, u);
-        if (!c) return 0.0;
-        const double f = c->a * (1.0 - 0.04 * u);
+    double callSample(const Call& c, double u) noexcept override {
+        const double f = c.a * (1.0 - 0.04 * u);
         const double phase = osc_.phase();
         const double y = osc_.next(f, fs_) + 0.12 * fastSin2Pi(2.0 * phase);
-        const double env = std::min(1.0, u * c->dur / 0.02) * std::min(1.0, (1.0 - u) / 0.4);
+        const double env = std::min(1.0, u * c.dur / 0.02) * std::min(1.0, (1.0 - u) / 0.4);
         return 0.8 * y * env;
     }
 
   private:
     double pitchHz_;
-    Series<20> series_;
     SineOsc osc_;
 };
 
@@ -329,10 +331,52 @@ double contour(const Call& c, double u) noexcept {
     return u < c.d ? lerp(c.a, c.b, u / c.d) : lerp(c.b, c.c, (u - c.d) / (1.0 - c.d));
 }
 
-// Hen: 3-8 clucks ("buk") of 50-90 ms with falling pitch, sometimes ending in a "ba-GAWK".
-class HenVoice final : public VoiceBase {
+// A series of calls through one formant core, pitched from the `pitch_hz` parameter.
+template <std::size_t N>
+class FormantSeriesVoice : public SeriesVoice<N> {
   public:
-    explicit HenVoice(const ParamSet& p) : pitchHz_(p.get("pitch_hz")) {}
+    explicit FormantSeriesVoice(const ParamSet& p) : pitchHz_(p.get("pitch_hz")) {}
+
+  protected:
+    void snapState() noexcept override { core_.snap(); }
+    double pitchHz_;
+    FormantCore core_;
+};
+
+// How a short call (a cluck, a bark) sounds: a fast attack, an exponential decay over a share of
+// the call, a linear release at its end (slope per unit of u), and the formant core's mix.
+struct Burst {
+    double attackS, decayShare, releaseSlope, noiseMix, f2Gain;
+};
+
+// Short calls on the call's pitch contour through fixed formants; `start` lays out the series.
+template <std::size_t N>
+class BurstSeriesVoice : public FormantSeriesVoice<N> {
+  public:
+    BurstSeriesVoice(const ParamSet& p, const Burst& burst)
+        : FormantSeriesVoice<N>(p), burst_(burst) {}
+
+  protected:
+    double callSample(const Call& c, double u) noexcept override {
+        const double env = attackDecay(u * c.dur, burst_.attackS, c.dur * burst_.decayShare) *
+                           std::min(1.0, (1 - u) * burst_.releaseSlope);
+        return env * this->core_.next(contour(c, u), this->fs_, burst_.noiseMix, this->noise_,
+                                      burst_.f2Gain);
+    }
+
+  private:
+    Burst burst_;
+};
+
+// Hen: 3-8 clucks ("buk") of 50-90 ms with falling pitch, sometimes ending in a "ba-GAWK".
+class HenVoice final : public BurstSeriesVoice<12> {
+  public:
+    explicit HenVoice(const ParamSet& p)
+        : BurstSeriesVoice(p, {.attackS = 0.006,
+                               .decayShare = 0.45,
+                               .releaseSlope = 8.0,
+                               .noiseMix = 0.15,
+                               .f2Gain = 0.6}) {}
     void start(Random& rng) noexcept override {
         series_.clear();
         const double p = pitchHz_ * rng.uniform(0.85, 1.15);
@@ -351,31 +395,41 @@ class HenVoice final : public VoiceBase {
         }
         core_.reset();
         core_.setFormants(fs_, 950.0, 3.0, 2100.0, 4.0);
-        setLengthSeconds(series_.total() + 0.03);
+        endAfterLastCall(0.03);
     }
+};
 
-  protected:
-    double sample(double t) noexcept override {
-        double u = 0;
-        const Call* c = series_.at(t, u);
-        if (!c) return 0.0;
-        const double env =
-            attackDecay(u * c->dur, 0.006, c->dur * 0.45) * std::min(1.0, (1 - u) * 8);
-        return env * core_.next(contour(*c, u), fs_, 0.15, noise_, 0.6);
+// Dog barks: 1-4 (sometimes up to 7) barks of 90-180 ms, pitch falling, a noisy harsh source.
+class DogVoice final : public BurstSeriesVoice<8> {
+  public:
+    explicit DogVoice(const ParamSet& p)
+        : BurstSeriesVoice(p, {.attackS = 0.008,
+                               .decayShare = 0.4,
+                               .releaseSlope = 6.0,
+                               .noiseMix = 0.35,
+                               .f2Gain = 0.7}) {}
+    void start(Random& rng) noexcept override {
+        series_.clear();
+        const double p = pitchHz_ * rng.uniform(0.85, 1.15);
+        const int barks = rng.uniform() < 0.3 ? 4 + static_cast<int>(rng.below(4))
+                                              : 1 + static_cast<int>(rng.below(4));
+        double t = 0.0;
+        for (int k = 0; k < barks; ++k) {
+            Call& c = series_.add();
+            c = {t, rng.uniform(0.09, 0.18), p * 1.1, p * 1.2, p * 0.8, 0.15};
+            t += rng.uniform(0.25, 0.45);
+        }
+        core_.reset();
+        core_.setFormants(fs_, 800.0 * rng.uniform(0.9, 1.1), 2.5, 1800.0, 3.0);
+        endAfterLastCall(0.02);
     }
-    void snapState() noexcept override { core_.snap(); }
-
-  private:
-    double pitchHz_;
-    Series<12> series_;
-    FormantCore core_;
 };
 
 // Rooster crow ("cock-a-doodle-doo"): four syllables of rising pitch, the last long and falling,
 // with 6 Hz vibrato, each with its own vowel (F1 650-1000 Hz, F2 1500-2400 Hz) and some rasp.
-class RoosterVoice final : public VoiceBase {
+class RoosterVoice final : public FormantSeriesVoice<4> {
   public:
-    explicit RoosterVoice(const ParamSet& p) : pitchHz_(p.get("pitch_hz")) {}
+    explicit RoosterVoice(const ParamSet& p) : FormantSeriesVoice(p) {}
     void start(Random& rng) noexcept override {
         series_.clear();
         const double p = pitchHz_ * rng.uniform(0.88, 1.12);
@@ -392,31 +446,23 @@ class RoosterVoice final : public VoiceBase {
         core_.reset();
         vib_.reset();
         syllable_ = -1;
-        setLengthSeconds(series_.total() + 0.02);
+        endAfterLastCall(0.02);
     }
 
   protected:
-    double sample(double t) noexcept override {
-        double u = 0;
-        const Call* c = series_.at(t, u);
-        if (!c) return 0.0;
+    double callSample(const Call& c, double u) noexcept override {
         if (series_.current != syllable_) {
             static constexpr double f1[4] = {650, 800, 900, 1000}, f2[4] = {1500, 1900, 2200, 2400};
             syllable_ = series_.current;
             const int k = std::min(syllable_, 3);
             core_.setFormants(fs_, f1[k], 3.0, f2[k], 4.0);
         }
-        const double f = contour(*c, u) * (1.0 + 0.02 * vib_.next(6.0, fs_));
-        const double env =
-            std::min(1.0, u * c->dur / 0.015) * std::min(1.0, (1 - u) * c->dur / 0.04);
+        const double f = contour(c, u) * (1.0 + 0.02 * vib_.next(6.0, fs_));
+        const double env = std::min(1.0, u * c.dur / 0.015) * std::min(1.0, (1 - u) * c.dur / 0.04);
         return env * core_.next(f, fs_, 0.12, noise_, 0.7);
     }
-    void snapState() noexcept override { core_.snap(); }
 
   private:
-    double pitchHz_;
-    Series<4> series_;
-    FormantCore core_;
     SineOsc vib_;
     int syllable_ = -1;
 };
@@ -455,49 +501,12 @@ class CowVoice final : public VoiceBase {
     int counter_ = 0;
 };
 
-// Dog barks: 1-4 (sometimes up to 7) barks of 90-180 ms, pitch falling, a noisy harsh source.
-class DogVoice final : public VoiceBase {
-  public:
-    explicit DogVoice(const ParamSet& p) : pitchHz_(p.get("pitch_hz")) {}
-    void start(Random& rng) noexcept override {
-        series_.clear();
-        const double p = pitchHz_ * rng.uniform(0.85, 1.15);
-        const int barks = rng.uniform() < 0.3 ? 4 + static_cast<int>(rng.below(4))
-                                              : 1 + static_cast<int>(rng.below(4));
-        double t = 0.0;
-        for (int k = 0; k < barks; ++k) {
-            Call& c = series_.add();
-            c = {t, rng.uniform(0.09, 0.18), p * 1.1, p * 1.2, p * 0.8, 0.15};
-            t += rng.uniform(0.25, 0.45);
-        }
-        core_.reset();
-        core_.setFormants(fs_, 800.0 * rng.uniform(0.9, 1.1), 2.5, 1800.0, 3.0);
-        setLengthSeconds(series_.total() + 0.02);
-    }
-
-  protected:
-    double sample(double t) noexcept override {
-        double u = 0;
-        const Call* c = series_.at(t, u);
-        if (!c) return 0.0;
-        const double env =
-            attackDecay(u * c->dur, 0.008, c->dur * 0.4) * std::min(1.0, (1 - u) * 6);
-        return env * core_.next(contour(*c, u), fs_, 0.35, noise_, 0.7);
-    }
-    void snapState() noexcept override { core_.snap(); }
-
-  private:
-    double pitchHz_;
-    Series<8> series_;
-    FormantCore core_;
-};
-
 // A distant human call or a child's shout: 2-5 syllables (0.12-0.35 s) with exaggerated rising
 // and falling contours and random vowels, low-passed by distance.
-class ShoutVoice final : public VoiceBase {
+class ShoutVoice final : public FormantSeriesVoice<6> {
   public:
     explicit ShoutVoice(const ParamSet& p)
-        : pitchHz_(p.get("pitch_hz")), distanceHz_(p.get("distance_hz")) {}
+        : FormantSeriesVoice(p), distanceHz_(p.get("distance_hz")) {}
     void start(Random& rng) noexcept override {
         series_.clear();
         const double p = pitchHz_ * rng.uniform(0.85, 1.2);
@@ -517,23 +526,19 @@ class ShoutVoice final : public VoiceBase {
         dist_.reset();
         dist_.set(fs_, distanceHz_, 0.7);
         syllable_ = -1;
-        setLengthSeconds(series_.total() + 0.02);
+        endAfterLastCall(0.02);
     }
 
   protected:
-    double sample(double t) noexcept override {
-        double u = 0;
-        const Call* c = series_.at(t, u);
-        double y = 0.0;
-        if (c) {
-            if (series_.current != syllable_) {
-                syllable_ = series_.current;
-                core_.setFormants(fs_, vowels_[syllable_][0], 4.0, vowels_[syllable_][1], 6.0);
-            }
-            const double env = 4.0 * u * (1.0 - u);
-            y = env * core_.next(contour(*c, u), fs_, 0.1, noise_, 0.6);
+    // The distance low-pass runs through the gaps too (its tail rings on).
+    double sample(double t) noexcept override { return dist_.process(SeriesVoice::sample(t)).low; }
+    double callSample(const Call& c, double u) noexcept override {
+        if (series_.current != syllable_) {
+            syllable_ = series_.current;
+            core_.setFormants(fs_, vowels_[syllable_][0], 4.0, vowels_[syllable_][1], 6.0);
         }
-        return dist_.process(y).low;
+        const double env = 4.0 * u * (1.0 - u);
+        return env * core_.next(contour(c, u), fs_, 0.1, noise_, 0.6);
     }
     void snapState() noexcept override {
         core_.snap();
@@ -541,10 +546,8 @@ class ShoutVoice final : public VoiceBase {
     }
 
   private:
-    double pitchHz_, distanceHz_;
-    Series<6> series_;
+    double distanceHz_;
     std::array<std::array<double, 2>, 6> vowels_{};
-    FormantCore core_;
     Svf dist_;
     int syllable_ = -1;
 };
@@ -729,46 +732,26 @@ class SkitterVoice final : public VoiceBase {
     Svf band_;
 };
 
+// The factories that Procedural.h declares (constant-initialised: usable at any time).
+template <class Generator>
+std::unique_ptr<EventVoice> makeVoice(const ParamSet& p) {
+    return std::make_unique<Generator>(p);
+}
+
 } // namespace
 
-std::unique_ptr<EventVoice> makeSongbird(const ParamSet& p) {
-    return std::make_unique<SongbirdVoice>(p);
-}
-std::unique_ptr<EventVoice> makeGull(const ParamSet& p) {
-    return std::make_unique<GullVoice>(p);
-}
-std::unique_ptr<EventVoice> makeCuckoo(const ParamSet& p) {
-    return std::make_unique<CuckooVoice>(p);
-}
-std::unique_ptr<EventVoice> makeWoodpecker(const ParamSet& p) {
-    return std::make_unique<WoodpeckerVoice>(p);
-}
-std::unique_ptr<EventVoice> makeHen(const ParamSet& p) {
-    return std::make_unique<HenVoice>(p);
-}
-std::unique_ptr<EventVoice> makeRooster(const ParamSet& p) {
-    return std::make_unique<RoosterVoice>(p);
-}
-std::unique_ptr<EventVoice> makeCow(const ParamSet& p) {
-    return std::make_unique<CowVoice>(p);
-}
-std::unique_ptr<EventVoice> makeDog(const ParamSet& p) {
-    return std::make_unique<DogVoice>(p);
-}
-std::unique_ptr<EventVoice> makeSwish(const ParamSet& p) {
-    return std::make_unique<SwishVoice>(p);
-}
-std::unique_ptr<EventVoice> makeScrape(const ParamSet& p) {
-    return std::make_unique<ScrapeVoice>(p);
-}
-std::unique_ptr<EventVoice> makeClank(const ParamSet& p) {
-    return std::make_unique<ClankVoice>(p);
-}
-std::unique_ptr<EventVoice> makeShout(const ParamSet& p) {
-    return std::make_unique<ShoutVoice>(p);
-}
-std::unique_ptr<EventVoice> makeSkitter(const ParamSet& p) {
-    return std::make_unique<SkitterVoice>(p);
-}
+constinit const VoiceFactory makeSongbird = makeVoice<SongbirdVoice>;
+constinit const VoiceFactory makeGull = makeVoice<GullVoice>;
+constinit const VoiceFactory makeCuckoo = makeVoice<CuckooVoice>;
+constinit const VoiceFactory makeWoodpecker = makeVoice<WoodpeckerVoice>;
+constinit const VoiceFactory makeHen = makeVoice<HenVoice>;
+constinit const VoiceFactory makeRooster = makeVoice<RoosterVoice>;
+constinit const VoiceFactory makeCow = makeVoice<CowVoice>;
+constinit const VoiceFactory makeDog = makeVoice<DogVoice>;
+constinit const VoiceFactory makeSwish = makeVoice<SwishVoice>;
+constinit const VoiceFactory makeScrape = makeVoice<ScrapeVoice>;
+constinit const VoiceFactory makeClank = makeVoice<ClankVoice>;
+constinit const VoiceFactory makeShout = makeVoice<ShoutVoice>;
+constinit const VoiceFactory makeSkitter = makeVoice<SkitterVoice>;
 
 } // namespace underfoot::soundscapes::procedural

@@ -1,30 +1,34 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
-/// Factories of the procedural generators (internal to soundscapes/; use Generators.h).
+/// Factories of the procedural generators (internal to soundscapes/; use Generators.h): each
+/// makes one generator from its parameters; the catalogue in Generators.cpp names them.
 #include "soundscapes/Generators.h"
 
 namespace underfoot::soundscapes::procedural {
 
-std::unique_ptr<BedGenerator> makeSea(const ParamSet& p);
-std::unique_ptr<BedGenerator> makeWind(const ParamSet& p);
-std::unique_ptr<BedGenerator> makeLeaves(const ParamSet& p);
-std::unique_ptr<BedGenerator> makeTraffic(const ParamSet& p);
-std::unique_ptr<BedGenerator> makeBabble(const ParamSet& p);
-std::unique_ptr<BedGenerator> makeTractor(const ParamSet& p);
-std::unique_ptr<BedGenerator> makeLift(const ParamSet& p);
+using BedFactory = std::unique_ptr<BedGenerator> (*)(const ParamSet&);
+using VoiceFactory = std::unique_ptr<EventVoice> (*)(const ParamSet&);
 
-std::unique_ptr<EventVoice> makeSongbird(const ParamSet& p);
-std::unique_ptr<EventVoice> makeGull(const ParamSet& p);
-std::unique_ptr<EventVoice> makeCuckoo(const ParamSet& p);
-std::unique_ptr<EventVoice> makeWoodpecker(const ParamSet& p);
-std::unique_ptr<EventVoice> makeHen(const ParamSet& p);
-std::unique_ptr<EventVoice> makeRooster(const ParamSet& p);
-std::unique_ptr<EventVoice> makeCow(const ParamSet& p);
-std::unique_ptr<EventVoice> makeDog(const ParamSet& p);
-std::unique_ptr<EventVoice> makeSwish(const ParamSet& p);
-std::unique_ptr<EventVoice> makeScrape(const ParamSet& p);
-std::unique_ptr<EventVoice> makeClank(const ParamSet& p);
-std::unique_ptr<EventVoice> makeShout(const ParamSet& p);
-std::unique_ptr<EventVoice> makeSkitter(const ParamSet& p);
+extern const BedFactory makeSea;
+extern const BedFactory makeWind;
+extern const BedFactory makeLeaves;
+extern const BedFactory makeTraffic;
+extern const BedFactory makeBabble;
+extern const BedFactory makeTractor;
+extern const BedFactory makeLift;
+
+extern const VoiceFactory makeSongbird;
+extern const VoiceFactory makeGull;
+extern const VoiceFactory makeCuckoo;
+extern const VoiceFactory makeWoodpecker;
+extern const VoiceFactory makeHen;
+extern const VoiceFactory makeRooster;
+extern const VoiceFactory makeCow;
+extern const VoiceFactory makeDog;
+extern const VoiceFactory makeSwish;
+extern const VoiceFactory makeScrape;
+extern const VoiceFactory makeClank;
+extern const VoiceFactory makeShout;
+extern const VoiceFactory makeSkitter;
 
 } // namespace underfoot::soundscapes::procedural

@@ -75,6 +75,10 @@ rate_per_minute = 3
 }
 
 TEST(SoundscapeDefinition, ErrorsNameFileLineColumnAndWhatWasExpected) {
+    EXPECT_EQ(errorOf("bed = 3\n" + std::string(kHead)),
+              "test.toml:1:7: 'bed' must be an array of tables: [[bed]]");
+    EXPECT_EQ(errorOf("event = [1]\n" + std::string(kHead)),
+              "test.toml:1:10: [[event]] entries must be tables");
     EXPECT_EQ(errorOf(std::string(kHead) + "[[bed]]\nname = \"w\"\ngenerator = \"wnd\"\n"),
               "test.toml:7:13: unknown bed generator 'wnd' (expected one of: babble, leaves, lift, "
               "sea, tractor, traffic, wind)");
@@ -189,6 +193,9 @@ TEST(Coherence, UnknownKeysAndWrongTypesNameTheirPlace) {
     EXPECT_EQ(
         errorOf("[[incoherent]]\nsurface = \"wood\"\nsoundscapes = [3]\n").rfind("c.toml:3:", 0),
         0u);
+    EXPECT_EQ(errorOf("incoherent = 3\n"),
+              "c.toml:1:14: 'incoherent' must be an array of tables: [[incoherent]]");
+    EXPECT_EQ(errorOf("coherent = [1]\n"), "c.toml:1:13: [[coherent]] entries must be tables");
 }
 
 TEST(Coherence, AnswersTheCoherentPairsOfTheStudy) {

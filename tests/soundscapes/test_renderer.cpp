@@ -55,21 +55,36 @@ Stereo render(SoundscapeRenderer& r, double seconds, int block) {
     return s;
 }
 
-// The five shipped environments, each prepared once (preparation includes calibration).
-SoundscapeRenderer& shipped(const std::string& id) {
-    static std::map<std::string, std::unique_ptr<SoundscapeRenderer>> cache;
-    auto& r = cache[id];
-    if (!r) {
-        r = std::make_unique<SoundscapeRenderer>(loadSoundscape(id));
-        r->prepare({kFs, 512});
-    }
-    return *r;
-}
-
 const std::vector<std::string> kIds = {"beach_summer", "farm_courtyard", "ski_slope", "forest",
                                        "park_fall"};
 
 const char* kHead = "[soundscape]\nid = \"t\"\nname = \"T\"\ntarget_level_dbfs = -30.0\n";
+
+// A renderer of that definition, prepared at 48 kHz for blocks of that size.
+std::unique_ptr<SoundscapeRenderer> prepared(SoundscapeDefinition def, int block = 512) {
+    auto r = std::make_unique<SoundscapeRenderer>(std::move(def));
+    r->prepare({kFs, block});
+    return r;
+}
+
+// A test soundscape: the common head, then these layers.
+SoundscapeDefinition withLayers(const std::string& layers) {
+    return parseSoundscapeDefinition(std::string(kHead) + layers, "t.toml");
+}
+
+// One event layer of metal clanks (about 1 s each) at that mean interval and jitter, then `more`.
+std::string clanks(double meanIntervalS, double jitter, const std::string& more = "") {
+    return "[[event]]\nname = \"k\"\ngenerator = \"clank\"\nmean_interval_s = " +
+           std::to_string(meanIntervalS) + "\njitter = " + std::to_string(jitter) + "\n" + more;
+}
+
+// The five shipped environments, each prepared once (preparation includes calibration).
+SoundscapeRenderer& shipped(const std::string& id) {
+    static std::map<std::string, std::unique_ptr<SoundscapeRenderer>> cache;
+    auto& r = cache[id];
+    if (!r) r = prepared(loadSoundscape(id));
+    return *r;
+}
 
 std::filesystem::path tempDir() {
     auto dir = std::filesystem::temp_directory_path() /
@@ -136,12 +151,11 @@ TEST(SoundscapeRenderer, EveryEnvironmentSpeaksWithinTheFirstSeconds) {
 }
 
 TEST(SoundscapeRenderer, OutputDoesNotDependOnTheBlockSize) {
-    SoundscapeRenderer small(loadSoundscape("forest"));
-    small.prepare({kFs, 37});
+    auto small = prepared(loadSoundscape("forest"), 37);
     auto& big = shipped("forest");
-    small.reset(3);
+    small->reset(3);
     big.reset(3);
-    const Stereo a = render(small, 10.0, 37), b = render(big, 10.0, 512);
+    const Stereo a = render(*small, 10.0, 37), b = render(big, 10.0, 512);
     EXPECT_TRUE(a.left == b.left && a.right == b.right);
 }
 
@@ -177,19 +191,10 @@ TEST(SoundscapeRenderer, MeasuredOnsetsInTheAudioMatchTheDeclaredDensity) {
     // Isolated metal clanks (about 1 s long) every 4 s on average with 30 % jitter, so that they
     // never overlap: count the onsets in the audio itself (10 ms energy frames crossing a
     // threshold from below, with 0.6 s refractory time) and compare with the declaration.
-    auto def = parseSoundscapeDefinition(std::string(kHead) + R"(
-[[event]]
-name = "k"
-generator = "clank"
-mean_interval_s = 4.0
-jitter = 0.3
-)",
-                                         "t.toml");
-    SoundscapeRenderer r(def);
-    r.prepare({kFs, 256});
-    r.reset(5);
+    const auto r = prepared(withLayers(clanks(4.0, 0.3)), 256);
+    r->reset(5);
     const double seconds = 400.0;
-    const Stereo s = render(r, seconds, 256);
+    const Stereo s = render(*r, seconds, 256);
     const int frame = 480;
     double peakEnergy = 0;
     std::vector<double> e;
@@ -210,29 +215,19 @@ jitter = 0.3
     // Intervals 4 s * (0.7 + 0.3 Exp(1)): mean 4 s, sd 1.2 s; over 400 s the count has a standard
     // deviation of about sqrt(100) * 1.2 / 4 = 3 (renewal CLT). Allow 4 sd.
     EXPECT_NEAR(onsets, seconds / 4.0, 12.0);
-    EXPECT_EQ(static_cast<std::uint64_t>(onsets), r.layerStats(0).eventsStarted)
+    EXPECT_EQ(static_cast<std::uint64_t>(onsets), r->layerStats(0).eventsStarted)
         << "every scheduled event is heard, and nothing else";
 }
 
 TEST(SoundscapeRenderer, RegularEventsKeepTheirInterval) {
-    auto def = parseSoundscapeDefinition(std::string(kHead) + R"(
-[[event]]
-name = "k"
-generator = "clank"
-mean_interval_s = 2.5
-jitter = 0.0
-first_onset_s = [0.5, 0.5]
-)",
-                                         "t.toml");
-    SoundscapeRenderer r(def);
-    r.prepare({kFs, 512});
-    r.reset(1);
-    render(r, 100.2, 512);
-    EXPECT_EQ(r.layerStats(0).eventsStarted, 40u); // onsets at 0.5, 3.0, ..., 98.0
+    const auto r = prepared(withLayers(clanks(2.5, 0.0, "first_onset_s = [0.5, 0.5]\n")));
+    r->reset(1);
+    render(*r, 100.2, 512);
+    EXPECT_EQ(r->layerStats(0).eventsStarted, 40u); // onsets at 0.5, 3.0, ..., 98.0
 }
 
 TEST(SoundscapeRenderer, OnlyTheDeclaredLayersAreComputed) {
-    auto def = parseSoundscapeDefinition(std::string(kHead) + R"(
+    const auto r = prepared(withLayers(R"(
 [[bed]]
 name = "wind"
 generator = "wind"
@@ -245,16 +240,14 @@ name = "late"
 generator = "cow"
 rate_per_minute = 1
 first_onset_s = [100, 100]
-)",
-                                         "t.toml");
-    SoundscapeRenderer r(def);
-    EXPECT_EQ(r.layerCount(), 2u);
-    r.prepare({kFs, 512});
-    r.reset(1);
-    render(r, 10.0, 512);
-    EXPECT_EQ(r.layerStats(0).framesComputed, 480000u);
-    EXPECT_EQ(r.layerStats(1).framesComputed, 0u) << "an event layer with nothing sounding is free";
-    EXPECT_EQ(r.layerStats(1).eventsStarted, 0u);
+)"));
+    EXPECT_EQ(r->layerCount(), 2u);
+    r->reset(1);
+    render(*r, 10.0, 512);
+    EXPECT_EQ(r->layerStats(0).framesComputed, 480000u);
+    EXPECT_EQ(r->layerStats(1).framesComputed, 0u)
+        << "an event layer with nothing sounding is free";
+    EXPECT_EQ(r->layerStats(1).eventsStarted, 0u);
 }
 
 TEST(SoundscapeRenderer, RecordedBedsLoopSeamlesslyAtTheTargetLevelAfterResampling) {
@@ -266,10 +259,9 @@ TEST(SoundscapeRenderer, RecordedBedsLoopSeamlesslyAtTheTargetLevelAfterResampli
                          << "[[bed]]\nname = \"tone\"\nfile = \"tone.wav\"\ncrossfade_s = 0.5\n";
         return p.string();
     }());
-    SoundscapeRenderer r(def);
-    r.prepare({kFs, 512});
-    r.reset(1);
-    const Stereo s = render(r, 10.0, 512); // about four loops of 2.5 s
+    const auto r = prepared(def);
+    r->reset(1);
+    const Stereo s = render(*r, 10.0, 512); // about four loops of 2.5 s
     EXPECT_NEAR(s.levelDb(), -30.0, 0.2);
     // Frequency kept (zero crossings) and no click at the loop points: no step larger than the
     // largest step of the tone itself (2 pi f / fs times its peak).
@@ -292,11 +284,10 @@ TEST(SoundscapeRenderer, RecordedEventsPlayTheirClips) {
         << kHead
         << "[[event]]\nname = \"e\"\nfiles = [\"a.wav\", \"b.flac.wav\"]\n"
            "rate_per_minute = 30\n";
-    SoundscapeRenderer r(loadSoundscapeDefinition((dir / "d.toml").string()));
-    r.prepare({kFs, 512});
-    r.reset(2);
-    const Stereo s = render(r, 120.0, 512);
-    const auto& st = r.layerStats(0);
+    const auto r = prepared(loadSoundscapeDefinition((dir / "d.toml").string()));
+    r->reset(2);
+    const Stereo s = render(*r, 120.0, 512);
+    const auto& st = r->layerStats(0);
     EXPECT_NEAR(static_cast<double>(st.eventsStarted), 60.0, 4.5 * std::sqrt(60.0));
     // Every started clip was played to its end (0.2 s or 0.3 s at 48 kHz).
     EXPECT_GE(st.framesComputed, st.eventsStarted * 9600u - 14400u);
@@ -332,7 +323,7 @@ TEST(SoundscapeRenderer, MissingOrCorruptRecordingsFailAtLoadTimeWithAClearMessa
 
 TEST(SoundscapeRenderer, LayerBalanceFollowsLevelDb) {
     // Two beds 6 dB apart: their calibrated powers differ by 6 dB and sum to the target.
-    auto def = parseSoundscapeDefinition(std::string(kHead) + R"(
+    const auto r = prepared(withLayers(R"(
 [[bed]]
 name = "a"
 generator = "wind"
@@ -341,12 +332,9 @@ level_db = 0
 name = "b"
 generator = "traffic"
 level_db = -6
-)",
-                                         "t.toml");
-    SoundscapeRenderer r(def);
-    r.prepare({kFs, 512});
-    const double pa = r.layerUnityPower(0) * r.layerGain(0) * r.layerGain(0);
-    const double pb = r.layerUnityPower(1) * r.layerGain(1) * r.layerGain(1);
+)"));
+    const double pa = r->layerUnityPower(0) * r->layerGain(0) * r->layerGain(0);
+    const double pb = r->layerUnityPower(1) * r->layerGain(1) * r->layerGain(1);
     EXPECT_NEAR(10 * std::log10(pa / pb), 6.0, 1e-9);
     EXPECT_NEAR(10 * std::log10(pa + pb), -30.0, 1e-9);
 }
