@@ -158,10 +158,10 @@ SoundscapeDefinition parseSoundscapeDefinition(std::string_view text, const std:
     def.footstepReferenceGainDb = r.number(h, "footstep_reference_gain_db", -60.0, 20.0, -10.0);
 
     std::set<std::string> names;
-    for (const auto& [key, kind] :
+    for (const auto& section :
          {std::pair{"bed", LayerKind::Bed}, std::pair{"event", LayerKind::Event}}) {
-        r.forEachTable(root, key, [&](const toml::table& t, const toml::node& item) {
-            LayerDefinition layer = parseLayer(r, t, item, kind, baseDirectory);
+        r.forEachTable(root, section.first, [&](const toml::table& t, const toml::node& item) {
+            LayerDefinition layer = parseLayer(r, t, item, section.second, baseDirectory);
             if (!names.insert(layer.name).second)
                 r.failAt(layer.location, fmt::format("duplicate layer name '{}'", layer.name));
             const toml::node* en = t.get("enabled");
