@@ -299,10 +299,13 @@ void SoundscapeRenderer::reset(std::uint64_t seed) noexcept {
             if (first)
                 layer.nextOnset =
                     layer.rng.uniform(first->first, first->second) * spec_.sampleRateHz;
-            else // a random phase of a regular process, or a Poisson wait
-                layer.nextOnset =
-                    layer.meanInterval * ((1.0 - layer.def->jitter) * layer.rng.uniform() +
-                                          layer.def->jitter * layer.rng.exponential(1.0));
+            else { // a random phase of a regular process, or a Poisson wait
+                // Two statements: the order of the draws is fixed, not the compiler's choice.
+                const double phase = layer.rng.uniform();
+                const double wait = layer.rng.exponential(1.0);
+                layer.nextOnset = layer.meanInterval *
+                                  ((1.0 - layer.def->jitter) * phase + layer.def->jitter * wait);
+            }
         }
     }
 }

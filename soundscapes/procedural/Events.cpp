@@ -265,8 +265,10 @@ class WoodpeckerVoice final : public VoiceBase {
         static constexpr double decays[4] = {0.018, 0.012, 0.008, 0.005};
         const double tree = rng.uniform(0.85, 1.15);
         for (int m = 0; m < 4; ++m) {
-            modes_[m].set(fs_, baseHz_ * tree * ratios[m] * rng.uniform(0.97, 1.03),
-                          decays[m] * rng.uniform(0.8, 1.25));
+            // Two statements: the order of the draws is fixed, not the compiler's choice.
+            const double decay = decays[m] * rng.uniform(0.8, 1.25);
+            const double freq = baseHz_ * tree * ratios[m] * rng.uniform(0.97, 1.03);
+            modes_[m].set(fs_, freq, decay);
             modes_[m].reset();
         }
         nextKnock_ = 0;

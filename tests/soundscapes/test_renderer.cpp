@@ -7,6 +7,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -130,6 +132,40 @@ TEST(SoundscapeRenderer, EveryEnvironmentIsDeterministicFiniteAndAtItsTargetLeve
         r.reset(2);
         const Stereo c = render(r, 5.0, 512);
         EXPECT_FALSE(std::equal(c.left.begin(), c.left.end(), a.left.begin()));
+    }
+}
+
+// FNV-1a over the float bit patterns of both channels.
+std::uint64_t samplesHash(const Stereo& s) {
+    std::uint64_t h = 14695981039346656037ull;
+    for (const auto* channel : {&s.left, &s.right})
+        for (const float x : *channel) {
+            std::uint32_t bits = 0;
+            std::memcpy(&bits, &x, sizeof bits);
+            for (int b = 0; b < 4; ++b) {
+                h ^= (bits >> (8 * b)) & 0xffu;
+                h *= 1099511628211ull;
+            }
+        }
+    return h;
+}
+
+// A stored seed replays what a participant heard, whichever compiler built the program: the
+// mix (bed and event scheduling included) is pinned, not only each generator
+// (test_generators.cpp). Values rendered by the GCC build and equal in the Clang (sanitizer)
+// build; a change of sound updates them in the same commit and says so
+// (docs/decisions/soundscape-samples-pinned.md).
+TEST(SoundscapeRenderer, EveryEnvironmentReplaysTheSameSamplesInEveryBuild) {
+    const std::map<std::string, std::uint64_t> pinned{{"beach_summer", 0x69c9f53be9f8a0c8ull},
+                                                      {"farm_courtyard", 0x373abd9f574a0b58ull},
+                                                      {"ski_slope", 0xf6a0c54a0409322aull},
+                                                      {"forest", 0x8578b9e6f7b6f24cull},
+                                                      {"park_fall", 0xaa1b9dfbf7d7aadull}};
+    for (const auto& id : kIds) {
+        auto& r = shipped(id);
+        r.reset(1);
+        const std::uint64_t h = samplesHash(render(r, 8.0, 512));
+        EXPECT_EQ(h, pinned.at(id)) << id << " rendered 0x" << std::hex << h << "ull";
     }
 }
 
