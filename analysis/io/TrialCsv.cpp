@@ -4,6 +4,7 @@
 #include "analysis/io/Csv.h"
 #include "analysis/model/Catalog.h"
 #include "base/Plural.h"
+#include "base/TrialColumns.h"
 
 #include <fmt/format.h>
 
@@ -16,42 +17,8 @@
 namespace underfoot::analysis {
 
 const std::vector<std::string>& trialCsvColumns() {
-    static const std::vector<std::string> columns{"study",
-                                                  "site",
-                                                  "protocol_id",
-                                                  "protocol_hash",
-                                                  "participant",
-                                                  "group",
-                                                  "session",
-                                                  "trial_index",
-                                                  "block",
-                                                  "practice",
-                                                  "stimulus_id",
-                                                  "surface",
-                                                  "soundscape",
-                                                  "modalities",
-                                                  "reverb",
-                                                  "repetition",
-                                                  "render_seed",
-                                                  "answer",
-                                                  "answer_label",
-                                                  "correct",
-                                                  "realism",
-                                                  "quality",
-                                                  "soundscape_answer",
-                                                  "soundscape_correct",
-                                                  "response_time_s",
-                                                  "excluded",
-                                                  "exclusion_reason",
-                                                  "comment",
-                                                  "started_at",
-                                                  "answered_at",
-                                                  "trial",
-                                                  "simulated",
-                                                  "clip_file",
-                                                  "clip_frames",
-                                                  "clip_rate",
-                                                  "clip_sha256"};
+    static const std::vector<std::string> columns(base::kTrialColumns.begin(),
+                                                  base::kTrialColumns.end());
     return columns;
 }
 
