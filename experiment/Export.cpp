@@ -220,6 +220,30 @@ int writeRatingsCsv(const StudyStore& store, std::ostream& out, ExportScope scop
     return rows;
 }
 
+namespace {
+/// One row of the codebook's trials.csv table.
+struct ColumnMeaning {
+    std::string_view name, type, meaning;
+};
+
+/// Whether the codebook names exactly kTrialColumns, in order (checked when compiling).
+template <std::size_t N>
+constexpr bool namesAreTheTrialColumns(const ColumnMeaning (&rows)[N]) {
+    if (N != kTrialColumns.size()) return false;
+    for (std::size_t i = 0; i < N; ++i)
+        if (rows[i].name != kTrialColumns[i]) return false;
+    return true;
+}
+
+/// A codebook table of answer options: heading with the question, then key, id and label.
+void writeOptionTable(std::ostream& out, std::string_view title, const std::string& prompt,
+                      const std::vector<AnswerOption>& options) {
+    out << fmt::format("\n## {} — {}\n\n| key | id | label |\n|---|---|---|\n", title, prompt);
+    for (const auto& o : options)
+        out << fmt::format("| {} | `{}` | {} |\n", o.letter, o.id, o.label);
+}
+} // namespace
+
 void writeCodebook(const StudyStore& store, std::ostream& out) {
     const StudyInfo info = store.info();
     const Protocol& p = store.protocol();
@@ -234,7 +258,7 @@ void writeCodebook(const StudyStore& store, std::ostream& out) {
            "a spreadsheet formula (=, +, -, @, tab or CR) is written with a leading apostrophe "
            "('=x); numbers such as -1.5 are written as they are.\n\n"
            "| column | type | meaning |\n|---|---|---|\n";
-    const char* const rows[][3] = {
+    constexpr ColumnMeaning rows[] = {
         {"study", "text", "study code"},
         {"site", "text", "site (lab) code"},
         {"protocol_id", "text", "protocol id"},
@@ -283,7 +307,9 @@ void writeCodebook(const StudyStore& store, std::ostream& out) {
         {"clip_sha256", "hex text",
          "SHA-256 of the clip's float32 samples (`underfoot replay` renders the trial again and "
          "compares)"}};
-    for (const auto& r : rows) out << fmt::format("| `{}` | {} | {} |\n", r[0], r[1], r[2]);
+    static_assert(namesAreTheTrialColumns(rows), "codebook rows must follow kTrialColumns");
+    for (const auto& r : rows)
+        out << fmt::format("| `{}` | {} | {} |\n", r.name, r.type, r.meaning);
     out << "\n## ratings.csv — one row per rating\n\n"
            "Columns: study, participant, group, trial_index, stimulus_id, practice, excluded, "
            "one column per factor of the protocol's [[factorial]] stimuli (their level; empty "
@@ -301,18 +327,12 @@ void writeCodebook(const StudyStore& store, std::ostream& out) {
             out << fmt::format("| `{}` | {}–{} | {} … {} | {} |\n", s.id, s.min, s.max, s.minLabel,
                                s.maxLabel, s.prompt);
     }
-    if (p.questions.asksSurface()) {
-        out << fmt::format("\n## Answer options — {}\n\n| key | id | label |\n|---|---|---|\n",
-                           p.questions.surfacePrompt);
-        for (const auto& o : p.questions.surfaceOptions)
-            out << fmt::format("| {} | `{}` | {} |\n", o.letter, o.id, o.label);
-    }
-    if (!p.questions.soundscapeOptions.empty()) {
-        out << fmt::format("\n## Soundscape options — {}\n\n| key | id | label |\n|---|---|---|\n",
-                           p.questions.soundscapePrompt);
-        for (const auto& o : p.questions.soundscapeOptions)
-            out << fmt::format("| {} | `{}` | {} |\n", o.letter, o.id, o.label);
-    }
+    if (p.questions.asksSurface())
+        writeOptionTable(out, "Answer options", p.questions.surfacePrompt,
+                         p.questions.surfaceOptions);
+    if (!p.questions.soundscapeOptions.empty())
+        writeOptionTable(out, "Soundscape options", p.questions.soundscapePrompt,
+                         p.questions.soundscapeOptions);
     out << "\n## Stimuli\n\n| id | surface | soundscape | modalities | reverb | factors |\n"
            "|---|---|---|---|---|---|\n";
     for (const auto& s : p.stimuli) {

@@ -3,7 +3,8 @@
 /// Long-format export (one row per trial) and its codebook.
 ///
 /// Column order is a contract with analysis/ (which reads exactly these columns):
-/// see kTrialColumns. RFC 4180 quoting, empty cell = missing, booleans 0/1, ISO 8601 UTC times.
+/// base/TrialColumns.h. RFC 4180 quoting, empty cell = missing, booleans 0/1, ISO 8601 UTC times.
+#include "base/TrialColumns.h"
 #include "experiment/Store.h"
 
 #include <array>
@@ -13,43 +14,8 @@
 
 namespace underfoot::experiment {
 
-/// The columns of the long-format trials CSV, in order.
-inline constexpr std::array<std::string_view, 36> kTrialColumns = {"study",
-                                                                   "site",
-                                                                   "protocol_id",
-                                                                   "protocol_hash",
-                                                                   "participant",
-                                                                   "group",
-                                                                   "session",
-                                                                   "trial_index",
-                                                                   "block",
-                                                                   "practice",
-                                                                   "stimulus_id",
-                                                                   "surface",
-                                                                   "soundscape",
-                                                                   "modalities",
-                                                                   "reverb",
-                                                                   "repetition",
-                                                                   "render_seed",
-                                                                   "answer",
-                                                                   "answer_label",
-                                                                   "correct",
-                                                                   "realism",
-                                                                   "quality",
-                                                                   "soundscape_answer",
-                                                                   "soundscape_correct",
-                                                                   "response_time_s",
-                                                                   "excluded",
-                                                                   "exclusion_reason",
-                                                                   "comment",
-                                                                   "started_at",
-                                                                   "answered_at",
-                                                                   "trial",
-                                                                   "simulated",
-                                                                   "clip_file",
-                                                                   "clip_frames",
-                                                                   "clip_rate",
-                                                                   "clip_sha256"};
+/// The columns of the long-format trials CSV, in order (the one list, base/TrialColumns.h).
+using base::kTrialColumns;
 
 /// Which trials are written.
 enum class ExportScope { Answered, All };

@@ -2,9 +2,11 @@
 #pragma once
 /// Seeded, portable random numbers for experiment plans and simulated participants.
 ///
-/// xoshiro256** (Blackman & Vigna 2018) seeded through SplitMix64. Written for experiment/ so
-/// that plans do not depend on the engine. No std:: distributions: the same seed gives the same
-/// plan with every compiler and standard library.
+/// The project's one generator (base/Xoshiro.h: xoshiro256** seeded through SplitMix64), with
+/// the draws plans need: unbiased bounded integers (Lemire 2019) and shuffles. No std::
+/// distributions: the same seed gives the same plan with every compiler and standard library.
+#include "base/Xoshiro.h"
+
 #include <cstdint>
 #include <utility>
 #include <vector>
@@ -12,7 +14,7 @@
 namespace underfoot::experiment {
 
 /// One SplitMix64 step: advances `state` and returns a well-mixed 64-bit value.
-std::uint64_t splitMix64(std::uint64_t& state) noexcept;
+using base::splitMix64;
 
 /// Derives an independent 64-bit seed from a seed and a list of stream numbers (e.g. study seed,
 /// participant index, purpose).
@@ -22,15 +24,15 @@ std::uint64_t deriveSeed(std::uint64_t seed, std::initializer_list<std::uint64_t
 class Rng {
   public:
     /// Seeds the 256-bit state from `seed` through SplitMix64.
-    explicit Rng(std::uint64_t seed) noexcept;
+    explicit Rng(std::uint64_t seed) noexcept : gen_(seed) {}
     /// Next raw 64-bit output.
-    std::uint64_t next() noexcept;
+    std::uint64_t next() noexcept { return gen_.next(); }
     /// Uniform integer in [0, bound) without modulo bias (Lemire's method); bound must be > 0.
     std::uint64_t below(std::uint64_t bound) noexcept;
     /// Uniform double in [0, 1) with 53 random bits.
-    double uniform() noexcept;
+    double uniform() noexcept { return gen_.uniform(); }
     /// Standard normal deviate (Box–Muller, one value per call).
-    double gaussian() noexcept;
+    double gaussian() noexcept { return gen_.gaussian(); }
     /// Fisher–Yates shuffle.
     template <typename T>
     void shuffle(std::vector<T>& values) noexcept {
@@ -41,7 +43,7 @@ class Rng {
     }
 
   private:
-    std::uint64_t s_[4];
+    base::Xoshiro256 gen_;
 };
 
 } // namespace underfoot::experiment

@@ -130,6 +130,24 @@ std::string recoveryHint(const std::string& path) {
         path);
 }
 
+/// Refuses a damaged study file before anything is written to it (or read from it).
+void refuseDamaged(SQLite::Database& db, const std::string& path) {
+    if (const std::string problems = quickCheck(db, std::chrono::seconds(10)); !problems.empty())
+        throw StoreError(fmt::format("{}: the study file is damaged (SQLite integrity check: {}); "
+                                     "{}",
+                                     path, problems, recoveryHint(path)));
+}
+
+/// The schema version of an opened study file; refuses a file that is not a study (0 or less).
+int studySchemaVersion(SQLite::Database& db, const std::string& path) {
+    const int version = db.execAndGet("PRAGMA user_version").getInt();
+    if (version <= 0)
+        throw StoreError(fmt::format("{}: not an Underfoot study (schema version {}; expected "
+                                     "1 to {})",
+                                     path, version, kSchemaVersion));
+    return version;
+}
+
 } // namespace
 
 StudyStore::StudyStore(std::string path, std::unique_ptr<SQLite::Database> db, Clock clock)
@@ -242,17 +260,9 @@ StudyStore StudyStore::open(const std::string& path, Clock clock, const Catalogu
     } catch (const SQLite::Exception& e) {
         throw StoreError(fmt::format("{}: not a readable study file ({})", path, e.what()));
     }
-    // A damaged file is refused before anything is written to it.
-    if (const std::string problems = quickCheck(*db, std::chrono::seconds(10)); !problems.empty())
-        throw StoreError(fmt::format("{}: the study file is damaged (SQLite integrity check: {}); "
-                                     "{}",
-                                     path, problems, recoveryHint(path)));
+    refuseDamaged(*db, path);
     StudyStore store(path, std::move(db), std::move(clock));
-    const int version = store.db_->execAndGet("PRAGMA user_version").getInt();
-    if (version <= 0)
-        throw StoreError(fmt::format("{}: not an Underfoot study (schema version {}; expected "
-                                     "1 to {})",
-                                     path, version, kSchemaVersion));
+    studySchemaVersion(*store.db_, path);
     try {
         store.configure();
         store.loadProtocol(catalogue);
@@ -317,17 +327,10 @@ StudyStore StudyStore::openReadOnly(const std::string& path, Clock clock,
                 path, e.what(), wal, path, folder));
         throw StoreError(fmt::format("{}: not a readable study file ({})", path, e.what()));
     }
-    if (const std::string problems = quickCheck(*db, std::chrono::seconds(10)); !problems.empty())
-        throw StoreError(fmt::format("{}: the study file is damaged (SQLite integrity check: {}); "
-                                     "{}",
-                                     path, problems, recoveryHint(path)));
+    refuseDamaged(*db, path);
     StudyStore store(path, std::move(db), std::move(clock));
     store.readOnly_ = true;
-    const int version = store.db_->execAndGet("PRAGMA user_version").getInt();
-    if (version <= 0)
-        throw StoreError(fmt::format("{}: not an Underfoot study (schema version {}; expected "
-                                     "1 to {})",
-                                     path, version, kSchemaVersion));
+    const int version = studySchemaVersion(*store.db_, path);
     if (version > kSchemaVersion)
         throw StoreError(fmt::format("{}: schema version {} was written by a newer Underfoot; "
                                      "this version reads up to {}",

@@ -9,6 +9,7 @@
 
 #include <cerrno>
 #include <cstdint>
+#include <map>
 #include <random>
 #include <string>
 
@@ -38,6 +39,25 @@ inline ParticipantStatus statusFromText(const std::string& s) {
     if (s == "completed") return ParticipantStatus::Completed;
     if (s == "dropped") return ParticipantStatus::Dropped;
     return ParticipantStatus::Registered;
+}
+
+/// Inserts one row (owner id, name, value) per entry of `values` with `insertSql` (three
+/// placeholders in that order) and returns the entries as "name=value name=value" for the
+/// journal event that records them (participant fields, ratings).
+template <typename Value>
+std::string insertNamedValues(SQLite::Database& db, const char* insertSql, std::int64_t ownerId,
+                              const std::map<std::string, Value>& values) {
+    SQLite::Statement ins(db, insertSql);
+    std::string text;
+    for (const auto& [name, value] : values) {
+        ins.reset();
+        ins.bind(1, ownerId);
+        ins.bind(2, name);
+        ins.bind(3, value);
+        ins.exec();
+        text += fmt::format("{}{}={}", text.empty() ? "" : " ", name, value);
+    }
+    return text;
 }
 
 inline constexpr const char* kParticipantColumns =

@@ -203,17 +203,9 @@ ParticipantInfo StudyStore::registerParticipant(const NewParticipant& np,
     ins.bind(12, np.simulated ? 1 : 0);
     ins.exec();
     const std::int64_t pid = db_->getLastInsertRowid();
-    SQLite::Statement field(*db_, "INSERT INTO participant_fields (participant_id, name, value) "
-                                  "VALUES (?, ?, ?)");
-    std::string fieldsText;
-    for (const auto& [name, value] : fields) {
-        field.reset();
-        field.bind(1, pid);
-        field.bind(2, name);
-        field.bind(3, value);
-        field.exec();
-        fieldsText += fmt::format("{}{}={}", fieldsText.empty() ? "" : " ", name, value);
-    }
+    const std::string fieldsText = insertNamedValues(
+        *db_, "INSERT INTO participant_fields (participant_id, name, value) VALUES (?, ?, ?)", pid,
+        fields);
     SQLite::Statement trial(*db_, "INSERT INTO trials (participant_id, trial_index, block, "
                                   "practice, stimulus_id, stimulus, repetition, break_after, "
                                   "planned_seed) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?)");

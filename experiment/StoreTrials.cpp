@@ -215,17 +215,9 @@ void StudyStore::commitAnswer(const std::string& code, int trialIndex, const Tri
         SQLite::Statement del(*db_, "DELETE FROM ratings WHERE trial_id = ?");
         del.bind(1, trialId);
         del.exec();
-        SQLite::Statement rate(*db_,
-                               "INSERT INTO ratings (trial_id, scale, value) VALUES (?, ?, ?)");
-        std::string ratingsText;
-        for (const auto& [scale, value] : answer.ratings) {
-            rate.reset();
-            rate.bind(1, trialId);
-            rate.bind(2, scale);
-            rate.bind(3, value);
-            rate.exec();
-            ratingsText += fmt::format("{}{}={}", ratingsText.empty() ? "" : " ", scale, value);
-        }
+        const std::string ratingsText =
+            insertNamedValues(*db_, "INSERT INTO ratings (trial_id, scale, value) VALUES (?, ?, ?)",
+                              trialId, answer.ratings);
         appendEvent(changing ? JournalEvent::AnswerChanged : JournalEvent::Answered, p.id,
                     trialIndex,
                     jsonObject({{"answer", answer.answer},

@@ -4,6 +4,7 @@
 #include "analysis/io/Csv.h"
 #include "analysis/model/Catalog.h"
 #include "base/Plural.h"
+#include "base/TrialColumns.h"
 
 #include <fmt/format.h>
 
@@ -16,42 +17,8 @@
 namespace underfoot::analysis {
 
 const std::vector<std::string>& trialCsvColumns() {
-    static const std::vector<std::string> columns{"study",
-                                                  "site",
-                                                  "protocol_id",
-                                                  "protocol_hash",
-                                                  "participant",
-                                                  "group",
-                                                  "session",
-                                                  "trial_index",
-                                                  "block",
-                                                  "practice",
-                                                  "stimulus_id",
-                                                  "surface",
-                                                  "soundscape",
-                                                  "modalities",
-                                                  "reverb",
-                                                  "repetition",
-                                                  "render_seed",
-                                                  "answer",
-                                                  "answer_label",
-                                                  "correct",
-                                                  "realism",
-                                                  "quality",
-                                                  "soundscape_answer",
-                                                  "soundscape_correct",
-                                                  "response_time_s",
-                                                  "excluded",
-                                                  "exclusion_reason",
-                                                  "comment",
-                                                  "started_at",
-                                                  "answered_at",
-                                                  "trial",
-                                                  "simulated",
-                                                  "clip_file",
-                                                  "clip_frames",
-                                                  "clip_rate",
-                                                  "clip_sha256"};
+    static const std::vector<std::string> columns(base::kTrialColumns.begin(),
+                                                  base::kTrialColumns.end());
     return columns;
 }
 
@@ -74,6 +41,15 @@ class RowReader {
         auto it = index_.find(column);
         if (it == index_.end()) return {};
         return row_.fields[it->second];
+    }
+    /// The cell of a column that every row must fill ("source:line: empty participant
+    /// (expected a participant code)" otherwise).
+    std::string nonEmpty(const std::string& column, const char* expected) const {
+        std::string v = text(column);
+        if (v.empty())
+            throw std::runtime_error(
+                fmt::format("{}:{}: empty {} (expected {})", source_, row_.line, column, expected));
+        return v;
     }
     std::optional<bool> boolean(const std::string& column) const {
         const std::string v = text(column);
@@ -152,20 +128,14 @@ std::vector<TrialRecord> recordsToTrials(const std::vector<csv::Record>& records
         const RowReader cells(sourceName, header, row, index);
         TrialRecord t;
         t.study = cells.text("study");
-        t.participant = cells.text("participant");
-        if (t.participant.empty())
-            throw std::runtime_error(fmt::format(
-                "{}:{}: empty participant (expected a participant code)", sourceName, row.line));
+        t.participant = cells.nonEmpty("participant", "a participant code");
         t.group = cells.text("group");
         t.session = cells.text("session");
         t.trialIndex = cells.integer("trial_index");
         t.block = cells.text("block");
         t.practice = cells.boolean("practice").value_or(false);
         t.stimulusId = cells.text("stimulus_id");
-        t.surfaceId = cells.text("surface");
-        if (t.surfaceId.empty())
-            throw std::runtime_error(fmt::format(
-                "{}:{}: empty surface (expected the presented surface id)", sourceName, row.line));
+        t.surfaceId = cells.nonEmpty("surface", "the presented surface id");
         t.soundscapeId = cells.text("soundscape");
         t.modalities = cells.text("modalities");
         t.repetition = cells.integer("repetition");

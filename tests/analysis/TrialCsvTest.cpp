@@ -81,6 +81,17 @@ TEST(TrialCsv, ReadsTheExportFormatByHeaderName) {
     EXPECT_FALSE(u.simulated);
 }
 
+TEST(TrialCsv, EmptyParticipantOrSurfaceIsNamedWithFileAndLine) {
+    // Messages as the reader wrote them before its checks shared one helper.
+    const std::string required = "participant,group,practice,stimulus_id,surface,soundscape,"
+                                 "answer,realism,quality,soundscape_answer,excluded\n";
+    EXPECT_EQ(
+        expectError(required + "P1,A,0,s1,gravel,,gravel,,,,0\n,A,0,s1,gravel,,gravel,,,,0\n"),
+        "trials.csv:3: empty participant (expected a participant code)");
+    EXPECT_EQ(expectError(required + "P1,A,0,s1,,,gravel,,,,0\n"),
+              "trials.csv:2: empty surface (expected the presented surface id)");
+}
+
 TEST(TrialCsv, MissingRequiredColumnsAreNamedWithFileAndLine) {
     const std::string msg = expectError("participant,group,surface\nP1,A,gravel\n");
     EXPECT_NE(msg.find("trials.csv:1"), std::string::npos) << msg;

@@ -4,12 +4,10 @@
 // soundscapes they know come from one catalogue generated from the preset files
 // (base/Catalogue.h, tools/catalogue/catalogue.py). They must name the same things, and a preset
 // file must be all a new surface needs.
-#include "analysis/io/TrialCsv.h"
 #include "analysis/model/Catalog.h"
 #include "base/Catalogue.h"
 #include "engine/surfaces/Surface.h"
 #include "experiment/Catalogue.h"
-#include "experiment/Export.h"
 #include "soundscapes/Library.h"
 
 #include <gtest/gtest.h>
@@ -53,14 +51,6 @@ TEST(Catalogues, SoundscapesAgreeEverywhere) {
     for (const auto& s : analysis::soundscapeCatalog()) ana.insert(s.id);
     EXPECT_EQ(lib, exp);
     EXPECT_EQ(lib, ana);
-}
-
-TEST(Catalogues, TheAnalysisReadsExactlyTheColumnsTheExperimentExports) {
-    // The long-format trials CSV is the contract between the two parts.
-    const auto& read = analysis::trialCsvColumns();
-    ASSERT_EQ(read.size(), experiment::kTrialColumns.size());
-    for (std::size_t i = 0; i < read.size(); ++i)
-        EXPECT_EQ(read[i], std::string(experiment::kTrialColumns[i])) << "column " << i + 1;
 }
 
 namespace {

@@ -67,6 +67,41 @@ TEST(ExperimentExport, CsvFieldQuoting) {
     EXPECT_EQ(csvField("two\nlines"), "\"two\nlines\"");
 }
 
+namespace {
+/// The column names of the trials.csv table of a codebook (Markdown rows "| `name` | ... |"
+/// between "## trials.csv" and the next "## " heading), in order.
+std::vector<std::string> codebookTrialColumns(const std::string& markdown) {
+    std::vector<std::string> names;
+    std::istringstream in(markdown);
+    std::string line;
+    bool inTrials = false;
+    while (std::getline(in, line)) {
+        if (line.starts_with("## ")) inTrials = line.starts_with("## trials.csv");
+        if (!inTrials || !line.starts_with("| `")) continue;
+        const std::size_t end = line.find('`', 3);
+        if (end != std::string::npos) names.push_back(line.substr(3, end - 3));
+    }
+    return names;
+}
+} // namespace
+
+TEST(ExperimentExport, BothCodebooksListExactlyTheTrialColumnsInOrder) {
+    // kTrialColumns (base/TrialColumns.h) is what the export writes and the analysis reads; the
+    // codebook of every export and docs/reference/codebook.md say what each column means.
+    const std::vector<std::string> columns(kTrialColumns.begin(), kTrialColumns.end());
+    TempDir dir;
+    StudyStore store = StudyStore::create(dir.file("c.db"), parseProtocol(miniProtocol(), "m.toml"),
+                                          {"EXP", "A", 5, "t"});
+    std::ostringstream written;
+    writeCodebook(store, written);
+    EXPECT_EQ(codebookTrialColumns(written.str()), columns) << "experiment/Export.cpp codebook";
+    std::ifstream doc(std::string(UNDERFOOT_SOURCE_DIR) + "/docs/reference/codebook.md");
+    ASSERT_TRUE(doc) << "docs/reference/codebook.md";
+    std::ostringstream text;
+    text << doc.rdbuf();
+    EXPECT_EQ(codebookTrialColumns(text.str()), columns) << "docs/reference/codebook.md";
+}
+
 TEST(ExperimentExport, RowsCarryAnswersCorrectnessAndQuotedComments) {
     TempDir dir;
     StudyStore store = StudyStore::create(dir.file("e.db"), parseProtocol(miniProtocol(), "m.toml"),

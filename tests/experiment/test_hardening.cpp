@@ -479,3 +479,35 @@ TEST(StoreFaults, ReadOnlyOpenOfAnOlderSchemaSaysAMigrationIsNeeded) {
     EXPECT_NE(msg.find("migrate"), std::string::npos) << msg;
     EXPECT_EQ(readAll(path), before);
 }
+
+TEST(StoreJournal, RatingsAndParticipantFieldsAreJournaledAsNameValueText) {
+    // The journal events carry the stored ratings and participant fields as "name=value ...",
+    // in name order (the events table is what a damaged study is checked against).
+    TempDir dir;
+    StudyStore s = StudyStore::create(dir.file("j.db"), miniStudyProtocol(), {"J", "lab", 3, "t"});
+    s.registerParticipant({"P1", {}, "", "", "", {}, ""});
+    const int session = s.startSession("P1", {});
+    ASSERT_EQ(answerNext(s, "P1", session, 1), 1);
+    TrialAnswer changed = validAnswer(0);
+    changed.ratings = {{"realism", 3}, {"quality", 5}};
+    s.commitAnswer("P1", 0, changed, 2.0);
+    StudyStore w = StudyStore::create(
+        dir.file("w.db"), loadProtocol(shipped("wading_realism.toml")), {"W", "lab", 3, "t"});
+    w.registerParticipant({"P1", {}, "", "", "", {}, ""},
+                          {{"music_expertise", "none"},
+                           {"audio_expertise", "professional"},
+                           {"listening_device", "laptop_speakers"}});
+    std::vector<std::string> details;
+    for (const auto& e : s.events())
+        if (e.kind == "answered" || e.kind == "answer_changed") details.push_back(e.detail);
+    for (const auto& e : w.events())
+        if (e.kind == "participant_registered") details.push_back(e.detail);
+    ASSERT_EQ(details.size(), 3u);
+    EXPECT_NE(details[0].find("\"ratings\":\"realism=1\""), std::string::npos) << details[0];
+    EXPECT_NE(details[1].find("\"ratings\":\"quality=5 realism=3\""), std::string::npos)
+        << details[1];
+    EXPECT_NE(details[2].find("\"fields\":\"audio_expertise=professional "
+                              "listening_device=laptop_speakers music_expertise=none\""),
+              std::string::npos)
+        << details[2];
+}
