@@ -12,6 +12,7 @@
 #include <chrono>
 #include <cmath>
 #include <functional>
+#include <initializer_list>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -224,31 +225,26 @@ std::vector<KnobMeasurement> measureKnobs(double seconds) {
         return renderSurface(surface, grf, options);
     };
     auto left = [](const RenderResult& r) { return r.audio.channel(0); };
-    {
-        AccuracyOptions full;
-        const auto ref = run("metal", full);
-        for (int modes : {3, 6, 10, 14}) {
+    // One knob swept on one surface: per setting, the distance to the render with `reference`
+    // and the CPU time per sample.
+    auto sweep = [&](const char* knob, const std::string& surface, const AccuracyOptions& reference,
+                     std::initializer_list<int> values, void (*set)(AccuracyOptions&, int)) {
+        const auto ref = run(surface, reference);
+        for (int value : values) {
             AccuracyOptions a;
-            a.maxModes = modes;
-            const auto r = run("metal", a);
-            out.push_back({"modes (metal, 14 in the preset)", std::to_string(modes),
+            set(a, value);
+            const auto r = run(surface, a);
+            out.push_back({knob, std::to_string(value),
                            spectralDistanceDb(left(r), left(ref), kRate),
                            1e9 * r.cpuSeconds / double(r.audio.frames())});
         }
-    }
-    {
-        AccuracyOptions high;
-        high.maxEventsPerSecond = 32000;
-        const auto ref = run("gravel", high);
-        for (int cap : {250, 1000, 4000, 32000}) {
-            AccuracyOptions a;
-            a.maxEventsPerSecond = cap;
-            const auto r = run("gravel", a);
-            out.push_back({"event cap (gravel, events/s per layer)", std::to_string(cap),
-                           spectralDistanceDb(left(r), left(ref), kRate),
-                           1e9 * r.cpuSeconds / double(r.audio.frames())});
-        }
-    }
+    };
+    sweep("modes (metal, 14 in the preset)", "metal", AccuracyOptions{}, {3, 6, 10, 14},
+          [](AccuracyOptions& a, int modes) { a.maxModes = modes; });
+    AccuracyOptions high;
+    high.maxEventsPerSecond = 32000;
+    sweep("event cap (gravel, events/s per layer)", "gravel", high, {250, 1000, 4000, 32000},
+          [](AccuracyOptions& a, int cap) { a.maxEventsPerSecond = cap; });
     // The friction solve's Newton stop on the bench's creak (friction-creak), against the
     // converged reference: the fixed-point passes with libm, started without a warm start and
     // run until a pass changes nothing (at most 50).
