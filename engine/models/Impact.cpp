@@ -577,6 +577,14 @@ template <bool Wide>
     double x = exciterX_, v = exciterV_, last = lastForce_, stored = contactEnergy_;
     double time = time_, s1 = subForce1_, s2 = subForce2_;
     bool inContact = inContact_;
+    // The sole and the contact's stored energy back in the members (for correctPassivity, and
+    // at the end of the sub-steps).
+    auto storeSole = [&]() noexcept {
+        exciterX_ = x;
+        exciterV_ = v;
+        lastForce_ = last;
+        contactEnergy_ = stored;
+    };
     double fextNext = f0 + (f1 - f0) * double(0) / sub;
     for (int j = 0; j < sub; ++j) {
         // (substepSample's external forces: sub-step j + 1 starts where sub-step j ends)
@@ -603,10 +611,7 @@ template <bool Wide>
             t.energy = 0.5 * M * t.v * t.v + resonator_.energyIfCommitted(0, t.force);
             t.work = 0.5 * (fextNow + fextNext) * (t.x - x);
             if (!(stored + (bodiesBefore + t.work - t.energy) >= -tolerance)) [[unlikely]] {
-                exciterX_ = x;
-                exciterV_ = v;
-                lastForce_ = last;
-                contactEnergy_ = stored;
+                storeSole();
                 newtonStart_ = start;
                 t = correctPassivity(fextNow, fextNext, bodiesBefore, tolerance);
             }
@@ -616,10 +621,7 @@ template <bool Wide>
         s2 = s1;
         s1 = f;
     }
-    exciterX_ = x;
-    exciterV_ = v;
-    lastForce_ = last;
-    contactEnergy_ = stored;
+    storeSole();
     time_ = time;
     inContact_ = inContact;
     subForce1_ = s1;

@@ -12,6 +12,7 @@
 #include <chrono>
 #include <cmath>
 #include <functional>
+#include <initializer_list>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -224,31 +225,26 @@ std::vector<KnobMeasurement> measureKnobs(double seconds) {
         return renderSurface(surface, grf, options);
     };
     auto left = [](const RenderResult& r) { return r.audio.channel(0); };
-    {
-        AccuracyOptions full;
-        const auto ref = run("metal", full);
-        for (int modes : {3, 6, 10, 14}) {
+    // One knob swept on one surface: per setting, the distance to the render with `reference`
+    // and the CPU time per sample.
+    auto sweep = [&](const char* knob, const std::string& surface, const AccuracyOptions& reference,
+                     std::initializer_list<int> values, void (*set)(AccuracyOptions&, int)) {
+        const auto ref = run(surface, reference);
+        for (int value : values) {
             AccuracyOptions a;
-            a.maxModes = modes;
-            const auto r = run("metal", a);
-            out.push_back({"modes (metal, 14 in the preset)", std::to_string(modes),
+            set(a, value);
+            const auto r = run(surface, a);
+            out.push_back({knob, std::to_string(value),
                            spectralDistanceDb(left(r), left(ref), kRate),
                            1e9 * r.cpuSeconds / double(r.audio.frames())});
         }
-    }
-    {
-        AccuracyOptions high;
-        high.maxEventsPerSecond = 32000;
-        const auto ref = run("gravel", high);
-        for (int cap : {250, 1000, 4000, 32000}) {
-            AccuracyOptions a;
-            a.maxEventsPerSecond = cap;
-            const auto r = run("gravel", a);
-            out.push_back({"event cap (gravel, events/s per layer)", std::to_string(cap),
-                           spectralDistanceDb(left(r), left(ref), kRate),
-                           1e9 * r.cpuSeconds / double(r.audio.frames())});
-        }
-    }
+    };
+    sweep("modes (metal, 14 in the preset)", "metal", AccuracyOptions{}, {3, 6, 10, 14},
+          [](AccuracyOptions& a, int modes) { a.maxModes = modes; });
+    AccuracyOptions high;
+    high.maxEventsPerSecond = 32000;
+    sweep("event cap (gravel, events/s per layer)", "gravel", high, {250, 1000, 4000, 32000},
+          [](AccuracyOptions& a, int cap) { a.maxEventsPerSecond = cap; });
     // The friction solve's Newton stop on the bench's creak (friction-creak), against the
     // converged reference: the fixed-point passes with libm, started without a warm start and
     // run until a pass changes nothing (at most 50).
@@ -332,6 +328,39 @@ struct Scenario {
     BlockFn block;
 };
 
+// gravel.toml's first ("sharp clicks") grains layer; with oneVoice, like for like with SDT's
+// crumpling patch: one grain resonator, retriggered by each event (the new grain cuts the last
+// one off), no follow-up bursts.
+AggregateParameters gravelGrains(bool oneVoice) {
+    AggregateParameters p;
+    p.gamma = -1.6;
+    p.energyMin = 0.001;
+    p.resonances = 2;
+    p.freqMinHz = 1690.95;
+    p.freqMaxHz = 7609.26;
+    p.qMin = 9.8455;
+    p.qMax = 41.0229;
+    p.voices = oneVoice ? 1 : 48;
+    p.burstEvents = oneVoice ? 0.0 : 1.0;
+    p.burstMs = 1.5;
+    return p;
+}
+
+// A stream of events (AggregateModel, BubbleStream) prepared for at most maxEventsPerSecond and
+// seeded 7, driven at a constant event rate (events/s) and energy scale 1.
+template <typename Stream, typename Parameters>
+Scenario streamScenario(const Parameters& p, float rateHz, int maxEventsPerSecond = 4000) {
+    auto s = std::make_shared<Stream>();
+    s->configure(p);
+    s->prepare(kRate, maxEventsPerSecond);
+    s->reset(7);
+    auto rate = std::make_shared<std::vector<float>>(kCostBlock, rateHz);
+    auto scale = std::make_shared<std::vector<float>>(kCostBlock, 1.0f);
+    return {s, [s, rate, scale](int, float* out) {
+                s->process(rate->data(), scale->data(), out, kCostBlock);
+            }};
+}
+
 Scenario makeScenario(const std::string& id) {
     const int strikeEvery = static_cast<int>(0.25 * kRate / kCostBlock);
     if (id == "impact-strikes" || id == "impact-pressed" || id == "impact-metal") {
@@ -360,46 +389,13 @@ Scenario makeScenario(const std::string& id) {
         auto anchor = std::make_shared<double>(0.0);
         return {f, [f, anchor](int, float* out) { creakBlock(*f, *anchor, out); }};
     }
-    if (id == "aggregate-gravel" || id == "aggregate-gravel-1voice") {
-        AggregateParameters p; // gravel.toml, first ("sharp clicks") grains layer
-        p.gamma = -1.6;
-        p.energyMin = 0.001;
-        p.resonances = 2;
-        p.freqMinHz = 1690.95;
-        p.freqMaxHz = 7609.26;
-        p.qMin = 9.8455;
-        p.qMax = 41.0229;
-        p.voices = 48;
-        p.burstEvents = 1.0;
-        p.burstMs = 1.5;
-        if (id == "aggregate-gravel-1voice") {
-            // Like for like with SDT's crumpling patch: one grain resonator, retriggered by each
-            // event (the new grain cuts the last one off), no follow-up bursts.
-            p.voices = 1;
-            p.burstEvents = 0.0;
-        }
-        auto a = std::make_shared<AggregateModel>();
-        a->configure(p);
-        a->prepare(kRate, 4000);
-        a->reset(7);
-        auto rate = std::make_shared<std::vector<float>>(kCostBlock, 1000.0f);
-        auto scale = std::make_shared<std::vector<float>>(kCostBlock, 1.0f);
-        return {a, [a, rate, scale](int, float* out) {
-                    a->process(rate->data(), scale->data(), out, kCostBlock);
-                }};
-    }
+    if (id == "aggregate-gravel" || id == "aggregate-gravel-1voice")
+        return streamScenario<AggregateModel>(gravelGrains(id == "aggregate-gravel-1voice"),
+                                              1000.0f);
     if (id == "bubbles") {
         BubbleStreamParameters p;
         p.voices = 48;
-        auto s = std::make_shared<BubbleStream>();
-        s->configure(p);
-        s->prepare(kRate, 4000);
-        s->reset(7);
-        auto rate = std::make_shared<std::vector<float>>(kCostBlock, 500.0f);
-        auto scale = std::make_shared<std::vector<float>>(kCostBlock, 1.0f);
-        return {s, [s, rate, scale](int, float* out) {
-                    s->process(rate->data(), scale->data(), out, kCostBlock);
-                }};
+        return streamScenario<BubbleStream>(p, 500.0f);
     }
     throw std::invalid_argument("unknown bench scenario '" + id + "'");
 }
@@ -517,17 +513,11 @@ std::vector<ScalingPoint> measureScaling(double seconds, int repeats) {
     // Grain rate: the aggregate-gravel scenario's grains layer at 250..16000 events/s.
     for (int rate : {250, 500, 1000, 2000, 4000, 8000, 16000}) {
         const double ns = timeRuns([&] {
-            Scenario sc = makeScenario("aggregate-gravel");
-            auto a = std::static_pointer_cast<AggregateModel>(sc.state);
-            a->prepare(kRate, 16000);
-            a->reset(7);
-            auto rates = std::make_shared<std::vector<float>>(kCostBlock, float(rate));
-            auto scale = std::make_shared<std::vector<float>>(kCostBlock, 1.0f);
+            auto sc = std::make_shared<Scenario>(
+                streamScenario<AggregateModel>(gravelGrains(false), float(rate), 16000));
             TimedRun run;
             run.prepare = [out](int) { std::fill(out->begin(), out->end(), 0.0f); };
-            run.block = [a, rates, scale, out](int) {
-                a->process(rates->data(), scale->data(), out->data(), kCostBlock);
-            };
+            run.block = [sc, out](int b) { sc->block(b, out->data()); };
             return run;
         });
         points.push_back({"grain events/s", rate, ns, ns / (rate / 1000.0)});

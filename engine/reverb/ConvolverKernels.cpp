@@ -96,76 +96,54 @@ void headSse(const float* hl, const float* hr, const float* line, int m, float* 
     headScalar(hl, hr, line, t, m, yl, yr);
 }
 
-__attribute__((target("avx"))) void headAvx(const float* hl, const float* hr, const float* line,
-                                            int m, float* yl, float* yr) noexcept {
-    constexpr int q = Convolver::kHeadLength;
-    int t = 0;
-    for (; t + 16 <= m; t += 16) { // two vectors of outputs share the tap broadcasts
-        __m256 l0 = _mm256_setzero_ps(), l1 = l0, r0 = l0, r1 = l0;
-        for (int k = 0; k < q; ++k) {
-            const __m256 x0 = _mm256_loadu_ps(line + q - 1 + t - k);
-            const __m256 x1 = _mm256_loadu_ps(line + q - 1 + t + 8 - k);
-            const __m256 a = _mm256_broadcast_ss(hl + k), b = _mm256_broadcast_ss(hr + k);
-            l0 = _mm256_add_ps(l0, _mm256_mul_ps(a, x0));
-            l1 = _mm256_add_ps(l1, _mm256_mul_ps(a, x1));
-            r0 = _mm256_add_ps(r0, _mm256_mul_ps(b, x0));
-            r1 = _mm256_add_ps(r1, _mm256_mul_ps(b, x1));
-        }
-        _mm256_storeu_ps(yl + t, l0);
-        _mm256_storeu_ps(yl + t + 8, l1);
-        _mm256_storeu_ps(yr + t, r0);
-        _mm256_storeu_ps(yr + t + 8, r1);
+// The wide heads: pairs of vectors of W outputs share the tap broadcasts, then single vectors,
+// then TAIL finishes the last < W outputs from t on. Each output's sum runs over the taps in the
+// same order as in headScalar: every kernel gives the same sums.
+#define UNDERFOOT_HEAD_KERNEL(NAME, ATTR, V, W, LOAD, STORE, ADD, MUL, ZERO, SET1, TAIL)           \
+    ATTR void NAME(const float* hl, const float* hr, const float* line, int m, float* yl,          \
+                   float* yr) noexcept {                                                           \
+        constexpr int q = Convolver::kHeadLength;                                                  \
+        int t = 0;                                                                                 \
+        for (; t + 2 * (W) <= m; t += 2 * (W)) {                                                   \
+            V l0 = ZERO(), l1 = l0, r0 = l0, r1 = l0;                                              \
+            for (int k = 0; k < q; ++k) {                                                          \
+                const V x0 = LOAD(line + q - 1 + t - k);                                           \
+                const V x1 = LOAD(line + q - 1 + t - k + (W));                                     \
+                const V a = SET1(hl[k]), b = SET1(hr[k]);                                          \
+                l0 = ADD(l0, MUL(a, x0));                                                          \
+                l1 = ADD(l1, MUL(a, x1));                                                          \
+                r0 = ADD(r0, MUL(b, x0));                                                          \
+                r1 = ADD(r1, MUL(b, x1));                                                          \
+            }                                                                                      \
+            STORE(yl + t, l0);                                                                     \
+            STORE(yl + t + (W), l1);                                                               \
+            STORE(yr + t, r0);                                                                     \
+            STORE(yr + t + (W), r1);                                                               \
+        }                                                                                          \
+        for (; t + (W) <= m; t += (W)) {                                                           \
+            V l = ZERO(), r = l;                                                                   \
+            for (int k = 0; k < q; ++k) {                                                          \
+                const V x = LOAD(line + q - 1 + t - k);                                            \
+                l = ADD(l, MUL(SET1(hl[k]), x));                                                   \
+                r = ADD(r, MUL(SET1(hr[k]), x));                                                   \
+            }                                                                                      \
+            STORE(yl + t, l);                                                                      \
+            STORE(yr + t, r);                                                                      \
+        }                                                                                          \
+        TAIL;                                                                                      \
     }
-    for (; t + 8 <= m; t += 8) {
-        __m256 l = _mm256_setzero_ps(), r = l;
-        for (int k = 0; k < q; ++k) {
-            const __m256 x = _mm256_loadu_ps(line + q - 1 + t - k);
-            l = _mm256_add_ps(l, _mm256_mul_ps(_mm256_broadcast_ss(hl + k), x));
-            r = _mm256_add_ps(r, _mm256_mul_ps(_mm256_broadcast_ss(hr + k), x));
-        }
-        _mm256_storeu_ps(yl + t, l);
-        _mm256_storeu_ps(yr + t, r);
-    }
-    headScalar(hl, hr, line, t, m, yl, yr);
-}
 
+UNDERFOOT_HEAD_KERNEL(headAvx, __attribute__((target("avx"))), __m256, 8, _mm256_loadu_ps,
+                      _mm256_storeu_ps, _mm256_add_ps, _mm256_mul_ps, _mm256_setzero_ps,
+                      _mm256_set1_ps, headScalar(hl, hr, line, t, m, yl, yr))
 // AVX-512F has fused multiply-adds, into which GCC would contract the intrinsics' products and
 // sums (-ffp-contract=fast is its default): not in this kernel, whose results must be those of
-// the SSE and AVX ones (tested).
-#define UNDERFOOT_AVX512 __attribute__((target("avx512f"), optimize("fp-contract=off")))
-UNDERFOOT_AVX512 void headAvx512(const float* hl, const float* hr, const float* line, int m,
-                                 float* yl, float* yr) noexcept {
-    constexpr int q = Convolver::kHeadLength;
-    int t = 0;
-    for (; t + 32 <= m; t += 32) { // two vectors of outputs share the tap broadcasts
-        __m512 l0 = _mm512_setzero_ps(), l1 = l0, r0 = l0, r1 = l0;
-        for (int k = 0; k < q; ++k) {
-            const __m512 x0 = _mm512_loadu_ps(line + q - 1 + t - k);
-            const __m512 x1 = _mm512_loadu_ps(line + q - 1 + t + 16 - k);
-            const __m512 a = _mm512_set1_ps(hl[k]), b = _mm512_set1_ps(hr[k]);
-            l0 = _mm512_add_ps(l0, _mm512_mul_ps(a, x0));
-            l1 = _mm512_add_ps(l1, _mm512_mul_ps(a, x1));
-            r0 = _mm512_add_ps(r0, _mm512_mul_ps(b, x0));
-            r1 = _mm512_add_ps(r1, _mm512_mul_ps(b, x1));
-        }
-        _mm512_storeu_ps(yl + t, l0);
-        _mm512_storeu_ps(yl + t + 16, l1);
-        _mm512_storeu_ps(yr + t, r0);
-        _mm512_storeu_ps(yr + t + 16, r1);
-    }
-    for (; t + 16 <= m; t += 16) {
-        __m512 l = _mm512_setzero_ps(), r = l;
-        for (int k = 0; k < q; ++k) {
-            const __m512 x = _mm512_loadu_ps(line + q - 1 + t - k);
-            l = _mm512_add_ps(l, _mm512_mul_ps(_mm512_set1_ps(hl[k]), x));
-            r = _mm512_add_ps(r, _mm512_mul_ps(_mm512_set1_ps(hr[k]), x));
-        }
-        _mm512_storeu_ps(yl + t, l);
-        _mm512_storeu_ps(yr + t, r);
-    }
-    if (t < m) headAvx(hl, hr, line + t, m - t, yl + t, yr + t); // the last < 16 outputs
-}
-#undef UNDERFOOT_AVX512
+// the SSE and AVX ones (tested). Its last < 16 outputs go through the AVX kernel.
+UNDERFOOT_HEAD_KERNEL(headAvx512, __attribute__((target("avx512f"), optimize("fp-contract=off"))),
+                      __m512, 16, _mm512_loadu_ps, _mm512_storeu_ps, _mm512_add_ps, _mm512_mul_ps,
+                      _mm512_setzero_ps, _mm512_set1_ps,
+                      if (t < m) headAvx(hl, hr, line + t, m - t, yl + t, yr + t))
+#undef UNDERFOOT_HEAD_KERNEL
 
 Convolver::Simd cpuSimd() noexcept {
     if (simdAllowsAvx512()) return Convolver::Simd::Avx512;

@@ -164,40 +164,54 @@ void RoomSpec::validate() const {
         fail(fmt::format("speed of sound {} m/s outside [300, 400]", speedOfSoundMps));
 }
 
+namespace {
+// The built-in rooms, in the order roomPresetNames() lists them.
+const std::vector<RoomSpec>& builtInRooms() {
+    static const std::vector<RoomSpec> rooms = {
+        {.name = "hall",
+         .description = "large hall (30 x 20 x 12 m), T_mid 1.8 s",
+         .lengthM = 30.0,
+         .widthM = 20.0,
+         .heightM = 12.0,
+         .t60Seconds = {2.00, 1.90, 1.84, 1.76, 1.62, 1.42, 1.15},
+         .sourceM = {11.0, 8.5, 0.01},
+         .listenerM = {11.2, 8.5, 1.6}},
+        {.name = "small_room",
+         .description = "small furnished room (4 x 3.5 x 2.5 m), T_mid 0.4 s",
+         .lengthM = 4.0,
+         .widthM = 3.5,
+         .heightM = 2.5,
+         .t60Seconds = {0.50, 0.45, 0.40, 0.40, 0.38, 0.35, 0.30},
+         .sourceM = {1.5, 1.6, 0.01},
+         .listenerM = {1.7, 1.6, 1.6}},
+        // A medium room with a wooden floor and wooden panelling: panels absorb the low
+        // frequencies a little (membrane absorption), furniture and air the highs.
+        {.name = "wooden_room",
+         .description = "medium room (7 x 5 x 3 m) with a wooden floor, T_mid 0.8 s",
+         .lengthM = 7.0,
+         .widthM = 5.0,
+         .heightM = 3.0,
+         .t60Seconds = {0.70, 0.76, 0.80, 0.80, 0.76, 0.70, 0.60},
+         .sourceM = {2.6, 2.2, 0.01},
+         .listenerM = {2.8, 2.2, 1.6}},
+    };
+    return rooms;
+}
+} // namespace
+
 std::vector<std::string> roomPresetNames() {
-    return {"hall", "small_room", "wooden_room"};
+    std::vector<std::string> names;
+    for (const RoomSpec& r : builtInRooms()) names.push_back(r.name);
+    return names;
 }
 
 RoomSpec roomPreset(const std::string& name) {
-    RoomSpec r;
-    r.name = name;
-    if (name == "wooden_room") {
-        // A medium room with a wooden floor and wooden panelling: panels absorb the low
-        // frequencies a little (membrane absorption), furniture and air the highs.
-        r.description = "medium room (7 x 5 x 3 m) with a wooden floor, T_mid 0.8 s";
-        r.lengthM = 7.0, r.widthM = 5.0, r.heightM = 3.0;
-        r.t60Seconds = {0.70, 0.76, 0.80, 0.80, 0.76, 0.70, 0.60};
-        r.sourceM = {2.6, 2.2, 0.01};
-        r.listenerM = {2.8, 2.2, 1.6};
-    } else if (name == "hall") {
-        r.description = "large hall (30 x 20 x 12 m), T_mid 1.8 s";
-        r.lengthM = 30.0, r.widthM = 20.0, r.heightM = 12.0;
-        r.t60Seconds = {2.00, 1.90, 1.84, 1.76, 1.62, 1.42, 1.15};
-        r.sourceM = {11.0, 8.5, 0.01};
-        r.listenerM = {11.2, 8.5, 1.6};
-    } else if (name == "small_room") {
-        r.description = "small furnished room (4 x 3.5 x 2.5 m), T_mid 0.4 s";
-        r.lengthM = 4.0, r.widthM = 3.5, r.heightM = 2.5;
-        r.t60Seconds = {0.50, 0.45, 0.40, 0.40, 0.38, 0.35, 0.30};
-        r.sourceM = {1.5, 1.6, 0.01};
-        r.listenerM = {1.7, 1.6, 1.6};
-    } else {
-        std::string names;
-        for (const auto& n : roomPresetNames()) names += (names.empty() ? "" : ", ") + n;
-        throw std::invalid_argument(
-            fmt::format("unknown room \"{}\"; expected one of: {}", name, names));
-    }
-    return r;
+    for (const RoomSpec& r : builtInRooms())
+        if (r.name == name) return r;
+    std::string names;
+    for (const auto& n : roomPresetNames()) names += (names.empty() ? "" : ", ") + n;
+    throw std::invalid_argument(
+        fmt::format("unknown room \"{}\"; expected one of: {}", name, names));
 }
 
 AudioBuffer generateRoomImpulseResponse(const RoomSpec& room, const RoomIrOptions& o) {

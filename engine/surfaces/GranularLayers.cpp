@@ -13,7 +13,6 @@ namespace underfoot::engine {
 namespace {
 constexpr double kTailSeconds = 0.25; // filters ring out this long before the layer sleeps
 constexpr double kDerivativeRefKnPerS = 10.0;
-constexpr double kJumpN = 100.0; // a rise from no contact by more than this in one sample is a cut
 
 } // namespace
 
@@ -25,9 +24,8 @@ GrainsLayer::GrainsLayer(const AggregateParameters& model, const GrainsControl& 
 }
 
 void GrainsLayer::prepare(const ProcessSpec& spec) {
-    sampleRateHz_ = spec.sampleRateHz;
+    prepareLoad(spec, control_.derivativeMs, control_.contactThresholdN, kTailSeconds);
     model_.prepare(spec.sampleRateHz, maxEventsPerSecond_);
-    derivativeG_ = onePoleCoefficientTau(control_.derivativeMs * 1e-3, sampleRateHz_);
     const double nyquistGuard = 0.45 * sampleRateHz_;
     useLowpass_ = control_.lowpassHz > 0 && control_.lowpassHz < nyquistGuard;
     useHighpass_ = control_.highpassHz > 0;
@@ -41,7 +39,6 @@ void GrainsLayer::prepare(const ProcessSpec& spec) {
     rate_.assign(block, 0.0f);
     loads_.assign(block, SampleLoad{});
     buffer_.assign(block, 0.0f);
-    tailLength_ = static_cast<int>(kTailSeconds * sampleRateHz_);
     settling_.prepare(control_.settling, sampleRateHz_);
     heelEnd_ = static_cast<std::int64_t>(
         std::ceil((control_.heelMs + 10.0 * control_.heelDecayMs) * 1e-3 * sampleRateHz_));
@@ -52,14 +49,9 @@ void GrainsLayer::reset(std::uint64_t seed) noexcept {
     model_.reset(seed);
     lowpass_.reset();
     highpass_.reset();
-    previousF_ = 0.0;
-    derivative_ = 0.0;
+    resetLoad();
     contactPeakN_ = 0.0;
     onsetArmed_ = true;
-    sleeping_ = true;
-    tailSamples_ = 0;
-    sleepGrid_.reset();
-    contactSinceGridPoint_ = false;
     heelAge_ = -1;
     settling_.reset();
 }
@@ -76,34 +68,8 @@ double GrainsLayer::heelEnvelope() noexcept {
     return std::exp(-(t - peak) / (control_.heelDecayMs * 1e-3)); // then the settling decay
 }
 
-void GrainsLayer::process(const float* grf, float* out, int n) noexcept {
-    const int block = static_cast<int>(buffer_.size());
-    if (block == 0) return; // not prepared
-    // Sleep is decided on the sleep grid, waking at the first sample in contact: the output does
-    // not depend on the host's block size (engine/dsp/SleepGrid.h).
-    sleepGrid_.split(n, [&](int offset, int length, bool atGridPoint) {
-        for (int done = 0; done < length; done += block)
-            processChunk(grf + offset + done, out + offset + done, std::min(block, length - done));
-        if (atGridPoint) sleepDecision();
-    });
-}
-
-void GrainsLayer::processChunk(const float* grf, float* out, int n) noexcept {
+bool GrainsLayer::processAwake(const float* grf, float* out, int n) noexcept {
     const double threshold = control_.contactThresholdN;
-    if (sleeping_) {
-        // The layer wakes at the first sample in contact. Until then only the load's smoothed
-        // derivative is tracked (as awake), so a landing's rise is the same whenever it wakes.
-        const int first = trackLoadUntilContact(grf, n, threshold, sampleRateHz_ * 1e-3,
-                                                derivativeG_, previousF_, derivative_);
-        if (first == n) return;
-        sleeping_ = false;
-        tailSamples_ = 0;
-        grf += first;
-        out += first;
-        n -= first;
-    }
-    const double toKnPerS = sampleRateHz_ * 1e-3;
-    const double g = derivativeG_;
     bool contactSeen = false;
     float* buffer = buffer_.data();
     std::fill(buffer, buffer + n, 0.0f);
@@ -113,15 +79,9 @@ void GrainsLayer::processChunk(const float* grf, float* out, int n) noexcept {
         if (control_.heelRateHz > 0) // heel burst: starts at a landing, not at a cut (below)
             heelAge_ = previousF_ <= threshold && f > threshold ? (f - previousF_ > kJumpN ? -1 : 0)
                                                                 : (f > threshold ? heelAge_ : -1);
-        if (previousF_ <= threshold && f - previousF_ > kJumpN) {
-            // No foot lands this fast: the GRF starts mid-stance (a file or walker starting in
-            // the middle of a step). Take the load as already there: no landing, no rise.
-            previousF_ = f;
-            onsetArmed_ = false;
-        }
-        const double raw = (f - previousF_) * toKnPerS;
-        previousF_ = f;
-        derivative_ = raw + g * (derivative_ - raw);
+        // A cut (a file or walker starting in the middle of a step): the load is already
+        // there, no landing.
+        if (trackLoad(f)) onsetArmed_ = false;
         const auto u = static_cast<std::size_t>(i);
         if (f > threshold) {
             contactSeen = true;
@@ -177,7 +137,7 @@ void GrainsLayer::processChunk(const float* grf, float* out, int n) noexcept {
             buffer[i] = static_cast<float>(lowpass_.processSample(buffer[i]));
     const float gain = static_cast<float>(gain_);
     for (int i = 0; i < n; ++i) out[i] += gain * buffer[i];
-    contactSinceGridPoint_ |= contactSeen;
+    return contactSeen;
 }
 
 void GrainsLayer::runModel(int from, int to, float* buffer) noexcept {
@@ -215,23 +175,15 @@ float GrainsLayer::scaleOf(std::size_t u) const noexcept {
     return static_cast<float>(scale);
 }
 
-void GrainsLayer::sleepDecision() noexcept {
-    const bool contactSeen = contactSinceGridPoint_;
-    contactSinceGridPoint_ = false;
-    derivative_ = snapToZero(derivative_);
-    if (sleeping_) return;
+bool GrainsLayer::settleTail() noexcept {
     highpass_.snapTinyState();
     lowpass_.snapTinyState();
-    if (!contactSeen && model_.idle()) {
-        tailSamples_ += kSleepGridSamples; // (awake for the whole span: no contact in it)
-        if (tailSamples_ >= tailLength_) { // rung out: sleep with clean state
-            lowpass_.reset();
-            highpass_.reset();
-            sleeping_ = true; // (the load's derivative is still tracked while asleep)
-        }
-    } else {
-        tailSamples_ = 0;
-    }
+    return model_.idle();
+}
+
+void GrainsLayer::fallAsleep() noexcept {
+    lowpass_.reset();
+    highpass_.reset();
 }
 
 std::unique_ptr<SurfaceLayer> makeGrainsLayer(PresetReader& r, const AccuracyOptions& options) {

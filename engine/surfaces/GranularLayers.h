@@ -49,10 +49,8 @@
 /// The sum of the voices goes through an optional 2nd-order Butterworth high-pass and low-pass
 /// (tone) and the layer gain.
 #include "engine/dsp/Biquad.h"
-#include "engine/dsp/SleepGrid.h"
 #include "engine/models/Aggregate.h"
-#include "engine/surfaces/Layer.h"
-#include "engine/surfaces/LoadInput.h"
+#include "engine/surfaces/LoadDrivenLayer.h"
 
 namespace underfoot::engine {
 
@@ -79,14 +77,12 @@ struct GrainsControl {
     LoadSettling::Params settling; ///< a load held still: the bed settles (LoadInput.h)
 };
 
-class GrainsLayer final : public SurfaceLayer {
+class GrainsLayer final : public LoadDrivenLayer {
   public:
     GrainsLayer(const AggregateParameters& model, const GrainsControl& control,
                 const AccuracyOptions& options);
     void prepare(const ProcessSpec& spec) override;
     void reset(std::uint64_t seed) noexcept override;
-    void process(const float* grfNewtons, float* out, int n) noexcept override;
-    bool isSleeping() const noexcept override { return sleeping_; }
     const char* kind() const noexcept override { return "grains"; }
 
     const AggregateModel& model() const noexcept { return model_; }
@@ -94,15 +90,14 @@ class GrainsLayer final : public SurfaceLayer {
     const GrainsControl& control() const noexcept { return control_; }
 
   private:
-    void processChunk(const float* grf, float* out, int n) noexcept;
+    bool processAwake(const float* grf, float* out, int n) noexcept override;
+    bool settleTail() noexcept override;
+    void fallAsleep() noexcept override;
     /// Heel burst: the envelope at this sample (advances it); 0 when no burst runs.
     double heelEnvelope() noexcept;
-    void sleepDecision() noexcept; // at a sleep grid point (engine/dsp/SleepGrid.h)
     AggregateModel model_;
     GrainsControl control_;
     int maxEventsPerSecond_;
-    double sampleRateHz_ = 48000.0;
-    double derivativeG_ = 0.0;
     double gain_ = 1.0;
     Biquad lowpass_, highpass_;
     bool useLowpass_ = false, useHighpass_ = false;
@@ -119,16 +114,11 @@ class GrainsLayer final : public SurfaceLayer {
     float scaleOf(std::size_t u) const noexcept;
     static float scaleAt(void* self, int i) noexcept;
     void runModel(int from, int to, float* buffer) noexcept;
-    double previousF_ = 0.0, derivative_ = 0.0;
     double contactPeakN_ = 0.0; ///< highest load of this contact so far (felicity_ratio)
     bool onsetArmed_ = true;
-    bool sleeping_ = true;
-    int tailSamples_ = 0, tailLength_ = 0;
     LoadSettling settling_;
     std::int64_t heelAge_ = -1; ///< samples since the heel burst started; -1: none running
     std::int64_t heelEnd_ = 0;  ///< its length (heel_ms + 10 heel_decay_ms) in samples
-    SleepGrid sleepGrid_;
-    bool contactSinceGridPoint_ = false;
 };
 
 /// Factory for the layer table: reads every parameter of a grains layer (with unit and range).

@@ -13,7 +13,6 @@ namespace underfoot::engine {
 namespace {
 constexpr double kTailSeconds = 0.1;
 constexpr double kDerivativeRefKnPerS = 10.0;
-constexpr double kJumpN = 100.0;  // a rise from no contact by more than this in one sample is a cut
 constexpr double kQuiet = 1e-6;   // envelopes below this are silent
 constexpr double kOffDb = -120.0; // noise levels at or below this are off
 constexpr double kWakeEnd = 1e-3; // the wake envelope ends 60 dB below its nominal start
@@ -30,9 +29,8 @@ BubblesLayer::BubblesLayer(const BubbleStreamParameters& stream, const BubblesCo
 }
 
 void BubblesLayer::prepare(const ProcessSpec& spec) {
-    sampleRateHz_ = spec.sampleRateHz;
+    prepareLoad(spec, control_.derivativeMs, control_.contactThresholdN, kTailSeconds);
     stream_.prepare(sampleRateHz_, maxEventsPerSecond_);
-    derivativeG_ = onePoleCoefficientTau(control_.derivativeMs * 1e-3, sampleRateHz_);
     splashDecayG_ = onePoleCoefficientTau(control_.splashDecayMs * 1e-3, sampleRateHz_);
     splashRiseG_ = control_.splashRiseMs > 0
                        ? onePoleCoefficientTau(control_.splashRiseMs * 1e-3, sampleRateHz_)
@@ -50,7 +48,6 @@ void BubblesLayer::prepare(const ProcessSpec& spec) {
     rate_.assign(block, 0.0f);
     scale_.assign(block, 1.0f);
     buffer_.assign(block, 0.0f);
-    tailLength_ = static_cast<int>(kTailSeconds * sampleRateHz_);
     reset(0);
 }
 
@@ -59,54 +56,21 @@ void BubblesLayer::reset(std::uint64_t seed) noexcept {
     noise_.setSeed(Random::deriveSeed(seed, 1));
     splashFilter_.reset();
     sloshFilter_.reset();
-    previousF_ = derivative_ = 0.0;
+    resetLoad();
     inContact_ = false;
     settling_.reset();
     contactSamples_ = 0;
     releasePeak_ = 0.0;
     splashEnv_ = wakeEnv_ = motionEnv_ = 0.0;
-    sleeping_ = true;
-    tailSamples_ = 0;
-    sleepGrid_.reset();
-    contactSinceGridPoint_ = false;
 }
 
-void BubblesLayer::process(const float* grf, float* out, int n) noexcept {
-    const int block = static_cast<int>(buffer_.size());
-    if (block == 0) return;
-    // Sleep is decided on the sleep grid, waking at the first sample in contact: the output does
-    // not depend on the host's block size (engine/dsp/SleepGrid.h).
-    sleepGrid_.split(n, [&](int offset, int length, bool atGridPoint) {
-        for (int done = 0; done < length; done += block)
-            processChunk(grf + offset + done, out + offset + done, std::min(block, length - done));
-        if (atGridPoint) sleepDecision();
-    });
-}
-
-void BubblesLayer::processChunk(const float* grf, float* out, int n) noexcept {
+bool BubblesLayer::processAwake(const float* grf, float* out, int n) noexcept {
     const double threshold = control_.contactThresholdN;
-    if (sleeping_) {
-        // The layer wakes at the first sample in contact. Until then only the load's smoothed
-        // derivative is tracked (as awake), so a landing's rise is the same whenever it wakes.
-        const int first = trackLoadUntilContact(grf, n, threshold, sampleRateHz_ * 1e-3,
-                                                derivativeG_, previousF_, derivative_);
-        if (first == n) return;
-        sleeping_ = false;
-        tailSamples_ = 0;
-        grf += first;
-        out += first;
-        n -= first;
-    }
-    const double toKnPerS = sampleRateHz_ * 1e-3;
     bool contactSeen = false;
     float* buffer = buffer_.data();
     for (int i = 0; i < n; ++i) {
         const double f = sanitizeForce(grf[i]);
-        const bool jump = previousF_ <= threshold && f - previousF_ > kJumpN;
-        if (jump) previousF_ = f; // the GRF starts mid-stance: the foot is already in the water
-        const double raw = (f - previousF_) * toKnPerS;
-        previousF_ = f;
-        derivative_ = raw + derivativeG_ * (derivative_ - raw);
+        const bool jump = trackLoad(f); // a cut: the foot is already in the water
         const bool contact = f > threshold;
         if (contact && !inContact_) {
             inContact_ = true;
@@ -161,29 +125,20 @@ void BubblesLayer::processChunk(const float* grf, float* out, int n) noexcept {
     stream_.process(rate_.data(), scale_.data(), buffer, n);
     const float gain = static_cast<float>(gain_);
     for (int i = 0; i < n; ++i) out[i] += gain * buffer[i];
-    contactSinceGridPoint_ |= contactSeen;
+    return contactSeen;
 }
 
-void BubblesLayer::sleepDecision() noexcept {
-    const bool contactSeen = contactSinceGridPoint_;
-    contactSinceGridPoint_ = false;
-    derivative_ = snapToZero(derivative_);
-    if (sleeping_) return;
+bool BubblesLayer::settleTail() noexcept {
     wakeEnv_ = snapToZero(wakeEnv_);
     splashEnv_ = snapToZero(splashEnv_);
     motionEnv_ = snapToZero(motionEnv_);
-    const bool quiet = wakeEnv_ < kQuiet && splashEnv_ < kQuiet && motionEnv_ < kQuiet;
-    if (!contactSeen && quiet && stream_.idle()) {
-        tailSamples_ += kSleepGridSamples; // (awake for the whole span: no contact in it)
-        if (tailSamples_ >= tailLength_) {
-            splashFilter_.reset();
-            sloshFilter_.reset();
-            wakeEnv_ = splashEnv_ = motionEnv_ = 0.0;
-            sleeping_ = true; // (the load's derivative is still tracked while asleep)
-        }
-    } else {
-        tailSamples_ = 0;
-    }
+    return wakeEnv_ < kQuiet && splashEnv_ < kQuiet && motionEnv_ < kQuiet && stream_.idle();
+}
+
+void BubblesLayer::fallAsleep() noexcept {
+    splashFilter_.reset();
+    sloshFilter_.reset();
+    wakeEnv_ = splashEnv_ = motionEnv_ = 0.0;
 }
 
 std::unique_ptr<SurfaceLayer> makeBubblesLayer(PresetReader& r, const AccuracyOptions& options) {

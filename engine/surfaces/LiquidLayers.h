@@ -23,10 +23,8 @@
 /// With the GRF at zero from reset the layer is silent and sleeps; after a step it sleeps again
 /// once the bubbles, the wake and the noise have decayed.
 #include "engine/dsp/Biquad.h"
-#include "engine/dsp/SleepGrid.h"
 #include "engine/models/Bubbles.h"
-#include "engine/surfaces/Layer.h"
-#include "engine/surfaces/LoadInput.h"
+#include "engine/surfaces/LoadDrivenLayer.h"
 
 namespace underfoot::engine {
 
@@ -48,40 +46,33 @@ struct BubblesControl {
     LoadSettling::Params settling; ///< a leg held still: the water calms (LoadInput.h)
 };
 
-class BubblesLayer final : public SurfaceLayer {
+class BubblesLayer final : public LoadDrivenLayer {
   public:
     BubblesLayer(const BubbleStreamParameters& stream, const BubblesControl& control,
                  const AccuracyOptions& options);
     void prepare(const ProcessSpec& spec) override;
     void reset(std::uint64_t seed) noexcept override;
-    void process(const float* grfNewtons, float* out, int n) noexcept override;
-    bool isSleeping() const noexcept override { return sleeping_; }
     const char* kind() const noexcept override { return "bubbles"; }
 
     const BubbleStream& stream() const noexcept { return stream_; }
 
   private:
-    void processChunk(const float* grf, float* out, int n) noexcept;
-    void sleepDecision() noexcept; // at a sleep grid point (engine/dsp/SleepGrid.h)
+    bool processAwake(const float* grf, float* out, int n) noexcept override;
+    bool settleTail() noexcept override;
+    void fallAsleep() noexcept override;
     BubbleStream stream_;
     BubblesControl control_;
     int maxEventsPerSecond_;
-    double sampleRateHz_ = 48000.0;
-    double derivativeG_ = 0, splashDecayG_ = 0, splashRiseG_ = 0, wakeG_ = 0, motionG_ = 0;
+    double splashDecayG_ = 0, splashRiseG_ = 0, wakeG_ = 0, motionG_ = 0;
     double gain_ = 1.0, splashGain_ = 0.0, sloshGain_ = 0.0;
     Biquad splashFilter_, sloshFilter_;
     Random noise_;
     std::vector<float> rate_, scale_, buffer_;
-    double previousF_ = 0, derivative_ = 0;
     bool inContact_ = false;
     LoadSettling settling_;
     int contactSamples_ = 0, splashSamples_ = 0;
     double releasePeak_ = 0;
     double splashEnv_ = 0, wakeEnv_ = 0, motionEnv_ = 0;
-    bool sleeping_ = true;
-    int tailSamples_ = 0, tailLength_ = 0;
-    SleepGrid sleepGrid_;
-    bool contactSinceGridPoint_ = false;
 };
 
 std::unique_ptr<SurfaceLayer> makeBubblesLayer(PresetReader& reader,
