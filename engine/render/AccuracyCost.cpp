@@ -23,6 +23,8 @@ namespace {
 using CostClock = std::chrono::steady_clock;
 constexpr double kRate = 48000.0;
 constexpr int kCostBlock = 64;
+/// Blocks between two strikes in the timed runs (one strike every 0.25 s).
+constexpr int kStrikeEvery = static_cast<int>(0.25 * kRate / kCostBlock);
 
 const std::vector<Mode>& benchModes() {
     static const std::vector<Mode> modes = {
@@ -109,15 +111,14 @@ BlockTimes timeBlocks(int blocks, int repeats, const std::function<TimedRun()>& 
 template <typename Real>
 void timeStrikes(const ImpactSetting& s, double seconds, ImpactMeasurement& m, int repeats = 5) {
     const int blocks = static_cast<int>(seconds * kRate / kCostBlock);
-    const int strikeEvery = static_cast<int>(0.25 * kRate / kCostBlock);
     auto out = std::make_shared<std::vector<float>>(kCostBlock);
     const BlockTimes t = timeBlocks(blocks, repeats, [&] {
         auto impact = std::make_shared<HuntCrossleyImpactT<Real>>();
         impact->configure(benchParams(s), benchModes(), {{1.0, 1.0, 1.0}});
         impact->prepare({kRate, kCostBlock});
         TimedRun run;
-        run.block = [impact, out, strikeEvery](int b) {
-            if (b % strikeEvery == 0) impact->strike(0.5);
+        run.block = [impact, out](int b) {
+            if (b % kStrikeEvery == 0) impact->strike(0.5);
             impact->process(nullptr, out->data(), kCostBlock);
         };
         return run;
@@ -362,7 +363,6 @@ Scenario streamScenario(const Parameters& p, float rateHz, int maxEventsPerSecon
 }
 
 Scenario makeScenario(const std::string& id) {
-    const int strikeEvery = static_cast<int>(0.25 * kRate / kCostBlock);
     if (id == "impact-strikes" || id == "impact-pressed" || id == "impact-metal") {
         auto impact = std::make_shared<HuntCrossleyImpact>();
         ImpactParams p = scenarioImpact();
@@ -378,8 +378,8 @@ Scenario makeScenario(const std::string& id) {
         impact->prepare({kRate, kCostBlock});
         const bool pressed = id == "impact-pressed";
         auto force = std::make_shared<std::vector<float>>(kCostBlock, pressed ? 300.0f : 0.0f);
-        return {impact, [impact, force, pressed, v, strikeEvery](int b, float* out) {
-                    if (pressed ? b == 0 : b % strikeEvery == 0) impact->strike(v);
+        return {impact, [impact, force, pressed, v](int b, float* out) {
+                    if (pressed ? b == 0 : b % kStrikeEvery == 0) impact->strike(v);
                     impact->process(pressed ? force->data() : nullptr, out, kCostBlock);
                 }};
     }
@@ -464,7 +464,6 @@ ScenarioMeasurement measureScenario(const std::string& id, double seconds, int r
 
 std::vector<ScalingPoint> measureScaling(double seconds, int repeats) {
     const int blocks = static_cast<int>(seconds * kRate / kCostBlock);
-    const int strikeEvery = static_cast<int>(0.25 * kRate / kCostBlock);
     auto out = std::make_shared<std::vector<float>>(kCostBlock);
     std::vector<ScalingPoint> points;
     auto timeRuns = [&](const std::function<TimedRun()>& make) {
@@ -480,10 +479,10 @@ std::vector<ScalingPoint> measureScaling(double seconds, int repeats) {
                 v.prepare({kRate, kCostBlock});
             }
             TimedRun run;
-            run.block = [pool, out, strikeEvery](int b) {
+            run.block = [pool, out](int b) {
                 for (std::size_t v = 0; v < pool->size(); ++v) {
                     auto& voice = (*pool)[v];
-                    if ((b + static_cast<int>(v) * 7) % strikeEvery == 0) voice.strike(0.5);
+                    if ((b + static_cast<int>(v) * 7) % kStrikeEvery == 0) voice.strike(0.5);
                     voice.process(nullptr, out->data(), kCostBlock);
                 }
             };
@@ -502,8 +501,8 @@ std::vector<ScalingPoint> measureScaling(double seconds, int repeats) {
             impact->configure(scenarioImpact(), m, {g});
             impact->prepare({kRate, kCostBlock});
             TimedRun run;
-            run.block = [impact, out, strikeEvery](int b) {
-                if (b % strikeEvery == 0) impact->strike(0.5);
+            run.block = [impact, out](int b) {
+                if (b % kStrikeEvery == 0) impact->strike(0.5);
                 impact->process(nullptr, out->data(), kCostBlock);
             };
             return run;
