@@ -103,6 +103,16 @@ void eachMode(toml::table& root, const Ranges& ranges,
     (void)ranges;
 }
 
+// A knob's rewrite that multiplies these keys of every layer of that type by 2^k.
+std::function<void(toml::table&, double, const Ranges&)> octaves(std::string type,
+                                                                 std::vector<std::string> keys) {
+    return [type = std::move(type), keys = std::move(keys)](toml::table& r, double x,
+                                                            const Ranges& rg) {
+        for (const auto& key : keys)
+            eachLayerKey(r, type, key, rg, [x](double v, int) { return v * std::exp2(x); });
+    };
+}
+
 struct ModeRow {
     double f = 0, t60 = 0, mass = 1, gain = 1;
 };
@@ -121,7 +131,6 @@ bool hasLayer(const toml::table& root, const std::string& type, int* count) {
 
 std::vector<Knob> knobsFor(const toml::table& root) {
     std::vector<Knob> k;
-    auto mul2 = [](double k2) { return [k2](double v, int) { return v * std::exp2(k2); }; };
     if (hasLayer(root, "impact")) {
         k.push_back({{"decay", "every mode's t60_s x 2^k", -4.5, 2, 0, 0},
                      [](toml::table& r, double x, const Ranges& rg) {
@@ -151,21 +160,12 @@ std::vector<Knob> knobsFor(const toml::table& root) {
     if (hasLayer(root, "grains", &grainLayers)) {
         k.push_back(
             {{"grain_band", "grain resonance band (freq_min/max_hz) x 2^k", -1.5, 1.5, 0, 0},
-             [mul2](toml::table& r, double x, const Ranges& rg) {
-                 eachLayerKey(r, "grains", "freq_min_hz", rg, mul2(x));
-                 eachLayerKey(r, "grains", "freq_max_hz", rg, mul2(x));
-             }});
+             octaves("grains", {"freq_min_hz", "freq_max_hz"})});
         k.push_back({{"grain_q", "grain resonance Q (q_min/max) x 2^k", -2, 2, 0, 0},
-                     [mul2](toml::table& r, double x, const Ranges& rg) {
-                         eachLayerKey(r, "grains", "q_min", rg, mul2(x));
-                         eachLayerKey(r, "grains", "q_max", rg, mul2(x));
-                     }});
+                     octaves("grains", {"q_min", "q_max"})});
         k.push_back({{"grain_rate", "event rates (events_per_*) x 2^k", -2, 1, 0, 0},
-                     [mul2](toml::table& r, double x, const Ranges& rg) {
-                         for (const char* key :
-                              {"events_per_kn_rise", "events_per_kn_fall", "events_per_s_per_kn"})
-                             eachLayerKey(r, "grains", key, rg, mul2(x));
-                     }});
+                     octaves("grains",
+                             {"events_per_kn_rise", "events_per_kn_fall", "events_per_s_per_kn"})});
         // The heel's thud: the level of the onset-only layers (one event when the heel loads).
         bool thud = false;
         if (const auto* layers = root["layer"].as_array())
@@ -217,22 +217,14 @@ std::vector<Knob> knobsFor(const toml::table& root) {
                     heel = heel || (*t)["heel_rate_hz"].value<double>().value_or(0.0) > 0;
         if (heel) {
             k.push_back({{"heel_rate", "heel burst's peak rate (heel_rate_hz) x 2^k", -3, 2, 0, 0},
-                         [mul2](toml::table& r, double x, const Ranges& rg) {
-                             eachLayerKey(r, "grains", "heel_rate_hz", rg, mul2(x));
-                         }});
+                         octaves("grains", {"heel_rate_hz"})});
             k.push_back({{"heel_time", "heel burst's time to peak (heel_ms) x 2^k", -2, 2, 0, 0},
-                         [mul2](toml::table& r, double x, const Ranges& rg) {
-                             eachLayerKey(r, "grains", "heel_ms", rg, mul2(x));
-                         }});
+                         octaves("grains", {"heel_ms"})});
             k.push_back({{"heel_decay", "heel burst's decay (heel_decay_ms) x 2^k", -2, 2, 0, 0},
-                         [mul2](toml::table& r, double x, const Ranges& rg) {
-                             eachLayerKey(r, "grains", "heel_decay_ms", rg, mul2(x));
-                         }});
+                         octaves("grains", {"heel_decay_ms"})});
             k.push_back(
                 {{"heel_energy", "heel burst's energy scale (heel_energy) x 2^k", -3, 3, 0, 0},
-                 [mul2](toml::table& r, double x, const Ranges& rg) {
-                     eachLayerKey(r, "grains", "heel_energy", rg, mul2(x));
-                 }});
+                 octaves("grains", {"heel_energy"})});
         }
         // Noise-burst grains (excitation = "noise", GranularLayers.h): their decay and colour.
         bool noiseLayers = false;
@@ -289,14 +281,9 @@ std::vector<Knob> knobsFor(const toml::table& root) {
     }
     if (hasLayer(root, "bubbles")) {
         k.push_back({{"bubble_size", "bubble radii (radius_min/max_mm) x 2^k", -2, 1, 0, 0},
-                     [mul2](toml::table& r, double x, const Ranges& rg) {
-                         eachLayerKey(r, "bubbles", "radius_min_mm", rg, mul2(x));
-                         eachLayerKey(r, "bubbles", "radius_max_mm", rg, mul2(x));
-                     }});
+                     octaves("bubbles", {"radius_min_mm", "radius_max_mm"})});
         k.push_back({{"splash_band", "splash noise centre (splash_hz) x 2^k", -1, 2.5, 0, 0},
-                     [mul2](toml::table& r, double x, const Ranges& rg) {
-                         eachLayerKey(r, "bubbles", "splash_hz", rg, mul2(x));
-                     }});
+                     octaves("bubbles", {"splash_hz"})});
         k.push_back({{"splash_level", "splash_noise_db + k", -12, 12, 0, 0},
                      [](toml::table& r, double x, const Ranges& rg) {
                          eachLayerKey(r, "bubbles", "splash_noise_db", rg,
@@ -304,10 +291,7 @@ std::vector<Knob> knobsFor(const toml::table& root) {
                      }});
         k.push_back(
             {{"splash_length", "splash length (splash_ms, splash_decay_ms) x 2^k", -2, 2, 0, 0},
-             [mul2](toml::table& r, double x, const Ranges& rg) {
-                 eachLayerKey(r, "bubbles", "splash_ms", rg, mul2(x));
-                 eachLayerKey(r, "bubbles", "splash_decay_ms", rg, mul2(x));
-             }});
+             octaves("bubbles", {"splash_ms", "splash_decay_ms"})});
         k.push_back({{"slosh_level", "slosh_db + k", -20, 6, 0, 0},
                      [](toml::table& r, double x, const Ranges& rg) {
                          eachLayerKey(r, "bubbles", "slosh_db", rg,
