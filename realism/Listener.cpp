@@ -31,6 +31,20 @@ std::vector<double> fileFeatures(const std::vector<StepDescriptors>& steps) {
     return f;
 }
 
+std::vector<Example> recordingExamples(const std::vector<Recording>& recordings,
+                                       const AnalysisOptions& o, std::vector<std::string>* silent) {
+    std::vector<Example> out;
+    for (const auto& r : recordings) {
+        const auto steps = describeFile(r.path, o);
+        if (steps.empty()) {
+            if (silent) silent->push_back(r.file);
+            continue;
+        }
+        out.push_back({r.file, r.source, r.material, fileFeatures(steps)});
+    }
+    return out;
+}
+
 void centreBySource(std::vector<Example>& ex) {
     std::set<std::string> sources;
     for (const auto& e : ex) sources.insert(e.source);

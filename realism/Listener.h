@@ -34,6 +34,16 @@ struct Example {
 /// Throws std::invalid_argument when there are no steps.
 std::vector<double> fileFeatures(const std::vector<StepDescriptors>& steps);
 
+struct Recording;
+
+/// One labelled example per recording: its steps described with `o` (the band every file of a
+/// comparison shares, sharedMaxHz), then fileFeatures. A file in which no step is found is left
+/// out, and its manifest name appended to `silent` when given. Throws engine::FileError for an
+/// unreadable file.
+std::vector<Example> recordingExamples(const std::vector<Recording>& recordings,
+                                       const AnalysisOptions& o,
+                                       std::vector<std::string>* silent = nullptr);
+
 struct ListenerOptions {
     bool centrePerSource = true;   ///< subtract each source's per-feature median first
     bool scalarsOnly = true;       ///< leave the third-octave envelope out

@@ -151,14 +151,10 @@ std::vector<SurfaceFigures> surfaceFigures(const std::vector<SurfaceUnderTest>& 
     // The listener's recordings: one feature vector per file on the band all of them share.
     AnalysisOptions listenerBand;
     listenerBand.maxHz = sharedMaxHz(recordings, o.spec.rateHz);
-    std::vector<Example> examples;
+    // As `compare --listener`: a file in which no step is found is left out.
+    const auto examples = recordingExamples(recordings, listenerBand);
     std::map<std::string, std::set<std::string>> recorded;
-    for (const auto& r : recordings) {
-        const auto steps = describeFile(r.path, listenerBand);
-        if (steps.empty()) continue; // as `compare --listener`: a silent file is left out
-        examples.push_back({r.file, r.source, r.material, fileFeatures(steps)});
-        recorded[r.source].insert(r.material);
-    }
+    for (const auto& e : examples) recorded[e.source].insert(e.material);
     if (recorded.size() < 2)
         throw std::invalid_argument("surfaceFigures: the recordings need two sources or more");
     RecordedSteps real(recordings, o.spec.rateHz);

@@ -511,15 +511,9 @@ int runListener(const CompareArgs& a) {
     const auto recs = manifest(a);
     rl::AnalysisOptions o;
     o.maxHz = rl::sharedMaxHz(recs, a.spec.rateHz);
-    std::vector<rl::Example> ex;
-    for (const auto& r : recs) {
-        auto steps = rl::describeFile(r.path, o);
-        if (steps.empty()) {
-            fmt::print("warning: {}: no step found, left out\n", r.file);
-            continue;
-        }
-        ex.push_back({r.file, r.source, r.material, rl::fileFeatures(steps)});
-    }
+    std::vector<std::string> silent;
+    const auto ex = rl::recordingExamples(recs, o, &silent);
+    for (const auto& f : silent) fmt::print("warning: {}: no step found, left out\n", f);
     std::ofstream csv;
     if (!a.features.empty()) {
         csv.open(a.features);

@@ -1,11 +1,14 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The listener, the manifest and, when the recordings cache is there, the real recordings.
+#include "engine/io/AudioFile.h"
 #include "realism/Compare.h"
 #include "realism/Listener.h"
 #include "realism/Recordings.h"
 #include "tests/realism/RecordingsCache.h"
 
+#include <fmt/core.h>
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
@@ -196,6 +199,42 @@ TEST(RealismListener, HeldOutRecordingsAddUpToLeaveOneSourceOut) {
     }
 }
 
+// The listener's examples from recordings, as `compare --listener` and `--figures` build them:
+// one per file with a step, the file's features; a silent file is left out and named.
+TEST(RealismListener, RecordingExamplesLeaveOutSilentFilesAndNameThem) {
+    const auto dir = fs::temp_directory_path() / fmt::format("uf_examples_{}", ::getpid());
+    fs::create_directories(dir);
+    Recording step;
+    step.file = "lab/wood/step.wav";
+    step.path = (dir / "step.wav").string();
+    step.source = step.package = "lab";
+    step.material = "wood";
+    underfoot::engine::writeAudioFile(step.path,
+                                      renderForComparison("wood", {"cadence=100", 2.0, 7, 48000}),
+                                      underfoot::engine::SampleFormat::Float32);
+    Recording quiet = step;
+    quiet.file = "lab/wood/silent.wav";
+    quiet.path = (dir / "silent.wav").string();
+    underfoot::engine::AudioBuffer zeros;
+    zeros.channels = 1;
+    zeros.sampleRateHz = 48000;
+    zeros.samples.assign(48000, 0.0f);
+    underfoot::engine::writeAudioFile(quiet.path, zeros, underfoot::engine::SampleFormat::Float32);
+
+    AnalysisOptions o;
+    std::vector<std::string> silent;
+    const auto ex = recordingExamples({quiet, step}, o, &silent);
+    ASSERT_EQ(ex.size(), 1u);
+    EXPECT_EQ(ex[0].name, "lab/wood/step.wav");
+    EXPECT_EQ(ex[0].source, "lab");
+    EXPECT_EQ(ex[0].material, "wood");
+    EXPECT_EQ(ex[0].features, fileFeatures(describeFile(step.path, o)));
+    EXPECT_EQ(silent, std::vector<std::string>{"lab/wood/silent.wav"});
+    EXPECT_EQ(recordingExamples({quiet}, o).size(), 0u)
+        << "no list asked for: left out all the same";
+    fs::remove_all(dir);
+}
+
 TEST(RealismRecordings, ManifestErrorsNameTheFileAndLine) {
     const auto dir = scratch("manifest");
     EXPECT_THROW(loadManifest(dir.string()), std::runtime_error); // missing
@@ -274,13 +313,11 @@ TEST_F(RealRecordings, EveryRecordingHasStepsAndTheListenerBeatsChance) {
             << " sources, this test is for the 4 of scripts/fetch-recordings.sh: re-run it";
     AnalysisOptions o;
     o.maxHz = sharedMaxHz(recs_, 48000);
-    std::vector<Example> ex;
-    for (const auto& r : recs_) {
-        ASSERT_TRUE(fs::exists(r.path)) << r.path;
-        const auto steps = describeFile(r.path, o);
-        ASSERT_FALSE(steps.empty()) << r.file << ": no step found";
-        ex.push_back({r.file, r.source, r.material, fileFeatures(steps)});
-    }
+    for (const auto& r : recs_) ASSERT_TRUE(fs::exists(r.path)) << r.path;
+    std::vector<std::string> silent;
+    const auto ex = recordingExamples(recs_, o, &silent);
+    ASSERT_TRUE(silent.empty()) << silent.front() << ": no step found";
+    ASSERT_EQ(ex.size(), recs_.size());
     const auto loso = leaveOneSourceOut(ex);
     ASSERT_GT(loso.files, 0);
     // Better than always answering the commonest material (or category) of the held-out files.

@@ -4,17 +4,21 @@
 // them lie within the bounds below. Each check is a robust z of realism/Distance.h against the
 // recordings of scripts/fetch-recordings.sh (either cache: the four-source one CI has, or the
 // seven-source one of `--large`), not a listener verdict, which moves with every other preset
-// (the renders are centred as one source). The presets before the re-voicing fail every
+// (the renders are centred as one source); high grass alone also keeps its held-out verdicts,
+// which its descriptors cannot express. The presets before the re-voicing fail every
 // descriptor bound below on both caches (their figures, `underfoot compare -s ID --seed 7`, are
 // in the comments: seven-source / four-source cache where they differ); skipped without the
 // cache.
 #include "realism/Compare.h"
+#include "realism/Listener.h"
 #include "realism/Recordings.h"
+#include "realism/SurfaceFigures.h"
 #include "tests/realism/RecordingsCache.h"
 
 #include <fmt/core.h>
 #include <gtest/gtest.h>
 
+#include <set>
 #include <string>
 #include <vector>
 
@@ -50,12 +54,53 @@ class Revoiced : public underfoot::realism::test::RecordingsCacheTest {
 
 // High grass: the soil's thud under the swish and the snaps of thicker stems. Before: 20-250 Hz
 // share -15.8 dB against a recorded median of -7.0 (z 1.72), peakiness 9.1 against 15.1 dB
-// (z 1.03), distance 0.55. Now (both caches): -5.7 dB (z 0.25), 14.5 dB (z 0.11), 0.41.
+// (z 1.03), distance 0.55. With the low swish (docs/decisions/high-grass-low-swish.md), both
+// caches: -5.0 dB (z 0.39), 13.3 dB (z 0.32). The distance to the pooled recordings pays for it
+// (0.41 -> 0.55: the walk is darker than their median, centroid 1078 Hz against 1908), which
+// the held-out listeners below gain.
 TEST_F(Revoiced, HighGrassHasTheSoilsLowEnd) {
     const auto c = compare("high_grass", "grass");
     EXPECT_LE(at(c, kBandLow).z, 0.8);
     EXPECT_LE(at(c, kPeakiness).z, 0.6);
-    EXPECT_LE(c.comparison.distance, 0.5);
+    EXPECT_LE(c.comparison.distance, 0.6);
+}
+
+// High grass is heard as an aggregate by the listener trained without each source that recorded
+// grass (`underfoot compare --listener`, seed 7; `--figures` counts the same verdicts), on the
+// four-source cache CI has: there it holds at each of seeds 1-10 (`compare --figures --seeds
+// 1,2,3,4,5,6,7,8,9,10`). On seven sources the listener without UFO:AI hears metal at 9 of 10
+// seeds, as it did before the low swish (docs/decisions/high-grass-low-swish.md): skipped there.
+// A verdict, not a descriptor bound: it moves with every other preset (the renders are centred
+// as one source), so a change elsewhere that fails this must say what it costs high grass.
+// Without the low swish, the listener without UFO:AI heard water at seed 7.
+TEST_F(Revoiced, HighGrassIsHeardAsAnAggregateWithoutEachSource) {
+    std::set<std::string> sources;
+    for (const auto& r : recs_) sources.insert(r.source);
+    if (sources.size() != 4)
+        GTEST_SKIP() << "for the four-source cache of scripts/fetch-recordings.sh; " << dir_
+                     << " has " << sources.size() << " sources";
+    const RenderSpec spec;
+    AnalysisOptions o;
+    o.maxHz = sharedMaxHz(recs_, spec.rateHz);
+    const auto recorded = recordingExamples(recs_, o);
+    std::vector<Example> renders;
+    std::size_t grass = 0;
+    for (const auto& s : bundledSurfaces()) {
+        if (s.surface == "high_grass") grass = renders.size();
+        const auto steps = describeSteps(renderForComparison(s.surface, spec), o);
+        ASSERT_FALSE(steps.empty()) << s.surface;
+        renders.push_back({s.surface, "synthetic", s.material, fileFeatures(steps)});
+    }
+    ASSERT_EQ(renders.at(grass).name, "high_grass");
+    std::set<std::string> grassSources;
+    for (const auto& e : recorded)
+        if (e.material == "grass") grassSources.insert(e.source);
+    EXPECT_GE(grassSources.size(), 3u) << "minetest, UFO:AI and lugaru recorded grass";
+    for (const auto& [source, heard] : heardWithoutEachSource(recorded, renders)) {
+        if (!grassSources.count(source)) continue;
+        EXPECT_EQ(categoryOfMaterial(heard.at(grass)), "aggregate")
+            << "without " << source << ": " << heard.at(grass);
+    }
 }
 
 // Metal: one or two clangs, not a stream of small events. Before: 121 micro-events per second
