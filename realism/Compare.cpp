@@ -26,6 +26,13 @@ engine::AudioBuffer renderForComparison(const std::string& surface, const Render
     return engine::renderSurface(surface, grf, o).audio;
 }
 
+std::optional<Example> renderExample(const std::string& id, const std::string& surface,
+                                     const RenderSpec& spec, const AnalysisOptions& o) {
+    const auto steps = describeSteps(renderForComparison(surface, spec), o);
+    if (steps.empty()) return std::nullopt;
+    return Example{id, "synthetic", materialOfSurface(id), fileFeatures(steps)};
+}
+
 namespace {
 engine::AudioBuffer readRoomImpulse(const engine::ReverbSpec& room) {
     return engine::readAudioFile(engine::findImpulseResponse(room.impulseResponse));

@@ -4,6 +4,7 @@
 #include "engine/io/AudioFile.h"
 #include "engine/surfaces/Surface.h"
 #include "realism/Distance.h"
+#include "realism/Listener.h"
 #include "realism/Recordings.h"
 
 #include <cstdint>
@@ -23,6 +24,12 @@ struct RenderSpec {
 
 /// Renders a surface (id or .toml) as `underfoot render` would. Throws on a bad surface.
 engine::AudioBuffer renderForComparison(const std::string& surface, const RenderSpec& spec);
+
+/// A render as the listener hears it: `surface` (id or .toml) rendered as renderForComparison
+/// does, its steps described with `o`, named `id` in source "synthetic" with the material of
+/// surface `id` (materialOfSurface). Empty when the render holds no step.
+std::optional<Example> renderExample(const std::string& id, const std::string& surface,
+                                     const RenderSpec& spec, const AnalysisOptions& o);
 
 struct SurfaceComparison {
     std::string surface, material;

@@ -16,6 +16,7 @@
 #include <set>
 #include <stdexcept>
 #include <thread>
+#include <utility>
 
 namespace underfoot::realism {
 namespace fs = std::filesystem;
@@ -130,11 +131,10 @@ NestedRefit nestedRefit(const std::vector<Recording>& recordings,
         std::vector<Example> synth;
         std::vector<std::string> ids;
         for (const auto& info : infos) {
-            const auto steps = describeSteps(
-                renderForComparison((dir / (info.id + ".toml")).string(), o.render), analysis);
-            if (steps.empty()) continue;
-            synth.push_back(
-                {info.id, "synthetic", materialOfSurface(info.id), fileFeatures(steps)});
+            auto e =
+                renderExample(info.id, (dir / (info.id + ".toml")).string(), o.render, analysis);
+            if (!e) continue;
+            synth.push_back(std::move(*e));
             ids.push_back(info.id);
         }
         fs::remove_all(dir);

@@ -34,6 +34,7 @@
 #include <memory>
 #include <optional>
 #include <set>
+#include <utility>
 
 namespace underfoot::cli::compare_command {
 namespace {
@@ -548,11 +549,9 @@ int runListener(const CompareArgs& a) {
     std::vector<rl::Example> synth;
     std::vector<eng::SurfaceInfo> infos;
     for (const auto& info : eng::listSurfaces()) {
-        const auto audio = rl::renderForComparison(info.id, a.spec);
-        const auto steps = rl::describeSteps(audio, o);
-        if (steps.empty()) continue;
-        synth.push_back(
-            {info.id, "synthetic", rl::materialOfSurface(info.id), rl::fileFeatures(steps)});
+        auto e = rl::renderExample(info.id, info.id, a.spec, o);
+        if (!e) continue;
+        synth.push_back(std::move(*e));
         infos.push_back(info);
         if (csv.is_open()) csv << featureLine(synth.back());
     }
