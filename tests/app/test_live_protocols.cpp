@@ -288,6 +288,12 @@ void LiveProtocols::run(const std::string& id, Compare compare) {
         ASSERT_TRUE(pty->ready());
         eng::SerialConfig config;
         config.path = pty->app;
+        // The emulated shoes are a thread of this process: on a loaded machine it can be
+        // descheduled for longer than the 400 ms a real shoe's silence is allowed (844 ms seen),
+        // and the session would rightly pause. This test compares the replay with what was
+        // heard; the silence watchdog is tested by SerialSocat.SilenceIsDetected* and
+        // test_app_session_sensors.
+        config.faults.silenceMs = 5000;
         shoes = std::make_shared<eng::SerialSource>(config);
         eng::StepGrfPlayerConfig playerConfig;
         playerConfig.seed = 5;
