@@ -1,0 +1,159 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""A seeded random search over one surface preset's parameters, judged by the nested listener of
+`underfoot compare --listener` (docs/explanation/realism.md, "The listener"; the searches behind
+docs/decisions/frozen-snow-and-gravel-trade-off.md).
+
+    python3 tools/research/preset_search.py --surface frozen_snow --variants 24 --seeds 3,7,11 \\
+        --rng-seed 5 --sources lugaru,minetest,ufoai --distance \\
+        1:gain_db:-11:-5 1:freq_min_hz:800:1400:log 2:gain_db:-12:-4 ...
+
+Each PARAM is LAYER:KEY:LOW:HIGH[:log]: LAYER is the 1-based [[layer]] of the preset (0: the
+preset's top level), KEY a key already there or added; a value is drawn uniformly in [LOW, HIGH]
+(log-uniformly with `log`), one draw per PARAM in the order given, written with 4 significant
+digits (--only N evaluates variant N alone, with the same draws). Every variant is a copy of the presets folder (--base, default engine/data/surfaces)
+under --out with the one preset changed; it is rendered at every --seeds seed against every
+--recordings cache (comma-separated; default $UNDERFOOT_RECORDINGS or build/recordings) with
+UNDERFOOT_SURFACES_DIR set to it.
+
+One line per variant: how many held-out listeners put the surface in its category (summed over
+seeds and caches; with --sources only those held-out sources count, e.g. the ones that recorded
+its material), with --distance the descriptor distance to its recordings at seed 7
+(`compare -s SURFACE`), the nested category count of row "all" summed, the folder, the values
+and every listener's verdict. The search only proposes: a variant is kept after
+`compare --figures` and `compare --all` on it, and the same --rng-seed gives the same variants.
+"""
+import argparse
+import math
+import os
+import random
+import re
+import shutil
+import subprocess
+import sys
+
+from listener_common import CATEGORY
+
+
+def set_keys(path, changes):
+    """Sets `key = value` lines of a preset: changes is [(layer, key, text)], layer 0 = top."""
+    with open(path) as f:
+        lines = f.read().split("\n")
+    for layer, key, text in changes:
+        starts = [i for i, l in enumerate(lines) if l.strip() == "[[layer]]"]
+        if layer > len(starts):
+            sys.exit(f"{path}: no [[layer]] number {layer} (it has {len(starts)})")
+        begin = 0 if layer == 0 else starts[layer - 1] + 1
+        end = len(lines)
+        for i in range(begin, len(lines)):
+            if lines[i].strip().startswith("["):
+                end = i
+                break
+        pattern = re.compile(rf"^(\s*{re.escape(key)}\s*=\s*)[^#]*?(\s*#.*)?$")
+        for i in range(begin, end):
+            m = pattern.match(lines[i])
+            if m:
+                lines[i] = m.group(1) + text + (("  " + m.group(2).strip()) if m.group(2) else "")
+                break
+        else:
+            lines.insert(end if layer else begin, f"{key} = {text}")
+    with open(path, "w") as f:
+        f.write("\n".join(lines))
+
+
+def parse_param(spec):
+    parts = spec.split(":")
+    if len(parts) not in (4, 5) or (len(parts) == 5 and parts[4] != "log"):
+        sys.exit(f"parameter '{spec}': expected LAYER:KEY:LOW:HIGH[:log]")
+    try:
+        layer, low, high = int(parts[0]), float(parts[2]), float(parts[3])
+    except ValueError:
+        sys.exit(f"parameter '{spec}': LAYER must be an integer, LOW and HIGH numbers")
+    if not low < high or (len(parts) == 5 and low <= 0):
+        sys.exit(f"parameter '{spec}': expected 0 < LOW < HIGH with log, LOW < HIGH without")
+    return layer, parts[1], low, high, len(parts) == 5
+
+
+def verdicts(text, surface):
+    """(source, material heard) per held-out source and the summed category count of row all."""
+    if "per surface" not in text:
+        sys.exit("underfoot compare --listener printed no per-surface table:\n" + text[-2000:])
+    rows = [l for l in text.split("per surface")[1].splitlines() if l.split()[:1] == [surface]]
+    if not rows:
+        sys.exit(f"underfoot compare --listener has no row for surface '{surface}'")
+    heard = re.findall(r"(\w+):(\w+)", rows[0])
+    m = re.search(r"^all\s+\S+\s+\S+\s+\S+ \(\d+ %\)\s+(\d+)/\d+", text, re.M)
+    return heard, int(m.group(1)) if m else 0
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--surface", required=True)
+    ap.add_argument("--variants", type=int, default=20)
+    ap.add_argument("--seeds", default="7")
+    ap.add_argument("--rng-seed", type=int, default=1)
+    ap.add_argument("--sources", default="", help="held-out sources that count (default: all)")
+    ap.add_argument("--recordings", default=os.environ.get("UNDERFOOT_RECORDINGS", "build/recordings"))
+    ap.add_argument("--base", default="engine/data/surfaces")
+    ap.add_argument("--out", default="/tmp/preset_search")
+    ap.add_argument("--underfoot", default="build/app/cli/underfoot")
+    ap.add_argument("--category", default="", help="the surface's category (default: from its id)")
+    ap.add_argument("--distance", action="store_true")
+    ap.add_argument("--only", type=int, action="append", default=[],
+                    help="evaluate only variant N (repeatable): the same draws, the others skipped")
+    ap.add_argument("params", nargs="+", metavar="PARAM")
+    a = ap.parse_args()
+    params = [parse_param(p) for p in a.params]
+    seeds = [int(s) for s in a.seeds.split(",")]
+    caches = a.recordings.split(",")
+    counted = set(filter(None, a.sources.split(",")))
+    preset = os.path.join(a.base, a.surface + ".toml")
+    if not os.path.isfile(preset):
+        sys.exit(f"{preset}: no such preset (--base is the presets folder)")
+    category = a.category
+    if not category:
+        m = re.search(r"^category\s*=\s*['\"](\w+)['\"]", open(preset).read(), re.M)
+        category = m.group(1) if m else "aggregate"
+    wanted = {m for m, c in CATEGORY.items() if c == category}
+    if not wanted:
+        sys.exit(f"{preset}: category '{category}' has no recorded material")
+    rng = random.Random(a.rng_seed)
+    for n in range(a.variants):
+        changes = []
+        for layer, key, low, high, log in params:
+            v = math.exp(rng.uniform(math.log(low), math.log(high))) if log else rng.uniform(low, high)
+            changes.append((layer, key, f"{v:.4g}"))
+        if a.only and n not in a.only:
+            continue
+        folder = os.path.join(a.out, f"{a.surface}_{a.rng_seed}_{n}")
+        shutil.rmtree(folder, ignore_errors=True)
+        shutil.copytree(a.base, folder)
+        set_keys(os.path.join(folder, a.surface + ".toml"), changes)
+        runs = []
+        for seed in seeds:
+            for cache in caches:
+                env = dict(os.environ, UNDERFOOT_SURFACES_DIR=folder, UNDERFOOT_RECORDINGS=cache)
+                runs.append((seed, subprocess.Popen(
+                    [a.underfoot, "compare", "--listener", "--seed", str(seed)], env=env,
+                    stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)))
+        placed, total, said = 0, 0, []
+        for seed, p in runs:
+            heard, cat = verdicts(p.communicate()[0], a.surface)
+            total += cat
+            placed += sum(1 for s, m in heard if m in wanted and (not counted or s in counted))
+            said.append(f"s{seed}:" + ",".join(f"{s}:{m}" for s, m in heard))
+        distance = ""
+        if a.distance:
+            out = subprocess.run([a.underfoot, "compare", "-s", a.surface, "--seed", "7"],
+                                 env=dict(os.environ, UNDERFOOT_SURFACES_DIR=folder,
+                                          UNDERFOOT_RECORDINGS=caches[0]),
+                                 capture_output=True, text=True).stdout
+            m = re.search(r"\): ([0-9.]+)\s*$", out, re.M)
+            distance = f" distance {m.group(1) if m else '?'}"
+        values = " ".join(f"{l}:{k}={t}" for l, k, t in changes)
+        print(f"{placed:3d} placed{distance} all-category {total} {folder} {values} | "
+              f"{' '.join(said)}", flush=True)
+
+
+if __name__ == "__main__":
+    main()
