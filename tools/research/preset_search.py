@@ -11,17 +11,19 @@ docs/decisions/frozen-snow-and-gravel-trade-off.md).
 Each PARAM is LAYER:KEY:LOW:HIGH[:log]: LAYER is the 1-based [[layer]] of the preset (0: the
 preset's top level), KEY a key already there or added; a value is drawn uniformly in [LOW, HIGH]
 (log-uniformly with `log`), one draw per PARAM in the order given, written with 4 significant
-digits (--only N evaluates variant N alone, with the same draws). Every variant is a copy of the presets folder (--base, default engine/data/surfaces)
-under --out with the one preset changed; it is rendered at every --seeds seed against every
---recordings cache (comma-separated; default $UNDERFOOT_RECORDINGS or build/recordings) with
-UNDERFOOT_SURFACES_DIR set to it.
+digits (--only N evaluates variant N alone, with the same draws). Every variant is a copy of the
+presets folder (--base, default engine/data/surfaces) under --out with the one preset changed;
+it is rendered at every --seeds seed against every --recordings cache (comma-separated; default
+$UNDERFOOT_RECORDINGS or build/recordings) with UNDERFOOT_SURFACES_DIR set to it.
 
 One line per variant: how many held-out listeners put the surface in its category (summed over
 seeds and caches; with --sources only those held-out sources count, e.g. the ones that recorded
-its material), with --distance the descriptor distance to its recordings at seed 7
-(`compare -s SURFACE`), the nested category count of row "all" summed, the folder, the values
-and every listener's verdict. The search only proposes: a variant is kept after
-`compare --figures` and `compare --all` on it, and the same --rng-seed gives the same variants.
+its material); with --distance the descriptor distance at seed 7 to its own material's
+recordings and to the nearest other material's (`compare -s SURFACE --real ...`, as
+`compare --all` computes them: "closest" or "NOT-closest"); row "all" of the nested table
+(category and material right, summed); the folder, the values and every listener's verdict.
+The search only proposes: a variant is kept after `compare --figures` and `compare --all` on it,
+and the same --rng-seed gives the same variants.
 """
 import argparse
 import math
@@ -75,15 +77,43 @@ def parse_param(spec):
 
 
 def verdicts(text, surface):
-    """(source, material heard) per held-out source and the summed category count of row all."""
+    """(source, material heard) per held-out source, and row all's category and material counts."""
     if "per surface" not in text:
         sys.exit("underfoot compare --listener printed no per-surface table:\n" + text[-2000:])
     rows = [l for l in text.split("per surface")[1].splitlines() if l.split()[:1] == [surface]]
     if not rows:
         sys.exit(f"underfoot compare --listener has no row for surface '{surface}'")
     heard = re.findall(r"(\w+):(\w+)", rows[0])
-    m = re.search(r"^all\s+\S+\s+\S+\s+\S+ \(\d+ %\)\s+(\d+)/\d+", text, re.M)
-    return heard, int(m.group(1)) if m else 0
+    m = re.search(r"^all\s+\S+\s+\S+\s+\S+ \(\d+ %\)\s+(\d+)/\d+ \(\d+ %\)\s+(\d+)/", text,
+                  re.M)
+    return heard, (int(m.group(1)), int(m.group(2))) if m else (0, 0)
+
+
+def distances(a, folder, cache):
+    """Distance of the surface (seed 7) to its own material's recordings and to each other
+    material's, as `compare --all` computes them (dry: a preset with a room is compared with dry
+    recordings here)."""
+    materials = sorted({m for s in os.listdir(cache) if os.path.isdir(os.path.join(cache, s))
+                        for m in os.listdir(os.path.join(cache, s))
+                        if os.path.isdir(os.path.join(cache, s, m))})
+    env = dict(os.environ, UNDERFOOT_SURFACES_DIR=folder, UNDERFOOT_RECORDINGS=cache)
+    own_material = None
+    out = subprocess.run([a.underfoot, "compare", "-s", a.surface, "--seed", "7"], env=env,
+                         capture_output=True, text=True).stdout
+    m = re.search(r"recordings \((\w+)\)", out)
+    if m:
+        own_material = m.group(1)
+    found = {}
+    for material in materials:
+        folders = [os.path.join(cache, s, material) for s in sorted(os.listdir(cache))
+                   if os.path.isdir(os.path.join(cache, s, material))]
+        out = subprocess.run([a.underfoot, "compare", "-s", a.surface, "--seed", "7", "--real"] +
+                             folders, env=env, capture_output=True, text=True).stdout
+        d = re.search(r"\): ([0-9.]+)\s*$", out, re.M)
+        if d:
+            found[material] = float(d.group(1))
+    own = found.pop(own_material, None)
+    return own, found
 
 
 def main():
@@ -93,7 +123,8 @@ def main():
     ap.add_argument("--seeds", default="7")
     ap.add_argument("--rng-seed", type=int, default=1)
     ap.add_argument("--sources", default="", help="held-out sources that count (default: all)")
-    ap.add_argument("--recordings", default=os.environ.get("UNDERFOOT_RECORDINGS", "build/recordings"))
+    ap.add_argument("--recordings",
+                    default=os.environ.get("UNDERFOOT_RECORDINGS", "build/recordings"))
     ap.add_argument("--base", default="engine/data/surfaces")
     ap.add_argument("--out", default="/tmp/preset_search")
     ap.add_argument("--underfoot", default="build/app/cli/underfoot")
@@ -121,7 +152,10 @@ def main():
     for n in range(a.variants):
         changes = []
         for layer, key, low, high, log in params:
-            v = math.exp(rng.uniform(math.log(low), math.log(high))) if log else rng.uniform(low, high)
+            if log:
+                v = math.exp(rng.uniform(math.log(low), math.log(high)))
+            else:
+                v = rng.uniform(low, high)
             changes.append((layer, key, f"{v:.4g}"))
         if a.only and n not in a.only:
             continue
@@ -136,23 +170,25 @@ def main():
                 runs.append((seed, subprocess.Popen(
                     [a.underfoot, "compare", "--listener", "--seed", str(seed)], env=env,
                     stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)))
-        placed, total, said = 0, 0, []
+        placed, category_right, material_right, said = 0, 0, 0, []
         for seed, p in runs:
-            heard, cat = verdicts(p.communicate()[0], a.surface)
-            total += cat
+            heard, (cat, mat) = verdicts(p.communicate()[0], a.surface)
+            category_right += cat
+            material_right += mat
             placed += sum(1 for s, m in heard if m in wanted and (not counted or s in counted))
             said.append(f"s{seed}:" + ",".join(f"{s}:{m}" for s, m in heard))
         distance = ""
         if a.distance:
-            out = subprocess.run([a.underfoot, "compare", "-s", a.surface, "--seed", "7"],
-                                 env=dict(os.environ, UNDERFOOT_SURFACES_DIR=folder,
-                                          UNDERFOOT_RECORDINGS=caches[0]),
-                                 capture_output=True, text=True).stdout
-            m = re.search(r"\): ([0-9.]+)\s*$", out, re.M)
-            distance = f" distance {m.group(1) if m else '?'}"
+            own, rivals = distances(a, folder, caches[0])
+            if own is None:
+                distance = " distance ?"
+            else:
+                near = min(rivals.items(), key=lambda kv: kv[1]) if rivals else ("-", math.inf)
+                distance = (f" distance {own:.2f} nearest-other {near[0]} {near[1]:.2f} "
+                            f"{'closest' if own < near[1] else 'NOT-closest'}")
         values = " ".join(f"{l}:{k}={t}" for l, k, t in changes)
-        print(f"{placed:3d} placed{distance} all-category {total} {folder} {values} | "
-              f"{' '.join(said)}", flush=True)
+        print(f"{placed:3d} placed{distance} all: category {category_right} material "
+              f"{material_right} {folder} {values} | {' '.join(said)}", flush=True)
 
 
 if __name__ == "__main__":
