@@ -1,0 +1,99 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Checks tools/research/preset_search.py (docs/decisions/frozen-snow-and-gravel-trade-off.md):
+the same --rng-seed writes the same variant, only the drawn keys change and each value lies in
+its range, the verdict line has its documented shape, and bad parameters are refused with a
+message. Needs the recordings cache (exits 77, skipped, without it).
+
+    preset_search_check.py SOURCE_DIR UNDERFOOT_BINARY SCRATCH_DIR
+"""
+import filecmp
+import os
+import re
+import shutil
+import subprocess
+import sys
+
+
+def fail(message):
+    print(f"FAIL: {message}")
+    sys.exit(1)
+
+
+def main():
+    source, binary, scratch = sys.argv[1:4]
+    cache = os.environ.get("UNDERFOOT_RECORDINGS") or os.path.join(source, "build", "recordings")
+    if not os.path.isfile(os.path.join(cache, "manifest.csv")):
+        print(f"SKIP: no recordings cache at {cache} (bash scripts/fetch-recordings.sh)")
+        sys.exit(77)
+    tool = os.path.join(source, "tools", "research", "preset_search.py")
+    base = os.path.join(source, "engine", "data", "surfaces")
+    shutil.rmtree(scratch, ignore_errors=True)
+    params = ["2:gain_db:-26:-8", "0:gain_db:-16:-15", "1:q_min:2:12:log"]
+
+    def search(out, *extra):
+        return subprocess.run(
+            [sys.executable, tool, "--surface", "gravel", "--variants", "2", "--only", "1",
+             "--rng-seed", "11", "--seeds", "7", "--sources", "minetest,ufoai", "--recordings",
+             cache, "--base", base, "--out", out, "--underfoot", binary, *extra],
+            capture_output=True, text=True)
+
+    runs = []
+    for name in ("a", "b"):
+        r = search(os.path.join(scratch, name), *params)
+        if r.returncode != 0:
+            fail(f"preset_search.py exited {r.returncode}: {r.stderr}{r.stdout}")
+        runs.append(r.stdout.strip().splitlines())
+    for lines in runs:
+        if len(lines) != 1:
+            fail(f"expected one line (--only 1), got {lines}")
+    a = os.path.join(scratch, "a", "gravel_11_1")
+    b = os.path.join(scratch, "b", "gravel_11_1")
+    line = runs[0][0]
+    m = re.match(r"^\s*(\d+) placed all: category (\d+) material (\d+) (\S+) (.*) \| s7:(\S+)$",
+                 line)
+    if not m:
+        fail(f"verdict line not in its documented shape: {line}")
+    if int(m.group(1)) > 2:
+        fail(f"{m.group(1)} placed, but two held-out sources at one seed count: {line}")
+    if m.group(4) != a:
+        fail(f"the line names {m.group(4)}, the variant is {a}")
+    if runs[0][0].replace(a, "VARIANT") != runs[1][0].replace(b, "VARIANT"):
+        fail(f"the same --rng-seed gave other values:\n{runs[0][0]}\n{runs[1][0]}")
+    cmp = filecmp.dircmp(a, b)
+    if cmp.diff_files or cmp.left_only or cmp.right_only:
+        fail(f"the same --rng-seed wrote different variants: {cmp.diff_files}")
+    with open(os.path.join(base, "gravel.toml")) as f:
+        shipped = f.read().split("\n")
+    with open(os.path.join(a, "gravel.toml")) as f:
+        variant = f.read().split("\n")
+    if len(shipped) != len(variant):
+        fail("a drawn key that exists must be replaced in place, not added")
+    changed = [(s, v) for s, v in zip(shipped, variant) if s != v]
+    if len(changed) != 3:
+        fail(f"expected the three drawn keys to change, got {changed}")
+    ranges = {"gain_db": [(-26, -8), (-16, -15)], "q_min": [(2, 12)]}
+    for s, v in changed:
+        key, value = re.match(r"^\s*(\w+)\s*=\s*([-0-9.e]+)", v).groups()
+        if not any(lo <= float(value) <= hi for lo, hi in ranges.get(key, [])):
+            fail(f"{key} = {value} is outside its range ({v!r})")
+        if "#" in s and "#" not in v:
+            fail(f"the comment of {s!r} was lost")
+    for f in os.listdir(base):
+        if f != "gravel.toml" and not filecmp.cmp(os.path.join(base, f), os.path.join(a, f),
+                                                  shallow=False):
+            fail(f"{f} changed, only gravel.toml was searched")
+    for bad, expected in (("2:gain_db:-8:-26", "expected 0 < LOW < HIGH"),
+                          ("x:gain_db:1:2", "LAYER must be an integer"),
+                          ("9:gain_db:1:2", "no [[layer]] number 9")):
+        r = search(os.path.join(scratch, "bad"), bad)
+        if r.returncode == 0 or expected not in r.stderr + r.stdout:
+            fail(f"parameter {bad}: expected a refusal with '{expected}', got "
+                 f"{r.returncode}: {r.stderr}{r.stdout}")
+    shutil.rmtree(scratch, ignore_errors=True)
+    print("ok: same seed, same variant; only the drawn keys change, in range; bad parameters "
+          "refused")
+
+
+if __name__ == "__main__":
+    main()
