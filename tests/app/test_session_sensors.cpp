@@ -28,6 +28,9 @@ using underfoot::test::SocatPair;
 
 namespace {
 
+/// The shoes' silence limit in these tests (the product's default is 400 ms).
+constexpr double kSilenceMs = 1000;
+
 const char* kProtocol = R"(
 [protocol]
 id = "fsr_live"
@@ -130,6 +133,11 @@ TEST(SessionSensors, AWriterDyingMidTrialPausesTheSessionAndTheTrialIsPresentedA
     // The shoes as the app wires them.
     eng::SerialConfig config;
     config.path = pair->app;
+    // The emulated shoes are a thread of this process. On a loaded machine (sanitizers, a build
+    // beside the tests) it was descheduled for 402 ms, longer than the default 400 ms limit, and
+    // the session rightly paused while the test expected a healthy stream. The pause logic is
+    // the same for any limit: 1 s here, and the pause must follow it within 0.6 s.
+    config.faults.silenceMs = kSilenceMs;
     auto shoes = std::make_shared<eng::SerialSource>(config);
     eng::StepGrfPlayerConfig playerConfig;
     playerConfig.seed = 77;
@@ -174,7 +182,8 @@ TEST(SessionSensors, AWriterDyingMidTrialPausesTheSessionAndTheTrialIsPresentedA
     const double pauseDelayS = eng::sensorClockSeconds() - lastLineS;
     std::printf("[ measured ] last shoe line -> session paused: %.0f ms (%s)\n", pauseDelayS * 1e3,
                 session.pauseReason().c_str());
-    EXPECT_LT(pauseDelayS, 1.0);
+    EXPECT_GE(pauseDelayS, kSilenceMs / 1e3 - 0.05);
+    EXPECT_LT(pauseDelayS, kSilenceMs / 1e3 + 0.6);
     EXPECT_NE(session.pauseReason().find("FSR shoes silent"), std::string::npos)
         << session.pauseReason();
     EXPECT_FALSE(player.playing());

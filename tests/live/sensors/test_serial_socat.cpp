@@ -44,6 +44,9 @@ TEST(SerialSocat, DetectsEveryScriptedStepWithFootPartAndTimingAndNoneWhileStand
 
     SerialConfig config;
     config.path = pair.app;
+    // A healthy stream is the premise: the writer thread of this test may be descheduled longer
+    // than the default 400 ms limit on a loaded machine (SilenceIsDetected* tests the limit).
+    config.faults.silenceMs = 1000;
     SerialSource source(config);
     StepDetector detector{StepThresholds{}};
     std::vector<StepEvent> events; // reader thread only until stop()
@@ -246,6 +249,7 @@ TEST(SerialSocat, UnplugIsDetectedWithinASecond) {
     REQUIRE_SOCAT(pair);
     SerialConfig config;
     config.path = pair.app;
+    config.faults.silenceMs = 1000; // a healthy stream until the unplug, as above
     SerialSource source(config);
     Transitions transitions;
     source.setStatusCallback(std::ref(transitions));
