@@ -18,12 +18,13 @@ $UNDERFOOT_RECORDINGS or build/recordings) with UNDERFOOT_SURFACES_DIR set to it
 
 One line per variant: how many held-out listeners put the surface in its category (summed over
 seeds and caches; with --sources only those held-out sources count, e.g. the ones that recorded
-its material); with --distance the descriptor distance at seed 7 to its own material's
-recordings and to the nearest other material's (`compare -s SURFACE --real ...`, as
+its material); with --distance the descriptor distance at seed 7 (first cache) to its own
+material's recordings and to the nearest other material's (`compare -s SURFACE --real ...`, as
 `compare --all` computes them: "closest" or "NOT-closest"); row "all" of the nested table
 (category and material right, summed); the folder, the values and every listener's verdict.
-The search only proposes: a variant is kept after `compare --figures` and `compare --all` on it,
-and the same --rng-seed gives the same variants.
+The search only proposes: a variant is kept after `compare --figures` on seeds it was not chosen
+on (docs/decisions/frozen-snow-and-gravel-trade-off.md), and the same --rng-seed gives the same
+variants.
 """
 import argparse
 import math
