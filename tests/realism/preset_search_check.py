@@ -2,8 +2,8 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """Checks tools/research/preset_search.py (docs/decisions/frozen-snow-and-gravel-trade-off.md):
 the same --rng-seed writes the same variant, only the drawn keys change and each value lies in
-its range, the verdict line has its documented shape, and bad parameters are refused with a
-message. Needs the recordings cache (exits 77, skipped, without it).
+its range, the verdict line (with --distance) has its documented shape, and bad parameters are
+refused with a message. Needs the recordings cache (exits 77, skipped, without it).
 
     preset_search_check.py SOURCE_DIR UNDERFOOT_BINARY SCRATCH_DIR
 """
@@ -40,7 +40,7 @@ def main():
 
     runs = []
     for name in ("a", "b"):
-        r = search(os.path.join(scratch, name), *params)
+        r = search(os.path.join(scratch, name), "--distance", *params)
         if r.returncode != 0:
             fail(f"preset_search.py exited {r.returncode}: {r.stderr}{r.stdout}")
         runs.append(r.stdout.strip().splitlines())
@@ -50,8 +50,9 @@ def main():
     a = os.path.join(scratch, "a", "gravel_11_1")
     b = os.path.join(scratch, "b", "gravel_11_1")
     line = runs[0][0]
-    m = re.match(r"^\s*(\d+) placed all: category (\d+) material (\d+) (\S+) (.*) \| s7:(\S+)$",
-                 line)
+    m = re.match(r"^\s*(\d+) placed distance [0-9.]+ nearest-other \w+ [0-9.]+ "
+                 r"(?:closest|NOT-closest) all: category (\d+) material (\d+) (\S+) (.*) "
+                 r"\| s7:(\S+)$", line)
     if not m:
         fail(f"verdict line not in its documented shape: {line}")
     if int(m.group(1)) > 2:

@@ -98,24 +98,24 @@ def distances(a, folder, cache):
                         for m in os.listdir(os.path.join(cache, s))
                         if os.path.isdir(os.path.join(cache, s, m))})
     env = dict(os.environ, UNDERFOOT_SURFACES_DIR=folder, UNDERFOOT_RECORDINGS=cache)
-    own_material = None
+    distance = re.compile(r"\): ([0-9.]+)\s*$", re.M)
+    # Against its own material's recordings (the default of `compare -s`), which names them.
     out = subprocess.run([a.underfoot, "compare", "-s", a.surface, "--seed", "7"], env=env,
                          capture_output=True, text=True).stdout
-    m = re.search(r"recordings \((\w+)\)", out)
-    if m:
-        own_material = m.group(1)
-    found = {}
+    m, d = re.search(r"recordings \((\w+)\)", out), distance.search(out)
+    own_material, own = (m.group(1), float(d.group(1))) if m and d else (None, None)
+    others = {}
     for material in materials:
+        if material == own_material:
+            continue
         folders = [os.path.join(cache, s, material) for s in sorted(os.listdir(cache))
                    if os.path.isdir(os.path.join(cache, s, material))]
         out = subprocess.run([a.underfoot, "compare", "-s", a.surface, "--seed", "7", "--real"] +
                              folders, env=env, capture_output=True, text=True).stdout
-        d = re.search(r"\): ([0-9.]+)\s*$", out, re.M)
+        d = distance.search(out)
         if d:
-            found[material] = float(d.group(1))
-    own = found.pop(own_material, None)
-    return own, found
-
+            others[material] = float(d.group(1))
+    return own, others
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
