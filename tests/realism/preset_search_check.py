@@ -51,16 +51,33 @@ def main():
     b = os.path.join(scratch, "b", "gravel_11_1")
     line = runs[0][0]
     m = re.match(r"^\s*(\d+) placed distance [0-9.]+ nearest-other \w+ [0-9.]+ "
-                 r"(?:closest|NOT-closest) all: category (\d+) material (\d+) (\S+) (.*) "
-                 r"\| s7:(\S+)$", line)
+                 r"(?:closest|NOT-closest) flatness (-?[0-9.]+) dB all: category (\d+) "
+                 r"material (\d+) (\S+) (.*) \| s7:(\S+)$", line)
     if not m:
         fail(f"verdict line not in its documented shape: {line}")
     if int(m.group(1)) > 2:
         fail(f"{m.group(1)} placed, but two held-out sources at one seed count: {line}")
-    if m.group(4) != a:
-        fail(f"the line names {m.group(4)}, the variant is {a}")
+    if not -60.0 < float(m.group(2)) < 0.0:
+        fail(f"flatness {m.group(2)} dB is not a spectral flatness: {line}")
+    if m.group(5) != a:
+        fail(f"the line names {m.group(5)}, the variant is {a}")
     if runs[0][0].replace(a, "VARIANT") != runs[1][0].replace(b, "VARIANT"):
         fail(f"the same --rng-seed gave other values:\n{runs[0][0]}\n{runs[1][0]}")
+    # Two caches (the same one twice): the sums are per cache too, and the two halves agree.
+    r = subprocess.run(
+        [sys.executable, tool, "--surface", "gravel", "--variants", "2", "--only", "1",
+         "--rng-seed", "11", "--seeds", "7", "--recordings", f"{cache},{cache}", "--base", base,
+         "--out", os.path.join(scratch, "c"), "--underfoot", binary, *params],
+        capture_output=True, text=True)
+    two = re.search(r"all: category (\d+) material (\d+) \(per cache (\d+)/(\d+) (\d+)/(\d+)\)",
+                    r.stdout)
+    if r.returncode != 0 or not two:
+        fail(f"two caches: expected the sums per cache, got {r.returncode}: {r.stderr}{r.stdout}")
+    cat, mat, c1, m1, c2, m2 = (int(g) for g in two.groups())
+    if (c1, m1) != (c2, m2) or (cat, mat) != (c1 + c2, m1 + m2) or (c1, m1) != (
+            int(m.group(3)), int(m.group(4))):
+        fail(f"two copies of one cache must give equal halves summing to the total, each equal "
+             f"to the one-cache line: {r.stdout}")
     cmp = filecmp.dircmp(a, b)
     if cmp.diff_files or cmp.left_only or cmp.right_only:
         fail(f"the same --rng-seed wrote different variants: {cmp.diff_files}")

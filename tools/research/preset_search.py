@@ -20,8 +20,9 @@ One line per variant: how many held-out listeners put the surface in its categor
 seeds and caches; with --sources only those held-out sources count, e.g. the ones that recorded
 its material); with --distance the descriptor distance at seed 7 (first cache) to its own
 material's recordings and to the nearest other material's (`compare -s SURFACE --real ...`, as
-`compare --all` computes them: "closest" or "NOT-closest"); row "all" of the nested table
-(category and material right, summed); the folder, the values and every listener's verdict.
+`compare --all` computes them: "closest" or "NOT-closest") and its spectral flatness there; row
+"all" of the nested table (category and material right, summed, then per cache when there are
+several); the folder, the values and every listener's verdict.
 The search only proposes: a variant is kept after `compare --figures` on seeds it was not chosen
 on (docs/decisions/frozen-snow-and-gravel-trade-off.md), and the same --rng-seed gives the same
 variants.
@@ -104,6 +105,8 @@ def distances(a, folder, cache):
                          capture_output=True, text=True).stdout
     m, d = re.search(r"recordings \((\w+)\)", out), distance.search(out)
     own_material, own = (m.group(1), float(d.group(1))) if m and d else (None, None)
+    f = re.search(r"^flatness\s+dB\s+(\S+)", out, re.M)
+    flatness = float(f.group(1)) if f else math.nan
     others = {}
     for material in materials:
         if material == own_material:
@@ -115,7 +118,7 @@ def distances(a, folder, cache):
         d = distance.search(out)
         if d:
             others[material] = float(d.group(1))
-    return own, others
+    return own, others, flatness
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
@@ -166,30 +169,36 @@ def main():
         set_keys(os.path.join(folder, a.surface + ".toml"), changes)
         runs = []
         for seed in seeds:
-            for cache in caches:
+            for k, cache in enumerate(caches):
                 env = dict(os.environ, UNDERFOOT_SURFACES_DIR=folder, UNDERFOOT_RECORDINGS=cache)
-                runs.append((seed, subprocess.Popen(
+                runs.append((seed, k, subprocess.Popen(
                     [a.underfoot, "compare", "--listener", "--seed", str(seed)], env=env,
                     stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)))
-        placed, category_right, material_right, said = 0, 0, 0, []
-        for seed, p in runs:
+        placed, said = 0, []
+        right = [[0, 0] for _ in caches]  # category, material per cache
+        for seed, k, p in runs:
             heard, (cat, mat) = verdicts(p.communicate()[0], a.surface)
-            category_right += cat
-            material_right += mat
+            right[k][0] += cat
+            right[k][1] += mat
             placed += sum(1 for s, m in heard if m in wanted and (not counted or s in counted))
             said.append(f"s{seed}:" + ",".join(f"{s}:{m}" for s, m in heard))
         distance = ""
         if a.distance:
-            own, rivals = distances(a, folder, caches[0])
+            own, rivals, flatness = distances(a, folder, caches[0])
             if own is None:
                 distance = " distance ?"
             else:
                 near = min(rivals.items(), key=lambda kv: kv[1]) if rivals else ("-", math.inf)
                 distance = (f" distance {own:.2f} nearest-other {near[0]} {near[1]:.2f} "
-                            f"{'closest' if own < near[1] else 'NOT-closest'}")
+                            f"{'closest' if own < near[1] else 'NOT-closest'} "
+                            f"flatness {flatness:.1f} dB")
         values = " ".join(f"{l}:{k}={t}" for l, k, t in changes)
+        category_right = sum(c for c, _ in right)
+        material_right = sum(m for _, m in right)
+        per_cache = (" (per cache " + " ".join(f"{c}/{m}" for c, m in right) + ")"
+                     if len(caches) > 1 else "")
         print(f"{placed:3d} placed{distance} all: category {category_right} material "
-              f"{material_right} {folder} {values} | {' '.join(said)}", flush=True)
+              f"{material_right}{per_cache} {folder} {values} | {' '.join(said)}", flush=True)
 
 
 if __name__ == "__main__":
