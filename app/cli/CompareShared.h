@@ -2,7 +2,7 @@
 #pragma once
 // What the parts of `underfoot compare` share (cmd_compare.cpp, cmd_compare_figures.cpp): the
 // command's arguments and its tables, printed aligned on the terminal or as Markdown (pasted
-// verbatim into docs/explanation/realism.md) and appended to the HTML report.
+// verbatim into docs/reference/realism-figures.md) and appended to the HTML report.
 #include "app/cli/CommandRegistry.h"
 #include "realism/Compare.h"
 #include "realism/Recordings.h"

@@ -4,7 +4,7 @@
 //   compare --surface gravel [--real FILES_OR_DIRS...] [-o report.html]
 //   compare --all [-o report.html]          every surface with recordings of its material
 //   compare --listener [-o report.html]     the listener's real baseline and its verdicts
-//           [--markdown]                    tables as Markdown (docs/explanation/realism.md)
+//           [--markdown]                    tables as Markdown (docs/reference/realism-figures.md)
 //           [--refit [--evaluations N] [--threads T]]   nested estimate, presets refitted
 //           [--classic-listener | --onset-listener [--listener-grid]]   other listeners
 //   compare --figures [--seeds 3,7,11] [--markdown] [-o report.html]   per surface and seed:
@@ -652,7 +652,7 @@ CommandRegistrar reg("compare", [](CLI::App& app, int& exitCode) {
                   "figures");
     cmd->add_flag("--markdown", args->markdown,
                   "with --listener or --figures: print the tables as Markdown (pasted verbatim "
-                  "into docs/explanation/realism.md)");
+                  "into docs/reference/realism-figures.md)");
     cmd->add_flag("--refit", args->refit,
                   "with --listener: the nested estimate with the presets refitted (as `underfoot "
                   "fit` does) without each held-out source; slow: one fit per preset and source "

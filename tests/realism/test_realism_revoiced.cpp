@@ -133,9 +133,9 @@ TEST_F(Revoiced, HighGrassHasTheSoilsLowEnd) {
 
 // High grass is heard as an aggregate by the listener trained without each source that recorded
 // grass (`underfoot compare --listener`, seed 7; `--figures` counts the same verdicts), on the
-// four-source cache CI has: there it holds at each of seeds 1-10 (`compare --figures --seeds
-// 1,2,3,4,5,6,7,8,9,10`). On seven sources the listener without UFO:AI hears metal at 9 of 10
-// seeds, as it did before the low swish (docs/decisions/high-grass-low-swish.md): skipped there.
+// four-source cache CI has: there it holds at each of seeds 1-20 (`compare --figures --seeds
+// 1,2,...,20`). On seven sources the listener without UFO:AI hears metal at 15 of those 20
+// seeds (docs/decisions/high-grass-low-swish.md, "Searched on both caches"): skipped there.
 // A verdict, not a descriptor bound: it moves with every other preset (the renders are centred
 // as one source), so a change elsewhere that fails this must say what it costs high grass.
 // Without the low swish, the listener without UFO:AI heard water at seed 7.
