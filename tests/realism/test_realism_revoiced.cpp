@@ -21,7 +21,6 @@
 #include <cstdint>
 #include <set>
 #include <string>
-#include <utility>
 #include <vector>
 
 using namespace underfoot::realism;
@@ -50,69 +49,33 @@ class Revoiced : public underfoot::realism::test::RecordingsCacheTest {
     static const DescriptorComparison& at(const SurfaceComparison& c, Descriptor d) {
         return c.comparison.d[static_cast<std::size_t>(d)];
     }
-    // Renders every bundled surface at `seed` as `compare --listener` does and returns, for each
-    // held-out source that recorded `material`, the material its listener hears in `surface`.
-    std::vector<std::pair<std::string, std::string>>
-    heardWithoutEachSourceOf(const std::string& surface, const std::string& material,
-                             std::uint64_t seed) const {
-        RenderSpec spec;
-        spec.seed = seed;
-        AnalysisOptions o;
-        o.maxHz = sharedMaxHz(recs_, spec.rateHz);
-        const auto recorded = recordingExamples(recs_, o);
-        std::vector<Example> renders;
-        std::size_t index = 0;
-        for (const auto& s : bundledSurfaces()) {
-            if (s.surface == surface) index = renders.size();
-            auto e = renderExample(s.surface, s.surface, spec, o);
-            EXPECT_TRUE(e) << s.surface << ": no step";
-            if (!e) return {};
-            renders.push_back(std::move(*e));
-        }
-        EXPECT_EQ(renders.at(index).name, surface);
-        std::set<std::string> recordedIt;
-        for (const auto& e : recorded)
-            if (e.material == material) recordedIt.insert(e.source);
-        std::vector<std::pair<std::string, std::string>> out;
-        for (const auto& [source, heard] : heardWithoutEachSource(recorded, renders))
-            if (recordedIt.count(source)) out.emplace_back(source, heard.at(index));
-        return out;
+    // The figures of `surface` at `seed`, as `underfoot compare --figures` computes them: every
+    // bundled surface is rendered (the listener centres the renders as one source). The
+    // recordings are not played through the rooms of the surfaces with a room: the distances of
+    // those (not asserted here) are to the dry recordings.
+    SurfaceFigures figuresOf(const std::string& surface, std::uint64_t seed) const {
+        SurfaceFiguresOptions o;
+        o.seeds = {seed};
+        o.dryRecordings = true;
+        for (auto& f : surfaceFigures(bundledSurfaces(), recs_, o))
+            if (f.surface == surface) {
+                std::printf("%s seed %llu: own %.2f, nearest other %s %.2f\n", surface.c_str(),
+                            static_cast<unsigned long long>(seed), f.ownDistance,
+                            f.nearestOther.c_str(), f.nearestOtherDistance);
+                return f;
+            }
+        ADD_FAILURE() << surface << " is not a bundled surface";
+        return {};
     }
-    // Expects every such listener to hear `surface` in the category of `material`; returns how
-    // many there are.
-    std::size_t placedWithoutEachSource(const std::string& surface, const std::string& material,
-                                        std::uint64_t seed) const {
-        const auto heard = heardWithoutEachSourceOf(surface, material, seed);
-        for (const auto& [source, m] : heard)
-            EXPECT_EQ(categoryOfMaterial(m), categoryOfMaterial(material))
-                << "without " << source << ": " << m;
-        return heard.size();
-    }
-    // Distances from the surface's render at `seed` to each material's recordings, as `underfoot
-    // compare --all` computes them: the nearest material, its distance, and `material`'s.
-    struct Nearest {
-        std::string material;
-        double distance = 1e300;
-        double own = 1e300;
-    };
-    Nearest nearestMaterial(const std::string& surface, const std::string& material,
-                            std::uint64_t seed) const {
-        std::set<std::string> materials;
-        for (const auto& r : recs_) materials.insert(r.material);
-        RenderSpec spec;
-        spec.seed = seed;
-        Nearest out;
-        for (const auto& m : materials) {
-            std::vector<Recording> real;
-            for (const auto& r : recs_)
-                if (r.material == m) real.push_back(r);
-            const double d = compareSurface(surface, real, spec).comparison.distance;
-            std::printf("%s seed %llu: distance to %s %.2f\n", surface.c_str(),
-                        static_cast<unsigned long long>(seed), m.c_str(), d);
-            if (m == material) out.own = d;
-            if (d < out.distance) out = {m, d, out.own};
+    // Expects the listener trained without each source that recorded the surface's material to
+    // hear it in its category; returns how many such sources there are.
+    static int placedWithoutEachSource(const SurfaceFigures& f) {
+        for (const auto& v : f.heardWithout) {
+            if (!v.scored) continue;
+            EXPECT_EQ(categoryOfMaterial(v.heard), f.category)
+                << f.surface << " without " << v.source << ": " << v.heard;
         }
-        return out;
+        return f.sources;
     }
 };
 
@@ -145,7 +108,7 @@ TEST_F(Revoiced, HighGrassIsHeardAsAnAggregateWithoutEachSource) {
     if (sources.size() != 4)
         GTEST_SKIP() << "for the four-source cache of scripts/fetch-recordings.sh; " << dir_
                      << " has " << sources.size() << " sources";
-    EXPECT_GE(placedWithoutEachSource("high_grass", "grass", 7), 3u)
+    EXPECT_GE(placedWithoutEachSource(figuresOf("high_grass", 7)), 3)
         << "minetest, UFO:AI and lugaru recorded grass";
 }
 
@@ -157,7 +120,7 @@ TEST_F(Revoiced, HighGrassIsHeardAsAnAggregateWithoutEachSource) {
 // --seeds 1,...,20` gives the rate. A verdict, like high grass's above: it moves with every
 // other preset.
 TEST_F(Revoiced, FrozenSnowIsHeardAsAnAggregateWithoutEachSnowSource) {
-    EXPECT_EQ(placedWithoutEachSource("frozen_snow", "snow", 4), 3u)
+    EXPECT_EQ(placedWithoutEachSource(figuresOf("frozen_snow", 4)), 3)
         << "lugaru, minetest and UFO:AI recorded snow";
 }
 
@@ -170,11 +133,12 @@ TEST_F(Revoiced, FrozenSnowIsHeardAsAnAggregateWithoutEachSnowSource) {
 // 0.54 and 0.65 against gravel's 0.49. A verdict, like high grass's above: it moves with every
 // other preset.
 TEST_F(Revoiced, PuddlesAreHeardAsALiquidAndNearestWater) {
-    EXPECT_GE(placedWithoutEachSource("puddles", "water", 2), 3u)
+    const auto f = figuresOf("puddles", 2);
+    EXPECT_GE(placedWithoutEachSource(f), 3)
         << "minetest, openarena and UFO:AI (and on seven sources a fourth) recorded water";
-    const auto n = nearestMaterial("puddles", "water", 2);
-    EXPECT_EQ(n.material, "water") << "at " << n.distance << ", water at " << n.own;
-    EXPECT_LE(n.own, 0.5);
+    EXPECT_LT(f.ownDistance, f.nearestOtherDistance)
+        << "nearer " << f.nearestOther << " than water (" << f.ownDistance << ")";
+    EXPECT_LE(f.ownDistance, 0.5);
 }
 
 // Metal: one or two clangs, not a stream of small events. Before: 121 micro-events per second
