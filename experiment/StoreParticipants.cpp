@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cstdint>
 
 namespace underfoot::experiment {
 
@@ -32,8 +33,9 @@ SQLite::Statement StudyStore::selectTrial(std::int64_t pid, const std::string& c
 }
 
 void StudyStore::noSuchTrial(const std::string& code, int trialIndex) const {
-    throw StoreError(
-        fmt::format("{}: participant '{}' has no trial {}", path_, code, trialIndex + 1));
+    // Any int from a request reaches here (INT_MAX included): the 1-based number is computed wide.
+    throw StoreError(fmt::format("{}: participant '{}' has no trial {}", path_, code,
+                                 std::int64_t{trialIndex} + 1));
 }
 
 namespace {

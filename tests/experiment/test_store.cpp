@@ -6,8 +6,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <fmt/format.h>
 #include <fstream>
+#include <limits>
 #include <map>
 
 using namespace underfoot::experiment;
@@ -202,6 +204,19 @@ TEST(ExperimentStore, KeepsOnlyTheSchemaNotTheProtocol) {
         << "answer before the stimulus started";
     EXPECT_THROW(s.commitAnswer("P01", 999, exp2Answer("gravel", true), 1.0), StoreError)
         << "no such trial";
+    // Any index a request can carry is refused with its 1-based number, computed without
+    // overflow.
+    for (const int index : {std::numeric_limits<int>::max(), std::numeric_limits<int>::min()}) {
+        try {
+            s.trial("P01", index);
+            ADD_FAILURE() << "trial " << index << " was found";
+        } catch (const StoreError& e) {
+            EXPECT_NE(
+                std::string(e.what()).find(fmt::format("has no trial {}", std::int64_t{index} + 1)),
+                std::string::npos)
+                << e.what();
+        }
+    }
     EXPECT_THROW(s.commitAnswer("P99", 0, exp2Answer("gravel", true), 1.0), StoreError)
         << "no such participant";
     s.markTrialStarted("P01", 0, session, 123, std::string("grf/P01-0.wav"));
