@@ -14,10 +14,12 @@
 #include <fmt/core.h>
 #include <gtest/gtest.h>
 
+#include <cstdint>
 #include <filesystem>
 #include <set>
 #include <string>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 using namespace underfoot::realism;
@@ -125,5 +127,35 @@ TEST_F(HeardInTheirCategory, SandAndDirtAreAsNoiseLikeAsTheirRecordings) {
                     f.realQ1, f.realQ3);
         EXPECT_GE(f.synthetic, f.realQ1) << surface << ": more tonal than the recordings' IQR";
         EXPECT_LE(f.synthetic, f.realQ3) << surface << ": flatter than the recordings' IQR";
+    }
+}
+
+// The same at every render seed from 1 to 20, not at seed 7 only, for the aggregates whose
+// ringing grains once made them too tonal: the walker's steps and the grains differ from seed to
+// seed, and so does the flatness (beach sand -15.1 to -11.6 dB, dirt -16.1 to -14.9 before their
+// hiss was raised; docs/decisions/aggregate-flatness-every-seed.md). Frozen snow is not held to
+// it: its crust's cracks make it flatter than the recordings' IQR at 4 of these seeds, and the
+// variants that fix that lose its listener verdicts (the same decision record).
+TEST_F(HeardInTheirCategory, AggregatesAreAsNoiseLikeAsTheirRecordingsAtEverySeed) {
+    for (const auto& [surface, material] :
+         {std::pair{"beach_sand", "sand"}, std::pair{"dirt_pebbles", "dirt"},
+          std::pair{"deep_snow", "snow"}}) {
+        const auto real = of({material});
+        ASSERT_GE(real.size(), 5u) << surface;
+        std::string line = fmt::format("{:<13} flatness dB by seed:", surface);
+        for (std::uint64_t seed = 1; seed <= 20; ++seed) {
+            RenderSpec spec;
+            spec.seed = seed;
+            const auto c = compareSurface(surface, real, spec);
+            const auto& f = c.comparison.d[kFlatness];
+            line += fmt::format(" {:.1f}", f.synthetic);
+            EXPECT_GE(f.synthetic, f.realQ1)
+                << surface << " seed " << seed << ": more tonal than the recordings' IQR ("
+                << f.realQ1 << ".." << f.realQ3 << " dB)";
+            EXPECT_LE(f.synthetic, f.realQ3)
+                << surface << " seed " << seed << ": flatter than the recordings' IQR (" << f.realQ1
+                << ".." << f.realQ3 << " dB)";
+        }
+        std::printf("%s\n", line.c_str());
     }
 }
