@@ -16,14 +16,16 @@
 namespace underfoot::cli::compare_command {
 namespace {
 
+bool inside(const realism::DescriptorComparison& d) {
+    return d.synthetic >= d.realQ1 && d.synthetic <= d.realQ3;
+}
+
+// "value (Q1..Q3)", then " outside" when the unrounded value lies outside the range: a value at
+// the range's edge prints like its bound, and the marker says on which side it is.
 std::string withRange(const realism::DescriptorComparison& d, const char* format) {
     return fmt::format(fmt::runtime(format), d.synthetic) + " (" +
            fmt::format(fmt::runtime(format), d.realQ1) + ".." +
-           fmt::format(fmt::runtime(format), d.realQ3) + ")";
-}
-
-bool inside(const realism::DescriptorComparison& d) {
-    return d.synthetic >= d.realQ1 && d.synthetic <= d.realQ3;
+           fmt::format(fmt::runtime(format), d.realQ3) + ")" + (inside(d) ? "" : " outside");
 }
 
 } // namespace

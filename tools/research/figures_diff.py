@@ -12,15 +12,17 @@ docs/decisions/beach-sand-short-shower.md) come from this tool.
     UNDERFOOT_SURFACES_DIR=VARIANT underfoot compare --figures --seeds 1,2,...,10 --markdown > after.md
     python3 tools/research/figures_diff.py before.md after.md [--all]
 
-Only the surfaces whose counts differ are listed (--all: every surface). The flatness and the
-distances are read as printed (0.1 dB, 0.01): a value at the edge of the IQR, or two equal
-distances, can count otherwise than in the summary line, which `compare` computes unrounded.
+Only the surfaces whose counts differ are listed (--all: every surface). A flatness is outside
+the IQR when `compare` marked it so (" outside": it compares the unrounded values) or when its
+printed value lies outside the printed range (tables written before the marker). The distances
+are read as printed (0.01): two equal distances can count otherwise than in the summary line,
+which `compare` computes unrounded.
 """
 import argparse
 import re
 import sys
 
-FLATNESS = re.compile(r"^(-?[\d.]+) \((-?[\d.]+)\.\.(-?[\d.]+)\)$")
+FLATNESS = re.compile(r"^(-?[\d.]+) \((-?[\d.]+)\.\.(-?[\d.]+)\)( outside)?$")
 
 
 class FiguresError(Exception):
@@ -68,8 +70,8 @@ def read(path):
             s[7].append(f"{row['seed']}: {row['other category without']}")
         flat = FLATNESS.match(row["flatness dB (IQR)"])
         if flat:
-            value, low, high = map(float, flat.groups())
-            s[3] += low <= value <= high
+            value, low, high = map(float, flat.groups()[:3])
+            s[3] += low <= value <= high and not flat.group(4)
         if row["own distance"] != "-" and row["nearest other"] != "-":
             s[4] += float(row["own distance"]) < float(row["nearest other"].split()[-1])
     if header is None:
