@@ -247,4 +247,47 @@ heldOutRecordings(const std::vector<Example>& input, ListenerOptions o) {
     return counts;
 }
 
+std::map<std::string, OneSourceFigures>
+trainedOnEachSource(const std::vector<Example>& recordings, const std::vector<Example>& renders,
+                    const std::vector<std::string>& renderMaterials, ListenerOptions o) {
+    if (renders.size() != renderMaterials.size())
+        throw std::invalid_argument(
+            fmt::format("trainedOnEachSource: {} renders but {} render materials", renders.size(),
+                        renderMaterials.size()));
+    std::vector<Example> ex = recordings, synth = renders;
+    if (o.centrePerSource) {
+        centreBySource(ex);
+        centreBySource(synth);
+    }
+    const auto count = [](JudgedCounts& c, const std::string& material, const std::string& heard) {
+        ++c.files;
+        c.materialRight += heard == material;
+        c.categoryRight += categoryOfMaterial(heard) == categoryOfMaterial(material);
+    };
+    std::map<std::string, OneSourceFigures> out;
+    for (const auto& only : twoSourcesOrMore(ex, "trainedOnEachSource")) {
+        std::vector<Example> train;
+        std::set<std::string> mats;
+        for (const auto& e : ex)
+            if (e.source == only) {
+                train.push_back(e);
+                mats.insert(e.material);
+            }
+        if (mats.size() < 2) continue; // a listener of one material hears nothing else
+        Listener l(o);
+        l.train(train);
+        auto& f = out[only];
+        for (const auto& e : ex)
+            if (e.source != only && mats.count(e.material))
+                count(f.recordings[e.material], e.material, l.classify(e.features));
+        f.heard.assign(synth.size(), std::string());
+        for (std::size_t i = 0; i < synth.size(); ++i) {
+            if (!mats.count(renderMaterials[i])) continue;
+            f.heard[i] = l.classify(synth[i].features);
+            count(f.renders[renderMaterials[i]], renderMaterials[i], f.heard[i]);
+        }
+    }
+    return out;
+}
+
 } // namespace underfoot::realism

@@ -130,4 +130,35 @@ struct HeldOutCounts {
 std::map<std::string, std::map<std::string, HeldOutCounts>>
 heldOutRecordings(const std::vector<Example>& recordings, ListenerOptions o = {});
 
+/// Files judged by a listener: how many, named as their material, put in its category.
+struct JudgedCounts {
+    int files = 0;
+    int materialRight = 0;
+    int categoryRight = 0;
+    bool operator==(const JudgedCounts&) const = default;
+};
+
+/// What one source alone teaches the listener (trainedOnEachSource), per material it recorded.
+struct OneSourceFigures {
+    std::map<std::string, JudgedCounts> recordings; ///< the other sources' recordings of it
+    std::map<std::string, JudgedCounts> renders;    ///< the renders of it
+    /// heard[i]: the material heard in renders[i], "" when the source did not record its
+    /// material.
+    std::vector<std::string> heard;
+    bool operator==(const OneSourceFigures&) const = default;
+};
+
+/// The nested figures turned round: for every source S of the labelled `recordings` that
+/// recorded two materials or more, a listener trained on S's recordings only (centred by source
+/// when the options say so) judges the other sources' recordings of every material S recorded,
+/// and every render whose material (renderMaterials[i], "" for none) S recorded (the renders
+/// centred on their own median). It asks whether a render carries to a recordist as well as the
+/// other recordists' footsteps do; for a source no preset was tuned on (the unseen source of
+/// scripts/fetch-recordings.sh), that is the presets judged on recordings nobody fitted them
+/// to. Throws std::invalid_argument with fewer than two sources, or when renders and
+/// renderMaterials differ in length.
+std::map<std::string, OneSourceFigures>
+trainedOnEachSource(const std::vector<Example>& recordings, const std::vector<Example>& renders,
+                    const std::vector<std::string>& renderMaterials, ListenerOptions o = {});
+
 } // namespace underfoot::realism

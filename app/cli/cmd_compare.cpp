@@ -381,6 +381,53 @@ void printNested(const std::vector<eng::SurfaceInfo>& infos, const std::vector<r
                          atPar, withSources));
 }
 
+// The nested figures turned round (rl::trainedOnEachSource): per source that recorded two
+// materials or more and per material it recorded, a listener trained on that source alone
+// judging the other sources' recordings of the material and the renders of it.
+void printOneSource(const std::vector<eng::SurfaceInfo>& infos,
+                    const std::vector<rl::Example>& recs, const std::vector<rl::Example>& synth,
+                    const rl::ListenerOptions& lo, Out& out) {
+    std::vector<std::string> mats;
+    for (const auto& info : infos) mats.push_back(rl::materialOfSurface(info.id));
+    const auto figs = rl::trainedOnEachSource(recs, synth, mats, lo);
+    out.heading("Each source alone: listener trained on one source's recordings, judging the "
+                "other sources' recordings and the renders of the materials it recorded");
+    Table t{{"trained on", "material", "others' recordings: material", "category",
+             "renders: material", "category", "renders in another category"},
+            {},
+            6};
+    rl::JudgedCounts rec, ren;
+    for (const auto& [src, f] : figs) {
+        for (const auto& [mat, r] : f.recordings) {
+            const auto it = f.renders.find(mat);
+            const rl::JudgedCounts c = it == f.renders.end() ? rl::JudgedCounts{} : it->second;
+            std::string wrong;
+            for (std::size_t i = 0; i < infos.size(); ++i)
+                if (mats[i] == mat && !f.heard[i].empty() &&
+                    rl::categoryOfMaterial(f.heard[i]) != rl::categoryOfMaterial(mat))
+                    wrong +=
+                        fmt::format("{}{}:{}", wrong.empty() ? "" : " ", infos[i].id, f.heard[i]);
+            t.rows.push_back(
+                {src, mat, ratio(r.materialRight, r.files), ratio(r.categoryRight, r.files),
+                 c.files ? ratio(c.materialRight, c.files) : "-",
+                 c.files ? ratio(c.categoryRight, c.files) : "-", wrong.empty() ? "-" : wrong});
+            rec.files += r.files;
+            rec.materialRight += r.materialRight;
+            rec.categoryRight += r.categoryRight;
+            ren.files += c.files;
+            ren.materialRight += c.materialRight;
+            ren.categoryRight += c.categoryRight;
+        }
+    }
+    t.rows.push_back({"all", "", percent(rec.materialRight, rec.files),
+                      percent(rec.categoryRight, rec.files), percent(ren.materialRight, ren.files),
+                      percent(ren.categoryRight, ren.files), ""});
+    out.table(t);
+    out.line("A source that recorded one material only teaches nothing to tell apart and has no "
+             "row. A render is heard at least as well as the real footsteps where its row's "
+             "render figures reach the recordings' share.");
+}
+
 // The onset listener (realism/OnsetListener.h): its configuration chosen from a fixed grid by
 // leave-one-source-out on the recordings; prints its figures, the nested estimate and the
 // renders' verdict.
@@ -565,6 +612,7 @@ int runListener(const CompareArgs& a) {
                 "presets as shipped (fitted with it)",
                 out);
     if (a.refit) printRefitNested(a, recs, ex, o, lo, loso, out);
+    printOneSource(infos, ex, synthUncentred, lo, out);
     printVerdicts(infos, heard, out);
     if (!a.output.empty()) writeHtml(a.output, "Underfoot listener", out.body);
     return 0;

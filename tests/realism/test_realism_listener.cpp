@@ -160,6 +160,51 @@ TEST(RealismListener, HeldOutRecordingsAreJudgedByTheRendersListener) {
     EXPECT_THROW(heldOutRecordings(one), std::invalid_argument);
 }
 
+TEST(RealismListener, EachSourceAloneJudgesTheOthersRecordingsAndTheRenders) {
+    // Sources a, b and c recorded metal (0) and water (8); c also gravel, at 4, and d metal
+    // alone. Trained on one source, the listener judges the other sources' recordings of the
+    // materials that source recorded, and the renders of them; d, with one material, has no
+    // listener to speak of.
+    std::mt19937 g(5);
+    std::vector<Example> rec;
+    for (const char* src : {"a", "b", "c"})
+        for (int i = 0; i < 3; ++i) {
+            rec.push_back(example(src, "metal", 0.0, g));
+            rec.push_back(example(src, "water", 8.0, g));
+        }
+    for (int i = 0; i < 3; ++i) rec.push_back(example("c", "gravel", 4.0, g));
+    for (int i = 0; i < 3; ++i) rec.push_back(example("d", "metal", 0.0, g));
+    const auto n = static_cast<std::size_t>(kDescriptorCount + 4);
+    const std::vector<Example> renders = {{"m", "synthetic", "", std::vector<double>(n, 0.2)},
+                                          {"g", "synthetic", "", std::vector<double>(n, 4.2)},
+                                          {"w", "synthetic", "", std::vector<double>(n, 7.9)},
+                                          {"l", "synthetic", "", std::vector<double>(n, 4.0)}};
+    const std::vector<std::string> mats = {"metal", "gravel", "water", ""};
+    const ListenerOptions plain{false, true, true};
+    const auto f = trainedOnEachSource(rec, renders, mats, plain);
+    ASSERT_EQ(f.size(), 3u) << "d recorded one material";
+    EXPECT_EQ(f.count("d"), 0u);
+    const auto& a = f.at("a");
+    EXPECT_EQ(a.recordings.at("metal").files, 9) << "b's, c's and d's metal";
+    EXPECT_EQ(a.recordings.at("metal").materialRight, 9);
+    EXPECT_EQ(a.recordings.at("water").files, 6);
+    EXPECT_EQ(a.recordings.count("gravel"), 0u) << "a did not record gravel";
+    ASSERT_EQ(a.heard.size(), 4u);
+    EXPECT_EQ(a.heard[0], "metal");
+    EXPECT_EQ(a.heard[1], "") << "a render of a material a did not record is not judged by it";
+    EXPECT_EQ(a.heard[3], "") << "nor a render of no recorded material";
+    EXPECT_EQ(a.renders.at("water").materialRight, 1);
+    const auto& c = f.at("c");
+    EXPECT_EQ(c.recordings.count("gravel"), 0u) << "no other source recorded gravel";
+    EXPECT_EQ(c.heard[1], "gravel");
+    EXPECT_EQ(c.renders.at("gravel").files, 1);
+    EXPECT_EQ(c.renders.at("gravel").categoryRight, 1);
+    EXPECT_EQ(trainedOnEachSource(rec, renders, mats), trainedOnEachSource(rec, renders, mats));
+    EXPECT_THROW(trainedOnEachSource(rec, renders, {"metal"}), std::invalid_argument);
+    std::vector<Example> one = {example("a", "metal", 0, g), example("a", "water", 8, g)};
+    EXPECT_THROW(trainedOnEachSource(one, renders, mats), std::invalid_argument);
+}
+
 TEST(RealismListener, HeldOutRecordingsAddUpToLeaveOneSourceOut) {
     // Overlapping materials, so that some files are misheard, and one material a single source
     // has: the counts per source and material add up to leaveOneSourceOut's totals, and the
