@@ -4,7 +4,7 @@
 # extracts them into a cache folder with a manifest, for `underfoot compare`, the realism
 # listener and the tests in tests/realism (which skip, saying so, when the cache is absent).
 #
-#   bash scripts/fetch-recordings.sh [--large] [CACHE_DIR]
+#   bash scripts/fetch-recordings.sh [--large] [--unseen] [CACHE_DIR]
 #
 # CACHE_DIR defaults to $UNDERFOOT_RECORDINGS, else build/recordings in a source tree, else
 # ~/.cache/underfoot/recordings (where an installed `underfoot compare` looks).
@@ -44,18 +44,36 @@
 #                  (CC-BY-SA-3.0, Red Eclipse Team). footstep*.ogg, the default step, names
 #                  no material and is left out.
 #
+#   0ad-data       (only with --unseen) public.zip audio/actor/singlesteps/fs_*.ogg: gravel,
+#                  snow, sand, grass (8 each), wood (4) (CC-BY-SA-3.0, Wildfire Games, per the
+#                  zip's audio/LICENSE.txt). fs_rock* are fs_gravel* again (the same Vorbis
+#                  packets under another stream serial): left out. The unseen source: no preset,
+#                  fit or design choice of this project has used it, and none may be chosen on
+#                  it; it is there to judge the presets on recordings nobody tuned them to
+#                  (docs/decisions/unseen-source.md).
+#
 # The first four are fetched always: a failed download stops the script, naming the package.
-# The last three only with --large; UNDERFOOT_RECORDINGS_SKIP="nexuiz-data ..." then still
-# leaves some of them out (each is named on the output).
+# The next three only with --large, 0ad-data only with --unseen (or
+# UNDERFOOT_RECORDINGS_UNSEEN=1); UNDERFOOT_RECORDINGS_SKIP="nexuiz-data ..." then still leaves
+# some of them out (each is named on the output).
 # Without nexuiz-data UFO:AI's metal1 and metal3 are kept (the four-source cache, 90 files).
 # The tests and `underfoot compare` read whatever the manifest lists.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 large="${UNDERFOOT_RECORDINGS_LARGE:-0}"
-if [ "${1:-}" = "--large" ]; then
-    large=1
+unseen="${UNDERFOOT_RECORDINGS_UNSEEN:-0}"
+while [ $# -gt 0 ]; do
+    case "$1" in
+    --large) large=1 ;;
+    --unseen) unseen=1 ;;
+    -*)
+        echo "fetch-recordings: unknown option '$1' (expected --large, --unseen or a cache folder)" >&2
+        exit 2
+        ;;
+    *) break ;;
+    esac
     shift
-fi
+done
 if [ -f "$root/CMakeLists.txt" ]; then
     default_cache="$root/build/recordings" # a source tree
 else
@@ -81,9 +99,13 @@ keep() { # file source package version licence material recordist: into the cach
     echo "$2/$6/$(basename "$1"),$2,$3,$4,$5,$6,$7" >>"$manifest.tmp"
 }
 
-skipped() { # package -> true when it is a large one and --large was not given, or
-    # UNDERFOOT_RECORDINGS_SKIP names it
-    [ "$large" = 1 ] || return 0
+skipped() { # package -> true when it is a large one and --large was not given, the unseen
+    # one and --unseen was not given, or UNDERFOOT_RECORDINGS_SKIP names it
+    if [ "$1" = 0ad-data ]; then
+        [ "$unseen" = 1 ] || return 0
+    else
+        [ "$large" = 1 ] || return 0
+    fi
     case " ${UNDERFOOT_RECORDINGS_SKIP:-} " in *" $1 "*) return 0 ;; esac
     return 1
 }
@@ -92,11 +114,15 @@ if [ "$large" != 1 ]; then
         "UNDERFOOT_RECORDINGS_LARGE=1) adds nexuiz-data, openclonk-data and redeclipse-data" \
         "(about 1.24 GB more)"
 fi
+if [ "$unseen" = 1 ]; then
+    echo "fetch-recordings: --unseen: adding 0ad-data, the source no preset was tuned on (1.38 GB" \
+        "to download, about 3.3 GB of temporary space while its sounds are extracted)"
+fi
 for p in ${UNDERFOOT_RECORDINGS_SKIP:-}; do
     case "$p" in
-    nexuiz-data | openclonk-data | redeclipse-data) echo "fetch-recordings: leaving out $p (UNDERFOOT_RECORDINGS_SKIP)" ;;
+    nexuiz-data | openclonk-data | redeclipse-data | 0ad-data) echo "fetch-recordings: leaving out $p (UNDERFOOT_RECORDINGS_SKIP)" ;;
     *)
-        echo "fetch-recordings: UNDERFOOT_RECORDINGS_SKIP: '$p' is not an optional source (nexuiz-data openclonk-data redeclipse-data)" >&2
+        echo "fetch-recordings: UNDERFOOT_RECORDINGS_SKIP: '$p' is not an optional source (nexuiz-data openclonk-data redeclipse-data 0ad-data)" >&2
         exit 2
         ;;
     esac
@@ -105,7 +131,7 @@ manifest="$cache/manifest.csv"
 # A source's folder from an earlier run would keep files the new manifest does not list; the
 # old manifest goes too, so that a run that fails leaves no cache (the tests then skip, naming
 # this script) rather than a manifest of deleted files.
-rm -rf "${cache:?}"/{minetest,openarena,ufoai,lugaru,nexuiz,openclonk,redeclipse} "$manifest"
+rm -rf "${cache:?}"/{minetest,openarena,ufoai,lugaru,nexuiz,openclonk,redeclipse,0ad} "$manifest"
 echo "file,source,package,version,licence,material,recordist" >"$manifest.tmp"
 
 # ---- minetest-data -------------------------------------------------------------------------
@@ -293,6 +319,41 @@ water swimstep
 LIST
     cp "$work/redeclipse/usr/share/doc/redeclipse-data/copyright" "$cache/licences/redeclipse-data.copyright"
     cp "$work/redeclipse/$rd/readme.txt" "$cache/licences/redeclipse-data-sounds-readme.txt"
+fi
+
+# ---- 0ad-data ------------------------------------------------------------------------------
+if ! skipped 0ad-data; then
+    # public.zip (3.3 GB inside the 1.38 GB package) holds the game's data; only its single
+    # footsteps are kept, and fs_rock* (fs_gravel* again) is left out.
+    deb="$(download 0ad-data)"
+    ver="$(dpkg-deb -f "$deb" Version)"
+    zad=./usr/share/games/0ad/mods/public
+    extract "$deb" "$work/0ad" "$zad/public.zip" ./usr/share/doc/0ad-data/copyright
+    rm -f "$deb"
+    python3 - "$work/0ad/$zad/public.zip" "$work/zad" <<'PY' ||
+import re, sys, zipfile
+z = zipfile.ZipFile(sys.argv[1])
+for n in z.namelist():
+    if re.fullmatch(r"audio/actor/singlesteps/fs_[a-z_0-9]+\.ogg", n) or n == "audio/LICENSE.txt":
+        z.extract(n, sys.argv[2])
+PY
+        unzip -q -o "$work/0ad/$zad/public.zip" 'audio/actor/singlesteps/fs_*.ogg' audio/LICENSE.txt -d "$work/zad"
+    rm -f "$work/0ad/$zad/public.zip"
+    while read -r material prefix; do
+        for f in "$work/zad/audio/actor/singlesteps/fs_$prefix"[0-9]*.ogg; do
+            [ -f "$f" ] || continue
+            keep "$f" 0ad 0ad-data "$ver" CC-BY-SA-3.0 "$material" "Wildfire Games (0 A.D.)"
+        done
+    done <<'LIST'
+gravel gravel
+snow snow_
+sand sand
+grass grass
+wood wood
+LIST
+    cp "$work/0ad/usr/share/doc/0ad-data/copyright" "$cache/licences/0ad-data.copyright"
+    cp "$work/zad/audio/LICENSE.txt" "$cache/licences/0ad-data-audio-LICENSE.txt"
+    rm -rf "$work/0ad" "$work/zad"
 fi
 
 mv "$manifest.tmp" "$manifest"
