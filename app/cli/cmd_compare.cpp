@@ -397,7 +397,10 @@ void printOneSource(const std::vector<eng::SurfaceInfo>& infos,
             {},
             6};
     rl::JudgedCounts rec, ren;
+    std::string atPar; // per source: rows whose renders are placed as often as the recordings
+    int parCat = 0, parMat = 0, rows = 0;
     for (const auto& [src, f] : figs) {
+        int srcRows = 0, srcCat = 0, srcMat = 0;
         for (const auto& [mat, r] : f.recordings) {
             const auto it = f.renders.find(mat);
             const rl::JudgedCounts c = it == f.renders.end() ? rl::JudgedCounts{} : it->second;
@@ -417,15 +420,28 @@ void printOneSource(const std::vector<eng::SurfaceInfo>& infos,
             ren.files += c.files;
             ren.materialRight += c.materialRight;
             ren.categoryRight += c.categoryRight;
+            if (c.files == 0) continue;
+            ++srcRows; // shares compared without rounding: a/b >= c/d as a*d >= c*b
+            srcCat += c.categoryRight * r.files >= r.categoryRight * c.files;
+            srcMat += c.materialRight * r.files >= r.materialRight * c.files;
         }
+        if (srcRows == 0) continue;
+        atPar += fmt::format("{}{} {}/{} and {}/{}", atPar.empty() ? "" : ", ", src, srcCat,
+                             srcRows, srcMat, srcRows);
+        rows += srcRows;
+        parCat += srcCat;
+        parMat += srcMat;
     }
     t.rows.push_back({"all", "", percent(rec.materialRight, rec.files),
                       percent(rec.categoryRight, rec.files), percent(ren.materialRight, ren.files),
                       percent(ren.categoryRight, ren.files), ""});
     out.table(t);
+    out.line(fmt::format("renders placed at least as often as the other sources' recordings, in "
+                         "category and in material, per source and material they share: {} "
+                         "({}/{} and {}/{})",
+                         atPar, parCat, rows, parMat, rows));
     out.line("A source that recorded one material only teaches nothing to tell apart and has no "
-             "row. A render is heard at least as well as the real footsteps where its row's "
-             "render figures reach the recordings' share.");
+             "row, nor has a material no other source recorded.");
 }
 
 // The onset listener (realism/OnsetListener.h): its configuration chosen from a fixed grid by
