@@ -19,6 +19,11 @@ std::string defaultRecordingsDir() {
     return base::recordingsDirectory();
 }
 
+std::vector<Recording> withoutUnseenSource(std::vector<Recording> recordings) {
+    std::erase_if(recordings, [](const Recording& r) { return r.source == kUnseenSource; });
+    return recordings;
+}
+
 std::vector<Recording> loadManifest(const std::string& dir) {
     const auto path = (fs::path(dir) / "manifest.csv").string();
     std::ifstream in(path);

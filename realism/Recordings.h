@@ -28,6 +28,15 @@ std::string defaultRecordingsDir();
 /// missing or malformed (a line with the wrong number of columns, an empty field).
 std::vector<Recording> loadManifest(const std::string& dir);
 
+/// The source `scripts/fetch-recordings.sh --unseen` adds (0 A.D.'s footsteps): no preset is
+/// fitted or chosen on it, so `underfoot fit`, the preset search and the realism tests leave it
+/// out of a cache's recordings; `underfoot compare` judges the presets on it
+/// (docs/decisions/unseen-source.md).
+inline constexpr const char* kUnseenSource = "0ad";
+
+/// The recordings without the unseen source's.
+std::vector<Recording> withoutUnseenSource(std::vector<Recording> recordings);
+
 /// Audio files (.wav .ogg .flac .aiff) named directly or found below the given folders,
 /// sorted; material and source unknown. Throws std::runtime_error for a path that does not exist.
 std::vector<Recording> collectRecordings(const std::vector<std::string>& paths);

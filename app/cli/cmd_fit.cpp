@@ -42,13 +42,26 @@ struct FitArgs {
     bool noModalSeed = false;
 };
 
+// The cache's recordings without the unseen source's (rl::kUnseenSource: presets are never
+// fitted on it), saying so when `say` and it held some.
+std::vector<rl::Recording> cacheRecordings(const std::string& dir, bool say) {
+    const auto all = rl::loadManifest(dir);
+    auto kept = rl::withoutUnseenSource(all);
+    if (say && kept.size() < all.size()) {
+        fmt::print("note: the unseen source {} ({} files of {}) is left out: no preset is fitted "
+                   "on it (--real names files to fit to)\n",
+                   rl::kUnseenSource, all.size() - kept.size(), dir);
+    }
+    return kept;
+}
+
 // Recordings of every other material in the cache, for the contrastive objective; empty (with
 // a note) when there is no cache or it holds no other material.
 std::vector<rl::Recording> otherMaterials(const FitArgs& a, const std::string& own) {
     const auto dir = a.recordings.empty() ? rl::defaultRecordingsDir() : a.recordings;
     std::vector<rl::Recording> out;
     try {
-        for (auto& r : rl::loadManifest(dir))
+        for (auto& r : cacheRecordings(dir, !a.real.empty())) // else runFit said it
             if (!r.material.empty() && r.material != own) out.push_back(r);
     } catch (const std::runtime_error& e) {
         if (!a.recordings.empty()) throw UserError(e.what()); // named explicitly: must load
@@ -103,8 +116,8 @@ int runFit(FitArgs& a) {
                 throw UserError(fmt::format(
                     "fit: no recorded material is known for \"{}\"; name recordings with --real",
                     a.surface));
-            for (auto& r :
-                 rl::loadManifest(a.recordings.empty() ? rl::defaultRecordingsDir() : a.recordings))
+            for (auto& r : cacheRecordings(
+                     a.recordings.empty() ? rl::defaultRecordingsDir() : a.recordings, true))
                 if (r.material == m) real.push_back(r);
             if (real.empty())
                 throw UserError(fmt::format("fit: the recordings cache has no {} recordings", m));
@@ -208,7 +221,8 @@ CommandRegistrar reg("fit", [](CLI::App& app, int& exitCode) {
     cmd->add_option("-s,--surface", args->surface, "surface id or preset .toml");
     cmd->add_option("--real", args->real,
                     "recorded footsteps: files or folders (default: the recordings cache, "
-                    "material of the surface)");
+                    "material of the surface, without the unseen source of "
+                    "fetch-recordings.sh --unseen)");
     cmd->add_option("--recordings", args->recordings,
                     "recordings cache (default build/recordings)");
     cmd->add_option("--evaluations", args->evaluations, "renders the optimiser may try")

@@ -9,15 +9,11 @@
 
 #include <gtest/gtest.h>
 
-#include <algorithm>
 #include <filesystem>
 #include <string>
 #include <vector>
 
 namespace underfoot::realism::test {
-
-/// The source fetch-recordings.sh --unseen adds.
-inline constexpr const char* kUnseenSource = "0ad";
 
 class RecordingsCacheTest : public ::testing::Test {
   protected:
@@ -27,10 +23,10 @@ class RecordingsCacheTest : public ::testing::Test {
             GTEST_SKIP()
                 << "no recordings cache at " << dir_
                 << ": run `bash scripts/fetch-recordings.sh` (or set UNDERFOOT_RECORDINGS)";
-        recs_ = loadManifest(dir_);
-        const auto unseen =
-            std::erase_if(recs_, [](const Recording& r) { return r.source == kUnseenSource; });
-        if (unseen > 0) RecordProperty("unseen_files_left_out", static_cast<int>(unseen));
+        const auto all = loadManifest(dir_);
+        recs_ = withoutUnseenSource(all);
+        if (recs_.size() < all.size())
+            RecordProperty("unseen_files_left_out", static_cast<int>(all.size() - recs_.size()));
     }
     std::string dir_;
     std::vector<Recording> recs_;

@@ -2,8 +2,9 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """Checks tools/research/preset_search.py (docs/decisions/frozen-snow-and-gravel-trade-off.md):
 the same --rng-seed writes the same variant, only the drawn keys change and each value lies in
-its range, the verdict line (with --distance) has its documented shape, and bad parameters are
-refused with a message. Needs the recordings cache (exits 77, skipped, without it).
+its range, the verdict line (with --distance) has its documented shape, a cache holding the
+unseen source is searched without it, and bad parameters are refused with a message. Needs the
+recordings cache (exits 77, skipped, without it).
 
     preset_search_check.py SOURCE_DIR UNDERFOOT_BINARY SCRATCH_DIR
 """
@@ -78,6 +79,30 @@ def main():
             int(m.group(3)), int(m.group(4))):
         fail(f"two copies of one cache must give equal halves summing to the total, each equal "
              f"to the one-cache line: {r.stdout}")
+    # A cache holding the unseen source is searched without it: a row of source 0ad whose file
+    # does not exist changes nothing, and the search says it left the source out.
+    unseen = os.path.join(scratch, "unseen_cache")
+    os.makedirs(unseen)
+    for entry in os.listdir(cache):
+        if entry != "manifest.csv":
+            os.symlink(os.path.abspath(os.path.join(cache, entry)), os.path.join(unseen, entry))
+    with open(os.path.join(cache, "manifest.csv")) as f:
+        rows = f.read().rstrip("\n")
+    with open(os.path.join(unseen, "manifest.csv"), "w") as f:
+        f.write(rows + "\n0ad/gravel/missing.ogg,0ad,0ad-data,0,CC-BY-SA-3.0,gravel,nobody\n")
+    u = os.path.join(scratch, "u")
+    r = subprocess.run(
+        [sys.executable, tool, "--surface", "gravel", "--variants", "2", "--only", "1",
+         "--rng-seed", "11", "--seeds", "7", "--sources", "minetest,ufoai", "--recordings",
+         unseen, "--base", base, "--out", u, "--underfoot", binary, "--distance", *params],
+        capture_output=True, text=True)
+    if r.returncode != 0 or "leaving out the unseen source 0ad (1 files)" not in r.stderr:
+        fail(f"a cache with the unseen source: expected it left out, saying so; got "
+             f"{r.returncode}: {r.stderr}{r.stdout}")
+    if r.stdout.strip().replace(os.path.join(u, "gravel_11_1"), "VARIANT").replace(
+            os.path.join(u, "recordings_0"), "CACHE") != runs[0][0].replace(a, "VARIANT"):
+        fail(f"without its unseen source the cache must give the same line:\n{r.stdout}\n"
+             f"{runs[0][0]}")
     cmp = filecmp.dircmp(a, b)
     if cmp.diff_files or cmp.left_only or cmp.right_only:
         fail(f"the same --rng-seed wrote different variants: {cmp.diff_files}")
@@ -109,8 +134,8 @@ def main():
             fail(f"parameter {bad}: expected a refusal with '{expected}', got "
                  f"{r.returncode}: {r.stderr}{r.stdout}")
     shutil.rmtree(scratch, ignore_errors=True)
-    print("ok: same seed, same variant; only the drawn keys change, in range; bad parameters "
-          "refused")
+    print("ok: same seed, same variant; only the drawn keys change, in range; the unseen source "
+          "left out; bad parameters refused")
 
 
 if __name__ == "__main__":

@@ -345,6 +345,29 @@ TEST(RealismRecordings, ManifestAcceptsAnEmptyRecordist) {
     fs::remove_all(dir);
 }
 
+// The unseen source (fetch-recordings.sh --unseen) is never fitted on: withoutUnseenSource,
+// which `underfoot fit` and the tests' fixture read the cache through, drops its rows alone.
+TEST(RealismRecordings, TheUnseenSourceIsLeftOutOfTheCacheForFitting) {
+    const auto dir = scratch("manifest_unseen");
+    {
+        std::ofstream(dir / "manifest.csv")
+            << "file,source,package,version,licence,material,recordist\n"
+            << "ufoai/gravel/gravel1.ogg,ufoai,ufoai-sound,2.5,CC-BY-SA-3.0,gravel,UFO:AI team\n"
+            << "0ad/gravel/fs_gravel1.ogg,0ad,0ad-data,0.0.26,CC-BY-SA-3.0,gravel,Wildfire\n"
+            << "minetest/snow/s.ogg,minetest,minetest-data,5.6,CC0-1.0,snow,Ryding\n"
+            << "0ad/snow/fs_snow_11.ogg,0ad,0ad-data,0.0.26,CC-BY-SA-3.0,snow,Wildfire\n";
+    }
+    const auto all = loadManifest(dir.string());
+    ASSERT_EQ(all.size(), 4u);
+    const auto kept = withoutUnseenSource(all);
+    ASSERT_EQ(kept.size(), 2u);
+    EXPECT_EQ(kept[0].source, "ufoai");
+    EXPECT_EQ(kept[1].source, "minetest");
+    EXPECT_EQ(std::string(kUnseenSource), "0ad");
+    EXPECT_EQ(withoutUnseenSource(kept).size(), 2u);
+    fs::remove_all(dir);
+}
+
 // The real recordings (scripts/fetch-recordings.sh). Skipped, saying so, without the cache.
 class RealRecordings : public underfoot::realism::test::RecordingsCacheTest {};
 

@@ -23,6 +23,8 @@ material's recordings and to the nearest other material's (`compare -s SURFACE -
 `compare --all` computes them: "closest" or "NOT-closest") and its spectral flatness there; row
 "all" of the nested table (category and material right, summed, then per cache when there are
 several); the folder, the values and every listener's verdict.
+A cache that holds the unseen source (`fetch-recordings.sh --unseen`) is searched without it,
+saying so: presets are never chosen on it (docs/decisions/unseen-source.md).
 The search only proposes: a variant is kept after `compare --figures` on seeds it was not chosen
 on (docs/decisions/frozen-snow-and-gravel-trade-off.md), and the same --rng-seed gives the same
 variants.
@@ -37,6 +39,36 @@ import subprocess
 import sys
 
 from listener_common import CATEGORY
+
+
+UNSEEN_SOURCE = "0ad"  # fetch-recordings.sh --unseen: never searched on
+
+
+def without_unseen(cache, out, k):
+    """The cache as the search may see it: when its manifest lists the unseen source
+    (docs/decisions/unseen-source.md), a view under `out` without it (the other sources' folders
+    linked, the manifest without its rows), else the cache itself."""
+    manifest = os.path.join(cache, "manifest.csv")
+    try:
+        with open(manifest) as f:
+            lines = f.read().splitlines()
+    except OSError as e:
+        sys.exit(f"{manifest}: cannot read the recordings' manifest ({e.strerror}); "
+                 "bash scripts/fetch-recordings.sh writes it")
+    kept = [l for l in lines if l.split(",")[1:2] != [UNSEEN_SOURCE]]
+    if len(kept) == len(lines):
+        return cache
+    view = os.path.join(out, f"recordings_{k}")
+    shutil.rmtree(view, ignore_errors=True)
+    os.makedirs(view)
+    for entry in os.listdir(cache):
+        if entry not in (UNSEEN_SOURCE, "manifest.csv"):
+            os.symlink(os.path.abspath(os.path.join(cache, entry)), os.path.join(view, entry))
+    with open(os.path.join(view, "manifest.csv"), "w") as f:
+        f.write("\n".join(kept) + "\n")
+    print(f"leaving out the unseen source {UNSEEN_SOURCE} ({len(lines) - len(kept)} files) of "
+          f"{cache}: presets are never chosen on it", file=sys.stderr)
+    return view
 
 
 def set_keys(path, changes):
@@ -140,7 +172,7 @@ def main():
     a = ap.parse_args()
     params = [parse_param(p) for p in a.params]
     seeds = [int(s) for s in a.seeds.split(",")]
-    caches = a.recordings.split(",")
+    caches = [without_unseen(c, a.out, k) for k, c in enumerate(a.recordings.split(","))]
     counted = set(filter(None, a.sources.split(",")))
     preset = os.path.join(a.base, a.surface + ".toml")
     if not os.path.isfile(preset):
