@@ -234,16 +234,19 @@ heardWithoutEachSource(const std::vector<Example>& recordings, const std::vector
     return heard;
 }
 
-std::map<std::string, std::map<std::string, HeldOutCounts>>
+void JudgedCounts::add(const std::string& material, const std::string& heard) {
+    ++files;
+    categoryRight += categoryOfMaterial(heard) == categoryOfMaterial(material);
+    materialRight += heard == material;
+}
+
+std::map<std::string, std::map<std::string, JudgedCounts>>
 heldOutRecordings(const std::vector<Example>& input, ListenerOptions o) {
-    std::map<std::string, std::map<std::string, HeldOutCounts>> counts;
-    judgeEachSourceWithout(
-        input, o, "heldOutRecordings", [&](const Example& e, const std::string& heard, bool) {
-            auto& c = counts[e.source][e.material];
-            ++c.files;
-            c.categoryRight += categoryOfMaterial(heard) == categoryOfMaterial(e.material);
-            c.materialRight += heard == e.material;
-        });
+    std::map<std::string, std::map<std::string, JudgedCounts>> counts;
+    judgeEachSourceWithout(input, o, "heldOutRecordings",
+                           [&](const Example& e, const std::string& heard, bool) {
+                               counts[e.source][e.material].add(e.material, heard);
+                           });
     return counts;
 }
 
@@ -259,11 +262,6 @@ trainedOnEachSource(const std::vector<Example>& recordings, const std::vector<Ex
         centreBySource(ex);
         centreBySource(synth);
     }
-    const auto count = [](JudgedCounts& c, const std::string& material, const std::string& heard) {
-        ++c.files;
-        c.materialRight += heard == material;
-        c.categoryRight += categoryOfMaterial(heard) == categoryOfMaterial(material);
-    };
     std::map<std::string, OneSourceFigures> out;
     for (const auto& only : twoSourcesOrMore(ex, "trainedOnEachSource")) {
         std::vector<Example> train;
@@ -279,12 +277,12 @@ trainedOnEachSource(const std::vector<Example>& recordings, const std::vector<Ex
         auto& f = out[only];
         for (const auto& e : ex)
             if (e.source != only && mats.count(e.material))
-                count(f.recordings[e.material], e.material, l.classify(e.features));
+                f.recordings[e.material].add(e.material, l.classify(e.features));
         f.heard.assign(synth.size(), std::string());
         for (std::size_t i = 0; i < synth.size(); ++i) {
             if (!mats.count(renderMaterials[i])) continue;
             f.heard[i] = l.classify(synth[i].features);
-            count(f.renders[renderMaterials[i]], renderMaterials[i], f.heard[i]);
+            f.renders[renderMaterials[i]].add(renderMaterials[i], f.heard[i]);
         }
     }
     return out;

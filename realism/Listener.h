@@ -113,11 +113,15 @@ std::map<std::string, std::vector<std::string>>
 heardWithoutEachSource(const std::vector<Example>& recordings, const std::vector<Example>& renders,
                        ListenerOptions o = {});
 
-/// How a held-out source's own recordings of one material are heard.
-struct HeldOutCounts {
-    int files = 0;         ///< the source's files of the material
-    int categoryRight = 0; ///< of those, put in the material's category
-    int materialRight = 0; ///< of those, named as the material (0 when no other source has it)
+/// Files of one material judged by a listener: how many, put in the material's category, named
+/// as the material.
+struct JudgedCounts {
+    int files = 0;
+    int categoryRight = 0;
+    int materialRight = 0; ///< 0 when the listener does not know the material
+    /// Counts one file of `material` heard as `heard`.
+    void add(const std::string& material, const std::string& heard);
+    bool operator==(const JudgedCounts&) const = default;
 };
 
 /// The recordings' side of the nested figures: every source S's own recordings judged by the
@@ -127,16 +131,8 @@ struct HeldOutCounts {
 /// renders' figures count such a source. A render cannot be asked to be heard in its category
 /// more often than the held-out source's own recordings of its material are. Throws
 /// std::invalid_argument with fewer than two sources.
-std::map<std::string, std::map<std::string, HeldOutCounts>>
+std::map<std::string, std::map<std::string, JudgedCounts>>
 heldOutRecordings(const std::vector<Example>& recordings, ListenerOptions o = {});
-
-/// Files judged by a listener: how many, named as their material, put in its category.
-struct JudgedCounts {
-    int files = 0;
-    int materialRight = 0;
-    int categoryRight = 0;
-    bool operator==(const JudgedCounts&) const = default;
-};
 
 /// What one source alone teaches the listener (trainedOnEachSource), per material it recorded.
 struct OneSourceFigures {

@@ -46,7 +46,7 @@ void scoreNested(const std::vector<SurfaceUnderTest>& surfaces,
     }
 }
 
-void addHeldOutRecordings(const std::map<std::string, std::map<std::string, HeldOutCounts>>& own,
+void addHeldOutRecordings(const std::map<std::string, std::map<std::string, JudgedCounts>>& own,
                           std::vector<SurfaceFigures>& figures) {
     for (auto& f : figures)
         for (auto& v : f.heardWithout) {

@@ -40,8 +40,8 @@ std::vector<SurfaceUnderTest> bundledSurfaces();
 /// How one held-out source heard one render.
 struct HeldOutVerdict {
     std::string source, heard;
-    bool scored = false; ///< the source recorded the surface's material: counted in the figures
-    HeldOutCounts recordings; ///< the source's own recordings of the material, same listener
+    bool scored = false;     ///< the source recorded the surface's material: counted in the figures
+    JudgedCounts recordings; ///< the source's own recordings of the material, same listener
 };
 
 struct SurfaceFigures {
@@ -86,14 +86,14 @@ void scoreNested(const std::vector<SurfaceUnderTest>& surfaces,
                  std::vector<SurfaceFigures>& out);
 
 /// Fills heardWithout[].recordings of every scored verdict from heldOutRecordings' counts.
-void addHeldOutRecordings(const std::map<std::string, std::map<std::string, HeldOutCounts>>& own,
+void addHeldOutRecordings(const std::map<std::string, std::map<std::string, JudgedCounts>>& own,
                           std::vector<SurfaceFigures>& figures);
 
 /// One surface's nested verdicts over every seed, per held-out source that recorded its material.
 struct HeldOutOverSeeds {
     std::string source;
     int seeds = 0, seedsInCategory = 0; ///< renders of the surface this source's listener judged
-    HeldOutCounts recordings;           ///< the source's own recordings of the material
+    JudgedCounts recordings;            ///< the source's own recordings of the material
     /// The render is heard in its category at least as often (as a share) as the recordings.
     bool atLeastAsOftenAsRecordings() const {
         return std::int64_t(seedsInCategory) * recordings.files >=

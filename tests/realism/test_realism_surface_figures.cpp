@@ -70,7 +70,7 @@ TEST(SurfaceFigures, OverSeedsSetsEachSourceAgainstItsOwnRecordings) {
         fig("wood", "wood", "solid", {{"a", "water", true, {}}, {"b", "snow", true, {}}}),
         fig("gravel", "gravel", "aggregate", {{"a", "sand", true, {}}, {"b", "wood", false, {}}}),
         fig("leaves", "", "aggregate", {{"a", "wood", false, {}}})};
-    const std::map<std::string, std::map<std::string, HeldOutCounts>> own{
+    const std::map<std::string, std::map<std::string, JudgedCounts>> own{
         {"a", {{"wood", {2, 1, 1}}, {"gravel", {4, 4, 3}}}}, {"b", {{"wood", {3, 0, 0}}}}};
     addHeldOutRecordings(own, figs);
     EXPECT_EQ(figs[0].heardWithout[0].recordings.files, 2);
