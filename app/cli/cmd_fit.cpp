@@ -48,9 +48,9 @@ std::vector<rl::Recording> cacheRecordings(const std::string& dir, bool say) {
     const auto all = rl::loadManifest(dir);
     auto kept = rl::withoutUnseenSource(all);
     if (say && kept.size() < all.size()) {
-        fmt::print("note: the unseen source {} ({} files of {}) is left out: no preset is fitted "
+        fmt::print("note: the unseen source {} ({} of {}) is left out: no preset is fitted "
                    "on it (--real names files to fit to)\n",
-                   rl::kUnseenSource, all.size() - kept.size(), dir);
+                   rl::kUnseenSource, counted(all.size() - kept.size(), "file"), dir);
     }
     return kept;
 }

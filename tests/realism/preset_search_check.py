@@ -96,7 +96,7 @@ def main():
          "--rng-seed", "11", "--seeds", "7", "--sources", "minetest,ufoai", "--recordings",
          unseen, "--base", base, "--out", u, "--underfoot", binary, "--distance", *params],
         capture_output=True, text=True)
-    if r.returncode != 0 or "leaving out the unseen source 0ad (1 files)" not in r.stderr:
+    if r.returncode != 0 or "leaving out the unseen source 0ad (1 file)" not in r.stderr:
         fail(f"a cache with the unseen source: expected it left out, saying so; got "
              f"{r.returncode}: {r.stderr}{r.stdout}")
     if r.stdout.strip().replace(os.path.join(u, "gravel_11_1"), "VARIANT").replace(

@@ -66,7 +66,8 @@ def without_unseen(cache, out, k):
             os.symlink(os.path.abspath(os.path.join(cache, entry)), os.path.join(view, entry))
     with open(os.path.join(view, "manifest.csv"), "w") as f:
         f.write("\n".join(kept) + "\n")
-    print(f"leaving out the unseen source {UNSEEN_SOURCE} ({len(lines) - len(kept)} files) of "
+    n = len(lines) - len(kept)
+    print(f"leaving out the unseen source {UNSEEN_SOURCE} ({n} file{'' if n == 1 else 's'}) of "
           f"{cache}: presets are never chosen on it", file=sys.stderr)
     return view
 
