@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Experiment runner speed (issue 4 targets):
+// Experiment runner speed, against these goals:
 //   - a durable answer commit (WAL, synchronous=FULL, own transaction): median < 10 ms;
 //   - opening a study with 200 participants and computing its plan summary: < 200 ms.
 // Run: build/tests/bench/bench_experiment   (study files go to $TMPDIR; same disk matters)

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Soundscape speed: the five environments of experiment 2 rendered together at 48 kHz on one
 // thread. The `rtf` counter is the real-time factor (seconds of audio per second of CPU for
-// the five together); issue 6 asks for more than 50.
+// the five together); the goal is more than 50.
 //   build-*/tests/bench/bench_soundscapes
 #include "engine/dsp/Denormals.h"
 #include "engine/dsp/Random.h"

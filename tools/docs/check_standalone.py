@@ -20,7 +20,7 @@ PATTERNS = [
     (re.compile(r"\b(STUDIES|MODELS|STYLE)\.md\b"), "cites a background note outside the repository"),
     (re.compile(r"(\.\./shared/|/work/shared|\bshared/(data|docs|seeds)\b|(?<![\w/])data/published\b)"),
      "cites a folder outside the repository"),
-    (re.compile(r"\b[Ii]ssue #\d+|\(#\d+\)|\bsee #\d+"), "cites an issue number"),
+    (re.compile(r"\b[Ii]ssues? #?\d+|\(#\d+\)|\bsee #\d+"), "cites an issue number"),
     (re.compile(r"\b\d{1,2} (Jan|Feb|Mar|Apr|May|Jun|Jul|Aug|Sep|Oct|Nov|Dec)[a-z]*\.? 20\d\d\b"),
      "dates a change (history goes in CHANGELOG.md and docs/decisions/)"),
 ]
@@ -87,13 +87,15 @@ def self_test() -> int:
         "a.toml": ("# see STUDIES.md\n"
                    "# set by hand on 28 Nov 2026\n"
                    "# fixed in issue #38\n"
+                   "# target (issue 8): one block\n"
                    "# (docs/guide.md, \"A section it lacks\")\n"
                    "# (docs/missing.md, \"Anything\")\n"
                    "# fine: (docs/guide.md, \"The listener\") and (docs/guide.md,\n"
                    "# \"A bold lead\"), ISO dates 2026-11-28 and code (docs/guide.md\") x\n"),
     }
     want = ["a.toml:1: cites a background note", "a.toml:2: dates a change",
-            "a.toml:3: cites an issue number", 'section "A section it lacks" of docs/guide.md',
+            "a.toml:3: cites an issue number", "a.toml:4: cites an issue number",
+            'section "A section it lacks" of docs/guide.md',
             "cites docs/missing.md, which the repository does not hold"]
     with tempfile.TemporaryDirectory() as root:
         for name, text in files.items():

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Latency from a gyroscope frame (a step in angular velocity) to sound, for v1 and v2
 // (engine/wading/WadingLatency.h; the same measurement as `underfoot wade --latency`).
-// Target (issue 8): no more than one audio block beyond the sensor's 10 ms frame period, not
+// Target: no more than one audio block beyond the sensor's 10 ms frame period, not
 // counting the paper's deliberate filter/follower dynamics, which are reported separately.
 #include "engine/wading/WadingLatency.h"
 
