@@ -24,23 +24,27 @@ std::vector<Recording> withoutUnseenSource(std::vector<Recording> recordings) {
     return recordings;
 }
 
-std::vector<Recording> loadManifest(const std::string& dir) {
-    const auto path = (fs::path(dir) / "manifest.csv").string();
+const std::vector<std::string>& fetchedSources() {
+    static const std::vector<std::string> s = {"minetest", "openarena", "ufoai",      "lugaru",
+                                               "nexuiz",   "openclonk", "redeclipse", "0ad"};
+    return s;
+}
+
+namespace {
+// The rows of one manifest file; `labOnly`: refuse a source the fetch script writes.
+void readManifestFile(const std::string& dir, const fs::path& path, bool labOnly,
+                      std::vector<Recording>& out) {
     std::ifstream in(path);
-    if (!in)
-        throw std::runtime_error(fmt::format(
-            "{}: no recordings manifest (run `bash scripts/fetch-recordings.sh {}`)", path, dir));
+    if (!in) throw std::runtime_error(fmt::format("{}: cannot be read", path.string()));
     std::string line;
-    std::vector<Recording> out;
     int lineNo = 0;
-    const char* expected = "file,source,package,version,licence,material,recordist";
     while (std::getline(in, line)) {
         ++lineNo;
         if (!line.empty() && line.back() == '\r') line.pop_back();
         if (lineNo == 1) {
-            if (line != expected)
+            if (line != kManifestHeader)
                 throw std::runtime_error(fmt::format("{}:1: expected the header \"{}\", got \"{}\"",
-                                                     path, expected, line));
+                                                     path.string(), kManifestHeader, line));
             continue;
         }
         if (line.empty()) continue;
@@ -51,22 +55,43 @@ std::vector<Recording> loadManifest(const std::string& dir) {
         if (line.back() == ',') f.emplace_back(); // an empty last column (recordist) is a column
         if (f.size() != 7)
             throw std::runtime_error(
-                fmt::format("{}:{}: expected 7 comma-separated columns ({}), got {}", path, lineNo,
-                            expected, f.size()));
+                fmt::format("{}:{}: expected 7 comma-separated columns ({}), got {}", path.string(),
+                            lineNo, kManifestHeader, f.size()));
         for (std::size_t c = 0; c < 6; ++c)
             if (f[c].empty())
                 throw std::runtime_error(
-                    fmt::format("{}:{}: column {} is empty", path, lineNo, c + 1));
+                    fmt::format("{}:{}: column {} is empty", path.string(), lineNo, c + 1));
+        const auto& fetched = fetchedSources();
+        if (labOnly && std::find(fetched.begin(), fetched.end(), f[1]) != fetched.end())
+            throw std::runtime_error(fmt::format(
+                "{}:{}: source \"{}\" is one that scripts/fetch-recordings.sh fetches; a lab's "
+                "recordings need a name of their own",
+                path.string(), lineNo, f[1]));
         Recording r;
         r.file = f[0];
         r.path = (fs::path(dir) / f[0]).string();
         r.source = f[1];
         r.package = f[2];
+        r.version = f[3];
         r.licence = f[4];
         r.material = f[5];
         r.recordist = f[6];
         out.push_back(std::move(r));
     }
+}
+} // namespace
+
+std::vector<Recording> loadManifest(const std::string& dir) {
+    const auto fetched = fs::path(dir) / "manifest.csv";
+    const auto lab = fs::path(dir) / "lab-manifest.csv";
+    const bool hasFetched = fs::exists(fetched), hasLab = fs::exists(lab);
+    if (!hasFetched && !hasLab)
+        throw std::runtime_error(
+            fmt::format("{}: no recordings manifest (run `bash scripts/fetch-recordings.sh {}`)",
+                        fetched.string(), dir));
+    std::vector<Recording> out;
+    if (hasFetched) readManifestFile(dir, fetched, false, out);
+    if (hasLab) readManifestFile(dir, lab, true, out);
     return out;
 }
 

@@ -15,6 +15,7 @@ struct Recording {
     std::string file;     ///< as named in the manifest (relative to the cache)
     std::string source;   ///< independent source (package or lab), e.g. "minetest"
     std::string package;  ///< Debian package (or "lab")
+    std::string version;  ///< the package's version (a lab's recordings: the day they were added)
     std::string licence;  ///< SPDX-like licence of the audio
     std::string material; ///< wood, metal, hard, gravel, sand, snow, dirt, grass, ice, water
     std::string recordist;
@@ -24,9 +25,20 @@ struct Recording {
 /// a program of the build tree, else ~/.cache/underfoot/recordings (base::recordingsDirectory).
 std::string defaultRecordingsDir();
 
-/// Reads DIR/manifest.csv. Throws std::runtime_error naming the file and line when it is
-/// missing or malformed (a line with the wrong number of columns, an empty field).
+/// Reads DIR/manifest.csv (the packages scripts/fetch-recordings.sh fetched, which it rewrites)
+/// and then DIR/lab-manifest.csv (a lab's own recordings, realism/LabRecordings.h, which the
+/// script never touches), each when present; the same columns in both. Throws
+/// std::runtime_error naming the file and line when neither is there or one is malformed (a
+/// line with the wrong number of columns, an empty field, or in the lab's manifest a source the
+/// script fetches).
 std::vector<Recording> loadManifest(const std::string& dir);
+
+/// The header line of both manifests.
+inline constexpr const char* kManifestHeader =
+    "file,source,package,version,licence,material,recordist";
+
+/// The sources scripts/fetch-recordings.sh fetches (and rewrites on every run).
+const std::vector<std::string>& fetchedSources();
 
 /// The source `scripts/fetch-recordings.sh --unseen` adds (0 A.D.'s footsteps): no preset is
 /// fitted or chosen on it, so `underfoot fit`, the preset search and the realism tests leave it

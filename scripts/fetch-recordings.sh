@@ -16,6 +16,8 @@
 #
 # Layout: CACHE_DIR/<source>/<material>/<file> and CACHE_DIR/manifest.csv with the columns
 # file,source,package,version,licence,material,recordist (file relative to CACHE_DIR).
+# A lab's own recordings (`underfoot recordings add`) are listed in CACHE_DIR/lab-manifest.csv,
+# under source names this script does not fetch: it never touches that file or their folders.
 # The audio is not shipped in the repository: it stays under its own licence (named per file in
 # the manifest, from each package's copyright file) and is fetched on demand.
 #

@@ -69,4 +69,38 @@ check compare_seeds_without_figures refused "--seeds goes with --figures" -- \
 check compare_markdown_all refused "--markdown goes with --listener or --figures" -- \
     "$underfoot" compare --all --markdown
 
+# 6. `recordings add|list|remove`: a lab's recordings go into a cache as their own source; bad
+#    names, materials and files are refused naming them, and leave the cache as it was.
+"$underfoot" render --surface gravel --seconds 2 -o lab_gravel.wav -q
+"$underfoot" render --surface wood --seconds 2 -o lab_wood.wav -q
+printf 'not audio' > lab_notes.wav
+check recordings_list_none refused "lab_cache/manifest.csv: no recordings manifest" -- \
+    "$underfoot" recordings list --recordings lab_cache
+check recordings_add ok "added 1 file" -- "$underfoot" recordings add --source hall-b \
+    --material gravel --licence CC-BY-4.0 --recordings lab_cache lab_gravel.wav
+check recordings_add_wood ok "hall-b/wood/lab_wood.wav" -- "$underfoot" recordings add \
+    --source hall-b --material wood --licence CC-BY-4.0 --recordings lab_cache lab_wood.wav
+check recordings_list ok "hall-b         2  gravel 1, wood 1  \[lab" -- \
+    "$underfoot" recordings list --recordings lab_cache
+cp lab_cache/lab-manifest.csv lab_manifest_before.csv
+check recordings_fetched_name refused '"ufoai" is a package scripts/fetch-recordings.sh' -- \
+    "$underfoot" recordings add --source ufoai --material gravel --licence x \
+    --recordings lab_cache lab_gravel.wav
+check recordings_material refused 'unknown material "stone"' -- "$underfoot" recordings add \
+    --source hall-c --material stone --licence x --recordings lab_cache lab_gravel.wav
+check recordings_not_audio refused "lab_notes.wav" -- "$underfoot" recordings add \
+    --source hall-c --material gravel --licence x --recordings lab_cache lab_gravel.wav lab_notes.wav
+check recordings_twice refused "hall-b/gravel/lab_gravel.wav is already in the cache" -- \
+    "$underfoot" recordings add --source hall-b --material gravel --licence x \
+    --recordings lab_cache lab_gravel.wav
+if cmp -s lab_manifest_before.csv lab_cache/lab-manifest.csv && [ ! -e lab_cache/hall-c ]; then
+    echo "ok   recordings_refusals_leave_the_cache"
+else
+    echo "FAIL recordings_refusals_leave_the_cache: a refused add changed the cache"; fail=1
+fi
+check recordings_remove ok "removed source hall-b (2 files)" -- \
+    "$underfoot" recordings remove --source hall-b --recordings lab_cache
+check recordings_remove_again refused 'no lab source "hall-b" (it lists: none)' -- \
+    "$underfoot" recordings remove --source hall-b --recordings lab_cache
+
 exit $fail

@@ -31,6 +31,7 @@ skip_reason() {
     *"--osc "*) echo "needs gyroscopes sending OSC" ;;
     *"underfoot analyze --study online.db"*) echo "needs answers: the participants take the test in their browsers first (tests/web do)" ;;
     *"underfoot serve "*) echo "starts the web server and runs until stopped (tests/web run it on loopback)" ;;
+    *"my_recordings/"* | *"recordings remove --source mylab"*) echo "needs your own recorded footsteps in my_recordings/ (the document says: record them first)" ;;
     *"my_floor/"*) echo "needs your own recorded footsteps in my_floor/ (the document says: record them first)" ;;
     *"wading_realism.toml -o clips3"* | *"--clips clips3"* | *"--study wading3.db"*"--format html"*) echo "needs the lab's own recordings in clips3/real/ (the document says: put them there first)" ;;
     *"underfoot replay --study exp2.db --participant P01 --trial 3"*) echo "needs P01 to have answered trial 3 in the interactive session above (stdin is empty here)" ;;

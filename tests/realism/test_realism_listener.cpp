@@ -311,7 +311,7 @@ TEST(RealismRecordings, ManifestErrorsNameTheFileAndLine) {
     fs::remove_all(dir);
 }
 
-// Found while seeding fuzz_recordings_manifest (task fuzz4): a row whose last column (recordist,
+// Found while seeding fuzz_recordings_manifest: a row whose last column (recordist,
 // the one column that may be empty) was empty counted 6 columns and the whole manifest was
 // refused.
 TEST(RealismRecordings, ManifestAcceptsAnEmptyRecordist) {
