@@ -90,6 +90,13 @@ int add(Options o) {
     fmt::print("`underfoot compare --listener` and `--figures` now hold {} out like any "
                "source\n",
                o.source.name);
+    for (const auto& s : rl::summariseSources(rl::loadManifest(dir)))
+        if (s.source == o.source.name && s.files.size() == 1)
+            fmt::print("note: {} has one material: the listener centres every source on its "
+                       "own median, which a one-material source turns into that material. Add "
+                       "a second material (your lab's hard floor will do) for its verdicts to "
+                       "count (docs/howto/judge-on-your-recordings.md)\n",
+                       o.source.name);
     return 0;
 }
 

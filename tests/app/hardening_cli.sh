@@ -76,7 +76,7 @@ check compare_markdown_all refused "--markdown goes with --listener or --figures
 printf 'not audio' > lab_notes.wav
 check recordings_list_none refused "lab_cache/manifest.csv: no recordings manifest" -- \
     "$underfoot" recordings list --recordings lab_cache
-check recordings_add ok "added 1 file" -- "$underfoot" recordings add --source hall-b \
+check recordings_add ok "note: hall-b has one material" -- "$underfoot" recordings add --source hall-b \
     --material gravel --licence CC-BY-4.0 --recordings lab_cache lab_gravel.wav
 check recordings_add_wood ok "hall-b/wood/lab_wood.wav" -- "$underfoot" recordings add \
     --source hall-b --material wood --licence CC-BY-4.0 --recordings lab_cache lab_wood.wav
