@@ -203,7 +203,7 @@ std::vector<SourceSummary> summariseSources(const std::vector<Recording>& record
             s.source = r.source;
             s.package = r.package;
             s.lab = !isFetched(r.source);
-            s.unseen = r.source == kUnseenSource;
+            s.unseen = isUnseenSource(r.source);
             out.push_back(std::move(s));
         }
         ++counts[r.source][r.material];

@@ -19,14 +19,25 @@ std::string defaultRecordingsDir() {
     return base::recordingsDirectory();
 }
 
-std::vector<Recording> withoutUnseenSource(std::vector<Recording> recordings) {
-    std::erase_if(recordings, [](const Recording& r) { return r.source == kUnseenSource; });
+const std::vector<std::string>& unseenSources() {
+    static const std::vector<std::string> s = {"0ad", "berusky2"};
+    return s;
+}
+
+bool isUnseenSource(const std::string& source) {
+    const auto& u = unseenSources();
+    return std::find(u.begin(), u.end(), source) != u.end();
+}
+
+std::vector<Recording> withoutUnseenSources(std::vector<Recording> recordings) {
+    std::erase_if(recordings, [](const Recording& r) { return isUnseenSource(r.source); });
     return recordings;
 }
 
 const std::vector<std::string>& fetchedSources() {
-    static const std::vector<std::string> s = {"minetest", "openarena", "ufoai",      "lugaru",
-                                               "nexuiz",   "openclonk", "redeclipse", "0ad"};
+    static const std::vector<std::string> s = {"minetest",   "openarena", "ufoai",
+                                               "lugaru",     "nexuiz",    "openclonk",
+                                               "redeclipse", "berusky2",  "0ad"};
     return s;
 }
 

@@ -40,14 +40,15 @@ inline constexpr const char* kManifestHeader =
 /// The sources scripts/fetch-recordings.sh fetches (and rewrites on every run).
 const std::vector<std::string>& fetchedSources();
 
-/// The source `scripts/fetch-recordings.sh --unseen` adds (0 A.D.'s footsteps): no preset is
-/// fitted or chosen on it, so `underfoot fit`, the preset search and the realism tests leave it
-/// out of a cache's recordings; `underfoot compare` judges the presets on it
-/// (docs/decisions/unseen-source.md).
-inline constexpr const char* kUnseenSource = "0ad";
+/// The sources `scripts/fetch-recordings.sh --unseen` adds (0 A.D.'s and Berusky 2's
+/// footsteps): no preset is fitted or chosen on them, so `underfoot fit`, the preset search and
+/// the realism tests leave them out of a cache's recordings; `underfoot compare` judges the
+/// presets on them (docs/decisions/unseen-source.md).
+const std::vector<std::string>& unseenSources();
+bool isUnseenSource(const std::string& source);
 
-/// The recordings without the unseen source's.
-std::vector<Recording> withoutUnseenSource(std::vector<Recording> recordings);
+/// The recordings without the unseen sources'.
+std::vector<Recording> withoutUnseenSources(std::vector<Recording> recordings);
 
 /// Audio files (.wav .ogg .flac .aiff) named directly or found below the given folders,
 /// sorted; material and source unknown. Throws std::runtime_error for a path that does not exist.

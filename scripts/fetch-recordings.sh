@@ -22,7 +22,7 @@
 # the manifest, from each package's copyright file) and is fetched on demand.
 #
 # Sources (seven independent packages, different microphones, rooms and processing; about
-# 1.35 GB downloaded in all, of which redeclipse-data is 862 MB):
+# 1.35 GB downloaded in all, of which redeclipse-data is 862 MB), and two unseen ones:
 #   minetest-data  minetest_game's default_*_footstep*.ogg (CC0-1.0 / CC-BY-3.0 / CC-BY-SA-3.0,
 #                  per file in mods/default/README.txt; freesound.org recordists)
 #   openarena-data baseoa/pak0.pk3 sound/player/footsteps/ (GPL-2+): boot (hard floor),
@@ -53,9 +53,17 @@
 #                  fit or design choice of this project has used it, and none may be chosen on
 #                  it; it is there to judge the presets on recordings nobody tuned them to
 #                  (docs/decisions/unseen-source.md).
+
+#   berusky2-data  (only with --unseen) sound/sound/steps{sand,grass,snow2,snow3,steel1,
+#                  stone2,wood}.wav and wstep[1-4].wav (GPL-2+, AnakreoN): the beetles' steps, chosen by the floor's
+#                  material in berusky2's src/kofola/animend_functions.cpp (GetStep: pisek sand,
+#                  trava grass, snih snow, zelezo steel = metal, kamen stone = hard floor, drevo
+#                  wood) and in water (PlaySteps: objects of class 12, water). 22.05 kHz
+#                  (wstep3 44.1 kHz), 0.65-0.96 s, two or three steps a file. The second
+#                  unseen source, found by searching every file of Debian's archive (apt-file).
 #
 # The first four are fetched always: a failed download stops the script, naming the package.
-# The next three only with --large, 0ad-data only with --unseen (or
+# The next three only with --large, 0ad-data and berusky2-data only with --unseen (or
 # UNDERFOOT_RECORDINGS_UNSEEN=1); UNDERFOOT_RECORDINGS_SKIP="nexuiz-data ..." then still leaves
 # some of them out (each is named on the output).
 # Without nexuiz-data UFO:AI's metal1 and metal3 are kept (the four-source cache, 90 files).
@@ -101,9 +109,9 @@ keep() { # file source package version licence material recordist: into the cach
     echo "$2/$6/$(basename "$1"),$2,$3,$4,$5,$6,$7" >>"$manifest.tmp"
 }
 
-skipped() { # package -> true when it is a large one and --large was not given, the unseen
+skipped() { # package -> true when it is a large one and --large was not given, an unseen
     # one and --unseen was not given, or UNDERFOOT_RECORDINGS_SKIP names it
-    if [ "$1" = 0ad-data ]; then
+    if [ "$1" = 0ad-data ] || [ "$1" = berusky2-data ]; then
         [ "$unseen" = 1 ] || return 0
     else
         [ "$large" = 1 ] || return 0
@@ -117,14 +125,15 @@ if [ "$large" != 1 ]; then
         "(about 1.24 GB more)"
 fi
 if [ "$unseen" = 1 ]; then
-    echo "fetch-recordings: --unseen: adding 0ad-data, the source no preset was tuned on (1.38 GB" \
-        "to download, about 3.3 GB of temporary space while its sounds are extracted)"
+    echo "fetch-recordings: --unseen: adding 0ad-data and berusky2-data, the sources no preset" \
+        "was tuned on (1.94 GB to download, about 3.3 GB of temporary space while 0ad-data's" \
+        "sounds are extracted)"
 fi
 for p in ${UNDERFOOT_RECORDINGS_SKIP:-}; do
     case "$p" in
-    nexuiz-data | openclonk-data | redeclipse-data | 0ad-data) echo "fetch-recordings: leaving out $p (UNDERFOOT_RECORDINGS_SKIP)" ;;
+    nexuiz-data | openclonk-data | redeclipse-data | berusky2-data | 0ad-data) echo "fetch-recordings: leaving out $p (UNDERFOOT_RECORDINGS_SKIP)" ;;
     *)
-        echo "fetch-recordings: UNDERFOOT_RECORDINGS_SKIP: '$p' is not an optional source (nexuiz-data openclonk-data redeclipse-data 0ad-data)" >&2
+        echo "fetch-recordings: UNDERFOOT_RECORDINGS_SKIP: '$p' is not an optional source (nexuiz-data openclonk-data redeclipse-data berusky2-data 0ad-data)" >&2
         exit 2
         ;;
     esac
@@ -133,7 +142,7 @@ manifest="$cache/manifest.csv"
 # A source's folder from an earlier run would keep files the new manifest does not list; the
 # old manifest goes too, so that a run that fails leaves no cache (the tests then skip, naming
 # this script) rather than a manifest of deleted files.
-rm -rf "${cache:?}"/{minetest,openarena,ufoai,lugaru,nexuiz,openclonk,redeclipse,0ad} "$manifest"
+rm -rf "${cache:?}"/{minetest,openarena,ufoai,lugaru,nexuiz,openclonk,redeclipse,berusky2,0ad} "$manifest"
 echo "file,source,package,version,licence,material,recordist" >"$manifest.tmp"
 
 # ---- minetest-data -------------------------------------------------------------------------
@@ -321,6 +330,33 @@ water swimstep
 LIST
     cp "$work/redeclipse/usr/share/doc/redeclipse-data/copyright" "$cache/licences/redeclipse-data.copyright"
     cp "$work/redeclipse/$rd/readme.txt" "$cache/licences/redeclipse-data-sounds-readme.txt"
+fi
+
+# ---- berusky2-data -------------------------------------------------------------------------
+if ! skipped berusky2-data; then
+    deb="$(download berusky2-data)"
+    ver="$(dpkg-deb -f "$deb" Version)"
+    bs=./usr/share/games/berusky2/sound/sound
+    extract "$deb" "$work/berusky2" "$bs/steps*.wav" "$bs/wstep*.wav" \
+        ./usr/share/doc/berusky2-data/copyright
+    rm -f "$deb"
+    while read -r material names; do
+        for n in $names; do
+            f="$work/berusky2/$bs/$n.wav"
+            [ -f "$f" ] || continue
+            keep "$f" berusky2 berusky2-data "$ver" GPL-2+ "$material" AnakreoN
+        done
+    done <<'LIST'
+sand stepsand
+grass stepsgrass
+snow stepsnow2 stepsnow3
+metal stepssteel1
+hard stepsstone2
+wood stepswood
+water wstep1 wstep2 wstep3 wstep4
+LIST
+    cp "$work/berusky2/usr/share/doc/berusky2-data/copyright" "$cache/licences/berusky2-data.copyright"
+    rm -rf "$work/berusky2"
 fi
 
 # ---- 0ad-data ------------------------------------------------------------------------------

@@ -21,6 +21,7 @@
 #include <fmt/core.h>
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -42,15 +43,20 @@ struct FitArgs {
     bool noModalSeed = false;
 };
 
-// The cache's recordings without the unseen source's (rl::kUnseenSource: presets are never
-// fitted on it), saying so when `say` and it held some.
+// The cache's recordings without the unseen sources' (rl::unseenSources: presets are never
+// fitted on them), saying so when `say` and it held some.
 std::vector<rl::Recording> cacheRecordings(const std::string& dir, bool say) {
     const auto all = rl::loadManifest(dir);
-    auto kept = rl::withoutUnseenSource(all);
+    auto kept = rl::withoutUnseenSources(all);
     if (say && kept.size() < all.size()) {
-        fmt::print("note: the unseen source {} ({} of {}) is left out: no preset is fitted "
-                   "on it (--real names files to fit to)\n",
-                   rl::kUnseenSource, counted(all.size() - kept.size(), "file"), dir);
+        std::string names;
+        for (const auto& s : rl::unseenSources())
+            if (std::any_of(all.begin(), all.end(),
+                            [&](const rl::Recording& r) { return r.source == s; }))
+                names += (names.empty() ? "" : ", ") + s;
+        fmt::print("note: the unseen sources ({}: {} of {}) are left out: no preset is fitted "
+                   "on them (--real names files to fit to)\n",
+                   names, counted(all.size() - kept.size(), "file"), dir);
     }
     return kept;
 }
@@ -221,7 +227,7 @@ CommandRegistrar reg("fit", [](CLI::App& app, int& exitCode) {
     cmd->add_option("-s,--surface", args->surface, "surface id or preset .toml");
     cmd->add_option("--real", args->real,
                     "recorded footsteps: files or folders (default: the recordings cache, "
-                    "material of the surface, without the unseen source of "
+                    "material of the surface, without the unseen sources of "
                     "fetch-recordings.sh --unseen)");
     cmd->add_option("--recordings", args->recordings,
                     "recordings cache (default build/recordings)");

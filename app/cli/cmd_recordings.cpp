@@ -70,7 +70,7 @@ int list(const Options& o) {
             n += k;
         }
         const char* kind = s.lab      ? "lab (lab-manifest.csv)"
-                           : s.unseen ? "fetched, the unseen source"
+                           : s.unseen ? "fetched, unseen (never tuned on)"
                                       : "fetched";
         fmt::print("  {:<12} {:>3}  {}  [{}]\n", s.source, n, files, kind);
     }

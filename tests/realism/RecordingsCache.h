@@ -26,7 +26,7 @@ class RecordingsCacheTest : public ::testing::Test {
                 << "no recordings cache at " << dir_
                 << ": run `bash scripts/fetch-recordings.sh` (or set UNDERFOOT_RECORDINGS)";
         const auto all = loadManifest(dir_);
-        recs_ = withoutUnseenSource(all);
+        recs_ = withoutUnseenSources(all);
         if (recs_.size() < all.size())
             RecordProperty("unseen_files_left_out", static_cast<int>(all.size() - recs_.size()));
         const auto& fetched = fetchedSources();

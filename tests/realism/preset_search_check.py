@@ -3,8 +3,8 @@
 """Checks tools/research/preset_search.py (docs/decisions/frozen-snow-and-gravel-trade-off.md):
 the same --rng-seed writes the same variant, only the drawn keys change and each value lies in
 its range, the verdict line (with --distance) has its documented shape, a cache holding the
-unseen source is searched without it, and bad parameters are refused with a message. Needs the
-recordings cache (exits 77, skipped, without it).
+unseen sources is searched without them, and bad parameters are refused with a message. Needs
+the recordings cache (exits 77, skipped, without it).
 
     preset_search_check.py SOURCE_DIR UNDERFOOT_BINARY SCRATCH_DIR
 """
@@ -79,8 +79,8 @@ def main():
             int(m.group(3)), int(m.group(4))):
         fail(f"two copies of one cache must give equal halves summing to the total, each equal "
              f"to the one-cache line: {r.stdout}")
-    # A cache holding the unseen source is searched without it: a row of source 0ad whose file
-    # does not exist changes nothing, and the search says it left the source out.
+    # A cache holding the unseen sources is searched without them: rows of sources 0ad and
+    # berusky2 whose files do not exist change nothing, and the search says it left them out.
     unseen = os.path.join(scratch, "unseen_cache")
     os.makedirs(unseen)
     for entry in os.listdir(cache):
@@ -89,19 +89,21 @@ def main():
     with open(os.path.join(cache, "manifest.csv")) as f:
         rows = f.read().rstrip("\n")
     with open(os.path.join(unseen, "manifest.csv"), "w") as f:
-        f.write(rows + "\n0ad/gravel/missing.ogg,0ad,0ad-data,0,CC-BY-SA-3.0,gravel,nobody\n")
+        f.write(rows + "\n0ad/gravel/missing.ogg,0ad,0ad-data,0,CC-BY-SA-3.0,gravel,nobody\n"
+                "berusky2/snow/missing.wav,berusky2,berusky2-data,0,GPL-2+,snow,nobody\n")
     u = os.path.join(scratch, "u")
     r = subprocess.run(
         [sys.executable, tool, "--surface", "gravel", "--variants", "2", "--only", "1",
          "--rng-seed", "11", "--seeds", "7", "--sources", "minetest,ufoai", "--recordings",
          unseen, "--base", base, "--out", u, "--underfoot", binary, "--distance", *params],
         capture_output=True, text=True)
-    if r.returncode != 0 or "leaving out the unseen source 0ad (1 file)" not in r.stderr:
-        fail(f"a cache with the unseen source: expected it left out, saying so; got "
+    if (r.returncode != 0
+            or "leaving out the unseen sources (0ad, berusky2: 2 files)" not in r.stderr):
+        fail(f"a cache with the unseen sources: expected them left out, saying so; got "
              f"{r.returncode}: {r.stderr}{r.stdout}")
     if r.stdout.strip().replace(os.path.join(u, "gravel_11_1"), "VARIANT").replace(
             os.path.join(u, "recordings_0"), "CACHE") != runs[0][0].replace(a, "VARIANT"):
-        fail(f"without its unseen source the cache must give the same line:\n{r.stdout}\n"
+        fail(f"without its unseen sources the cache must give the same line:\n{r.stdout}\n"
              f"{runs[0][0]}")
     cmp = filecmp.dircmp(a, b)
     if cmp.diff_files or cmp.left_only or cmp.right_only:
@@ -134,7 +136,7 @@ def main():
             fail(f"parameter {bad}: expected a refusal with '{expected}', got "
                  f"{r.returncode}: {r.stderr}{r.stdout}")
     shutil.rmtree(scratch, ignore_errors=True)
-    print("ok: same seed, same variant; only the drawn keys change, in range; the unseen source "
+    print("ok: same seed, same variant; only the drawn keys change, in range; the unseen sources "
           "left out; bad parameters refused")
 
 

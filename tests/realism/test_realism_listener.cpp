@@ -345,8 +345,8 @@ TEST(RealismRecordings, ManifestAcceptsAnEmptyRecordist) {
     fs::remove_all(dir);
 }
 
-// The unseen source (fetch-recordings.sh --unseen) is never fitted on: withoutUnseenSource,
-// which `underfoot fit` and the tests' fixture read the cache through, drops its rows alone.
+// The unseen sources (fetch-recordings.sh --unseen) are never fitted on: withoutUnseenSources,
+// which `underfoot fit` and the tests' fixture read the cache through, drops their rows alone.
 TEST(RealismRecordings, TheUnseenSourceIsLeftOutOfTheCacheForFitting) {
     const auto dir = scratch("manifest_unseen");
     {
@@ -355,16 +355,19 @@ TEST(RealismRecordings, TheUnseenSourceIsLeftOutOfTheCacheForFitting) {
             << "ufoai/gravel/gravel1.ogg,ufoai,ufoai-sound,2.5,CC-BY-SA-3.0,gravel,UFO:AI team\n"
             << "0ad/gravel/fs_gravel1.ogg,0ad,0ad-data,0.0.26,CC-BY-SA-3.0,gravel,Wildfire\n"
             << "minetest/snow/s.ogg,minetest,minetest-data,5.6,CC0-1.0,snow,Ryding\n"
-            << "0ad/snow/fs_snow_11.ogg,0ad,0ad-data,0.0.26,CC-BY-SA-3.0,snow,Wildfire\n";
+            << "0ad/snow/fs_snow_11.ogg,0ad,0ad-data,0.0.26,CC-BY-SA-3.0,snow,Wildfire\n"
+            << "berusky2/snow/stepsnow2.wav,berusky2,berusky2-data,0.12-2,GPL-2+,snow,AnakreoN\n";
     }
     const auto all = loadManifest(dir.string());
-    ASSERT_EQ(all.size(), 4u);
-    const auto kept = withoutUnseenSource(all);
+    ASSERT_EQ(all.size(), 5u);
+    const auto kept = withoutUnseenSources(all);
     ASSERT_EQ(kept.size(), 2u);
     EXPECT_EQ(kept[0].source, "ufoai");
     EXPECT_EQ(kept[1].source, "minetest");
-    EXPECT_EQ(std::string(kUnseenSource), "0ad");
-    EXPECT_EQ(withoutUnseenSource(kept).size(), 2u);
+    EXPECT_EQ(unseenSources(), (std::vector<std::string>{"0ad", "berusky2"}));
+    EXPECT_TRUE(isUnseenSource("berusky2"));
+    EXPECT_FALSE(isUnseenSource("ufoai"));
+    EXPECT_EQ(withoutUnseenSources(kept).size(), 2u);
     fs::remove_all(dir);
 }
 

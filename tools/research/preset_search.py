@@ -41,13 +41,13 @@ import sys
 from listener_common import CATEGORY
 
 
-UNSEEN_SOURCE = "0ad"  # fetch-recordings.sh --unseen: never searched on
+UNSEEN_SOURCES = ("0ad", "berusky2")  # fetch-recordings.sh --unseen: never searched on
 
 
 def without_unseen(cache, out, k):
-    """The cache as the search may see it: when its manifest lists the unseen source
-    (docs/decisions/unseen-source.md), a view under `out` without it (the other sources' folders
-    linked, the manifest without its rows), else the cache itself."""
+    """The cache as the search may see it: when its manifest lists an unseen source
+    (docs/decisions/unseen-source.md), a view under `out` without them (the other sources'
+    folders linked, the manifest without their rows), else the cache itself."""
     manifest = os.path.join(cache, "manifest.csv")
     try:
         with open(manifest) as f:
@@ -55,20 +55,21 @@ def without_unseen(cache, out, k):
     except OSError as e:
         sys.exit(f"{manifest}: cannot read the recordings' manifest ({e.strerror}); "
                  "bash scripts/fetch-recordings.sh writes it")
-    kept = [l for l in lines if l.split(",")[1:2] != [UNSEEN_SOURCE]]
+    kept = [l for l in lines if l.split(",")[1:2] not in ([u] for u in UNSEEN_SOURCES)]
     if len(kept) == len(lines):
         return cache
     view = os.path.join(out, f"recordings_{k}")
     shutil.rmtree(view, ignore_errors=True)
     os.makedirs(view)
     for entry in os.listdir(cache):
-        if entry not in (UNSEEN_SOURCE, "manifest.csv"):
+        if entry not in UNSEEN_SOURCES + ("manifest.csv",):
             os.symlink(os.path.abspath(os.path.join(cache, entry)), os.path.join(view, entry))
     with open(os.path.join(view, "manifest.csv"), "w") as f:
         f.write("\n".join(kept) + "\n")
     n = len(lines) - len(kept)
-    print(f"leaving out the unseen source {UNSEEN_SOURCE} ({n} file{'' if n == 1 else 's'}) of "
-          f"{cache}: presets are never chosen on it", file=sys.stderr)
+    names = ", ".join(u for u in UNSEEN_SOURCES if any(l.split(",")[1:2] == [u] for l in lines))
+    print(f"leaving out the unseen sources ({names}: {n} file{'' if n == 1 else 's'}) of "
+          f"{cache}: presets are never chosen on them", file=sys.stderr)
     return view
 
 
