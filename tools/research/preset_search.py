@@ -44,6 +44,12 @@ from listener_common import CATEGORY
 UNSEEN_SOURCES = ("0ad", "berusky2")  # fetch-recordings.sh --unseen: never searched on
 
 
+def source_of(row):
+    """The source column of a manifest row (None for a row without one)."""
+    cells = row.split(",")
+    return cells[1] if len(cells) > 1 else None
+
+
 def without_unseen(cache, out, k):
     """The cache as the search may see it: when its manifest lists an unseen source
     (docs/decisions/unseen-source.md), a view under `out` without them (the other sources'
@@ -55,7 +61,7 @@ def without_unseen(cache, out, k):
     except OSError as e:
         sys.exit(f"{manifest}: cannot read the recordings' manifest ({e.strerror}); "
                  "bash scripts/fetch-recordings.sh writes it")
-    kept = [l for l in lines if l.split(",")[1:2] not in ([u] for u in UNSEEN_SOURCES)]
+    kept = [l for l in lines if source_of(l) not in UNSEEN_SOURCES]
     if len(kept) == len(lines):
         return cache
     view = os.path.join(out, f"recordings_{k}")
@@ -67,7 +73,7 @@ def without_unseen(cache, out, k):
     with open(os.path.join(view, "manifest.csv"), "w") as f:
         f.write("\n".join(kept) + "\n")
     n = len(lines) - len(kept)
-    names = ", ".join(u for u in UNSEEN_SOURCES if any(l.split(",")[1:2] == [u] for l in lines))
+    names = ", ".join(u for u in UNSEEN_SOURCES if any(source_of(l) == u for l in lines))
     print(f"leaving out the unseen sources ({names}: {n} file{'' if n == 1 else 's'}) of "
           f"{cache}: presets are never chosen on them", file=sys.stderr)
     return view
