@@ -141,9 +141,11 @@ std::vector<AddedRecording> addLabRecordings(const std::string& dir, const LabSo
         copies.emplace_back(f.path, target);
     }
 
-    std::vector<fs::path> done;
+    std::vector<fs::path> done, madeDirs; // undone if anything fails
     try {
         for (const auto& [from, to] : copies) {
+            for (auto d = to.parent_path(); !d.empty() && !fs::exists(d); d = d.parent_path())
+                madeDirs.push_back(d);
             fs::create_directories(to.parent_path());
             fs::copy_file(from, to);
             done.push_back(to);
@@ -163,6 +165,7 @@ std::vector<AddedRecording> addLabRecordings(const std::string& dir, const LabSo
     } catch (...) {
         std::error_code ec;
         for (const auto& p : done) fs::remove(p, ec);
+        for (const auto& d : madeDirs) fs::remove(d, ec); // innermost first; only if empty
         throw;
     }
     return added;

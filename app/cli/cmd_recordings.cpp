@@ -60,9 +60,10 @@ int guarded(F f) {
 int list(const Options& o) {
     const auto dir = cacheDir(o);
     const auto recs = rl::loadManifest(dir);
+    const auto sources = rl::summariseSources(recs);
     fmt::print("{}: {} from {}\n", dir, counted(recs.size(), "file"),
-               counted(rl::summariseSources(recs).size(), "source"));
-    for (const auto& s : rl::summariseSources(recs)) {
+               counted(sources.size(), "source"));
+    for (const auto& s : sources) {
         std::string files;
         std::size_t n = 0;
         for (const auto& [m, k] : s.files) {
