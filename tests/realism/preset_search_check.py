@@ -2,7 +2,8 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """Checks tools/research/preset_search.py (docs/decisions/frozen-snow-and-gravel-trade-off.md):
 the same --rng-seed writes the same variant, only the drawn keys change and each value lies in
-its range, the verdict line (with --distance) has its documented shape, a cache holding the
+its range, a SURFACE/ parameter changes that second preset, the verdict line (with --distance)
+has its documented shape and its misses add up, a cache holding the
 unseen sources is searched without them, and bad parameters are refused with a message. Needs
 the recordings cache (exits 77, skipped, without it).
 
@@ -53,15 +54,18 @@ def main():
     line = runs[0][0]
     m = re.match(r"^\s*(\d+) placed distance [0-9.]+ nearest-other \w+ [0-9.]+ "
                  r"(?:closest|NOT-closest) flatness (-?[0-9.]+) dB all: category (\d+) "
-                 r"material (\d+) (\S+) (.*) \| s7:(\S+)$", line)
+                 r"material (\d+) missed (\d+) \(([^)]*)\) (\S+) (.*) \| s7:(\S+)$", line)
     if not m:
         fail(f"verdict line not in its documented shape: {line}")
     if int(m.group(1)) > 2:
         fail(f"{m.group(1)} placed, but two held-out sources at one seed count: {line}")
     if not -60.0 < float(m.group(2)) < 0.0:
         fail(f"flatness {m.group(2)} dB is not a spectral flatness: {line}")
-    if m.group(5) != a:
-        fail(f"the line names {m.group(5)}, the variant is {a}")
+    per_surface = [re.fullmatch(r"(\w+):(\d+)", x) for x in m.group(6).split()]
+    if not all(per_surface) or sum(int(x.group(2)) for x in per_surface) != int(m.group(5)):
+        fail(f"the misses per surface must be SURFACE:COUNT adding up to the total: {line}")
+    if m.group(7) != a:
+        fail(f"the line names {m.group(7)}, the variant is {a}")
     if runs[0][0].replace(a, "VARIANT") != runs[1][0].replace(b, "VARIANT"):
         fail(f"the same --rng-seed gave other values:\n{runs[0][0]}\n{runs[1][0]}")
     # Two caches (the same one twice): the sums are per cache too, and the two halves agree.
@@ -128,7 +132,29 @@ def main():
         if f != "gravel.toml" and not filecmp.cmp(os.path.join(base, f), os.path.join(a, f),
                                                   shallow=False):
             fail(f"{f} changed, only gravel.toml was searched")
+    # A second preset searched together with the first: its key changes in its own file, the
+    # line names it, and the first preset's keys are drawn as before (variant 0: the draws of
+    # a later variant follow every parameter's draw of the ones before).
+    def first(out, *extra):
+        return subprocess.run(
+            [sys.executable, tool, "--surface", "gravel", "--variants", "1", "--rng-seed", "11",
+             "--seeds", "7", "--sources", "minetest,ufoai", "--recordings", cache, "--base", base,
+             "--out", out, "--underfoot", binary, *params, *extra], capture_output=True, text=True)
+    one = first(os.path.join(scratch, "one"))
+    r = first(os.path.join(scratch, "two"), "water/1:gain_db:-9:-8")
+    one_dir = os.path.join(scratch, "one", "gravel_11_0")
+    two_dir = os.path.join(scratch, "two", "gravel_11_0")
+    if one.returncode != 0 or r.returncode != 0 or " water/1:gain_db=" not in r.stdout:
+        fail(f"a SURFACE/ parameter: expected it in the line, got {r.returncode}: "
+             f"{one.stderr}{r.stderr}{r.stdout}")
+    if not filecmp.cmp(os.path.join(one_dir, "gravel.toml"), os.path.join(two_dir, "gravel.toml"),
+                       shallow=False):
+        fail("a SURFACE/ parameter changed the draws of --surface's own parameters")
+    if filecmp.cmp(os.path.join(base, "water.toml"), os.path.join(two_dir, "water.toml"),
+                   shallow=False):
+        fail("a SURFACE/ parameter left its preset unchanged")
     for bad, expected in (("2:gain_db:-8:-26", "expected 0 < LOW < HIGH"),
+                          ("nowhere/1:gain_db:1:2", "no such preset"),
                           ("x:gain_db:1:2", "LAYER must be an integer"),
                           ("9:gain_db:1:2", "no [[layer]] number 9")):
         r = search(os.path.join(scratch, "bad"), bad)
@@ -136,8 +162,9 @@ def main():
             fail(f"parameter {bad}: expected a refusal with '{expected}', got "
                  f"{r.returncode}: {r.stderr}{r.stdout}")
     shutil.rmtree(scratch, ignore_errors=True)
-    print("ok: same seed, same variant; only the drawn keys change, in range; the unseen sources "
-          "left out; bad parameters refused")
+    print("ok: same seed, same variant; only the drawn keys change, in range; a second preset "
+          "searched alongside; the misses add up; the unseen sources left out; bad parameters "
+          "refused")
 
 
 if __name__ == "__main__":
