@@ -140,9 +140,12 @@ def strict_misses(text):
     """The surfaces some held-out source that recorded their material puts in another category
     (the per-surface table's category column k/n with k < n)."""
     table = text.split("per surface")[1].split("\n\n")[0]
-    return [r[0] for r in (l.split() for l in table.splitlines())
-            if len(r) > 3 and re.fullmatch(r"(\d+)/(\d+)", r[2])
-            and int(r[2].split("/")[0]) < int(r[2].split("/")[1])]
+    missed = []
+    for row in (line.split() for line in table.splitlines()):
+        m = re.fullmatch(r"(\d+)/(\d+)", row[2]) if len(row) > 3 else None
+        if m and int(m.group(1)) < int(m.group(2)):
+            missed.append(row[0])
+    return missed
 
 
 def distances(a, folder, cache):
@@ -199,6 +202,10 @@ def main():
     preset = os.path.join(a.base, a.surface + ".toml")
     if not os.path.isfile(preset):
         sys.exit(f"{preset}: no such preset (--base is the presets folder)")
+    for surface in sorted({p[0] for p in params if p[0]}):
+        if not os.path.isfile(os.path.join(a.base, surface + ".toml")):
+            sys.exit(f"{os.path.join(a.base, surface + '.toml')}: no such preset (a PARAM's "
+                     "SURFACE/ names a preset of --base)")
     category = a.category
     if not category:
         m = re.search(r"^category\s*=\s*['\"](\w+)['\"]", open(preset).read(), re.M)
@@ -221,11 +228,8 @@ def main():
         shutil.rmtree(folder, ignore_errors=True)
         shutil.copytree(a.base, folder)
         for surface in sorted({c[0] for c in changes}):
-            preset_of = os.path.join(folder, surface + ".toml")
-            if not os.path.isfile(preset_of):
-                sys.exit(f"{preset_of}: no such preset (a PARAM's SURFACE/ names a preset of "
-                         "--base)")
-            set_keys(preset_of, [c[1:] for c in changes if c[0] == surface])
+            set_keys(os.path.join(folder, surface + ".toml"),
+                     [c[1:] for c in changes if c[0] == surface])
         runs = []
         for seed in seeds:
             for k, cache in enumerate(caches):
