@@ -3,9 +3,10 @@
 """Checks tools/research/preset_search.py (docs/decisions/frozen-snow-and-gravel-trade-off.md):
 the same --rng-seed writes the same variant, only the drawn keys change and each value lies in
 its range, a SURFACE/ parameter changes that second preset, the verdict line (with --distance)
-has its documented shape and its misses add up, a cache holding the
-unseen sources is searched without them, and bad parameters are refused with a message. Needs
-the recordings cache (exits 77, skipped, without it).
+has its documented shape and counts gravel among the misses exactly when a held-out gravel
+source put it in another category, a cache holding the unseen sources is searched without them,
+and bad parameters are refused with a message. Needs the recordings cache (exits 77, skipped,
+without it).
 
     preset_search_check.py SOURCE_DIR UNDERFOOT_BINARY SCRATCH_DIR
 """
@@ -33,11 +34,11 @@ def main():
     shutil.rmtree(scratch, ignore_errors=True)
     params = ["2:gain_db:-26:-8", "0:gain_db:-16:-15", "1:q_min:2:12:log"]
 
-    def search(out, *extra):
+    def search(out, *extra, only=1):
         return subprocess.run(
-            [sys.executable, tool, "--surface", "gravel", "--variants", "2", "--only", "1",
-             "--rng-seed", "11", "--seeds", "7", "--sources", "minetest,ufoai", "--recordings",
-             cache, "--base", base, "--out", out, "--underfoot", binary, *extra],
+            [sys.executable, tool, "--surface", "gravel", "--variants", str(only + 1), "--only",
+             str(only), "--rng-seed", "11", "--seeds", "7", "--sources", "minetest,ufoai",
+             "--recordings", cache, "--base", base, "--out", out, "--underfoot", binary, *extra],
             capture_output=True, text=True)
 
     runs = []
@@ -64,6 +65,12 @@ def main():
     per_surface = [re.fullmatch(r"(\w+):(\d+)", x) for x in m.group(6).split()]
     if not all(per_surface) or sum(int(x.group(2)) for x in per_surface) != int(m.group(5)):
         fail(f"the misses per surface must be SURFACE:COUNT adding up to the total: {line}")
+    # minetest and UFO:AI are gravel's only sources: one seed, one cache, so gravel is a miss
+    # (once) exactly when fewer than both placed it.
+    gravel_missed = {x.group(1): int(x.group(2)) for x in per_surface}.get("gravel", 0)
+    if gravel_missed != (1 if int(m.group(1)) < 2 else 0):
+        fail(f"{m.group(1)} of 2 gravel sources placed it, but gravel is missed "
+             f"{gravel_missed} times: {line}")
     if m.group(7) != a:
         fail(f"the line names {m.group(7)}, the variant is {a}")
     if runs[0][0].replace(a, "VARIANT") != runs[1][0].replace(b, "VARIANT"):
@@ -135,13 +142,8 @@ def main():
     # A second preset searched together with the first: its key changes in its own file, the
     # line names it, and the first preset's keys are drawn as before (variant 0: the draws of
     # a later variant follow every parameter's draw of the ones before).
-    def first(out, *extra):
-        return subprocess.run(
-            [sys.executable, tool, "--surface", "gravel", "--variants", "1", "--rng-seed", "11",
-             "--seeds", "7", "--sources", "minetest,ufoai", "--recordings", cache, "--base", base,
-             "--out", out, "--underfoot", binary, *params, *extra], capture_output=True, text=True)
-    one = first(os.path.join(scratch, "one"))
-    r = first(os.path.join(scratch, "two"), "water/1:gain_db:-9:-8")
+    one = search(os.path.join(scratch, "one"), *params, only=0)
+    r = search(os.path.join(scratch, "two"), *params, "water/1:gain_db:-9:-8", only=0)
     one_dir = os.path.join(scratch, "one", "gravel_11_0")
     two_dir = os.path.join(scratch, "two", "gravel_11_0")
     if one.returncode != 0 or r.returncode != 0 or " water/1:gain_db=" not in r.stdout:
