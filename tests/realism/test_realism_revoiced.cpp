@@ -119,9 +119,10 @@ TEST_F(Revoiced, HighGrassIsHeardAsAnAggregateWithoutEachSource) {
 // before it at 18 and 15 of 20, and at neither of these seeds on either cache (without UFO:AI: a
 // hard floor; at seed 11 without minetest too). Searched again on seeds 11-20 of seven sources
 // when deep snow's crunch became noise (docs/decisions/deep-snow-crunch-as-noise.md), it is
-// placed at every seed from 1 to 30 on four sources and at 23 of 30 on seven (25 before that
-// search). `underfoot compare --figures --seeds 1,...,30` gives the rate. A verdict, like high
-// grass's above: it moves with every other preset.
+// placed at every seed from 1 to 30 on four sources and at 23 of 30 on seven (25 before either
+// snow changed, 16 with deep snow's noise crunch and frozen snow as it was). `underfoot compare
+// --figures --seeds 1,...,30` gives the rate. A verdict, like high grass's above: it moves with
+// every other preset.
 TEST_F(Revoiced, FrozenSnowIsHeardAsAnAggregateWithoutEachSnowSource) {
     for (const std::uint64_t seed : {3, 11})
         EXPECT_EQ(placedWithoutEachSource(figuresOf("frozen_snow", seed)), 3)
