@@ -5,10 +5,12 @@ the same --rng-seed writes the same variant, only the drawn keys change and each
 its range, a SURFACE/ parameter changes that second preset, the verdict line (with --distance)
 has its documented shape and counts gravel among the misses exactly when a held-out gravel
 source put it in another category, a cache holding the unseen sources is searched without them,
-and bad parameters are refused with a message. Needs the recordings cache (exits 77, skipped,
+bad parameters are refused with a message, and --check lists the googletest tests a variant
+fails (a level far from the calibration fails GranularSurfaces.CalibratedToAboutMinus12DbfsPeak
+of TEST_ENGINE, the shipped level does not). Needs the recordings cache (exits 77, skipped,
 without it).
 
-    preset_search_check.py SOURCE_DIR UNDERFOOT_BINARY SCRATCH_DIR
+    preset_search_check.py SOURCE_DIR UNDERFOOT_BINARY SCRATCH_DIR TEST_ENGINE
 """
 import filecmp
 import os
@@ -24,7 +26,7 @@ def fail(message):
 
 
 def main():
-    source, binary, scratch = sys.argv[1:4]
+    source, binary, scratch, test_engine = sys.argv[1:5]
     cache = os.environ.get("UNDERFOOT_RECORDINGS") or os.path.join(source, "build", "recordings")
     if not os.path.isfile(os.path.join(cache, "manifest.csv")):
         print(f"SKIP: no recordings cache at {cache} (bash scripts/fetch-recordings.sh)")
@@ -163,10 +165,23 @@ def main():
         if r.returncode == 0 or expected not in r.stderr + r.stdout:
             fail(f"parameter {bad}: expected a refusal with '{expected}', got "
                  f"{r.returncode}: {r.stderr}{r.stdout}")
+    # --check: the calibration test fails for a gravel 45 dB too quiet, not for its own level
+    # (gain_db -15.3), and the line lists it with the cache's index; a bad --check is refused.
+    calibration = "GranularSurfaces.CalibratedToAboutMinus12DbfsPeak"
+    check = f"{test_engine}:{calibration}"
+    for level, expected in (("0:gain_db:-60.01:-60", f"checks failed 1 ({calibration}@0)"),
+                            ("0:gain_db:-15.31:-15.3", "checks failed 0 ()")):
+        r = search(os.path.join(scratch, "check"), "--check", check, level)
+        if r.returncode != 0 or f") {expected} " not in r.stdout:
+            fail(f"--check with {level}: expected '{expected}' after the misses, got "
+                 f"{r.returncode}: {r.stderr}{r.stdout}")
+    r = search(os.path.join(scratch, "check"), "--check", test_engine, "0:gain_db:-16:-15")
+    if r.returncode == 0 or "expected PROGRAM:FILTER" not in r.stderr:
+        fail(f"--check without a filter: expected a refusal, got {r.returncode}: {r.stderr}")
     shutil.rmtree(scratch, ignore_errors=True)
     print("ok: same seed, same variant; only the drawn keys change, in range; a second preset "
           "searched alongside; the misses add up; the unseen sources left out; bad parameters "
-          "refused")
+          "refused; --check lists the tests a variant fails")
 
 
 if __name__ == "__main__":

@@ -26,7 +26,11 @@ material's recordings and to the nearest other material's (`compare -s SURFACE -
 "all" of the nested table (category and material right, summed, then per cache when there are
 several); "missed": how many times (seeds and caches summed) a surface, any surface, was put
 in another category by a held-out source that recorded its material, with the count per
-surface; the folder, the values and every listener's verdict.
+surface; with --check PROGRAM:FILTER (repeatable), the googletest program run with that
+--gtest_filter on the variant against every cache, and the tests that failed, as
+`checks failed N (Suite.Test@K ...)` with K the cache's place in --recordings (how the
+deep and frozen snow searches screened variants against the checks that had failed a candidate,
+docs/decisions/deep-snow-crunch-as-noise.md); the folder, the values and every listener's verdict.
 A cache that holds the unseen source (`fetch-recordings.sh --unseen`) is searched without it,
 saying so: presets are never chosen on it (docs/decisions/unseen-source.md).
 The search only proposes: a variant is kept after `compare --figures` on seeds it was not chosen
@@ -177,6 +181,33 @@ def distances(a, folder, cache):
             others[material] = float(d.group(1))
     return own, others, flatness
 
+def failed_checks(checks, folder, caches):
+    """The googletest tests of each PROGRAM:FILTER that fail with the variant's presets, against
+    each cache (`Suite.Test@K`, K the cache's index), in the order run."""
+    failed = []
+    for program, test_filter in checks:
+        for k, cache in enumerate(caches):
+            env = dict(os.environ, UNDERFOOT_SURFACES_DIR=folder, UNDERFOOT_RECORDINGS=cache)
+            out = subprocess.run([program, f"--gtest_filter={test_filter}"], env=env,
+                                 capture_output=True, text=True).stdout
+            names = re.findall(r"^\[  FAILED  \] (\S+\.\S+) \(", out, re.M)
+            if not names and "[  PASSED  ]" not in out:
+                sys.exit(f"{program} --gtest_filter={test_filter}: no googletest summary "
+                         f"(UNDERFOOT_RECORDINGS={cache}):\n{out[-2000:]}")
+            failed += [f"{n}@{k}" for n in names]
+    return failed
+
+
+def parse_check(spec):
+    program, sep, test_filter = spec.partition(":")  # a filter may hold ':' itself
+    if not sep or not program or not test_filter:
+        sys.exit(f"--check '{spec}': expected PROGRAM:FILTER (a googletest program and a "
+                 "--gtest_filter pattern)")
+    if not (os.path.isfile(program) and os.access(program, os.X_OK)):
+        sys.exit(f"--check '{spec}': {program} is not an executable file")
+    return program, test_filter
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--surface", required=True)
@@ -193,9 +224,13 @@ def main():
     ap.add_argument("--distance", action="store_true")
     ap.add_argument("--only", type=int, action="append", default=[],
                     help="evaluate only variant N (repeatable): the same draws, the others skipped")
+    ap.add_argument("--check", action="append", default=[], metavar="PROGRAM:FILTER",
+                    help="also run this googletest program with this filter on each variant, "
+                         "against each cache, and list the tests that fail (repeatable)")
     ap.add_argument("params", nargs="+", metavar="PARAM")
     a = ap.parse_args()
     params = [parse_param(p) for p in a.params]
+    checks = [parse_check(c) for c in a.check]
     seeds = [int(s) for s in a.seeds.split(",")]
     caches = [without_unseen(c, a.out, k) for k, c in enumerate(a.recordings.split(","))]
     counted = set(filter(None, a.sources.split(",")))
@@ -265,9 +300,13 @@ def main():
         per_cache = (" (per cache " + " ".join(f"{c}/{m}" for c, m in right) + ")"
                      if len(caches) > 1 else "")
         misses = " ".join(f"{s}:{k}" for s, k in sorted(missed.items()))
+        checked = ""
+        if checks:
+            failed = failed_checks(checks, folder, caches)
+            checked = f" checks failed {len(failed)} ({' '.join(failed)})"
         print(f"{placed:3d} placed{distance} all: category {category_right} material "
-              f"{material_right}{per_cache} missed {sum(missed.values())} ({misses}) {folder} "
-              f"{values} | {' '.join(said)}", flush=True)
+              f"{material_right}{per_cache} missed {sum(missed.values())} ({misses}){checked} "
+              f"{folder} {values} | {' '.join(said)}", flush=True)
 
 
 if __name__ == "__main__":
