@@ -1,14 +1,14 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""Checks tools/research/preset_search.py (docs/decisions/frozen-snow-and-gravel-trade-off.md):
-the same --rng-seed writes the same variant, only the drawn keys change and each value lies in
-its range, a SURFACE/ parameter changes that second preset, the verdict line (with --distance)
-has its documented shape and counts gravel among the misses exactly when a held-out gravel
-source put it in another category, a cache holding the unseen sources is searched without them,
-bad parameters are refused with a message, and --check lists the googletest tests a variant
-fails (a level far from the calibration fails GranularSurfaces.CalibratedToAboutMinus12DbfsPeak
-of TEST_ENGINE, the shipped level does not). Needs the recordings cache (exits 77, skipped,
-without it).
+"""Checks tools/research/preset_search.py (docs/decisions/frozen-snow-and-gravel-trade-off.md): the
+same --rng-seed writes the same variant, only the drawn keys change and each value lies in its
+range, a SURFACE/ parameter changes that second preset, the verdict line (with --distance) has its
+documented shape and counts gravel among the misses exactly when a held-out gravel source put it
+in another category, a cache holding the unseen sources is searched without them, bad parameters
+are refused with a message, and --check lists the googletest tests a variant fails (a level far
+from the calibration fails GranularSurfaces.CalibratedToAboutMinus12DbfsPeak of TEST_ENGINE, the
+shipped level does not; a filter matching no test is refused). Needs the recordings cache (exits
+77, skipped, without it).
 
     preset_search_check.py SOURCE_DIR UNDERFOOT_BINARY SCRATCH_DIR TEST_ENGINE
 """
@@ -178,6 +178,11 @@ def main():
     r = search(os.path.join(scratch, "check"), "--check", test_engine, "0:gain_db:-16:-15")
     if r.returncode == 0 or "expected PROGRAM:FILTER" not in r.stderr:
         fail(f"--check without a filter: expected a refusal, got {r.returncode}: {r.stderr}")
+    r = search(os.path.join(scratch, "check"), "--check", f"{test_engine}:NoSuchSuite.*",
+               "0:gain_db:-16:-15")
+    if r.returncode == 0 or "matches no test" not in r.stderr:
+        fail(f"--check whose filter matches no test: expected a refusal (a check that runs "
+             f"nothing cannot fail), got {r.returncode}: {r.stderr}{r.stdout}")
     shutil.rmtree(scratch, ignore_errors=True)
     print("ok: same seed, same variant; only the drawn keys change, in range; a second preset "
           "searched alongside; the misses add up; the unseen sources left out; bad parameters "

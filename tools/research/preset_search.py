@@ -181,6 +181,7 @@ def distances(a, folder, cache):
             others[material] = float(d.group(1))
     return own, others, flatness
 
+
 def failed_checks(checks, folder, caches):
     """The googletest tests of each PROGRAM:FILTER that fail with the variant's presets, against
     each cache (`Suite.Test@K`, K the cache's index), in the order run."""
@@ -191,9 +192,12 @@ def failed_checks(checks, folder, caches):
             out = subprocess.run([program, f"--gtest_filter={test_filter}"], env=env,
                                  capture_output=True, text=True).stdout
             names = re.findall(r"^\[  FAILED  \] (\S+\.\S+) \(", out, re.M)
-            if not names and "[  PASSED  ]" not in out:
+            ran = re.search(r"^\[==========\] (\d+) tests? from \d+ test suites? ran", out, re.M)
+            if not ran:
                 sys.exit(f"{program} --gtest_filter={test_filter}: no googletest summary "
                          f"(UNDERFOOT_RECORDINGS={cache}):\n{out[-2000:]}")
+            if int(ran.group(1)) == 0:
+                sys.exit(f"{program} --gtest_filter={test_filter}: the filter matches no test")
             failed += [f"{n}@{k}" for n in names]
     return failed
 
