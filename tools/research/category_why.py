@@ -61,6 +61,29 @@ def centre_by_source(ex):
             e["c"] = [e["f"][k] - med[k] for k in range(NS)]
 
 
+def train(ex, without=None):
+    """The listener of realism/Listener.cpp on the files of `read`: every source centred on its
+    own median, every file (renders included) standardised by the recordings' pooled median and
+    IQR / 1.349 (floored), one centroid per (material, source) of the recordings, without the
+    source `without` if given. Sets e["c"] and e["z"]; returns (recordings, centroids), the
+    centroids as (material, source, z) sorted."""
+    centre_by_source(ex)
+    rec = [e for e in ex if e["source"] not in ("synthetic", without)]
+    if not rec:
+        return rec, []
+    centre = [quantile([e["c"][k] for e in rec], .5) for k in range(NS)]
+    scale = [max((quantile([e["c"][k] for e in rec], .75) -
+                  quantile([e["c"][k] for e in rec], .25)) / 1.349, FLOORS[k])
+             for k in range(NS)]
+    for e in ex:
+        e["z"] = [(e["c"][k] - centre[k]) / scale[k] for k in range(NS)]
+    cents = []
+    for m, s in sorted({(e["material"], e["source"]) for e in rec}):
+        zs = [e["z"] for e in rec if e["material"] == m and e["source"] == s]
+        cents.append((m, s, [quantile([v[k] for v in zs], .5) for k in range(NS)]))
+    return rec, cents
+
+
 def category_of_render(e):
     if e["material"] in CATEGORY:
         return CATEGORY[e["material"]]
@@ -81,30 +104,13 @@ def main(argv):
     show_all = "--all" in argv
     only = set(args[1:])
     ex = read(args[0])
-    centre_by_source(ex)
-    rec = [e for e in ex if e["source"] != "synthetic"]
-    if without is not None:
-        if without not in {e["source"] for e in rec}:
-            sys.exit(f"{args[0]}: no recording of source '{without}'")
-        rec = [e for e in rec if e["source"] != without]
+    if without is not None and without not in {e["source"] for e in ex
+                                                if e["source"] != "synthetic"}:
+        sys.exit(f"{args[0]}: no recording of source '{without}'")
+    rec, cents = train(ex, without)
     syn = [e for e in ex if e["source"] == "synthetic"]
     if not rec or not syn:
         sys.exit(f"{args[0]}: needs recordings and renders (source 'synthetic')")
-    centre = [quantile([e["c"][k] for e in rec], .5) for k in range(NS)]
-    scale = [max((quantile([e["c"][k] for e in rec], .75) -
-                  quantile([e["c"][k] for e in rec], .25)) / 1.349, FLOORS[k])
-             for k in range(NS)]
-
-    def z(e):
-        return [(e["c"][k] - centre[k]) / scale[k] for k in range(NS)]
-
-    for e in ex:
-        e["z"] = z(e)
-    groups = sorted({(e["material"], e["source"]) for e in rec})
-    cents = []
-    for m, s in groups:
-        zs = [e["z"] for e in rec if e["material"] == m and e["source"] == s]
-        cents.append((m, s, [quantile([v[k] for v in zs], .5) for k in range(NS)]))
     by_cat = {}
     for e in rec:
         by_cat.setdefault(CATEGORY[e["material"]], []).append(e["z"])

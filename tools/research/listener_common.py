@@ -2,8 +2,8 @@
 """What the listener scripts under realism/ share: the 14 scalar descriptors of
 realism/Descriptors.h (in `underfoot compare --features` order), their spread floors, the
 category of each recorded material (realism/Listener.cpp, categoryOfMaterial) and a linear
-quantile. Imported by listener_grid.py, listener_lda.py and category_why.py (run from any
-folder: Python puts the script's own folder first on its path)."""
+quantile. Imported by listener_grid.py, listener_lda.py, category_why.py and material_spread.py
+(run from any folder: Python puts the script's own folder first on its path)."""
 import math
 
 NS = 14  # scalar descriptors (realism/Descriptors.h)
