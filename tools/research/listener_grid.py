@@ -9,7 +9,9 @@ Reads the per-file listener features written by `compare --features` and evaluat
 source-out on the recordings only, a small fixed grid: feature set (all, scalar descriptors
 only, scalars + third-octave bands from 200 Hz), centring (none, each source on its own median,
 each source standardised by its own median and spread, each source on its own median with the
-sources of one material left out of training: centring puts their one material at the origin)
+sources of one material left out of training: centring puts their one material at the origin;
+each source on its own median but those of one material, centred on the pooled median of the
+training sources that recorded several)
 and classifier (one centroid per
 material, one per source and material, 3 nearest neighbours). Same scaling as realism/
 Listener.cpp (training set median and IQR / 1.349 with the descriptors' floors).
@@ -35,16 +37,27 @@ def spread(v, k):
     return max((quantile(v, .75) - quantile(v, .25)) / 1.349, FLOORS[k] if k < NS else 1.0)
 
 
-def centre(examples, mode):
+def centre(examples, mode, held=None):
     if mode == "none":
         return examples
     if mode == "c-multi":
         mode = "c"
+    mats_of = {}
+    for e in examples:
+        mats_of.setdefault(e[1], set()).add(e[2])
+    n = len(examples[0][3])
+    if mode == "c-pool1":
+        # the pooled median of the raw features of the training sources that recorded several
+        # materials (the held-out one excluded: it must not shape the training)
+        pool = [e for e in examples if len(mats_of[e[1]]) > 1 and e[1] != held]
+        pooled = [quantile([e[3][k] for e in pool], .5) for k in range(n)]
     out = []
     for s in sorted({e[1] for e in examples}):
         es = [e for e in examples if e[1] == s]
-        n = len(es[0][3])
-        med = [quantile([e[3][k] for e in es], .5) for k in range(n)]
+        if mode == "c-pool1" and len(mats_of[s]) == 1 and s != held:
+            med = pooled
+        else:
+            med = [quantile([e[3][k] for e in es], .5) for k in range(n)]
         sc = [spread([e[3][k] for e in es], k) if mode == "z" else 1.0 for k in range(n)]
         out += [(e[0], e[1], e[2], [(e[3][k] - med[k]) / sc[k] for k in range(n)]) for e in es]
     return out
@@ -88,6 +101,8 @@ def loso(examples, feats, mode, method, only=None):
     for held in sorted({e[1] for e in ex}):
         if only and held != only:
             continue
+        if mode == "c-pool1":
+            ex = centre(examples, mode, held)
         train = [e for e in ex if e[1] != held]
         if mode == "c-multi":
             mats_of = {}
@@ -115,10 +130,12 @@ def main():
     sets = {"all": list(range(nf)), "scalars": list(range(NS)),
             "scalars+bands>=200Hz": list(range(NS)) +
             [k for k in range(NS, nf) if float(header[3 + k][2:]) >= 200]}
-    grid = [(f, c, m) for f in sets for c in ("none", "centre", "z", "centre-multi")
+    grid = [(f, c, m) for f in sets for c in ("none", "centre", "z", "centre-multi",
+                                                               "centre-pool1")
             for m in ("centroid", "source-centroid", "3-nn")]
     method = {"centroid": "centroid", "source-centroid": "source-centroid", "3-nn": "knn"}
-    mode = {"none": "none", "centre": "c", "z": "z", "centre-multi": "c-multi"}
+    mode = {"none": "none", "centre": "c", "z": "z", "centre-multi": "c-multi",
+            "centre-pool1": "c-pool1"}
     print(f"{len(rec)} recordings from {len({e[1] for e in rec})} sources")
     print(f"{'features':22} {'centring':12} {'classifier':16} material  category")
     for f, c, m in grid:
