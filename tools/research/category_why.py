@@ -90,7 +90,10 @@ def category_of_render(e):
     return SURFACE_CATEGORY.get(e["name"], "?")
 
 
-def main(argv):
+def parse_args(argv, usage):
+    """The command line shared with material_spread.py: FEATURES.csv [--without SOURCE] [NAME ...].
+    Returns (without or None, the positional arguments, the other --flags); exits with `usage`
+    when no features file is given."""
     without = None
     if "--without" in argv:
         i = argv.index("--without")
@@ -100,8 +103,13 @@ def main(argv):
         argv = argv[:i] + argv[i + 2:]
     args = [a for a in argv[1:] if not a.startswith("--")]
     if not args:
-        sys.exit(__doc__)
-    show_all = "--all" in argv
+        sys.exit(usage)
+    return without, args, [a for a in argv[1:] if a.startswith("--")]
+
+
+def main(argv):
+    without, args, flags = parse_args(argv, __doc__)
+    show_all = "--all" in flags
     only = set(args[1:])
     ex = read(args[0])
     if without is not None and without not in {e["source"] for e in ex

@@ -23,21 +23,12 @@ import itertools
 import math
 import sys
 
-from category_why import read, train
+from category_why import parse_args, read, train
 from listener_common import quantile
 
 
 def main(argv):
-    without = None
-    if "--without" in argv:
-        i = argv.index("--without")
-        if i + 1 >= len(argv):
-            sys.exit("--without needs a source name")
-        without = argv[i + 1]
-        argv = argv[:i] + argv[i + 2:]
-    args = [a for a in argv[1:] if not a.startswith("--")]
-    if not args:
-        sys.exit(__doc__)
+    without, args, _ = parse_args(argv, __doc__)
     path, only = args[0], set(args[1:])
     ex = read(path)
     sources = {e["source"] for e in ex if e["source"] != "synthetic"}
