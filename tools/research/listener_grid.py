@@ -130,8 +130,8 @@ def main():
     sets = {"all": list(range(nf)), "scalars": list(range(NS)),
             "scalars+bands>=200Hz": list(range(NS)) +
             [k for k in range(NS, nf) if float(header[3 + k][2:]) >= 200]}
-    grid = [(f, c, m) for f in sets for c in ("none", "centre", "z", "centre-multi",
-                                                               "centre-pool1")
+    centrings = ("none", "centre", "z", "centre-multi", "centre-pool1")
+    grid = [(f, c, m) for f in sets for c in centrings
             for m in ("centroid", "source-centroid", "3-nn")]
     method = {"centroid": "centroid", "source-centroid": "source-centroid", "3-nn": "knn"}
     mode = {"none": "none", "centre": "c", "z": "z", "centre-multi": "c-multi",
