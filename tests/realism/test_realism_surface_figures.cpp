@@ -13,6 +13,7 @@
 #include <set>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 using namespace underfoot::realism;
@@ -188,4 +189,47 @@ TEST_F(SurfaceFiguresOnRecordings, RefusesWhatItCannotJudge) {
     } catch (const std::invalid_argument& e) {
         EXPECT_NE(std::string(e.what()).find("two sources"), std::string::npos) << e.what();
     }
+}
+
+// The realism result of `underfoot compare --figures` (docs/explanation/realism.md, "Per surface
+// and seed"): over its default seeds, every bundled surface is heard in its category by every
+// held-out source that recorded its material, at every seed, and in any case at least as often
+// as that source's own recordings of the material. The known misses are named with the reason
+// each is allowed; any other miss fails, whichever cache (four or seven sources) is used.
+TEST_F(SurfaceFiguresOnRecordings, EverySurfaceIsPlacedAsOftenAsTheHeldOutRecordings) {
+    // (surface, held-out source): the listener without that source misses the surface at some
+    // seeds. Gravel without minetest: the same listener hears minetest's own gravel as metal
+    // (0 of 4 on four sources, 1 of 4 on seven), so on seven sources the render can fall below
+    // them too (docs/decisions/frozen-snow-and-gravel-trade-off.md, "What a third recordist
+    // does"). Frozen snow without UFO:AI, seven sources: a render near the renders' median is
+    // heard as openclonk's hard floors (docs/decisions/listener-origin-and-snow.md); at par.
+    const std::set<std::pair<std::string, std::string>> mayMiss{{"gravel", "minetest"},
+                                                                {"frozen_snow", "ufoai"}};
+    const std::set<std::pair<std::string, std::string>> mayFallBelowRecordings{
+        {"gravel", "minetest"}};
+    SurfaceFiguresOptions o; // the command's defaults: cadence 100, 10 s, seeds 3, 7 and 11
+    const auto figs = surfaceFigures(bundledSurfaces(), recs_, o);
+    int always = 0, atPar = 0, judged = 0;
+    for (const auto& s : overSeeds(figs)) {
+        if (s.sources.empty()) continue;
+        ++judged;
+        always += s.alwaysInCategory();
+        atPar += s.atLeastAsOftenAsRecordings();
+        for (const auto& h : s.sources) {
+            SCOPED_TRACE(s.surface + " without " + h.source);
+            const std::pair<std::string, std::string> key{s.surface, h.source};
+            if (!mayMiss.contains(key)) {
+                EXPECT_EQ(h.seedsInCategory, h.seeds) << "heard in another category at some seed";
+            }
+            if (!mayFallBelowRecordings.contains(key)) {
+                EXPECT_TRUE(h.atLeastAsOftenAsRecordings())
+                    << h.seedsInCategory << " of " << h.seeds << " seeds against "
+                    << h.recordings.categoryRight << " of " << h.recordings.files
+                    << " of the source's own recordings";
+            }
+        }
+    }
+    RecordProperty("surfaces_in_category_everywhere", always);
+    RecordProperty("surfaces_at_par", atPar);
+    EXPECT_EQ(judged, 16) << "bundled surfaces with a recorded material";
 }
