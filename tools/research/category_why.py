@@ -61,12 +61,16 @@ def centre_by_source(ex):
             e["c"] = [e["f"][k] - med[k] for k in range(NS)]
 
 
-def train(ex, without=None):
+def train(ex, without=None, path="features"):
     """The listener of realism/Listener.cpp on the files of `read`: every source centred on its
     own median, every file (renders included) standardised by the recordings' pooled median and
     IQR / 1.349 (floored), one centroid per (material, source) of the recordings, without the
     source `without` if given. Sets e["c"] and e["z"]; returns (recordings, centroids), the
-    centroids as (material, source, z) sorted."""
+    centroids as (material, source, z) sorted. Exits naming `path` when `without` recorded
+    nothing there."""
+    if without is not None and without not in {e["source"] for e in ex
+                                                if e["source"] != "synthetic"}:
+        sys.exit(f"{path}: no recording of source '{without}'")
     centre_by_source(ex)
     rec = [e for e in ex if e["source"] not in ("synthetic", without)]
     if not rec:
@@ -112,10 +116,7 @@ def main(argv):
     show_all = "--all" in flags
     only = set(args[1:])
     ex = read(args[0])
-    if without is not None and without not in {e["source"] for e in ex
-                                                if e["source"] != "synthetic"}:
-        sys.exit(f"{args[0]}: no recording of source '{without}'")
-    rec, cents = train(ex, without)
+    rec, cents = train(ex, without, args[0])
     syn = [e for e in ex if e["source"] == "synthetic"]
     if not rec or not syn:
         sys.exit(f"{args[0]}: needs recordings and renders (source 'synthetic')")

@@ -96,9 +96,10 @@ def classify(m, train, x, feats, method):
 
 
 def loso(examples, feats, mode, method, only=None):
-    ex = centre(examples, mode)
+    # c-pool1's centring depends on the held-out source: centred per source in the loop
+    ex = centre(examples, mode) if mode != "c-pool1" else None
     mc = cc = n = 0
-    for held in sorted({e[1] for e in ex}):
+    for held in sorted({e[1] for e in examples}):
         if only and held != only:
             continue
         if mode == "c-pool1":

@@ -31,10 +31,7 @@ def main(argv):
     without, args, _ = parse_args(argv, __doc__)
     path, only = args[0], set(args[1:])
     ex = read(path)
-    sources = {e["source"] for e in ex if e["source"] != "synthetic"}
-    if without is not None and without not in sources:
-        sys.exit(f"{path}: no recording of source '{without}'")
-    rec, cents = train(ex, without)
+    rec, cents = train(ex, without, path)
     if not rec:
         sys.exit(f"{path}: no recordings (every row is a render, source 'synthetic')")
     materials = sorted({m for m, _, _ in cents})
